@@ -1,0 +1,273 @@
+//! `HwConfig`: every width and per-op cost of the simulated machine, and its presets.
+//!
+//! Machine variants are data: a preset is a value of this type, a TOML file deserializes into
+//! it, and a sweep edits one field at a time. Every leaf field has a globally unique name
+//! (`weight_bits`, `recip_iterations`, ...) so that `texsim sweep --vary NAME=...` can address it
+//! without a path. Widths are validated by [`HwConfig::validate`], which names the field at fault.
+
+use crate::fixed::Rounding;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A configuration value out of its supported range; names the field.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ConfigError {
+    /// Dotted path of the field, e.g. `trilinear.weight_bits`.
+    pub field: String,
+    /// What is wrong with it.
+    pub what: String,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "hw config field '{}': {}", self.field, self.what)
+    }
+}
+
+impl std::error::Error for ConfigError {}
+
+fn check(field: &str, value: u32, lo: u32, hi: u32) -> Result<(), ConfigError> {
+    if value < lo || value > hi {
+        return Err(ConfigError {
+            field: field.to_string(),
+            what: format!("{value} is out of range {lo}..={hi}"),
+        });
+    }
+    Ok(())
+}
+
+/// Rasterizer: vertex snapping, depth, and its timing costs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RasterConfig {
+    /// Sub-pixel bits of snapped vertex positions (D3D11 requires 8; Vulkan's minimum is 4).
+    pub subpixel_bits: u32,
+    /// Depth buffer bits (unsigned normalized).
+    pub depth_bits: u32,
+    /// Cycles to set up one triangle (edge and plane equations).
+    pub setup_cycles: u32,
+    /// Cycles to start one span (one scanline of one triangle).
+    pub span_cycles: u32,
+}
+
+/// Reciprocal unit (1/w and 1/area): LUT seed plus Newton-Raphson refinement.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReciprocalConfig {
+    /// Index bits of the seed LUT (the LUT has 2^bits entries).
+    pub recip_lut_bits: u32,
+    /// Newton-Raphson iterations after the LUT.
+    pub recip_iterations: u32,
+    /// Fraction bits of the mantissa the unit computes and returns.
+    pub recip_mantissa_bits: u32,
+    /// Rounding of each multiply inside the unit and of its result.
+    pub recip_rounding: Rounding,
+    /// Cycles of the LUT lookup.
+    pub recip_lut_cycles: u32,
+    /// Cycles per Newton-Raphson iteration (two multiplies and a subtract).
+    pub recip_iteration_cycles: u32,
+}
+
+/// Attribute interpolator: perspective-correct barycentrics and per-attribute interpolation.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InterpConfig {
+    /// Fraction bits of per-vertex 1/w after per-triangle normalization (largest = 1.0).
+    pub inv_w_bits: u32,
+    /// Fraction bits of the perspective-correct barycentrics (they sum to exactly 1.0).
+    pub bary_bits: u32,
+    /// Fraction bits of interpolated texture coordinates (normalized: 1.0 = one texture width).
+    pub texcoord_frac_bits: u32,
+    /// Integer bits (plus sign) of texture coordinates: the repeat range is +-2^int_bits.
+    pub texcoord_int_bits: u32,
+    /// Rounding of interpolation results.
+    pub interp_rounding: Rounding,
+    /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
+    pub bary_cycles: u32,
+    /// Cycles per interpolated scalar attribute.
+    pub attr_cycles: u32,
+}
+
+/// LOD unit: log2 of the texel footprint from the texture-coordinate derivatives.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LodConfig {
+    /// Fraction bits of the LOD (D3D11 requires 8; Vulkan's minimum `mipmapPrecisionBits` is 4).
+    pub lod_frac_bits: u32,
+    /// Fixed cycles of the unit (squares, compare, normalize).
+    pub lod_cycles: u32,
+    /// Extra cycles per LOD fraction bit (the log2 produces one bit per squaring step).
+    pub lod_cycles_per_bit: u32,
+}
+
+/// Texel address/wrap and the trilinear filter unit.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrilinearConfig {
+    /// Sub-texel bits: fraction bits of the bilinear weights (D3D11: 8; Vulkan minimum: 4).
+    /// A weight is in [0, 2^weight_bits] inclusive, i.e. weight_bits + 1 bits.
+    pub weight_bits: u32,
+    /// Bits per texel channel as stored in texture memory (unsigned normalized).
+    pub texel_bits: u32,
+    /// Rounding of the bilinear lerps and of the level blend.
+    pub filter_rounding: Rounding,
+    /// Rounding when the texel-space coordinate is reduced to weight_bits.
+    pub weight_rounding: Rounding,
+    /// Cycles of one bilinear footprint (4 texels, 3 lerps per channel).
+    pub bilinear_cycles: u32,
+    /// Cycles of the blend between the two levels.
+    pub level_lerp_cycles: u32,
+}
+
+/// Colour datapath: vertex colour and the modulate (colour x texel) unit.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColorConfig {
+    /// Bits per colour channel (unsigned normalized).
+    pub color_bits: u32,
+    /// Rounding of the modulate multiply.
+    pub color_rounding: Rounding,
+    /// Cycles of one modulate (4 channels in parallel).
+    pub modulate_cycles: u32,
+}
+
+/// The whole simulated machine.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HwConfig {
+    /// Preset or user name of this configuration.
+    pub name: String,
+    pub raster: RasterConfig,
+    pub reciprocal: ReciprocalConfig,
+    pub interp: InterpConfig,
+    pub lod: LodConfig,
+    pub trilinear: TrilinearConfig,
+    pub color: ColorConfig,
+}
+
+/// Names of the built-in presets, in the order `texsim hw list` shows them.
+pub const PRESETS: &[&str] = &["texram16", "d3d11", "vulkan-min", "cuda"];
+
+impl HwConfig {
+    /// Texram-style machine: 16-bit datapath throughout (texels, weights, LOD fraction, colour).
+    #[must_use]
+    pub fn texram16() -> Self {
+        Self {
+            name: "texram16".into(),
+            raster: RasterConfig {
+                subpixel_bits: 8,
+                depth_bits: 24,
+                setup_cycles: 16,
+                span_cycles: 2,
+            },
+            reciprocal: ReciprocalConfig {
+                recip_lut_bits: 8,
+                recip_iterations: 1,
+                recip_mantissa_bits: 24,
+                recip_rounding: Rounding::HalfEven,
+                recip_lut_cycles: 1,
+                recip_iteration_cycles: 2,
+            },
+            interp: InterpConfig {
+                inv_w_bits: 24,
+                bary_bits: 16,
+                texcoord_frac_bits: 16,
+                texcoord_int_bits: 8,
+                interp_rounding: Rounding::HalfEven,
+                bary_cycles: 2,
+                attr_cycles: 1,
+            },
+            lod: LodConfig {
+                lod_frac_bits: 16,
+                lod_cycles: 2,
+                lod_cycles_per_bit: 0,
+            },
+            trilinear: TrilinearConfig {
+                weight_bits: 16,
+                texel_bits: 16,
+                filter_rounding: Rounding::HalfEven,
+                weight_rounding: Rounding::Truncate,
+                bilinear_cycles: 1,
+                level_lerp_cycles: 1,
+            },
+            color: ColorConfig {
+                color_bits: 16,
+                color_rounding: Rounding::HalfEven,
+                modulate_cycles: 1,
+            },
+        }
+    }
+
+    /// The D3D11 precision floor: 8 sub-pixel, 8 sub-texel and 8 LOD-fraction bits.
+    #[must_use]
+    pub fn d3d11() -> Self {
+        let mut c = Self::texram16();
+        c.name = "d3d11".into();
+        c.raster.subpixel_bits = 8;
+        c.trilinear.weight_bits = 8;
+        c.lod.lod_frac_bits = 8;
+        c
+    }
+
+    /// Vulkan's required minimums: 4 sub-pixel, 4 sub-texel and 4 mipmap-precision bits
+    /// (the Vulkan 1.4 roadmap profile raises sub-texel to 8 and mipmap precision to 6).
+    #[must_use]
+    pub fn vulkan_min() -> Self {
+        let mut c = Self::texram16();
+        c.name = "vulkan-min".into();
+        c.raster.subpixel_bits = 4;
+        c.trilinear.weight_bits = 4;
+        c.lod.lod_frac_bits = 4;
+        c
+    }
+
+    /// A CUDA-like texture unit: filter weights in 9-bit fixed point with 8 fraction bits.
+    #[must_use]
+    pub fn cuda() -> Self {
+        let mut c = Self::texram16();
+        c.name = "cuda".into();
+        c.trilinear.weight_bits = 8;
+        c.trilinear.weight_rounding = Rounding::HalfEven;
+        c.lod.lod_frac_bits = 8;
+        c
+    }
+
+    /// A preset by name (`texram16`, `d3d11`, `vulkan-min`, `cuda`).
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "texram16" => Some(Self::texram16()),
+            "d3d11" => Some(Self::d3d11()),
+            "vulkan-min" => Some(Self::vulkan_min()),
+            "cuda" => Some(Self::cuda()),
+            _ => None,
+        }
+    }
+
+    /// Checks every width against the range the units support; the error names the field.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let r = &self.raster;
+        check("raster.subpixel_bits", r.subpixel_bits, 1, 12)?;
+        check("raster.depth_bits", r.depth_bits, 8, 30)?;
+        let q = &self.reciprocal;
+        check("reciprocal.recip_lut_bits", q.recip_lut_bits, 1, 16)?;
+        check("reciprocal.recip_iterations", q.recip_iterations, 0, 4)?;
+        check("reciprocal.recip_mantissa_bits", q.recip_mantissa_bits, 8, 30)?;
+        let i = &self.interp;
+        check("interp.inv_w_bits", i.inv_w_bits, 4, 30)?;
+        check("interp.bary_bits", i.bary_bits, 4, 30)?;
+        check("interp.texcoord_frac_bits", i.texcoord_frac_bits, 4, 24)?;
+        check("interp.texcoord_int_bits", i.texcoord_int_bits, 1, 16)?;
+        check("lod.lod_frac_bits", self.lod.lod_frac_bits, 0, 16)?;
+        let t = &self.trilinear;
+        check("trilinear.weight_bits", t.weight_bits, 0, 16)?;
+        check("trilinear.texel_bits", t.texel_bits, 1, 16)?;
+        check("color.color_bits", self.color.color_bits, 1, 16)?;
+        Ok(())
+    }
+}
+
+impl Default for HwConfig {
+    fn default() -> Self {
+        Self::texram16()
+    }
+}

@@ -1,0 +1,181 @@
+//! Fixed-point formats, the one rounding routine, and saturation/wrap with event counting.
+//!
+//! A raw value `r` in a format with `frac_bits = f` means `r * 2^-f`. Formats are at most
+//! 32 bits wide so that any product of two values fits an `i64` exactly; wider intermediates
+//! (accumulators) are `i64`/`i128` and are reduced through [`round_shift_right`] and
+//! [`Format::fit`]. Nothing in this module uses a std operator with build-dependent overflow.
+
+use serde::{Deserialize, Serialize};
+
+/// Rounding mode, always passed explicitly (never a global).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Rounding {
+    /// Toward minus infinity (drop the bits).
+    Truncate,
+    /// To nearest, ties toward plus infinity.
+    HalfUp,
+    /// To nearest, ties to even.
+    HalfEven,
+}
+
+/// What happens to a value outside a format's range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Overflow {
+    /// Clamp to the nearest representable value.
+    Saturate,
+    /// Keep the low bits (two's complement wrap).
+    Wrap,
+}
+
+/// Counts of overflow events, so a stage can report "saturated N times".
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct SatCounter {
+    /// Values clamped to the range of their format.
+    pub saturated: u64,
+    /// Values that wrapped.
+    pub wrapped: u64,
+}
+
+impl SatCounter {
+    /// Adds another counter into this one.
+    pub fn add(&mut self, o: &SatCounter) {
+        self.saturated = self.saturated.saturating_add(o.saturated);
+        self.wrapped = self.wrapped.saturating_add(o.wrapped);
+    }
+}
+
+/// A fixed-point format chosen at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Format {
+    /// Two's complement if true, unsigned otherwise.
+    pub signed: bool,
+    /// Integer bits, not counting the sign bit.
+    pub int_bits: u32,
+    /// Fraction bits.
+    pub frac_bits: u32,
+    /// Rounding when a wider value is reduced into this format.
+    pub rounding: Rounding,
+    /// Behaviour outside the range.
+    pub overflow: Overflow,
+}
+
+impl Format {
+    /// Unsigned normalized-style format with `frac` fraction bits and `int` integer bits.
+    #[must_use]
+    pub const fn unsigned(int_bits: u32, frac_bits: u32, rounding: Rounding) -> Self {
+        Self { signed: false, int_bits, frac_bits, rounding, overflow: Overflow::Saturate }
+    }
+
+    /// Signed format with `int` integer bits plus sign and `frac` fraction bits.
+    #[must_use]
+    pub const fn signed(int_bits: u32, frac_bits: u32, rounding: Rounding) -> Self {
+        Self { signed: true, int_bits, frac_bits, rounding, overflow: Overflow::Saturate }
+    }
+
+    /// Total storage bits (sign + integer + fraction).
+    #[must_use]
+    pub const fn total_bits(&self) -> u32 {
+        self.int_bits + self.frac_bits + self.signed as u32
+    }
+
+    /// Largest raw value.
+    #[must_use]
+    pub const fn max_raw(&self) -> i64 {
+        (1i64 << (self.int_bits + self.frac_bits)) - 1
+    }
+
+    /// Smallest raw value.
+    #[must_use]
+    pub const fn min_raw(&self) -> i64 {
+        if self.signed {
+            -(1i64 << (self.int_bits + self.frac_bits))
+        } else {
+            0
+        }
+    }
+
+    /// Brings `raw` into range by this format's overflow rule, counting the event.
+    #[inline]
+    #[must_use]
+    pub fn fit(&self, raw: i64, sat: &mut SatCounter) -> i64 {
+        let (lo, hi) = (self.min_raw(), self.max_raw());
+        if raw >= lo && raw <= hi {
+            return raw;
+        }
+        match self.overflow {
+            Overflow::Saturate => {
+                sat.saturated += 1;
+                raw.clamp(lo, hi)
+            }
+            Overflow::Wrap => {
+                sat.wrapped += 1;
+                let bits = self.total_bits();
+                let m = raw & ((1i64 << bits) - 1);
+                if self.signed && m >= (1i64 << (bits - 1)) {
+                    m - (1i64 << bits)
+                } else {
+                    m
+                }
+            }
+        }
+    }
+
+    /// Reduces `raw` (which has `from_frac` fraction bits) into this format: rounds by this
+    /// format's rounding mode, then fits by its overflow rule.
+    #[inline]
+    #[must_use]
+    pub fn requantize(&self, raw: i64, from_frac: u32, sat: &mut SatCounter) -> i64 {
+        let v = if from_frac >= self.frac_bits {
+            round_shift_right(raw, from_frac - self.frac_bits, self.rounding)
+        } else {
+            raw.saturating_mul(1i64 << (self.frac_bits - from_frac))
+        };
+        self.fit(v, sat)
+    }
+}
+
+/// The one rounding routine: `x / 2^shift`, rounded by `mode`. Exact for every `i64` input
+/// (no intermediate overflow); `shift` may be up to 63.
+#[inline]
+#[must_use]
+pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
+    if shift == 0 {
+        return x;
+    }
+    let floor = x >> shift;
+    let rem = x & ((1i64 << shift) - 1);
+    let half = 1i64 << (shift - 1);
+    match mode {
+        Rounding::Truncate => floor,
+        Rounding::HalfUp => floor + i64::from(rem >= half),
+        Rounding::HalfEven => floor + i64::from(rem > half || (rem == half && (floor & 1) == 1)),
+    }
+}
+
+/// `round_shift_right` for `i128` accumulators, result saturated to `i64`.
+#[inline]
+#[must_use]
+pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
+    let v = if shift == 0 {
+        x
+    } else {
+        let floor = x >> shift;
+        let rem = x & ((1i128 << shift) - 1);
+        let half = 1i128 << (shift - 1);
+        match mode {
+            Rounding::Truncate => floor,
+            Rounding::HalfUp => floor + i128::from(rem >= half),
+            Rounding::HalfEven => floor + i128::from(rem > half || (rem == half && (floor & 1) == 1)),
+        }
+    };
+    v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+}
+
+/// Count of leading zeros of a 64-bit value (64 for zero).
+#[inline]
+#[must_use]
+pub const fn clz64(x: u64) -> u32 {
+    x.leading_zeros()
+}

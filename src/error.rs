@@ -1,0 +1,50 @@
+//! One error type for everything a user can get wrong: it always names the file or field.
+
+use std::fmt;
+use std::path::Path;
+
+/// A user-facing error: a message that names the file, field or value at fault.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Error {
+    msg: String,
+}
+
+/// Result alias used across texsim.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// A free-form message.
+    pub fn msg(msg: impl Into<String>) -> Self {
+        Self { msg: msg.into() }
+    }
+    /// A problem with a file: `path: what`.
+    pub fn file(path: &Path, what: impl fmt::Display) -> Self {
+        Self { msg: format!("{}: {what}", path.display()) }
+    }
+    /// A problem with a named field or option: `field 'name': what`.
+    pub fn field(name: &str, what: impl fmt::Display) -> Self {
+        Self { msg: format!("field '{name}': {what}") }
+    }
+    /// Prefixes context (e.g. the file that held a bad field).
+    pub fn context(self, ctx: impl fmt::Display) -> Self {
+        Self { msg: format!("{ctx}: {}", self.msg) }
+    }
+    /// The message text.
+    pub fn message(&self) -> &str {
+        &self.msg
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.msg)
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl From<hw_model::ConfigError> for Error {
+    fn from(e: hw_model::ConfigError) -> Self {
+        Self { msg: e.to_string() }
+    }
+}
