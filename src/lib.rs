@@ -8,12 +8,16 @@
 //! visibility buffer) -> per-pixel planned stages (each Fixed or Float) -> images + metrics.
 
 pub mod error;
+pub mod cli;
 pub mod fixedpoint;
+pub mod hwconfig;
 pub mod maps;
 pub mod pipeline;
+pub mod probe;
 pub mod raster;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod summary;
 
 pub use error::{Error, Result};

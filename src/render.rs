@@ -1,1 +1,413 @@
-//! placeholder
+//! One frame, end to end: host geometry (float) -> raster setup and traversal (fixed) ->
+//! the planned stages per visible fragment, once with the hardware's twins and once with the
+//! float reference -> images, error metrics, per-stage counts and a first cycle estimate.
+//!
+//! The simulated machine textures visible fragments only (a visibility buffer resolves depth
+//! first, then each covered pixel runs its material's stages once), so stage counts and cycles
+//! do not depend on triangle order, and the hardware and reference passes see the same
+//! fragments by default (shared coverage).
+
+use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
+use crate::pipeline::stages::{run, Counters, Machine, TriAttrs};
+use crate::pipeline::{plan, Frag, Impl, Plan, StageImpls, StageKind};
+use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
+use crate::report::{compare, ErrorMetrics, Image};
+use crate::scene::{Light, Scene};
+use crate::fixedpoint::to_unorm;
+use glam::DVec3;
+use hw_model::fixed::SatCounter;
+use hw_model::{HwConfig, UnitCost};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::time::Instant;
+
+/// The prepared texture maps of a scene: float MIP chains (host) and their quantization to the
+/// texel width of the machine.
+pub struct Maps {
+    pub float: Vec<MipChain>,
+    pub fixed: Vec<FixedMipChain>,
+}
+
+impl Maps {
+    /// Builds every texture's MIP chain and quantizes it to `texel_bits`.
+    #[must_use]
+    pub fn new(scene: &Scene, texel_bits: u32) -> Self {
+        let float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
+        let fixed = float.par_iter().map(|c| quantize_chain(c, texel_bits)).collect();
+        Self { float, fixed }
+    }
+
+    /// Re-quantizes for another texel width if needed (sweeps reuse the float chains).
+    pub fn ensure_texel_bits(&mut self, texel_bits: u32) {
+        if self.fixed.first().is_some_and(|f| f.texel_bits != texel_bits) {
+            self.fixed = self.float.par_iter().map(|c| quantize_chain(c, texel_bits)).collect();
+        }
+    }
+}
+
+/// Host-side geometry: clip-space vertices, Gouraud vertex colours, texture coordinates, the
+/// triangles to draw and the plan of each mesh.
+pub struct Geometry {
+    pub clip: Vec<[f64; 4]>,
+    pub color: Vec<[f64; 3]>,
+    pub uv: Vec<[f64; 2]>,
+    pub draws: Vec<DrawTri>,
+    /// Plan index of each draw.
+    pub draw_plan: Vec<u32>,
+    /// One plan per mesh.
+    pub plans: Vec<Plan>,
+}
+
+impl Geometry {
+    /// Transforms, lights (per vertex, float) and plans every mesh of `scene`.
+    #[must_use]
+    pub fn new(scene: &Scene) -> Self {
+        let aspect = f64::from(scene.width) / f64::from(scene.height.max(1));
+        let vp = scene.camera.projection(aspect) * scene.camera.view();
+        let n: usize = scene.meshes.iter().map(|m| m.positions.len()).sum();
+        let mut g = Geometry {
+            clip: Vec::with_capacity(n),
+            color: Vec::with_capacity(n),
+            uv: Vec::with_capacity(n),
+            draws: Vec::with_capacity(scene.triangle_count()),
+            draw_plan: Vec::with_capacity(scene.triangle_count()),
+            plans: Vec::with_capacity(scene.meshes.len()),
+        };
+        for (mi, mesh) in scene.meshes.iter().enumerate() {
+            let mat = &scene.materials[mesh.material];
+            let base = g.clip.len() as u32;
+            let kd = DVec3::from(mat.kd.map(f64::from));
+            for (vi, p) in mesh.positions.iter().enumerate() {
+                let p = DVec3::from(p.map(f64::from));
+                g.clip.push((vp * p.extend(1.0)).to_array());
+                let c = if mat.lit {
+                    let nrm = mesh.normals.get(vi).map_or(DVec3::Z, |n| DVec3::from(n.map(f64::from)));
+                    kd * lighting(scene, p, nrm.normalize_or_zero())
+                } else {
+                    kd
+                };
+                g.color.push(c.clamp(DVec3::ZERO, DVec3::ONE).to_array());
+                g.uv.push(mesh.uvs.get(vi).map_or([0.0; 2], |t| t.map(f64::from)));
+            }
+            g.plans.push(plan(mat, !mesh.uvs.is_empty()));
+            for t in &mesh.indices {
+                g.draws.push(DrawTri { v: t.map(|i| base + i), cull_back: mat.cull_back });
+                g.draw_plan.push(mi as u32);
+            }
+        }
+        g
+    }
+}
+
+/// Lambert irradiance at `p` with unit normal `n` (ambient + each light's n.l).
+fn lighting(scene: &Scene, p: DVec3, n: DVec3) -> DVec3 {
+    let mut e = DVec3::from(scene.ambient.map(f64::from));
+    for l in &scene.lights {
+        let (dir, col) = match l {
+            Light::Directional { direction, color } => {
+                (-DVec3::from(direction.map(f64::from)).normalize_or_zero(), color)
+            }
+            Light::Point { position, color } => {
+                ((DVec3::from(position.map(f64::from)) - p).normalize_or_zero(), color)
+            }
+        };
+        e += DVec3::from(col.map(f64::from)) * n.dot(dir).max(0.0);
+    }
+    e
+}
+
+/// How the reference pass chooses its fragments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CoverageMode {
+    /// The reference shades exactly the fragments the hardware rasterizer produced.
+    Shared,
+    /// The reference rasterizes with unsnapped float coverage and float depth.
+    Independent,
+}
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Twins of the "hardware" image (all Fixed = the machine; one Fixed = that stage alone).
+    pub hw_impls: StageImpls,
+    /// Also render the all-float reference and compare.
+    pub reference: bool,
+    pub coverage: CoverageMode,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self { hw_impls: StageImpls::FIXED, reference: true, coverage: CoverageMode::Shared }
+    }
+}
+
+/// Per-stage statistics of the hardware pass.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageStats {
+    pub stage: StageKind,
+    #[serde(rename = "impl")]
+    pub imp: Impl,
+    pub invocations: u64,
+    pub saturated: u64,
+    pub wrapped: u64,
+    pub ops: u64,
+    pub cycles: u64,
+    pub texels: u64,
+}
+
+/// Wall times in milliseconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timings {
+    pub geometry_ms: f64,
+    pub setup_ms: f64,
+    pub raster_ms: f64,
+    pub shade_hw_ms: f64,
+    pub raster_ref_ms: f64,
+    pub shade_ref_ms: f64,
+    /// Setup + raster + hardware shading.
+    pub hw_total_ms: f64,
+    /// Setup + (shared or float) raster + reference shading.
+    pub ref_total_ms: f64,
+}
+
+/// First cycle estimate: each unit's invocations x its cycles from HwConfig (no overlap, no
+/// memory effects; the detailed timing model is separate).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CycleEstimate {
+    pub setup: u64,
+    pub spans: u64,
+    pub stages: u64,
+    pub total: u64,
+    pub per_covered_pixel: f64,
+}
+
+/// Everything one render produced.
+pub struct Rendered {
+    pub hw_image: Image,
+    pub ref_image: Option<Image>,
+    /// Pixels covered by the hardware or the reference pass (the compared set).
+    pub mask: Vec<bool>,
+    pub stats: RenderStats,
+}
+
+/// The numbers of one render (serialized into summary.json).
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderStats {
+    pub scene: String,
+    pub hw: String,
+    pub width: u32,
+    pub height: u32,
+    pub triangles: u64,
+    pub coverage: CoverageMode,
+    pub setup: SetupStats,
+    pub raster: RasterStats,
+    pub covered_pixels: u64,
+    /// Host-to-hardware conversions that saturated (vertex attributes out of format range).
+    pub input_saturated: u64,
+    pub stages: Vec<StageStats>,
+    pub cycles: CycleEstimate,
+    pub timings: Timings,
+    /// Error of the hardware image against the reference, in 8-bit and 16-bit LSBs.
+    pub error_8bit: Option<ErrorMetrics>,
+    pub error_16bit: Option<ErrorMetrics>,
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Per-triangle attributes of every screen triangle, in the machine's formats.
+fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
+    let out: Vec<(TriAttrs, SatCounter)> = setup
+        .tris
+        .par_iter()
+        .map(|t| {
+            let d = &geo.draws[t.src as usize];
+            let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
+                let w = t.src_bary[k];
+                let mut c = [0.0; 3];
+                let mut uv = [0.0; 2];
+                for (j, &vi) in d.v.iter().enumerate() {
+                    let vi = vi as usize;
+                    for ch in 0..3 {
+                        c[ch] += w[j] * geo.color[vi][ch];
+                    }
+                    for ax in 0..2 {
+                        uv[ax] += w[j] * geo.uv[vi][ax];
+                    }
+                }
+                (c, uv)
+            };
+            let (c0, t0) = blend(0);
+            let (c1, t1) = blend(1);
+            let (c2, t2) = blend(2);
+            let mut sat = SatCounter::default();
+            let plan = geo.draw_plan[t.src as usize];
+            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], &mut sat);
+            (a, sat)
+        })
+        .collect();
+    let mut sat = SatCounter::default();
+    let attrs = out
+        .into_iter()
+        .map(|(a, s)| {
+            sat.add(&s);
+            a
+        })
+        .collect();
+    (attrs, sat)
+}
+
+/// Shades every covered pixel of `vis` with `impls`; returns the image and the counters.
+fn shade(
+    vis: &VisBuffer,
+    setup: &Setup,
+    attrs: &[TriAttrs],
+    geo: &Geometry,
+    m: &Machine,
+    costs: &[[UnitCost; 6]],
+    impls: &StageImpls,
+    background: [u16; 4],
+) -> (Image, Counters) {
+    let w = vis.width as usize;
+    let mut img = Image::new(vis.width, vis.height, background);
+    let counters = img
+        .px
+        .par_chunks_mut(w.max(1))
+        .enumerate()
+        .map(|(y, row)| {
+            let mut c = Counters::default();
+            let mut frag = Frag::default();
+            let tris = &vis.tri[y * w..(y + 1) * w];
+            for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
+                if t == NO_TRI {
+                    continue;
+                }
+                let a = &attrs[t as usize];
+                let pi = a.plan as usize;
+                let plan = &geo.plans[pi];
+                run(plan, &costs[pi], impls, m, &setup.tris[t as usize], a, x as i64, y as i64, &mut frag, &mut c);
+                *out = frag.out.map(|v| to_unorm(v, 16) as u16);
+            }
+            c
+        })
+        .reduce(Counters::default, |mut a, b| {
+            a.add(&b);
+            a
+        });
+    (img, counters)
+}
+
+/// Renders `scene` on the machine `hw` (and, if asked, the float reference) and measures both.
+pub fn render(
+    scene: &Scene,
+    maps: &Maps,
+    hw: &HwConfig,
+    opts: &RenderOptions,
+) -> crate::Result<Rendered> {
+    hw.validate()?;
+    let mut tm = Timings::default();
+    let t = Instant::now();
+    let geo = Geometry::new(scene);
+    tm.geometry_ms = ms(t);
+
+    let t = Instant::now();
+    let setup = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &hw.raster);
+    let m = Machine::new(hw, &maps.float, &maps.fixed);
+    let (attrs, input_sat) = tri_attrs(&setup, &geo, &m);
+    let costs: Vec<[UnitCost; 6]> = geo.plans.iter().map(|p| m.plan_costs(p)).collect();
+    tm.setup_ms = ms(t);
+
+    let t = Instant::now();
+    let (vis, raster_stats) = raster::rasterize(&setup, Coverage::Fixed, true);
+    tm.raster_ms = ms(t);
+
+    let bg = scene.background.map(|c| to_unorm(f64::from(c), 16) as u16);
+    let t = Instant::now();
+    let (hw_image, counters) = shade(&vis, &setup, &attrs, &geo, &m, &costs, &opts.hw_impls, bg);
+    tm.shade_hw_ms = ms(t);
+    tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
+
+    let mut mask: Vec<bool> = vis.tri.iter().map(|&t| t != NO_TRI).collect();
+    let mut ref_image = None;
+    let (mut e8, mut e16) = (None, None);
+    if opts.reference {
+        let ref_vis;
+        let rv = match opts.coverage {
+            CoverageMode::Shared => {
+                tm.raster_ref_ms = tm.raster_ms;
+                &vis
+            }
+            CoverageMode::Independent => {
+                let t = Instant::now();
+                ref_vis = raster::rasterize(&setup, Coverage::Float, true).0;
+                tm.raster_ref_ms = ms(t);
+                for (mk, &t) in mask.iter_mut().zip(&ref_vis.tri) {
+                    *mk |= t != NO_TRI;
+                }
+                &ref_vis
+            }
+        };
+        let t = Instant::now();
+        let (img, _) = shade(rv, &setup, &attrs, &geo, &m, &costs, &StageImpls::FLOAT, bg);
+        tm.shade_ref_ms = ms(t);
+        tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
+        e8 = Some(compare(&hw_image, &img, 8, Some(&mask)));
+        e16 = Some(compare(&hw_image, &img, 16, Some(&mask)));
+        ref_image = Some(img);
+    }
+
+    let mut stages = Vec::with_capacity(6);
+    let mut stage_cycles = 0u64;
+    for kind in StageKind::ALL {
+        let k = kind.index();
+        let inv = counters.invocations[k];
+        let [ops, cyc, texels] = counters.cost[k];
+        let s = StageStats {
+            stage: kind,
+            imp: opts.hw_impls.of(kind),
+            invocations: inv,
+            saturated: counters.sat[k].saturated,
+            wrapped: counters.sat[k].wrapped,
+            ops,
+            cycles: cyc,
+            texels,
+        };
+        stage_cycles += s.cycles;
+        stages.push(s);
+    }
+    let covered = vis.tri.iter().filter(|&&t| t != NO_TRI).count() as u64;
+    let rc = &hw.raster;
+    let mut cycles = CycleEstimate {
+        setup: setup.tris.len() as u64 * u64::from(rc.setup_cycles),
+        spans: raster_stats.spans * u64::from(rc.span_cycles),
+        stages: stage_cycles,
+        ..Default::default()
+    };
+    cycles.total = cycles.setup + cycles.spans + cycles.stages;
+    cycles.per_covered_pixel = cycles.total as f64 / covered.max(1) as f64;
+
+    Ok(Rendered {
+        hw_image,
+        ref_image,
+        mask,
+        stats: RenderStats {
+            scene: scene.name.clone(),
+            hw: hw.name.clone(),
+            width: scene.width,
+            height: scene.height,
+            triangles: scene.triangle_count() as u64,
+            coverage: opts.coverage,
+            setup: setup.stats.clone(),
+            raster: raster_stats,
+            covered_pixels: covered,
+            input_saturated: input_sat.saturated,
+            stages,
+            cycles,
+            timings: tm,
+            error_8bit: e8,
+            error_16bit: e16,
+        },
+    })
+}

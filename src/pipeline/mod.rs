@@ -1,1 +1,193 @@
-//! placeholder
+//! The per-fragment pipeline: a material's stages, each run Fixed (hw_model) or Float (reference).
+//!
+//! The planner ([`plan`]) pushes only the stages a material needs, as a fixed-function state
+//! vector would enable them: an untextured unlit material has no stage at all, a texture adds
+//! texture-coordinate, LOD and trilinear stages, lighting adds the colour interpolator. An absent
+//! effect is a stage that was never pushed, so it costs neither simulation time nor cycles.
+//!
+//! Stages communicate through a [`Frag`] whose signals are `f64` carriers. A Fixed stage converts
+//! its inputs to its declared input formats, computes in integers, and writes back the exact
+//! value of its fixed result; since every fixed value is exactly representable in `f64`, a chain
+//! of Fixed stages is bit-accurate, and a Fixed stage after a Float one sees the float value
+//! rounded into its input format (how a mixed run isolates one stage's error).
+
+pub mod stages;
+
+use crate::scene::{Material, WrapMode};
+use serde::Serialize;
+use std::fmt;
+
+/// The kinds of stage, in pipeline order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StageKind {
+    /// Perspective-correct barycentrics (reciprocal unit + interpolator setup).
+    Bary,
+    /// Vertex colour interpolation (Gouraud lighting result).
+    Color,
+    /// Texture-coordinate interpolation, with the helper samples for derivatives.
+    Texcoord,
+    /// LOD from the texture-coordinate derivatives.
+    Lod,
+    /// Wrap + trilinear MIP filtering.
+    Trilinear,
+    /// Colour x texel.
+    Modulate,
+}
+
+impl StageKind {
+    /// Every stage kind, in pipeline order.
+    pub const ALL: [StageKind; 6] = [
+        StageKind::Bary,
+        StageKind::Color,
+        StageKind::Texcoord,
+        StageKind::Lod,
+        StageKind::Trilinear,
+        StageKind::Modulate,
+    ];
+
+    /// The name used on the command line and in reports.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            StageKind::Bary => "bary",
+            StageKind::Color => "color",
+            StageKind::Texcoord => "texcoord",
+            StageKind::Lod => "lod",
+            StageKind::Trilinear => "trilinear",
+            StageKind::Modulate => "modulate",
+        }
+    }
+
+    /// Parses a stage name.
+    pub fn parse(s: &str) -> crate::Result<StageKind> {
+        Self::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
+            crate::Error::msg(format!(
+                "unknown stage '{s}' (stages: {})",
+                names.join(", ")
+            ))
+        })
+    }
+
+    /// Position in [`StageKind::ALL`].
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl fmt::Display for StageKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Which twin of a stage runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Impl {
+    /// The bit-accurate hw_model unit.
+    Fixed,
+    /// The exact-math reference.
+    Float,
+}
+
+/// Which twin each stage kind uses in one run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StageImpls(pub [Impl; 6]);
+
+impl StageImpls {
+    /// Every stage fixed: the hardware.
+    pub const FIXED: StageImpls = StageImpls([Impl::Fixed; 6]);
+    /// Every stage float: the reference.
+    pub const FLOAT: StageImpls = StageImpls([Impl::Float; 6]);
+
+    /// The twin used for `kind`.
+    #[must_use]
+    pub const fn of(&self, kind: StageKind) -> Impl {
+        self.0[kind.index()]
+    }
+
+    /// Returns a copy with `kind` set to `imp`.
+    #[must_use]
+    pub fn with(mut self, kind: StageKind, imp: Impl) -> Self {
+        self.0[kind.index()] = imp;
+        self
+    }
+
+    /// True when every stage is of one twin.
+    #[must_use]
+    pub fn is_all(&self, imp: Impl) -> bool {
+        self.0.iter().all(|&i| i == imp)
+    }
+}
+
+/// The stages one material needs, with what they need to know.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// Stage kinds in execution order.
+    pub stages: Vec<StageKind>,
+    /// Index of the texture (into the prepared maps), when textured.
+    pub texture: Option<usize>,
+    /// Colour used when no colour interpolation stage runs (unlit: kd; alpha 1).
+    pub const_color: [f64; 4],
+    /// Whether the texture-coordinate stage must also produce derivatives (for LOD).
+    pub derivatives: bool,
+    /// Texture addressing of s and t.
+    pub wrap: [WrapMode; 2],
+}
+
+impl Plan {
+    /// True when the plan contains `kind`.
+    #[must_use]
+    pub fn has(&self, kind: StageKind) -> bool {
+        self.stages.contains(&kind)
+    }
+}
+
+/// Builds the plan of one material. `has_uvs`: the mesh supplies texture coordinates.
+#[must_use]
+pub fn plan(material: &Material, has_uvs: bool) -> Plan {
+    let mut stages = Vec::with_capacity(6);
+    let textured = material.texture.is_some() && has_uvs;
+    let kd = material.kd.map(f64::from);
+    let white = kd.iter().all(|&c| c == 1.0);
+    if material.lit || textured {
+        stages.push(StageKind::Bary);
+    }
+    if material.lit {
+        stages.push(StageKind::Color);
+    }
+    if textured {
+        stages.extend([StageKind::Texcoord, StageKind::Lod, StageKind::Trilinear]);
+        if material.lit || !white {
+            stages.push(StageKind::Modulate);
+        }
+    }
+    Plan {
+        stages,
+        texture: if textured { material.texture } else { None },
+        const_color: [kd[0], kd[1], kd[2], 1.0],
+        derivatives: textured,
+        wrap: [material.wrap_s, material.wrap_t],
+    }
+}
+
+/// Per-fragment signals passed between stages (f64 carriers, see the module docs).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Frag {
+    /// Perspective-correct barycentrics at the sample, and at the helper samples (x+1, y) and
+    /// (x, y+1) when derivatives are needed.
+    pub bary: [[f64; 3]; 3],
+    /// Interpolated colour (unorm, 0..1).
+    pub color: [f64; 4],
+    /// Texture coordinates at the sample and the two helper samples (normalized).
+    pub uv: [[f64; 2]; 3],
+    /// Level of detail (log2 texels per pixel).
+    pub lod: f64,
+    /// Filtered texel (unorm).
+    pub texel: [f64; 4],
+    /// The fragment's output colour (unorm).
+    pub out: [f64; 4],
+}

@@ -1,0 +1,368 @@
+//! The `texsim` command line. `texsim` alone is `texsim render --scene demo --out ./out`.
+
+use crate::hwconfig;
+use crate::pipeline::{Impl, StageImpls, StageKind};
+use crate::render::{render, CoverageMode, Maps, RenderOptions, Rendered};
+use crate::report::{self, OutputSet};
+use crate::scene::{self, Scene};
+use crate::{Error, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use hw_model::HwConfig;
+use std::path::PathBuf;
+
+/// Bit-accurate simulator of fixed-function texture hardware (Texram-style).
+#[derive(Parser, Debug)]
+#[command(name = "texsim", version, about, long_about = None)]
+pub struct Cli {
+    /// Worker threads (default: all cores). Output is bit-identical for any count.
+    #[arg(long, global = true)]
+    pub threads: Option<usize>,
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene on the simulated hardware and the float reference; write PNGs and summary.json.
+    Render(RenderArgs),
+    /// List the built-in scenes.
+    Scenes,
+    /// Render once per setting of one or more HwConfig fields; print and write the table.
+    Sweep(SweepArgs),
+    /// Hardware configurations.
+    Hw {
+        #[command(subcommand)]
+        cmd: HwCmd,
+    },
+    /// Sample one texture through the trilinear unit (fixed and float), showing texels and weights.
+    Probe(ProbeArgs),
+}
+
+#[derive(Subcommand, Debug)]
+pub enum HwCmd {
+    /// Print a preset (or a hw TOML file, resolved) as TOML.
+    Show {
+        /// Preset name (texram16, d3d11, vulkan-min, cuda) or path to a hw TOML file.
+        preset: String,
+    },
+    /// List the presets.
+    List,
+}
+
+/// Which scene to use: a file or a built-in.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SceneArgs {
+    /// Scene file: an OBJ (with its MTL) or a TOML scene.
+    pub input: Option<PathBuf>,
+    /// Built-in scene (see `texsim scenes`); used when no INPUT is given (default: demo).
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// Hardware: a preset (texram16, d3d11, vulkan-min, cuda) or a hw TOML file.
+    /// Default: the scene's `hw`, else texram16.
+    #[arg(long)]
+    pub hw: Option<String>,
+    /// Output directory.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Override the image width.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Override the image height.
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CoverageArg {
+    /// The reference shades the hardware's fragments (isolates the shading error).
+    Shared,
+    /// The reference rasterizes on its own in float (adds the coverage error).
+    Independent,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Also write 16-bit PNGs (hw16.png, ref16.png).
+    #[arg(long)]
+    pub png16: bool,
+    /// How the reference chooses fragments.
+    #[arg(long, value_enum, default_value = "shared")]
+    pub coverage: CoverageArg,
+    /// Stages the "hardware" image runs in float (comma list: bary,color,texcoord,lod,trilinear,modulate).
+    #[arg(long, value_delimiter = ',')]
+    pub float: Vec<String>,
+    /// Run only this stage in fixed point (all others float): the error of one stage in isolation.
+    #[arg(long, conflicts_with = "float")]
+    pub isolate: Option<String>,
+    /// Skip the float reference (no error metrics).
+    #[arg(long)]
+    pub no_reference: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// FIELD=A..B (inclusive integer range) or FIELD=v1,v2,... ; FIELD is any HwConfig field
+    /// name (`texsim hw show texram16`). Several --vary make a grid.
+    #[arg(long, required = true)]
+    pub vary: Vec<String>,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct ProbeArgs {
+    /// Texture image (PNG or JPEG).
+    #[arg(long)]
+    pub texture: PathBuf,
+    /// Normalized texture coordinate u (1.0 = texture width).
+    #[arg(long, allow_hyphen_values = true)]
+    pub u: f64,
+    /// Normalized texture coordinate v.
+    #[arg(long, allow_hyphen_values = true)]
+    pub v: f64,
+    /// Level of detail (log2 texels per pixel; <= 0 magnifies).
+    #[arg(long, allow_hyphen_values = true)]
+    pub lod: f64,
+    /// Hardware preset or hw TOML file.
+    #[arg(long, default_value = "texram16")]
+    pub hw: String,
+    /// Wrap mode of both axes.
+    #[arg(long, default_value = "repeat")]
+    pub wrap: String,
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    if let Some(n) = cli.threads {
+        if n == 0 {
+            return Err(Error::field("--threads", "must be at least 1"));
+        }
+        // A second initialization (tests calling run twice) keeps the first pool: harmless.
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+    }
+    match cli.command {
+        None => render_cmd(&RenderArgs {
+            scene: SceneArgs { scene: Some("demo".into()), ..SceneArgs::default_out() },
+            png16: false,
+            coverage: CoverageArg::Shared,
+            float: vec![],
+            isolate: None,
+            no_reference: false,
+        }),
+        Some(Command::Render(a)) => render_cmd(&a),
+        Some(Command::Scenes) => {
+            println!("built-in scenes (texsim render --scene NAME):");
+            for (name, desc) in scene::BUILTIN {
+                println!("  {name:<14} {desc}");
+            }
+            Ok(())
+        }
+        Some(Command::Sweep(a)) => sweep_cmd(&a),
+        Some(Command::Hw { cmd: HwCmd::Show { preset } }) => {
+            print!("{}", hwconfig::to_toml(&hwconfig::resolve(&preset)?));
+            Ok(())
+        }
+        Some(Command::Hw { cmd: HwCmd::List }) => {
+            for p in hw_model::config::PRESETS {
+                println!("{p}");
+            }
+            Ok(())
+        }
+        Some(Command::Probe(a)) => crate::probe::probe_cmd(&a),
+    }
+}
+
+impl SceneArgs {
+    fn default_out() -> Self {
+        Self { out: PathBuf::from("out"), ..Default::default() }
+    }
+
+    /// Loads the scene and resolves the hardware config.
+    pub fn load(&self) -> Result<(Scene, HwConfig)> {
+        let mut sc = match (&self.input, &self.scene) {
+            (Some(_), Some(_)) => {
+                return Err(Error::msg("give either a scene file or --scene, not both"))
+            }
+            (Some(p), None) => scene::load(p)?,
+            (None, name) => scene::builtin(name.as_deref().unwrap_or("demo"))?,
+        };
+        if let Some(w) = self.width {
+            sc.width = w;
+        }
+        if let Some(h) = self.height {
+            sc.height = h;
+        }
+        scene::validate(&sc)?;
+        let spec = self.hw.clone().or_else(|| sc.hw.clone()).unwrap_or_else(|| "texram16".into());
+        let hw = hwconfig::resolve(&spec)?;
+        Ok((sc, hw))
+    }
+}
+
+fn impls_from(a: &RenderArgs) -> Result<StageImpls> {
+    if let Some(s) = &a.isolate {
+        let k = StageKind::parse(s).map_err(|e| e.context("--isolate"))?;
+        return Ok(StageImpls::FLOAT.with(k, Impl::Fixed));
+    }
+    let mut im = StageImpls::FIXED;
+    for s in &a.float {
+        let k = StageKind::parse(s).map_err(|e| e.context("--float"))?;
+        im = im.with(k, Impl::Float);
+    }
+    Ok(im)
+}
+
+fn render_cmd(a: &RenderArgs) -> Result<()> {
+    let (sc, hw) = a.scene.load()?;
+    let impls = impls_from(a)?;
+    for w in &sc.warnings {
+        eprintln!("warning: {w}");
+    }
+    eprintln!(
+        "texsim: rendering '{}' ({}x{}, {} triangles) on '{}'...",
+        sc.name,
+        sc.width,
+        sc.height,
+        sc.triangle_count(),
+        hw.name
+    );
+    let maps = Maps::new(&sc, hw.trilinear.texel_bits);
+    let opts = RenderOptions {
+        hw_impls: impls,
+        reference: !a.no_reference,
+        coverage: match a.coverage {
+            CoverageArg::Shared => CoverageMode::Shared,
+            CoverageArg::Independent => CoverageMode::Independent,
+        },
+    };
+    let r = render(&sc, &maps, &hw, &opts)?;
+    let mut out = OutputSet::new();
+    stage_images(&r, a.png16, &mut out)?;
+    let json = serde_json::json!({
+        "scene": &r.stats.scene,
+        "hw_config": &hw,
+        "stats": &r.stats,
+        "warnings": &sc.warnings,
+    });
+    out.add("summary.json", serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?);
+    let written = out.write_to(&a.scene.out)?;
+    print!("{}", crate::summary::text(&r.stats));
+    println!("wrote:");
+    for p in written {
+        println!("  {}", p.display());
+    }
+    Ok(())
+}
+
+fn stage_images(r: &Rendered, png16: bool, out: &mut OutputSet) -> Result<()> {
+    out.add("hw.png", report::encode_png8(&r.hw_image)?);
+    if png16 {
+        out.add("hw16.png", report::encode_png16(&r.hw_image)?);
+    }
+    if let Some(rf) = &r.ref_image {
+        out.add("ref.png", report::encode_png8(rf)?);
+        if png16 {
+            out.add("ref16.png", report::encode_png16(rf)?);
+        }
+        let heat = report::heatmap(&r.hw_image, rf, 8, Some(&r.mask));
+        let hwp = report::image_to_pixmap(&r.hw_image);
+        let rfp = report::image_to_pixmap(rf);
+        let sheet = report::sheet(&[("hardware", &hwp), ("reference", &rfp), ("error (8-bit LSB)", &heat)]);
+        out.add("error.png", report::encode_pixmap(&heat)?);
+        out.add("sheet.png", report::encode_pixmap(&sheet)?);
+    }
+    Ok(())
+}
+
+/// One `--vary` axis: a field and its values.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Axis {
+    pub field: String,
+    pub values: Vec<String>,
+}
+
+/// Parses `FIELD=A..B` or `FIELD=v1,v2,...`.
+pub fn parse_axis(s: &str) -> Result<Axis> {
+    let (field, vals) = s
+        .split_once('=')
+        .ok_or_else(|| Error::field("--vary", format!("'{s}' is not FIELD=A..B or FIELD=v1,v2")))?;
+    let field = field.trim().to_string();
+    if field.is_empty() {
+        return Err(Error::field("--vary", format!("'{s}' has no field name")));
+    }
+    let values: Vec<String> = if let Some((a, b)) = vals.split_once("..") {
+        let parse = |x: &str| {
+            x.trim()
+                .parse::<i64>()
+                .map_err(|_| Error::field("--vary", format!("'{x}' in '{s}' is not an integer")))
+        };
+        let (a, b) = (parse(a)?, parse(b)?);
+        if b < a || b - a > 4096 {
+            return Err(Error::field("--vary", format!("range {a}..{b} in '{s}' is empty or too long")));
+        }
+        (a..=b).map(|v| v.to_string()).collect()
+    } else {
+        vals.split(',').map(|v| v.trim().to_string()).filter(|v| !v.is_empty()).collect()
+    };
+    if values.is_empty() {
+        return Err(Error::field("--vary", format!("'{s}' has no values")));
+    }
+    Ok(Axis { field, values })
+}
+
+/// The cartesian product of the axes, first axis slowest.
+#[must_use]
+pub fn grid(axes: &[Axis]) -> Vec<Vec<(String, String)>> {
+    let mut rows: Vec<Vec<(String, String)>> = vec![vec![]];
+    for ax in axes {
+        let mut next = Vec::with_capacity(rows.len() * ax.values.len());
+        for r in &rows {
+            for v in &ax.values {
+                let mut n = r.clone();
+                n.push((ax.field.clone(), v.clone()));
+                next.push(n);
+            }
+        }
+        rows = next;
+    }
+    rows
+}
+
+fn sweep_cmd(a: &SweepArgs) -> Result<()> {
+    let (sc, base) = a.scene.load()?;
+    let axes: Vec<Axis> = a.vary.iter().map(|s| parse_axis(s)).collect::<Result<_>>()?;
+    let settings = grid(&axes);
+    // Validate every setting before rendering anything.
+    let configs: Vec<HwConfig> = settings
+        .iter()
+        .map(|row| {
+            row.iter().try_fold(base.clone(), |c, (f, v)| hwconfig::set_field(&c, f, v))
+        })
+        .collect::<Result<_>>()?;
+    for w in &sc.warnings {
+        eprintln!("warning: {w}");
+    }
+    let mut maps = Maps::new(&sc, base.trilinear.texel_bits);
+    let mut rows = Vec::with_capacity(configs.len());
+    for (i, (cfg, set)) in configs.iter().zip(&settings).enumerate() {
+        let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
+        eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
+        maps.ensure_texel_bits(cfg.trilinear.texel_bits);
+        let r = render(&sc, &maps, cfg, &RenderOptions::default())?;
+        rows.push(crate::summary::SweepRow::new(set.clone(), &r.stats));
+    }
+    let table = crate::summary::sweep_table(&rows);
+    print!("{table}");
+    let mut out = OutputSet::new();
+    out.add("sweep.csv", crate::summary::sweep_csv(&rows).into_bytes());
+    out.add(
+        "sweep.json",
+        serde_json::to_vec_pretty(&rows).map_err(|e| Error::msg(e.to_string()))?,
+    );
+    for p in out.write_to(&a.scene.out)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,331 @@
+//! The stage twins: for each [`StageKind`], a Fixed implementation (hw_model units, declared
+//! formats) and a Float implementation (`crate::reference`, exact math), behind one entry point
+//! [`run`]. Per-triangle vertex data is prepared once ([`TriAttrs`]), in float and in the
+//! hardware's input formats, so the per-pixel loop allocates nothing.
+
+use super::{Frag, Impl, Plan, StageImpls, StageKind};
+use crate::fixedpoint::{from_raw, to_raw, to_unorm};
+use crate::maps::{FixedMipChain, MipChain};
+use crate::raster::ScreenTri;
+use crate::reference::{
+    interpolate_f64, lod_f64, perspective_bary_f64, trilinear_f64, LevelF,
+};
+use hw_model::config::HwConfig;
+use hw_model::fixed::{Format, Rounding, SatCounter};
+use hw_model::interpolator::{interpolate, interpolate_cost, perspective_bary, perspective_bary_cost};
+use hw_model::lod::{lod, lod_cost};
+use hw_model::modulate::{modulate, modulate_cost};
+use hw_model::reciprocal::Reciprocal;
+use hw_model::trilinear::{trilinear, trilinear_cost, Level};
+use hw_model::UnitCost;
+
+/// Per-stage counters of one run (summed over fragments; order-independent integer sums).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Counters {
+    /// Invocations per stage kind (index = `StageKind::index`).
+    pub invocations: [u64; 6],
+    /// Overflow events per stage kind.
+    pub sat: [SatCounter; 6],
+    /// Cost per stage kind, summed over invocations (ops, cycles, texels).
+    pub cost: [[u64; 3]; 6],
+}
+
+impl Counters {
+    /// Adds another set of counters.
+    pub fn add(&mut self, o: &Counters) {
+        for i in 0..6 {
+            self.invocations[i] += o.invocations[i];
+            self.sat[i].add(&o.sat[i]);
+            for j in 0..3 {
+                self.cost[i][j] += o.cost[i][j];
+            }
+        }
+    }
+}
+
+/// The fixed units and formats of one hardware configuration, built once per render.
+pub struct Machine<'a> {
+    pub hw: &'a HwConfig,
+    pub recip: Reciprocal,
+    /// Texture coordinates: signed, texcoord_int_bits.texcoord_frac_bits.
+    pub uv_fmt: Format,
+    /// Colour channels: unorm color_bits (raw 0..2^bits-1).
+    pub color_fmt: Format,
+    /// LOD: signed, lod_frac_bits fraction bits.
+    pub lod_fmt: Format,
+    /// Barycentrics: signed, bary_bits fraction bits.
+    pub bary_fmt: Format,
+    /// Per texture: fixed levels and float levels.
+    pub tex_fixed: Vec<Vec<Level<'a>>>,
+    pub tex_float: Vec<Vec<LevelF<'a>>>,
+}
+
+impl<'a> Machine<'a> {
+    /// Builds the units of `hw` over the prepared maps (`fixed[i]` quantizes `float[i]`).
+    #[must_use]
+    pub fn new(hw: &'a HwConfig, float: &'a [MipChain], fixed: &'a [FixedMipChain]) -> Self {
+        let i = &hw.interp;
+        Self {
+            hw,
+            recip: Reciprocal::new(&hw.reciprocal),
+            uv_fmt: Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding),
+            color_fmt: Format::unsigned(0, hw.color.color_bits, hw.color.color_rounding),
+            lod_fmt: Format::signed(8, hw.lod.lod_frac_bits, Rounding::Truncate),
+            bary_fmt: Format::signed(16, i.bary_bits, i.interp_rounding),
+            tex_fixed: fixed
+                .iter()
+                .map(|c| {
+                    c.levels
+                        .iter()
+                        .map(|l| Level { width: l.width, height: l.height, texels: &l.texels })
+                        .collect()
+                })
+                .collect(),
+            tex_float: float
+                .iter()
+                .map(|c| {
+                    c.levels
+                        .iter()
+                        .map(|l| LevelF { width: l.width, height: l.height, texels: &l.texels })
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// Cost of one invocation of each stage kind of `plan` (zero for absent stages).
+    #[must_use]
+    pub fn plan_costs(&self, plan: &Plan) -> [UnitCost; 6] {
+        let mut c = [UnitCost::default(); 6];
+        for &k in &plan.stages {
+            c[k.index()] = self.stage_cost(k, plan);
+        }
+        c
+    }
+
+    /// Cost of one invocation of `kind` in `plan` (fixed units' op and cycle counts).
+    #[must_use]
+    pub fn stage_cost(&self, kind: StageKind, plan: &Plan) -> UnitCost {
+        let samples = if plan.derivatives { 3 } else { 1 };
+        let i = &self.hw.interp;
+        match kind {
+            StageKind::Bary => perspective_bary_cost(i, &self.recip).times(samples),
+            StageKind::Color => interpolate_cost(i).times(3),
+            StageKind::Texcoord => interpolate_cost(i).times(2 * samples),
+            StageKind::Lod => lod_cost(&self.hw.lod),
+            StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
+            StageKind::Modulate => modulate_cost(&self.hw.color),
+        }
+    }
+}
+
+/// One screen triangle's vertex data, in float and in the hardware's input formats.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TriAttrs {
+    /// Plan index (the plan of the mesh the triangle came from).
+    pub plan: u32,
+    pub inv_w_f: [f64; 3],
+    /// 1/w normalized so the largest is exactly 1 << inv_w_bits.
+    pub inv_w_x: [i64; 3],
+    pub color_f: [[f64; 3]; 3],
+    pub color_x: [[i64; 3]; 3],
+    pub uv_f: [[f64; 2]; 3],
+    pub uv_x: [[i64; 2]; 3],
+}
+
+impl TriAttrs {
+    /// Converts float vertex data (post-clip) into the machine's formats. Host-to-hardware
+    /// conversions that overflow are counted in `sat`.
+    #[must_use]
+    pub fn new(
+        m: &Machine,
+        plan: u32,
+        inv_w: [f64; 3],
+        color: [[f64; 3]; 3],
+        uv: [[f64; 2]; 3],
+        sat: &mut SatCounter,
+    ) -> Self {
+        let bits = m.hw.interp.inv_w_bits;
+        let max = inv_w.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+        let norm = Format::unsigned(1, bits, Rounding::HalfEven);
+        let inv_w_x = inv_w.map(|q| to_raw(q / max, &norm, sat).max(1));
+        let cb = m.hw.color.color_bits;
+        Self {
+            plan,
+            inv_w_f: inv_w,
+            inv_w_x,
+            color_f: color,
+            color_x: color.map(|c| c.map(|x| i64::from(to_unorm(x, cb)))),
+            uv_f: uv,
+            uv_x: uv.map(|t| t.map(|x| to_raw(x, &m.uv_fmt, sat))),
+        }
+    }
+}
+
+#[inline]
+fn column<const N: usize>(v: &[[i64; N]; 3], c: usize) -> [i64; 3] {
+    [v[0][c], v[1][c], v[2][c]]
+}
+
+#[inline]
+fn column_f<const N: usize>(v: &[[f64; N]; 3], c: usize) -> [f64; 3] {
+    [v[0][c], v[1][c], v[2][c]]
+}
+
+#[inline]
+fn unorm(raw: u32, bits: u32) -> f64 {
+    f64::from(raw) / ((1u64 << bits) - 1) as f64
+}
+
+/// Sample offsets of the fragment and its two helper samples (x+1, y) and (x, y+1).
+const OFFSETS: [(i64, i64); 3] = [(0, 0), (1, 0), (0, 1)];
+
+/// Runs `plan` on one fragment at pixel (`px`, `py`) of `tri`, each stage by its twin in
+/// `impls`; the result is in `frag.out`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn run(
+    plan: &Plan,
+    costs: &[UnitCost; 6],
+    impls: &StageImpls,
+    m: &Machine,
+    tri: &ScreenTri,
+    a: &TriAttrs,
+    px: i64,
+    py: i64,
+    frag: &mut Frag,
+    c: &mut Counters,
+) {
+    let samples = if plan.derivatives { 3 } else { 1 };
+    frag.color = plan.const_color;
+    frag.out = plan.const_color;
+    for &kind in &plan.stages {
+        let k = kind.index();
+        c.invocations[k] += 1;
+        let cost = &costs[k];
+        c.cost[k][0] += u64::from(cost.ops);
+        c.cost[k][1] += u64::from(cost.cycles);
+        c.cost[k][2] += u64::from(cost.texels);
+        let fixed = impls.of(kind) == Impl::Fixed;
+        let sat = &mut c.sat[k];
+        match kind {
+            StageKind::Bary => {
+                let sub = m.hw.raster.subpixel_bits;
+                let bb = m.hw.interp.bary_bits;
+                for (s, &(dx, dy)) in OFFSETS.iter().enumerate().take(samples) {
+                    frag.bary[s] = if fixed {
+                        let e = tri.edges_fixed(px + dx, py + dy, sub);
+                        let b = perspective_bary(e, a.inv_w_x, &m.hw.interp, &m.recip, sat);
+                        b.map(|r| from_raw(r, bb))
+                    } else {
+                        let e = tri.edges_float((px + dx) as f64, (py + dy) as f64);
+                        perspective_bary_f64(e, a.inv_w_f)
+                    };
+                }
+            }
+            StageKind::Color => {
+                if fixed {
+                    let bb = m.hw.interp.bary_bits;
+                    let b = frag.bary[0].map(|x| to_raw(x, &m.bary_fmt, sat));
+                    let cb = m.hw.color.color_bits;
+                    for ch in 0..3 {
+                        let r = interpolate(b, bb, column(&a.color_x, ch), &m.color_fmt, sat);
+                        frag.color[ch] = unorm(r as u32, cb);
+                    }
+                } else {
+                    for ch in 0..3 {
+                        frag.color[ch] = interpolate_f64(frag.bary[0], column_f(&a.color_f, ch));
+                    }
+                }
+                frag.color[3] = 1.0;
+                frag.out = frag.color;
+            }
+            StageKind::Texcoord => {
+                for s in 0..samples {
+                    if fixed {
+                        let bb = m.hw.interp.bary_bits;
+                        let b = frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat));
+                        let fb = m.uv_fmt.frac_bits;
+                        for ax in 0..2 {
+                            let r = interpolate(b, bb, column(&a.uv_x, ax), &m.uv_fmt, sat);
+                            frag.uv[s][ax] = from_raw(r, fb);
+                        }
+                    } else {
+                        for ax in 0..2 {
+                            frag.uv[s][ax] = interpolate_f64(frag.bary[s], column_f(&a.uv_f, ax));
+                        }
+                    }
+                }
+            }
+            StageKind::Lod => {
+                let Some(t) = plan.texture else { continue };
+                let (w, h) = match m.tex_float[t].first() {
+                    Some(l) => (l.width, l.height),
+                    None => continue,
+                };
+                let uv = &frag.uv;
+                if fixed {
+                    let f = m.uv_fmt.frac_bits;
+                    let q = |x: f64| to_raw(x, &m.uv_fmt, sat);
+                    let (u0, v0) = (q(uv[0][0]), q(uv[0][1]));
+                    let d = [
+                        (q(uv[1][0]) - u0) * i64::from(w),
+                        (q(uv[1][1]) - v0) * i64::from(h),
+                        (q(uv[2][0]) - u0) * i64::from(w),
+                        (q(uv[2][1]) - v0) * i64::from(h),
+                    ];
+                    let l = lod(d, f, &m.hw.lod, sat);
+                    frag.lod = from_raw(l, m.hw.lod.lod_frac_bits);
+                } else {
+                    let (wf, hf) = (f64::from(w), f64::from(h));
+                    frag.lod = lod_f64([
+                        (uv[1][0] - uv[0][0]) * wf,
+                        (uv[1][1] - uv[0][1]) * hf,
+                        (uv[2][0] - uv[0][0]) * wf,
+                        (uv[2][1] - uv[0][1]) * hf,
+                    ]);
+                }
+            }
+            StageKind::Trilinear => {
+                let Some(t) = plan.texture else { continue };
+                let [u, v] = frag.uv[0];
+                frag.texel = if fixed {
+                    let tc = &m.hw.trilinear;
+                    let lfb = m.hw.lod.lod_frac_bits;
+                    let l = to_raw(frag.lod, &m.lod_fmt, sat);
+                    let r = trilinear(
+                        &m.tex_fixed[t],
+                        to_raw(u, &m.uv_fmt, sat),
+                        to_raw(v, &m.uv_fmt, sat),
+                        m.uv_fmt.frac_bits,
+                        l,
+                        lfb,
+                        plan.wrap,
+                        tc,
+                        None,
+                    );
+                    r.map(|x| unorm(u32::from(x), tc.texel_bits))
+                } else {
+                    trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap)
+                };
+                frag.out = frag.texel;
+            }
+            StageKind::Modulate => {
+                if fixed {
+                    let cb = m.hw.color.color_bits;
+                    let tb = m.hw.trilinear.texel_bits;
+                    let rnd = m.hw.color.color_rounding;
+                    for ch in 0..4 {
+                        let x = to_unorm(frag.color[ch], cb);
+                        let y = to_unorm(frag.texel[ch], tb);
+                        frag.out[ch] = unorm(modulate(x, cb, y, tb, cb, rnd), cb);
+                    }
+                } else {
+                    for ch in 0..4 {
+                        frag.out[ch] = frag.color[ch] * frag.texel[ch];
+                    }
+                }
+            }
+        }
+    }
+}

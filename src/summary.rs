@@ -1,0 +1,178 @@
+//! Human-readable summaries of a render and the sweep table (terminal, CSV, JSON rows).
+
+use crate::render::RenderStats;
+use crate::report::{format_metrics_table, ErrorMetrics};
+use serde::Serialize;
+use std::fmt::Write;
+
+/// The terminal summary of one render.
+#[must_use]
+pub fn text(s: &RenderStats) -> String {
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "scene '{}' {}x{}, {} triangles ({} after setup: {} culled, {} degenerate, {} non-finite, {} clipped away), hw '{}'",
+        s.scene,
+        s.width,
+        s.height,
+        s.triangles,
+        s.setup.output,
+        s.setup.culled,
+        s.setup.degenerate,
+        s.setup.non_finite,
+        s.setup.clipped_away,
+        s.hw
+    );
+    let _ = writeln!(
+        o,
+        "fragments: {} rasterized, {} failed depth, {} pixels covered; {} spans",
+        s.raster.fragments, s.raster.depth_fails, s.covered_pixels, s.raster.spans
+    );
+    if let (Some(e8), Some(e16)) = (&s.error_8bit, &s.error_16bit) {
+        let _ = writeln!(o, "error, hardware vs float reference ({:?} coverage):", s.coverage);
+        o.push_str(&format_metrics_table(&[("8-bit", e8), ("16-bit", e16)]));
+    }
+    let _ = writeln!(
+        o,
+        "{:<10} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
+        "stage", "impl", "invocations", "saturated", "wrapped", "cycles", "texels"
+    );
+    for st in &s.stages {
+        let _ = writeln!(
+            o,
+            "{:<10} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
+            st.stage.name(),
+            if st.invocations == 0 { "-" } else { imp_name(st.imp) },
+            st.invocations,
+            st.saturated,
+            st.wrapped,
+            st.cycles,
+            st.texels
+        );
+    }
+    if s.input_saturated > 0 {
+        let _ = writeln!(o, "vertex attributes saturated on input: {}", s.input_saturated);
+    }
+    let c = &s.cycles;
+    let _ = writeln!(
+        o,
+        "cycles (first estimate, units x cycles/op): {} total = {} setup + {} spans + {} stages; {:.2} per covered pixel",
+        c.total, c.setup, c.spans, c.stages, c.per_covered_pixel
+    );
+    let t = &s.timings;
+    let _ = writeln!(
+        o,
+        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1})",
+        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms
+    );
+    o
+}
+
+fn imp_name(i: crate::pipeline::Impl) -> &'static str {
+    match i {
+        crate::pipeline::Impl::Fixed => "fixed",
+        crate::pipeline::Impl::Float => "float",
+    }
+}
+
+/// One row of a sweep: the settings, the error against the reference, the cost.
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepRow {
+    pub settings: Vec<(String, String)>,
+    pub error_8bit: Option<ErrorMetrics>,
+    pub error_16bit: Option<ErrorMetrics>,
+    pub saturated: u64,
+    pub texels: u64,
+    pub cycles: u64,
+    pub cycles_per_pixel: f64,
+    pub hw_ms: f64,
+    pub ref_ms: f64,
+}
+
+impl SweepRow {
+    /// The row of one render.
+    #[must_use]
+    pub fn new(settings: Vec<(String, String)>, s: &RenderStats) -> Self {
+        Self {
+            settings,
+            error_8bit: s.error_8bit.clone(),
+            error_16bit: s.error_16bit.clone(),
+            saturated: s.stages.iter().map(|x| x.saturated + x.wrapped).sum::<u64>() + s.input_saturated,
+            texels: s.stages.iter().map(|x| x.texels).sum(),
+            cycles: s.cycles.total,
+            cycles_per_pixel: s.cycles.per_covered_pixel,
+            hw_ms: s.timings.hw_total_ms,
+            ref_ms: s.timings.ref_total_ms,
+        }
+    }
+}
+
+const HEADER: [&str; 11] = [
+    "max8", "mean8", "rmse8", "psnr8_db", "exact8_%", "max16", "rmse16", "sat", "cycles", "cyc/px", "hw_ms",
+];
+
+fn cells(r: &SweepRow) -> Vec<String> {
+    let e8 = r.error_8bit.as_ref();
+    let e16 = r.error_16bit.as_ref();
+    let psnr = |e: Option<&ErrorMetrics>| match e.and_then(|e| e.psnr_db) {
+        Some(p) => format!("{p:.2}"),
+        None => "inf".into(),
+    };
+    vec![
+        e8.map_or("-".into(), |e| e.max_abs_lsb.to_string()),
+        e8.map_or("-".into(), |e| format!("{:.4}", e.mean_abs_lsb)),
+        e8.map_or("-".into(), |e| format!("{:.4}", e.rmse_lsb)),
+        psnr(e8),
+        e8.map_or("-".into(), |e| format!("{:.2}", e.pct_exact)),
+        e16.map_or("-".into(), |e| e.max_abs_lsb.to_string()),
+        e16.map_or("-".into(), |e| format!("{:.2}", e.rmse_lsb)),
+        r.saturated.to_string(),
+        r.cycles.to_string(),
+        format!("{:.2}", r.cycles_per_pixel),
+        format!("{:.1}", r.hw_ms),
+    ]
+}
+
+/// The sweep as an aligned terminal table.
+#[must_use]
+pub fn sweep_table(rows: &[SweepRow]) -> String {
+    let mut grid: Vec<Vec<String>> = Vec::with_capacity(rows.len() + 1);
+    let set_names: Vec<String> =
+        rows.first().map_or(vec![], |r| r.settings.iter().map(|(f, _)| f.clone()).collect());
+    let mut head = set_names.clone();
+    head.extend(HEADER.iter().map(|s| s.to_string()));
+    grid.push(head);
+    for r in rows {
+        let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
+        line.extend(cells(r));
+        grid.push(line);
+    }
+    let ncol = grid[0].len();
+    let widths: Vec<usize> =
+        (0..ncol).map(|c| grid.iter().map(|l| l.get(c).map_or(0, |s| s.len())).max().unwrap_or(0)).collect();
+    let mut o = String::new();
+    for l in &grid {
+        let cols: Vec<String> = l.iter().zip(&widths).map(|(s, w)| format!("{s:>w$}")).collect();
+        let _ = writeln!(o, "{}", cols.join("  "));
+    }
+    o
+}
+
+/// The sweep as CSV.
+#[must_use]
+pub fn sweep_csv(rows: &[SweepRow]) -> String {
+    let mut o = String::new();
+    if let Some(r) = rows.first() {
+        let mut head: Vec<String> = r.settings.iter().map(|(f, _)| f.clone()).collect();
+        head.extend(HEADER.iter().map(|s| s.to_string()));
+        head.push("ref_ms".into());
+        let _ = writeln!(o, "{}", head.join(","));
+    }
+    for r in rows {
+        let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
+        line.extend(cells(r));
+        line.push(format!("{:.1}", r.ref_ms));
+        let _ = writeln!(o, "{}", line.join(","));
+    }
+    o
+}

@@ -1,0 +1,94 @@
+//! The command line as users and scripts see it: exit codes, files written, messages.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn texsim(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_texsim"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run texsim")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("texsim-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("tmp dir");
+    d
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+#[test]
+fn render_writes_every_output() {
+    let d = tmp("render");
+    let o = texsim(&["render", "--scene", "demo", "--width", "160", "--height", "120", "--out", "o", "--png16"], &d);
+    assert!(o.status.success(), "{}", text(&o));
+    for f in ["hw.png", "ref.png", "error.png", "sheet.png", "summary.json", "hw16.png", "ref16.png"] {
+        assert!(d.join("o").join(f).is_file(), "missing {f}");
+    }
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("o/summary.json")).unwrap()).unwrap();
+    assert!(j["stats"]["error_8bit"]["max_abs_lsb"].is_u64());
+    assert!(j["stats"]["cycles"]["total"].as_u64().unwrap() > 0);
+    assert!(text(&o).contains("PSNR") || text(&o).contains("psnr"), "{}", text(&o));
+}
+
+#[test]
+fn bad_inputs_fail_cleanly_and_write_nothing() {
+    let d = tmp("bad");
+    std::fs::write(d.join("broken.toml"), "this is = = not toml").unwrap();
+    std::fs::write(d.join("hw_bad.toml"), "[trilinear]\nweight_bits = 99\n").unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["render", "missing.obj", "--out", "o"], "missing.obj"),
+        (vec!["render", "broken.toml", "--out", "o"], "broken.toml"),
+        (vec!["render", "--scene", "nope", "--out", "o"], "nope"),
+        (vec!["render", "--scene", "demo", "--hw", "hw_bad.toml", "--out", "o"], "weight_bits"),
+        (vec!["render", "--scene", "demo", "--hw", "nosuchpreset", "--out", "o"], "nosuchpreset"),
+        (vec!["render", "--scene", "demo", "--width", "0", "--out", "o"], "width"),
+        (vec!["render", "--scene", "demo", "--isolate", "foo", "--out", "o"], "foo"),
+        (vec!["sweep", "--scene", "demo", "--vary", "no_such_field=1..2", "--out", "o"], "no_such_field"),
+        (vec!["sweep", "--scene", "demo", "--vary", "weight_bits=1..99", "--out", "o"], "weight_bits"),
+        (vec!["probe", "--texture", "nothere.png", "--u", "0.5", "--v", "0.5", "--lod", "0"], "nothere.png"),
+    ];
+    for (args, needle) in cases {
+        let o = texsim(&args, &d);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let t = text(&o);
+        assert!(t.contains(needle), "{args:?}: message does not name '{needle}': {t}");
+        assert!(!t.contains("panicked"), "{args:?} panicked: {t}");
+        assert!(!d.join("o").exists(), "{args:?} wrote output");
+    }
+}
+
+#[test]
+fn hw_show_round_trips_and_sweep_writes_table() {
+    let d = tmp("hw");
+    let o = texsim(&["hw", "show", "d3d11"], &d);
+    assert!(o.status.success());
+    std::fs::write(d.join("mine.toml"), &o.stdout).unwrap();
+    let o2 = texsim(&["hw", "show", "mine.toml"], &d);
+    assert!(o2.status.success(), "{}", text(&o2));
+    assert!(String::from_utf8_lossy(&o2.stdout).contains("weight_bits = 8"));
+
+    let o = texsim(
+        &["sweep", "--scene", "demo", "--width", "96", "--height", "72", "--vary", "weight_bits=2..4", "--out", "s"],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = std::fs::read_to_string(d.join("s/sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    assert!(d.join("s/sweep.json").is_file());
+}
+
+#[test]
+fn scenes_lists_the_catalogue() {
+    let o = texsim(&["scenes"], &std::env::temp_dir());
+    let t = text(&o);
+    for s in ["demo", "w1-plane", "w2-mesh"] {
+        assert!(t.contains(s), "{t}");
+    }
+}
