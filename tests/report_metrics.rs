@@ -221,10 +221,7 @@ fn model(a: &Image, b: &Image, bits: u32, mask: &[bool]) -> Model {
     let maxv = f64::from((1u32 << bits) - 1);
     let q = |x: u16| (f64::from(x) * maxv / 65535.0 + 0.5).floor() as i64;
     let (mut n, mut mx, mut s, mut s2, mut h) = (0u64, 0u32, 0f64, 0f64, [0u64; 8]);
-    for i in 0..a.px.len() {
-        if !mask[i] {
-            continue;
-        }
+    for (i, _) in mask.iter().enumerate().filter(|(_, &m)| m) {
         n += 1;
         let mut pm = 0u32;
         for c in 0..3 {
@@ -261,16 +258,15 @@ fn random_against_model() {
                 .map(|_| [0; 4].map(|_: u16| rng.below(65536) as u16))
                 .collect(),
         };
-        let px_b: Vec<[u16; 4]> = a
-            .px
-            .iter()
-            .map(|p| {
-                p.map(|c| {
-                    let d = rng.below(2 * spread as u64) as i64 - spread;
-                    (i64::from(c) + d).clamp(0, 65535) as u16
+        let px_b: Vec<[u16; 4]> =
+            a.px.iter()
+                .map(|p| {
+                    p.map(|c| {
+                        let d = rng.below(2 * spread as u64) as i64 - spread;
+                        (i64::from(c) + d).clamp(0, 65535) as u16
+                    })
                 })
-            })
-            .collect();
+                .collect();
         let b = Image {
             width: w,
             height: h,

@@ -21,7 +21,7 @@ pub(crate) fn new_pixmap(width: u32, height: u32) -> Pixmap {
     }
 }
 
-/// Fills the rectangle `[x, x+w) x [y, y+h)` (clipped to the pixmap and to `clip_right`) with `rgb`.
+/// Fills the rectangle `[x, x+w) x [y, y+h)` (clipped to the pixmap) with opaque `rgb`.
 pub(crate) fn fill_rect(p: &mut Pixmap, x: i64, y: i64, w: i64, h: i64, rgb: [u8; 3]) {
     fill_rect_clipped(p, x, y, w, h, rgb, i64::MAX);
 }
@@ -149,8 +149,9 @@ pub(crate) fn box_downscale(src: &Pixmap, dw: u32, dh: u32) -> Pixmap {
             let q = |v: u128| ((v + denom / 2) / denom).min(255) as u8;
             let (r, g, b, a) = (q(acc[0]), q(acc[1]), q(acc[2]), q(acc[3]));
             // Equal weights keep r, g, b <= a; the min() guards the invariant regardless.
-            opx[y * dw as usize + x] = PremultipliedColorU8::from_rgba(r.min(a), g.min(a), b.min(a), a)
-                .unwrap_or(PremultipliedColorU8::TRANSPARENT);
+            opx[y * dw as usize + x] =
+                PremultipliedColorU8::from_rgba(r.min(a), g.min(a), b.min(a), a)
+                    .unwrap_or(PremultipliedColorU8::TRANSPARENT);
         }
     }
     out
@@ -183,11 +184,19 @@ pub(crate) fn blit_over_checker(
             if tx >= dw {
                 break;
             }
-            let bg = if (sx / cell + sy / cell) % 2 == 0 { c0 } else { c1 };
+            let bg = if (sx / cell + sy / cell) & 1 == 0 {
+                c0
+            } else {
+                c1
+            };
             let inv = 255 - u32::from(c.alpha());
-            let mix = |s: u8, d: u8| (u32::from(s) + (u32::from(d) * inv + 127) / 255).min(255) as u8;
-            dpx[ty * dw + tx] =
-                opaque([mix(c.red(), bg[0]), mix(c.green(), bg[1]), mix(c.blue(), bg[2])]);
+            let mix =
+                |s: u8, d: u8| (u32::from(s) + (u32::from(d) * inv + 127) / 255).min(255) as u8;
+            dpx[ty * dw + tx] = opaque([
+                mix(c.red(), bg[0]),
+                mix(c.green(), bg[1]),
+                mix(c.blue(), bg[2]),
+            ]);
         }
     }
 }

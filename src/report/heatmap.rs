@@ -37,7 +37,11 @@ const VIRIDIS: [[u8; 3]; 9] = [
 
 /// The ramp at `t` in [0, 1].
 fn ramp(t: f64) -> [u8; 3] {
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 1.0 };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
     let x = t * (VIRIDIS.len() - 1) as f64;
     let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
     let f = x - i as f64;
@@ -157,7 +161,14 @@ pub fn heatmap(a: &Image, b: &Image, bits: u32, mask: Option<&[bool]>) -> Pixmap
         .map(|e| opaque(heatmap_colour(e, max_err)))
         .collect();
     let masked = opaque(MASKED_RGB);
-    fill_rect(&mut p, 0, 0, i64::from(lay.width), i64::from(lay.height), BG_RGB);
+    fill_rect(
+        &mut p,
+        0,
+        0,
+        i64::from(lay.width),
+        i64::from(lay.height),
+        BG_RGB,
+    );
     let stride = lay.width as usize;
     let px = p.pixels_mut();
     for y in 0..a.height {
@@ -186,7 +197,15 @@ fn draw_legend(
     let (z0, z1) = (i64::from(lay.zero_top), i64::from(lay.zero_bottom));
     let right = i64::from(lay.width);
     for (k, t) in titles(bits).iter().enumerate() {
-        draw_text(p, bar_x, 6 * s + k as i64 * 9 * s, t, lay.scale, TEXT_RGB, right);
+        draw_text(
+            p,
+            bar_x,
+            6 * s + k as i64 * 9 * s,
+            t,
+            lay.scale,
+            TEXT_RGB,
+            right,
+        );
     }
     // Frames, then the zero box and the ramp rows (each row's colour is the LUT colour of the
     // error value at that height, so the bar shows exactly what the pixels use).
@@ -212,7 +231,15 @@ fn draw_legend(
     let label = |p: &mut Pixmap, yc: i64, v: u32| {
         fill_rect(p, bar_x + bar_w, yc - s / 2, 3 * s, s, TEXT_RGB);
         let top = yc - 3 * s - s / 2;
-        draw_text(p, i64::from(lay.label_x), top, &v.to_string(), lay.scale, TEXT_RGB, right);
+        draw_text(
+            p,
+            i64::from(lay.label_x),
+            top,
+            &v.to_string(),
+            lay.scale,
+            TEXT_RGB,
+            right,
+        );
     };
     label(p, (z0 + z1) / 2, 0);
     if max_err == 0 {

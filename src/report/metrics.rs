@@ -71,7 +71,10 @@ pub(crate) fn channel_errors(pa: [u16; 4], pb: [u16; 4], bits: u32) -> [u32; 3] 
 /// excluded).
 #[inline]
 pub(crate) fn selected(mask: Option<&[bool]>, i: usize) -> bool {
-    mask.map_or(true, |m| m.get(i).copied().unwrap_or(false))
+    match mask {
+        None => true,
+        Some(m) => m.get(i).copied().unwrap_or(false),
+    }
 }
 
 /// Compares the RGB channels of `a` and `b` (alpha ignored), both reduced to `bits` bits first
@@ -160,7 +163,8 @@ pub fn format_metrics_table(rows: &[(&str, &ErrorMetrics)]) -> String {
             m.max_abs_lsb.to_string(),
             format!("{:.4}", m.mean_abs_lsb),
             format!("{:.4}", m.rmse_lsb),
-            m.psnr_db.map_or_else(|| "inf".to_string(), |p| format!("{p:.2}")),
+            m.psnr_db
+                .map_or_else(|| "inf".to_string(), |p| format!("{p:.2}")),
             format!("{:.3}", m.pct_exact),
             format!("{:.3}", m.pct_within_1lsb),
         ];
@@ -174,7 +178,13 @@ pub fn format_metrics_table(rows: &[(&str, &ErrorMetrics)]) -> String {
     }
     let ncol = table[0].len();
     let widths: Vec<usize> = (0..ncol)
-        .map(|c| table.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
+        .map(|c| {
+            table
+                .iter()
+                .map(|r| r[c].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
         .collect();
     let mut out = String::new();
     for (ri, r) in table.iter().enumerate() {

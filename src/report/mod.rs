@@ -35,7 +35,11 @@ impl Image {
     #[must_use]
     pub fn new(width: u32, height: u32, fill: [u16; 4]) -> Self {
         let n = width as usize * height as usize;
-        Self { width, height, px: vec![fill; n] }
+        Self {
+            width,
+            height,
+            px: vec![fill; n],
+        }
     }
 
     /// The pixel at (x, y), if inside the image.
@@ -44,7 +48,9 @@ impl Image {
         if x >= self.width || y >= self.height {
             return None;
         }
-        self.px.get(y as usize * self.width as usize + x as usize).copied()
+        self.px
+            .get(y as usize * self.width as usize + x as usize)
+            .copied()
     }
 
     /// Interleaved RGBA8 bytes (straight alpha), each channel reduced with round half up:

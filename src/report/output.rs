@@ -72,14 +72,20 @@ impl OutputSet {
             check_name(name)?;
         }
         if dir.exists() && !dir.is_dir() {
-            return Err(Error::file(dir, "output directory exists and is not a directory"));
+            return Err(Error::file(
+                dir,
+                "output directory exists and is not a directory",
+            ));
         }
         fs::create_dir_all(dir)
             .map_err(|e| Error::file(dir, format!("cannot create output directory: {e}")))?;
         let finals: Vec<PathBuf> = self.files.iter().map(|(n, _)| dir.join(n)).collect();
         for path in &finals {
             if path.is_dir() {
-                return Err(Error::file(path, "is a directory; cannot write an output file over it"));
+                return Err(Error::file(
+                    path,
+                    "is a directory; cannot write an output file over it",
+                ));
             }
         }
         let pid = std::process::id();
@@ -97,7 +103,10 @@ impl OutputSet {
         for (i, (tmp, fin)) in temps.iter().zip(&finals).enumerate() {
             if let Err(e) = fs::rename(tmp, fin) {
                 remove_all(&temps[i..]);
-                return Err(Error::file(fin, format!("cannot rename temp file into place: {e}")));
+                return Err(Error::file(
+                    fin,
+                    format!("cannot rename temp file into place: {e}"),
+                ));
             }
         }
         Ok(finals)

@@ -38,7 +38,12 @@ fn encode(bytes: &[u8], w: u32, h: u32, ty: ExtendedColorType) -> Result<Vec<u8>
 /// PNG, RGBA 8 bits per channel, straight alpha, channels rounded as [`Image::to_rgba8`].
 pub fn encode_png8(img: &Image) -> Result<Vec<u8>> {
     check(img)?;
-    encode(&img.to_rgba8(), img.width, img.height, ExtendedColorType::Rgba8)
+    encode(
+        &img.to_rgba8(),
+        img.width,
+        img.height,
+        ExtendedColorType::Rgba8,
+    )
 }
 
 /// PNG, RGBA 16 bits per channel, exactly the image's values.
@@ -55,7 +60,11 @@ pub fn encode_png16(img: &Image) -> Result<Vec<u8>> {
 /// PNG of a pixmap (tiny-skia demultiplies it to straight alpha).
 pub fn encode_pixmap(p: &Pixmap) -> Result<Vec<u8>> {
     p.encode_png().map_err(|e| {
-        Error::msg(format!("PNG encoding of a {}x{} pixmap failed: {e}", p.width(), p.height()))
+        Error::msg(format!(
+            "PNG encoding of a {}x{} pixmap failed: {e}",
+            p.width(),
+            p.height()
+        ))
     })
 }
 

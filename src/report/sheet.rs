@@ -53,15 +53,45 @@ pub fn sheet(panels: &[(&str, &Pixmap)]) -> Pixmap {
     if out.width() != width || out.height() != height {
         return out;
     }
-    fill_rect(&mut out, 0, 0, i64::from(width), i64::from(height), SHEET_BG);
+    fill_rect(
+        &mut out,
+        0,
+        0,
+        i64::from(width),
+        i64::from(height),
+        SHEET_BG,
+    );
     let mut x = SHEET_PAD;
     for ((title, p), &(w, h)) in panels.iter().zip(&sizes) {
         let (xi, yi) = (i64::from(x), i64::from(SHEET_PAD));
-        fill_rect(&mut out, xi, yi, i64::from(w), i64::from(SHEET_TITLE_H), TITLE_BG);
-        draw_text(&mut out, xi + 4, yi + 4, title, 2, TITLE_RGB, xi + i64::from(w));
+        fill_rect(
+            &mut out,
+            xi,
+            yi,
+            i64::from(w),
+            i64::from(SHEET_TITLE_H),
+            TITLE_BG,
+        );
+        draw_text(
+            &mut out,
+            xi + 4,
+            yi + 4,
+            title,
+            2,
+            TITLE_RGB,
+            xi + i64::from(w),
+        );
         let scaled = box_downscale(p, w, h);
         let (c0, c1) = CHECKER;
-        blit_over_checker(&mut out, &scaled, x, SHEET_PAD + SHEET_TITLE_H, CHECKER_CELL, c0, c1);
+        blit_over_checker(
+            &mut out,
+            &scaled,
+            x,
+            SHEET_PAD + SHEET_TITLE_H,
+            CHECKER_CELL,
+            c0,
+            c1,
+        );
         x += w + SHEET_PAD;
     }
     out
