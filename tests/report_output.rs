@@ -1,0 +1,121 @@
+//! OutputSet: all files written in order, no temp files left, bad names refused, and failures
+//! (target is a file, a name collides with a directory) write nothing.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use texsim::report::OutputSet;
+
+/// A fresh scratch directory unique to this process and test.
+fn scratch(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("texsim-report-{}-{test}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).expect("scratch dir");
+    d
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .expect("read_dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+fn sample() -> OutputSet {
+    let mut o = OutputSet::new();
+    o.add("hw.png", vec![1, 2, 3]);
+    o.add("ref.png", vec![4; 1000]);
+    o.add("metrics.json", b"{}".to_vec());
+    o
+}
+
+#[test]
+fn writes_all_files_without_temps() {
+    let root = scratch("all");
+    let dir = root.join("nested").join("out");
+    let o = sample();
+    let paths = o.write_to(&dir).expect("write");
+    assert_eq!(
+        paths,
+        ["hw.png", "ref.png", "metrics.json"].map(|n| dir.join(n))
+    );
+    assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [1, 2, 3]);
+    assert_eq!(
+        fs::read(dir.join("ref.png")).expect("read"),
+        vec![4u8; 1000]
+    );
+    assert_eq!(fs::read(dir.join("metrics.json")).expect("read"), b"{}");
+    assert_eq!(listing(&dir), ["hw.png", "metrics.json", "ref.png"]);
+    // overwriting an existing set replaces contents, still without temp files
+    let mut o2 = OutputSet::new();
+    o2.add("hw.png", vec![9]);
+    o2.add("hw.png", vec![7, 7]); // same name again replaces, keeps one entry
+    assert_eq!(o2.len(), 1);
+    o2.write_to(&dir).expect("rewrite");
+    assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [7, 7]);
+    assert!(listing(&dir).iter().all(|n| !n.contains(".tmp")));
+    assert_eq!(listing(&dir).len(), 3);
+    // an empty set just makes the directory
+    let empty = root.join("empty");
+    assert!(OutputSet::new().write_to(&empty).expect("empty").is_empty());
+    assert!(empty.is_dir());
+    fs::remove_dir_all(&root).expect("cleanup");
+}
+
+#[test]
+fn refuses_bad_names_and_writes_nothing() {
+    let root = scratch("names");
+    for bad in ["", ".", "..", "a/b.png", "../up.png", "x\\y", "a..b"] {
+        let dir = root.join("out");
+        let mut o = sample();
+        o.add(bad, vec![0]);
+        let e = o.write_to(&dir).expect_err(bad);
+        assert!(e.message().contains("file name"), "{bad}: {e}");
+        assert!(!dir.exists(), "{bad}: directory must not be created");
+    }
+    assert!(listing(&root).is_empty());
+    assert!(!root.parent().expect("parent").join("up.png").exists());
+    fs::remove_dir_all(&root).expect("cleanup");
+}
+
+#[test]
+fn target_is_a_file() {
+    let root = scratch("file");
+    let target = root.join("out");
+    fs::write(&target, b"keep me").expect("file");
+    let e = sample().write_to(&target).expect_err("file as dir");
+    assert!(e.message().contains(&target.display().to_string()), "{e}");
+    assert_eq!(fs::read(&target).expect("read"), b"keep me");
+    assert_eq!(listing(&root), ["out"]);
+    // a path below a regular file fails too, naming the path
+    let below = target.join("sub");
+    let e = sample().write_to(&below).expect_err("below a file");
+    assert!(e.message().contains(&below.display().to_string()), "{e}");
+    assert_eq!(listing(&root), ["out"]);
+    fs::remove_dir_all(&root).expect("cleanup");
+}
+
+#[test]
+fn name_colliding_with_directory_writes_nothing() {
+    let root = scratch("collide");
+    fs::create_dir(root.join("ref.png")).expect("dir");
+    let e = sample().write_to(&root).expect_err("collision");
+    assert!(e.message().contains("ref.png"), "{e}");
+    assert_eq!(listing(&root), ["ref.png"]);
+    fs::remove_dir_all(&root).expect("cleanup");
+}
+
+#[test]
+fn failed_write_removes_temps_already_written() {
+    let root = scratch("cleanup");
+    // Block the third file's temp path with a directory: its write fails after the first two
+    // temp files exist, and those must be removed again.
+    let blocker = format!("metrics.json.tmp-{}", std::process::id());
+    fs::create_dir(root.join(&blocker)).expect("dir");
+    let e = sample().write_to(&root).expect_err("blocked");
+    assert!(e.message().contains("metrics.json"), "{e}");
+    assert_eq!(listing(&root), [blocker]);
+    fs::remove_dir_all(&root).expect("cleanup");
+}
