@@ -12,6 +12,7 @@ pub mod fixedpoint;
 pub mod maps;
 pub mod pipeline;
 pub mod raster;
+pub mod reference;
 pub mod render;
 pub mod report;
 pub mod scene;
