@@ -101,7 +101,9 @@ impl Reciprocal {
             n += 1;
         }
         let l = self.cfg.recip_lut_bits;
-        let idx = ((m >> (p - l)) & ((1i64 << l) - 1)) as usize;
+        // Top L fraction bits of m (m has only P; a wider index sees zeros below them).
+        let top = if l <= p { m >> (p - l) } else { m << (l - p) };
+        let idx = (top & ((1i64 << l) - 1)) as usize;
         let mut y = self.lut[idx] as i64;
         let two = 2i64 << p;
         for _ in 0..self.cfg.recip_iterations {
