@@ -22,7 +22,11 @@ pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
         Rounding::HalfUp => fl + if rem >= 0.5 { 1.0 } else { 0.0 },
         Rounding::HalfEven => {
             let odd = (fl * 0.5).floor() != fl * 0.5;
-            fl + if rem > 0.5 || (rem == 0.5 && odd) { 1.0 } else { 0.0 }
+            fl + if rem > 0.5 || (rem == 0.5 && odd) {
+                1.0
+            } else {
+                0.0
+            }
         }
     };
     // 2^63 is exactly representable; anything at or beyond it does not fit i64.

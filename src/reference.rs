@@ -73,7 +73,11 @@ pub fn wrap_index_f64(i: f64, size: u32, mode: WrapMode) -> u32 {
 pub fn wrap_f64(coord: f64, size: u32, mode: WrapMode) -> (u32, u32, f64) {
     let s = coord * f64::from(size.max(1)) - 0.5;
     let i0 = s.floor();
-    (wrap_index_f64(i0, size, mode), wrap_index_f64(i0 + 1.0, size, mode), s - i0)
+    (
+        wrap_index_f64(i0, size, mode),
+        wrap_index_f64(i0 + 1.0, size, mode),
+        s - i0,
+    )
 }
 
 /// One MIP level of float texels (row-major, top row first).

@@ -1,7 +1,9 @@
 //! `hw_model::fixed`: `round_shift_right`(`_wide`) vs exact i128 floor division for every mode,
 //! shift and sign; `Format::fit`/`requantize` saturate and wrap with exact event counts.
 
-use hw_model::fixed::{round_shift_right, round_shift_right_wide, Format, Overflow, Rounding, SatCounter};
+use hw_model::fixed::{
+    round_shift_right, round_shift_right_wide, Format, Overflow, Rounding, SatCounter,
+};
 
 struct SplitMix(u64);
 impl SplitMix {
@@ -54,13 +56,20 @@ fn round_shift_right_vs_exact() {
         let s = (rng.next() % 80) as u32;
         let mode = ROUNDINGS[(k % 3) as usize];
         let want = exact(i128::from(x), s, mode);
-        assert_eq!(i128::from(round_shift_right(x, s, mode)), want, "x={x} s={s} {mode:?}");
+        assert_eq!(
+            i128::from(round_shift_right(x, s, mode)),
+            want,
+            "x={x} s={s} {mode:?}"
+        );
     }
     // Exhaustive small range: all x in -2^11..2^11, s in 0..14.
     for x in -2048i64..2048 {
         for s in 0..14 {
             for mode in ROUNDINGS {
-                assert_eq!(i128::from(round_shift_right(x, s, mode)), exact(i128::from(x), s, mode));
+                assert_eq!(
+                    i128::from(round_shift_right(x, s, mode)),
+                    exact(i128::from(x), s, mode)
+                );
             }
         }
     }
@@ -75,15 +84,31 @@ fn round_shift_right_wide_vs_exact() {
         let s = (rng.next() % 120) as u32;
         let mode = ROUNDINGS[(k % 3) as usize];
         let want = exact(x, s, mode).clamp(i128::from(i64::MIN), i128::from(i64::MAX));
-        assert_eq!(i128::from(round_shift_right_wide(x, s, mode)), want, "x={x} s={s} {mode:?}");
+        assert_eq!(
+            i128::from(round_shift_right_wide(x, s, mode)),
+            want,
+            "x={x} s={s} {mode:?}"
+        );
     }
     for mode in ROUNDINGS {
-        assert_eq!(round_shift_right_wide(i128::MIN, 128, mode), if mode == Rounding::Truncate { -1 } else { 0 });
+        assert_eq!(
+            round_shift_right_wide(i128::MIN, 128, mode),
+            if mode == Rounding::Truncate { -1 } else { 0 }
+        );
         assert_eq!(round_shift_right_wide(i128::MAX, 200, mode), 0);
-        assert_eq!(round_shift_right_wide(-1, 127, mode), if mode == Rounding::Truncate { -1 } else { 0 });
+        assert_eq!(
+            round_shift_right_wide(-1, 127, mode),
+            if mode == Rounding::Truncate { -1 } else { 0 }
+        );
         assert_eq!(round_shift_right(i64::MIN, 63, mode), -1);
-        assert_eq!(round_shift_right(i64::MIN, 64, mode), if mode == Rounding::Truncate { -1 } else { 0 });
-        assert_eq!(round_shift_right(-1, 90, mode), if mode == Rounding::Truncate { -1 } else { 0 });
+        assert_eq!(
+            round_shift_right(i64::MIN, 64, mode),
+            if mode == Rounding::Truncate { -1 } else { 0 }
+        );
+        assert_eq!(
+            round_shift_right(-1, 90, mode),
+            if mode == Rounding::Truncate { -1 } else { 0 }
+        );
     }
 }
 
@@ -105,7 +130,10 @@ fn fit_saturate_and_wrap_counts() {
         let span = 1i64 << (int_bits + frac_bits + 3);
         let raw = (rng.next() % (2 * span as u64)) as i64 - span;
         let (lo, hi) = if signed {
-            (-(1i64 << (int_bits + frac_bits)), (1i64 << (int_bits + frac_bits)) - 1)
+            (
+                -(1i64 << (int_bits + frac_bits)),
+                (1i64 << (int_bits + frac_bits)) - 1,
+            )
         } else {
             (0, (1i64 << (int_bits + frac_bits)) - 1)
         };

@@ -28,10 +28,22 @@ fn to_raw_rounding_and_ties() {
     assert_eq!(to_raw(-2.59375, &s(Rounding::HalfEven), &mut sat), -42); // -41.5 -> -42
     assert_eq!(sat, SatCounter::default());
     assert_eq!(to_raw(f64::NAN, &s(Rounding::HalfEven), &mut sat), 0);
-    assert_eq!(to_raw(f64::INFINITY, &s(Rounding::HalfEven), &mut sat), (1 << 14) - 1);
-    assert_eq!(to_raw(f64::NEG_INFINITY, &s(Rounding::HalfEven), &mut sat), -(1 << 14));
-    assert_eq!(to_raw(1e300, &s(Rounding::HalfEven), &mut sat), (1 << 14) - 1);
-    assert_eq!(to_raw(5000.0, &s(Rounding::HalfEven), &mut sat), (1 << 14) - 1);
+    assert_eq!(
+        to_raw(f64::INFINITY, &s(Rounding::HalfEven), &mut sat),
+        (1 << 14) - 1
+    );
+    assert_eq!(
+        to_raw(f64::NEG_INFINITY, &s(Rounding::HalfEven), &mut sat),
+        -(1 << 14)
+    );
+    assert_eq!(
+        to_raw(1e300, &s(Rounding::HalfEven), &mut sat),
+        (1 << 14) - 1
+    );
+    assert_eq!(
+        to_raw(5000.0, &s(Rounding::HalfEven), &mut sat),
+        (1 << 14) - 1
+    );
     assert_eq!(sat.saturated, 5);
     let mut w = s(Rounding::Truncate);
     w.overflow = Overflow::Wrap;
@@ -48,7 +60,10 @@ fn to_raw_random_vs_integer_model() {
         let n = (rng.next() as i64) >> 18;
         let x = n as f64 / 1048576.0;
         for mode in [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven] {
-            let fm = Format { rounding: mode, ..f };
+            let fm = Format {
+                rounding: mode,
+                ..f
+            };
             let mut sat = SatCounter::default();
             let got = to_raw(x, &fm, &mut sat);
             let want = hw_model::fixed::round_shift_right(n, 4, mode);

@@ -80,7 +80,11 @@ fn bary_vs_exact_rational() {
         let recip = Reciprocal::new(&hw.reciprocal);
         let b = cfg.bary_bits;
         let er = recip_rel_bound(&hw);
-        let h = if cfg.interp_rounding == Rounding::Truncate { 1.0 } else { 0.5 };
+        let h = if cfg.interp_rounding == Rounding::Truncate {
+            1.0
+        } else {
+            0.5
+        };
         let mut max_in = 0.0f64;
         let mut degenerate = 0;
         for k in 0..400_000 {
@@ -90,7 +94,9 @@ fn bary_vs_exact_rational() {
             let mut sat = SatCounter::default();
             let p = perspective_bary(e, w, &cfg, &recip, &mut sat);
             assert_eq!(p[0] + p[1] + p[2], 1i64 << b, "sum != 1");
-            let q: Vec<i128> = (0..3).map(|i| i128::from(e[i]) * i128::from(w[i])).collect();
+            let q: Vec<i128> = (0..3)
+                .map(|i| i128::from(e[i]) * i128::from(w[i]))
+                .collect();
             let d: i128 = q.iter().sum();
             if d <= 0 {
                 degenerate += 1;
@@ -104,10 +110,15 @@ fn bary_vs_exact_rational() {
                 if exact.abs() * 2f64.powi(b as i32) > BARY_LIMIT as f64 / 2.0 {
                     continue;
                 }
-                let Some(pd) = i128::from(p[i]).checked_mul(d) else { continue };
+                let Some(pd) = i128::from(p[i]).checked_mul(d) else {
+                    continue;
+                };
                 let err = (pd - (q[i] << b)) as f64 / d as f64;
                 let bound = exact.abs() * 2f64.powi(b as i32) * er + h + 1e-6;
-                assert!(err.abs() <= bound, "p{i} err {err} > {bound}: e={e:?} w={w:?} {p:?}");
+                assert!(
+                    err.abs() <= bound,
+                    "p{i} err {err} > {bound}: e={e:?} w={w:?} {p:?}"
+                );
                 bounds[i] = bound;
                 if inside {
                     max_in = max_in.max(err.abs());
@@ -146,14 +157,26 @@ fn bary_degenerate_and_vertices() {
     let recip = Reciprocal::new(&hw.reciprocal);
     let one = 1i64 << hw.interp.bary_bits;
     let mut sat = SatCounter::default();
-    assert_eq!(perspective_bary([0, 0, 0], [1, 1, 1 << 24], &hw.interp, &recip, &mut sat), [one, 0, 0]);
+    assert_eq!(
+        perspective_bary([0, 0, 0], [1, 1, 1 << 24], &hw.interp, &recip, &mut sat),
+        [one, 0, 0]
+    );
     assert_eq!(sat.saturated, 1);
-    assert_eq!(perspective_bary([-5, 1, 1], [1 << 24; 3], &hw.interp, &recip, &mut sat), [one, 0, 0]);
+    assert_eq!(
+        perspective_bary([-5, 1, 1], [1 << 24; 3], &hw.interp, &recip, &mut sat),
+        [one, 0, 0]
+    );
     assert_eq!(sat.saturated, 2);
     // At a vertex the barycentrics are exact.
     let w = [1 << 24, 3 << 20, 5 << 18];
-    assert_eq!(perspective_bary([0, 1 << 40, 0], w, &hw.interp, &recip, &mut sat), [0, one, 0]);
-    assert_eq!(perspective_bary([0, 0, 12345], w, &hw.interp, &recip, &mut sat), [0, 0, one]);
+    assert_eq!(
+        perspective_bary([0, 1 << 40, 0], w, &hw.interp, &recip, &mut sat),
+        [0, one, 0]
+    );
+    assert_eq!(
+        perspective_bary([0, 0, 12345], w, &hw.interp, &recip, &mut sat),
+        [0, 0, one]
+    );
     assert_eq!(sat.saturated, 2);
 }
 
@@ -174,14 +197,22 @@ fn interpolate_exact_rounding() {
     let modes = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
     for k in 0..1_200_000u32 {
         let bb = 4 + rng.below(27) as u32;
-        let mut out = Format::signed(8 + rng.below(8) as u32, 4 + rng.below(20) as u32, modes[(k % 3) as usize]);
+        let mut out = Format::signed(
+            8 + rng.below(8) as u32,
+            4 + rng.below(20) as u32,
+            modes[(k % 3) as usize],
+        );
         if k % 7 == 0 {
             out.overflow = Overflow::Wrap;
         }
         let lim = (out.max_raw() as u64) * 2;
         let attr = [0; 3].map(|_: i64| rng.below(lim) as i64 - out.max_raw());
         let one = 1i64 << bb;
-        let spread = if k % 5 == 0 { 4 * one as u64 } else { one as u64 };
+        let spread = if k % 5 == 0 {
+            4 * one as u64
+        } else {
+            one as u64
+        };
         let p1 = rng.below(spread) as i64 - if k % 5 == 0 { one } else { 0 };
         let p2 = rng.below(spread) as i64 - if k % 5 == 0 { one } else { 0 };
         let bary = [one - p1 - p2, p1, p2];
@@ -199,12 +230,19 @@ fn interpolate_exact_rounding() {
                     assert_eq!(sat.saturated, 1);
                 }
                 Overflow::Wrap => {
-                    assert_eq!(i128::from(got).rem_euclid(hi - lo + 1), r.rem_euclid(hi - lo + 1));
+                    assert_eq!(
+                        i128::from(got).rem_euclid(hi - lo + 1),
+                        r.rem_euclid(hi - lo + 1)
+                    );
                     assert_eq!(sat.wrapped, 1);
                 }
             }
         } else {
-            assert_eq!(i128::from(got), r, "bary={bary:?} attr={attr:?} bb={bb} {out:?}");
+            assert_eq!(
+                i128::from(got),
+                r,
+                "bary={bary:?} attr={attr:?} bb={bb} {out:?}"
+            );
             assert_eq!(sat, SatCounter::default());
             if k % 8 == 0 {
                 let s = 2f64.powi(-(bb as i32));

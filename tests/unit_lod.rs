@@ -39,7 +39,10 @@ fn check(got: i64, x: f64, ctx: &str) -> bool {
     if g == fl + 1.0 && fl + 1.0 - x < 1e-9 {
         return false;
     }
-    assert!(g == fl - 1.0 && x - fl < NEAR, "{ctx}: got {got}, exact {x}");
+    assert!(
+        g == fl - 1.0 && x - fl < NEAR,
+        "{ctx}: got {got}, exact {x}"
+    );
     MAXD.with(|m| m.set(m.get().max(x - fl)));
     true
 }
@@ -84,12 +87,21 @@ fn random_all_widths() {
         let mut sat = SatCounter::default();
         let got = lod(d, frac, &c, &mut sat);
         let s = 2f64.powi(-(frac as i32));
-        let lam = lod_f64([d[0] as f64 * s, d[1] as f64 * s, d[2] as f64 * s, d[3] as f64 * s]);
+        let lam = lod_f64([
+            d[0] as f64 * s,
+            d[1] as f64 * s,
+            d[2] as f64 * s,
+            d[3] as f64 * s,
+        ]);
         if lam <= -32.0 {
             assert_eq!(got, lod_zero(f));
             continue;
         }
-        if check(got, lam * 2f64.powi(f as i32), &format!("{d:?} frac={frac} F={f}")) {
+        if check(
+            got,
+            lam * 2f64.powi(f as i32),
+            &format!("{d:?} frac={frac} F={f}"),
+        ) {
             low += 1;
         }
         assert_eq!(sat, SatCounter::default());
@@ -107,8 +119,14 @@ fn exact_cases() {
                 let v = 1i64 << k;
                 let want = (k - i64::from(frac)) << f;
                 assert_eq!(lod([v, 0, 0, 0], frac, &c, &mut sat), want.max(lod_zero(f)));
-                assert_eq!(lod([0, -v, v / 2, 0], frac, &c, &mut sat), want.max(lod_zero(f)));
-                assert_eq!(lod([3 * v, 4 * v, 0, 0], frac, &c, &mut sat) >> f, (k - i64::from(frac)) + 2);
+                assert_eq!(
+                    lod([0, -v, v / 2, 0], frac, &c, &mut sat),
+                    want.max(lod_zero(f))
+                );
+                assert_eq!(
+                    lod([3 * v, 4 * v, 0, 0], frac, &c, &mut sat) >> f,
+                    (k - i64::from(frac)) + 2
+                );
             }
         }
         assert_eq!(lod([0; 4], 0, &c, &mut sat), -(32 << f));

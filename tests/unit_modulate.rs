@@ -24,8 +24,11 @@ fn assert_rounded(q: u32, num: u128, den: u128, mode: Rounding, ctx: &dyn Fn() -
     let q = u128::from(q);
     let ok = match mode {
         Rounding::Truncate => q * den <= num && num < (q + 1) * den,
-        Rounding::HalfUp => (2 * q).saturating_sub(1) * den <= 2 * num && 2 * num < (2 * q + 1) * den
-            && (q > 0 || 2 * num < den),
+        Rounding::HalfUp => {
+            (2 * q).saturating_sub(1) * den <= 2 * num
+                && 2 * num < (2 * q + 1) * den
+                && (q > 0 || 2 * num < den)
+        }
         Rounding::HalfEven => {
             let lo = 2 * q * den; // 2 num compared to (2q +- 1) den
             let d2 = 2 * num;
@@ -63,15 +66,23 @@ fn modulate_exhaustive_8_bit() {
 fn modulate_random_mixed_widths() {
     let mut rng = SplitMix(0x30d_0001);
     for k in 0..1_500_000u32 {
-        let (ab, bb, ob) = (1 + (k % 16), 1 + (k / 16 % 16), 1 + (rng.next() % 16) as u32);
+        let (ab, bb, ob) = (
+            1 + (k % 16),
+            1 + (k / 16 % 16),
+            1 + (rng.next() % 16) as u32,
+        );
         let mode = ROUNDINGS[(k / 256 % 3) as usize];
         let a = (rng.next() % (1 << ab)) as u32;
         let b = (rng.next() % (1 << bb)) as u32;
         let q = modulate(a, ab, b, bb, ob, mode);
         let (ma, mb, mo) = ((1u128 << ab) - 1, (1u128 << bb) - 1, (1u128 << ob) - 1);
-        assert_rounded(q, u128::from(a) * u128::from(b) * mo, ma * mb, mode, &|| {
-            format!("modulate({a}/{ab},{b}/{bb}) -> {ob} {mode:?}")
-        });
+        assert_rounded(
+            q,
+            u128::from(a) * u128::from(b) * mo,
+            ma * mb,
+            mode,
+            &|| format!("modulate({a}/{ab},{b}/{bb}) -> {ob} {mode:?}"),
+        );
         if mode != Rounding::Truncate {
             let f = modulate_f64(from_unorm(a, ab), from_unorm(b, bb)) * mo as f64;
             assert!((f64::from(q) - f).abs() <= 0.5 + 1e-9);
@@ -94,7 +105,9 @@ fn unorm_convert_exhaustive_and_random() {
                 while x < n {
                     let q = unorm_convert(x, from, to, mode);
                     let (mf, mt) = ((1u128 << from) - 1, (1u128 << to) - 1);
-                    assert_rounded(q, u128::from(x) * mt, mf, mode, &|| format!("{x}: {from}->{to}"));
+                    assert_rounded(q, u128::from(x) * mt, mf, mode, &|| {
+                        format!("{x}: {from}->{to}")
+                    });
                     x += step;
                 }
             }
@@ -110,6 +123,12 @@ fn unorm_convert_exhaustive_and_random() {
     for _ in 0..500_000 {
         let x = rng.next() as u32;
         let q = unorm_convert(x, 32, 16, Rounding::HalfEven);
-        assert_rounded(q, u128::from(x) * 65535, (1u128 << 32) - 1, Rounding::HalfEven, &|| format!("{x}"));
+        assert_rounded(
+            q,
+            u128::from(x) * 65535,
+            (1u128 << 32) - 1,
+            Rounding::HalfEven,
+            &|| format!("{x}"),
+        );
     }
 }

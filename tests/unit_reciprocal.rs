@@ -33,7 +33,11 @@ fn bound_ulps(cfg: &ReciprocalConfig) -> f64 {
     for _ in 0..cfg.recip_iterations {
         e = e * e + 4.0 * tp;
     }
-    let h = if cfg.recip_rounding == Rounding::Truncate { 1.0 } else { 0.5 };
+    let h = if cfg.recip_rounding == Rounding::Truncate {
+        1.0
+    } else {
+        0.5
+    };
     2f64.powi(m as i32 + 1) * (e + tp) * 1.001 + h
 }
 
@@ -50,7 +54,11 @@ fn check(unit: &Reciprocal, cfg: &ReciprocalConfig, x: u64, bound: f64, max: &mu
     let mut sat = SatCounter::default();
     let r = unit.eval(x, &mut sat);
     assert_eq!(sat, SatCounter::default());
-    assert_eq!(r.mant >> cfg.recip_mantissa_bits, 1, "mantissa not normalized for x={x}");
+    assert_eq!(
+        r.mant >> cfg.recip_mantissa_bits,
+        1,
+        "mantissa not normalized for x={x}"
+    );
     let e = err_ulps(x, r).abs();
     assert!(e <= bound, "x={x} err {e} ulps > bound {bound} ({cfg:?})");
     if e > *max {
@@ -74,7 +82,16 @@ fn texram16_exhaustive_24_bit() {
 #[test]
 fn lut_iteration_table() {
     let mut rng = SplitMix(0x5eed_0001);
-    let combos = [(8, 0), (8, 1), (6, 2), (12, 1), (8, 2), (16, 0), (4, 3), (10, 1)];
+    let combos = [
+        (8, 0),
+        (8, 1),
+        (6, 2),
+        (12, 1),
+        (8, 2),
+        (16, 0),
+        (4, 3),
+        (10, 1),
+    ];
     for (l, n) in combos {
         let cfg = cfg_with(l, n, 24, Rounding::HalfEven);
         let unit = Reciprocal::new(&cfg);

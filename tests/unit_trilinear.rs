@@ -66,7 +66,11 @@ fn lerp_random_16_bit() {
         let b = rng.below(65536) as u32;
         let w = rng.below((1 << wb) + 1) as u32;
         let got = lerp(a, b, w, wb, mode);
-        assert_eq!(got, exact_lerp(a, b, w, wb, mode), "lerp({a},{b},{w},{wb}) {mode:?}");
+        assert_eq!(
+            got,
+            exact_lerp(a, b, w, wb, mode),
+            "lerp({a},{b},{w},{wb}) {mode:?}"
+        );
         assert!(got >= a.min(b) && got <= a.max(b));
     }
 }
@@ -82,11 +86,19 @@ fn pyramid(rng: &mut SplitMix, texel_bits: u32) -> Pyramid {
     let mut h = 1 + rng.below(40) as u32;
     let levels = 1 + rng.below(5) as usize;
     let max = (1u64 << texel_bits) - 1;
-    let mut p = Pyramid { dims: vec![], fixed: vec![], float: vec![] };
+    let mut p = Pyramid {
+        dims: vec![],
+        fixed: vec![],
+        float: vec![],
+    };
     for _ in 0..levels {
-        let texels: Vec<[u16; 4]> =
-            (0..w * h).map(|_| [0; 4].map(|_: u16| rng.below(max + 1) as u16)).collect();
-        let fl = texels.iter().map(|t| t.map(|c| (f64::from(c) / max as f64) as f32)).collect();
+        let texels: Vec<[u16; 4]> = (0..w * h)
+            .map(|_| [0; 4].map(|_: u16| rng.below(max + 1) as u16))
+            .collect();
+        let fl = texels
+            .iter()
+            .map(|t| t.map(|c| (f64::from(c) / max as f64) as f32))
+            .collect();
         p.dims.push((w, h));
         p.fixed.push(texels);
         p.float.push(fl);
@@ -123,10 +135,18 @@ fn trilinear_vs_f64_within_bound() {
             for _ in 0..40 {
                 let p = pyramid(&mut rng, cfg.texel_bits);
                 let lv: Vec<Level> = (0..p.dims.len())
-                    .map(|i| Level { width: p.dims[i].0, height: p.dims[i].1, texels: &p.fixed[i] })
+                    .map(|i| Level {
+                        width: p.dims[i].0,
+                        height: p.dims[i].1,
+                        texels: &p.fixed[i],
+                    })
                     .collect();
                 let lf: Vec<LevelF> = (0..p.dims.len())
-                    .map(|i| LevelF { width: p.dims[i].0, height: p.dims[i].1, texels: &p.float[i] })
+                    .map(|i| LevelF {
+                        width: p.dims[i].0,
+                        height: p.dims[i].1,
+                        texels: &p.float[i],
+                    })
                     .collect();
                 for k in 0..2_000u32 {
                     let wrap = [MODES[(k % 3) as usize], MODES[(k / 3 % 3) as usize]];
@@ -137,16 +157,23 @@ fn trilinear_vs_f64_within_bound() {
                     let s = 2f64.powi(-(frac as i32));
                     let lod_f = lod as f64 * 2f64.powi(-(lfb as i32));
                     let want = trilinear_f64(&lf, u as f64 * s, v as f64 * s, lod_f, wrap);
-                    let two = lod > 0 && (lod >> lfb) < lv.len() as i64 - 1 && lod & ((1 << lfb) - 1) != 0;
+                    let two = lod > 0
+                        && (lod >> lfb) < lv.len() as i64 - 1
+                        && lod & ((1 << lfb) - 1) != 0;
                     let bound = if two { bound_tri } else { bound_bi } + 0.01;
                     for c in 0..4 {
                         let e = (f64::from(got[c]) - want[c] * max).abs();
-                        assert!(e <= bound, "{name} lfb={lfb}: err {e} > {bound} (u={u} v={v} lod={lod})");
+                        assert!(
+                            e <= bound,
+                            "{name} lfb={lfb}: err {e} > {bound} (u={u} v={v} lod={lod})"
+                        );
                         worst = worst.max(e);
                     }
                 }
             }
-            println!("{name:10} lod_frac_bits={lfb:2}: max |err| {worst:8.3} LSB (bound {bound_tri:.3})");
+            println!(
+                "{name:10} lod_frac_bits={lfb:2}: max |err| {worst:8.3} LSB (bound {bound_tri:.3})"
+            );
         }
     }
 }
@@ -158,8 +185,16 @@ fn bilinear_vs_f64_and_trace() {
     let bound = trilinear_error_bound_q8(&cfg, 16, false) as f64 / 256.0 + 0.01;
     for _ in 0..50 {
         let p = pyramid(&mut rng, 16);
-        let l = Level { width: p.dims[0].0, height: p.dims[0].1, texels: &p.fixed[0] };
-        let f = LevelF { width: p.dims[0].0, height: p.dims[0].1, texels: &p.float[0] };
+        let l = Level {
+            width: p.dims[0].0,
+            height: p.dims[0].1,
+            texels: &p.fixed[0],
+        };
+        let f = LevelF {
+            width: p.dims[0].0,
+            height: p.dims[0].1,
+            texels: &p.float[0],
+        };
         for k in 0..2000u32 {
             let wrap = [MODES[(k % 3) as usize], MODES[(k / 3 % 3) as usize]];
             let u = rng.below(1 << 18) as i64 - (1 << 17);
@@ -177,7 +212,10 @@ fn bilinear_vs_f64_and_trace() {
             assert_eq!(tr.result, a);
             assert_eq!(tr.level[0].result.map(|x| x as u16), a);
             for (i, &(x, y)) in tr.level[0].coords.iter().enumerate() {
-                assert_eq!(tr.level[0].texels[i], p.fixed[0][(y * l.width + x) as usize]);
+                assert_eq!(
+                    tr.level[0].texels[i],
+                    p.fixed[0][(y * l.width + x) as usize]
+                );
             }
         }
     }
@@ -190,12 +228,26 @@ fn lod_rule_and_trace() {
     let t1 = vec![[1000u16, 2000, 3000, 4000]; 4];
     let t2 = vec![[9000u16, 9000, 9000, 9000]; 1];
     let lv = [
-        Level { width: 4, height: 4, texels: &t0 },
-        Level { width: 2, height: 2, texels: &t1 },
-        Level { width: 1, height: 1, texels: &t2 },
+        Level {
+            width: 4,
+            height: 4,
+            texels: &t0,
+        },
+        Level {
+            width: 2,
+            height: 2,
+            texels: &t1,
+        },
+        Level {
+            width: 1,
+            height: 1,
+            texels: &t2,
+        },
     ];
     let w = [WrapMode::Repeat; 2];
-    let run = |lod: i64, tr: Option<&mut TrilinearTrace>| trilinear(&lv, 5000, 7000, 16, lod, 8, w, &cfg, tr);
+    let run = |lod: i64, tr: Option<&mut TrilinearTrace>| {
+        trilinear(&lv, 5000, 7000, 16, lod, 8, w, &cfg, tr)
+    };
     assert_eq!(run(-1000, None), [100, 200, 300, 400]);
     assert_eq!(run(0, None), [100, 200, 300, 400]);
     assert_eq!(run(256, None), [1000, 2000, 3000, 4000]);
@@ -204,9 +256,20 @@ fn lod_rule_and_trace() {
     let mut tr = TrilinearTrace::default();
     // lod = 0.5: halfway between level 0 and 1.
     assert_eq!(run(128, Some(&mut tr)), [550, 1100, 1650, 2200]);
-    assert_eq!((tr.levels_used, tr.level_weight, tr.level[0].level, tr.level[1].level), (2, 128, 0, 1));
+    assert_eq!(
+        (
+            tr.levels_used,
+            tr.level_weight,
+            tr.level[0].level,
+            tr.level[1].level
+        ),
+        (2, 128, 0, 1)
+    );
     assert_eq!(trilinear(&[], 0, 0, 16, 0, 8, w, &cfg, None), [0; 4]);
     assert_eq!(trilinear_cost(&cfg, 2).texels, 8);
     assert_eq!(trilinear_cost(&cfg, 1).texels, 4);
-    assert_eq!(trilinear_cost(&cfg, 2).cycles, 2 * cfg.bilinear_cycles + cfg.level_lerp_cycles);
+    assert_eq!(
+        trilinear_cost(&cfg, 2).cycles,
+        2 * cfg.bilinear_cycles + cfg.level_lerp_cycles
+    );
 }

@@ -43,7 +43,7 @@ fn model(coord: i64, frac: u32, size: u32, mode: WrapMode, wb: u32, rnd: Roundin
     let num = i128::from(coord) * i128::from(size) * 2 - (1i128 << frac);
     let mut i0 = num.div_euclid(den);
     let r = num.rem_euclid(den); // fraction = r / den
-    // weight = round(r * 2^wb / den)
+                                 // weight = round(r * 2^wb / den)
     let wn = r << wb;
     let q = wn / den;
     let rr = wn % den;
@@ -57,7 +57,11 @@ fn model(coord: i64, frac: u32, size: u32, mode: WrapMode, wb: u32, rnd: Roundin
         w = 0;
     }
     let n = i128::from(size);
-    WrapOut { i0: model_index(i0, n, mode), i1: model_index(i0 + 1, n, mode), weight: w as u32 }
+    WrapOut {
+        i0: model_index(i0, n, mode),
+        i1: model_index(i0 + 1, n, mode),
+        weight: w as u32,
+    }
 }
 
 fn tcfg(wb: u32, rnd: Rounding) -> TrilinearConfig {
@@ -78,7 +82,10 @@ fn exhaustive_grid() {
                     for coord in -1200i64..1200 {
                         let got = wrap(coord, 8, size, mode, &c);
                         let want = model(coord, 8, size, mode, wb, rnd);
-                        assert_eq!(got, want, "coord={coord} size={size} {mode:?} wb={wb} {rnd:?}");
+                        assert_eq!(
+                            got, want,
+                            "coord={coord} size={size} {mode:?} wb={wb} {rnd:?}"
+                        );
                         assert!(got.i0 < size && got.i1 < size && got.weight < (1 << wb).max(1));
                         n += 1;
                     }
@@ -102,14 +109,21 @@ fn random_wide() {
         let coord = (rng.next() >> (64 - bits)) as i64 - (1i64 << (bits - 1));
         let c = tcfg(wb, rnd);
         let got = wrap(coord, frac, size, mode, &c);
-        assert_eq!(got, model(coord, frac, size, mode, wb, rnd), "coord={coord} frac={frac} size={size}");
+        assert_eq!(
+            got,
+            model(coord, frac, size, mode, wb, rnd),
+            "coord={coord} frac={frac} size={size}"
+        );
     }
     // Extreme coordinates do not overflow and still wrap exactly.
     let c = tcfg(8, Rounding::HalfEven);
     for coord in [i64::MIN, i64::MAX, i64::MIN + 1, i64::MAX - 1] {
         for mode in MODES {
             for size in [1u32, 3, 256, u32::MAX] {
-                assert_eq!(wrap(coord, 4, size, mode, &c), model(coord, 4, size, mode, 8, Rounding::HalfEven));
+                assert_eq!(
+                    wrap(coord, 4, size, mode, &c),
+                    model(coord, 4, size, mode, 8, Rounding::HalfEven)
+                );
             }
         }
     }
@@ -147,7 +161,10 @@ fn twin_agrees() {
         let t = |i: u32| f64::from((i.wrapping_mul(2_654_435_761)) >> 16) / 65536.0;
         let hw = t(got.i0) + (t(got.i1) - t(got.i0)) * wq;
         let fl = t(a) + (t(b) - t(a)) * w;
-        assert!((hw - fl).abs() <= tol + 1e-12, "coord={coord} size={size} {mode:?}: {hw} vs {fl}");
+        assert!(
+            (hw - fl).abs() <= tol + 1e-12,
+            "coord={coord} size={size} {mode:?}: {hw} vs {fl}"
+        );
         if (a, b) == (got.i0, got.i1) && w < 1.0 - tol {
             assert!((wq - w).abs() <= tol + 1e-12, "w {wq} vs {w}");
         }

@@ -51,7 +51,10 @@ pub fn perspective_bary(
     let s = bl.saturating_sub(62);
     let dn = (d >> s) as u64;
     let r = recip.eval(dn, sat);
-    let r = Recip { mant: r.mant, shift: r.shift + s as i32 };
+    let r = Recip {
+        mant: r.mant,
+        shift: r.shift + s as i32,
+    };
     let mut p = [0i64; 3];
     for i in 1..3 {
         let v = apply(r, q[i], cfg.bary_bits, cfg.interp_rounding);
@@ -100,11 +103,19 @@ pub fn interpolate(
 #[must_use]
 pub fn perspective_bary_cost(cfg: &InterpConfig, recip: &Reciprocal) -> UnitCost {
     let rc = recip.cost();
-    UnitCost { ops: 9 + rc.ops, cycles: cfg.bary_cycles + rc.cycles, texels: 0 }
+    UnitCost {
+        ops: 9 + rc.ops,
+        cycles: cfg.bary_cycles + rc.cycles,
+        texels: 0,
+    }
 }
 
 /// Cost of one scalar attribute: 2 subtracts, 2 multiplies, 2 adds, 1 round.
 #[must_use]
 pub fn interpolate_cost(cfg: &InterpConfig) -> UnitCost {
-    UnitCost { ops: 7, cycles: cfg.attr_cycles, texels: 0 }
+    UnitCost {
+        ops: 7,
+        cycles: cfg.attr_cycles,
+        texels: 0,
+    }
 }

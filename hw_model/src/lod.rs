@@ -53,7 +53,7 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
         return floor_val;
     }
     let e = 127 - l.leading_zeros(); // bit index of the MSB
-    // Normalized mantissa with MANT_BITS fraction bits (truncated).
+                                     // Normalized mantissa with MANT_BITS fraction bits (truncated).
     let mut m: u64 = if e >= MANT_BITS {
         (l >> (e - MANT_BITS)) as u64
     } else {

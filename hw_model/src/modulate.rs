@@ -33,11 +33,22 @@ fn unorm_max(bits: u32) -> u64 {
 /// clamped to it.
 #[inline]
 #[must_use]
-pub fn modulate(a: u32, a_bits: u32, b: u32, b_bits: u32, out_bits: u32, rounding: Rounding) -> u32 {
+pub fn modulate(
+    a: u32,
+    a_bits: u32,
+    b: u32,
+    b_bits: u32,
+    out_bits: u32,
+    rounding: Rounding,
+) -> u32 {
     if a_bits == 0 || b_bits == 0 || out_bits == 0 {
         return 0;
     }
-    let (ma, mb, mo) = (unorm_max(a_bits.min(16)), unorm_max(b_bits.min(16)), unorm_max(out_bits.min(16)));
+    let (ma, mb, mo) = (
+        unorm_max(a_bits.min(16)),
+        unorm_max(b_bits.min(16)),
+        unorm_max(out_bits.min(16)),
+    );
     let num = u64::from(a).min(ma) * u64::from(b).min(mb) * mo;
     div_round(num, ma * mb, rounding) as u32
 }
@@ -61,5 +72,9 @@ pub fn unorm_convert(x: u32, from_bits: u32, to_bits: u32, rounding: Rounding) -
 /// divide-by-constant (multiply + shift).
 #[must_use]
 pub fn modulate_cost(cfg: &ColorConfig) -> UnitCost {
-    UnitCost { ops: 4 * 3, cycles: cfg.modulate_cycles, texels: 0 }
+    UnitCost {
+        ops: 4 * 3,
+        cycles: cfg.modulate_cycles,
+        texels: 0,
+    }
 }

@@ -85,7 +85,10 @@ impl Reciprocal {
         let m_bits = self.cfg.recip_mantissa_bits;
         if x == 0 {
             sat.saturated += 1;
-            return Recip { mant: (1u64 << (m_bits + 1)) - 1, shift: 0 };
+            return Recip {
+                mant: (1u64 << (m_bits + 1)) - 1,
+                shift: 0,
+            };
         }
         let p = self.p;
         let rnd = self.cfg.recip_rounding;

@@ -108,7 +108,12 @@ pub fn bilinear(
         out[c] = lerp(top, bot, wy.weight, wb, r);
     }
     if let Some(t) = trace {
-        t.coords = [(wx.i0, wy.i0), (wx.i1, wy.i0), (wx.i0, wy.i1), (wx.i1, wy.i1)];
+        t.coords = [
+            (wx.i0, wy.i0),
+            (wx.i1, wy.i0),
+            (wx.i0, wy.i1),
+            (wx.i1, wy.i1),
+        ];
         t.texels = [t00, t10, t01, t11];
         t.weights = [wx.weight, wy.weight];
         t.result = out;
@@ -145,8 +150,19 @@ pub fn trilinear(
     } else {
         ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
     };
-    let mut bt0 = BilinearTrace { level: l0 as u32, ..BilinearTrace::default() };
-    let c0 = bilinear(&levels[l0], u, v, frac, wrap_mode, cfg, trace.as_ref().map(|_| &mut bt0));
+    let mut bt0 = BilinearTrace {
+        level: l0 as u32,
+        ..BilinearTrace::default()
+    };
+    let c0 = bilinear(
+        &levels[l0],
+        u,
+        v,
+        frac,
+        wrap_mode,
+        cfg,
+        trace.as_ref().map(|_| &mut bt0),
+    );
     let mut out = [0u16; 4];
     if lw == 0 {
         for c in 0..4 {
@@ -162,13 +178,29 @@ pub fn trilinear(
         }
         return out;
     }
-    let mut bt1 = BilinearTrace { level: l0 as u32 + 1, ..BilinearTrace::default() };
-    let c1 = bilinear(&levels[l0 + 1], u, v, frac, wrap_mode, cfg, trace.as_ref().map(|_| &mut bt1));
+    let mut bt1 = BilinearTrace {
+        level: l0 as u32 + 1,
+        ..BilinearTrace::default()
+    };
+    let c1 = bilinear(
+        &levels[l0 + 1],
+        u,
+        v,
+        frac,
+        wrap_mode,
+        cfg,
+        trace.as_ref().map(|_| &mut bt1),
+    );
     for c in 0..4 {
         out[c] = lerp(c0[c], c1[c], lw, lf, cfg.filter_rounding) as u16;
     }
     if let Some(t) = trace {
-        *t = TrilinearTrace { levels_used: 2, level: [bt0, bt1], level_weight: lw, result: out };
+        *t = TrilinearTrace {
+            levels_used: 2,
+            level: [bt0, bt1],
+            level_weight: lw,
+            result: out,
+        };
     }
     out
 }
@@ -177,9 +209,17 @@ pub fn trilinear(
 /// 4 fetches and 3 lerps per channel; plus the level blend (4 lerps) when two levels are used.
 #[must_use]
 pub fn trilinear_cost(cfg: &TrilinearConfig, levels_used: u32) -> UnitCost {
-    let per_level = UnitCost { ops: 2 * 5 + 12, cycles: cfg.bilinear_cycles, texels: 4 };
+    let per_level = UnitCost {
+        ops: 2 * 5 + 12,
+        cycles: cfg.bilinear_cycles,
+        texels: 4,
+    };
     let blend = if levels_used > 1 {
-        UnitCost { ops: 4, cycles: cfg.level_lerp_cycles, texels: 0 }
+        UnitCost {
+            ops: 4,
+            cycles: cfg.level_lerp_cycles,
+            texels: 0,
+        }
     } else {
         UnitCost::default()
     };

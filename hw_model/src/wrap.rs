@@ -104,5 +104,9 @@ pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
 /// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps.
 #[must_use]
 pub fn wrap_cost() -> crate::cost::UnitCost {
-    crate::cost::UnitCost { ops: 5, cycles: 0, texels: 0 }
+    crate::cost::UnitCost {
+        ops: 5,
+        cycles: 0,
+        texels: 0,
+    }
 }
