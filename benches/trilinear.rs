@@ -1,5 +1,6 @@
 //! Per-sample cost of the bit-accurate trilinear filter vs its f64 twin (256x256 RGBA pyramid,
-//! 1024 pseudo-random samples per iteration, both level blend and single-level cases).
+//! 1024 samples per iteration: pseudo-random (cache-missing) and a coherent scanline walk at
+//! LOD 1.5).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use hw_model::config::HwConfig;
@@ -68,6 +69,10 @@ fn bench(c: &mut Criterion) {
             )
         })
         .collect();
+    // Coherent: a scanline-like walk (neighbouring samples share texels), as in rasterization.
+    let coherent: Vec<(i64, i64, i64)> = (0..N as i64)
+        .map(|i| (i * 97 + 12345, (i / 32) * 101 + 777, 3 << 15))
+        .collect();
     let cfg = HwConfig::texram16();
     let wrap = [WrapMode::Repeat, WrapMode::Mirror];
     let mut g = c.benchmark_group("trilinear_per_sample");
@@ -86,6 +91,27 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let mut acc = 0.0;
             for &(u, v, l) in &samples {
+                let s = 1.0 / 65536.0;
+                let r = trilinear_f64(&lf, u as f64 * s, v as f64 * s, l as f64 * s, wrap);
+                acc += r[0];
+            }
+            black_box(acc)
+        })
+    });
+    g.bench_function("fixed_texram16_coherent", |b| {
+        b.iter(|| {
+            let mut acc = 0u32;
+            for &(u, v, l) in &coherent {
+                let r = trilinear(&lv, u, v, 16, l, 16, wrap, &cfg.trilinear, None);
+                acc = acc.wrapping_add(u32::from(r[0]));
+            }
+            black_box(acc)
+        })
+    });
+    g.bench_function("float_f64_coherent", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &(u, v, l) in &coherent {
                 let s = 1.0 / 65536.0;
                 let r = trilinear_f64(&lf, u as f64 * s, v as f64 * s, l as f64 * s, wrap);
                 acc += r[0];

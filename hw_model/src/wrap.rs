@@ -28,7 +28,8 @@ pub struct WrapOut {
 /// Texel address of one axis (texel centres at half-integers, see `trilinear`).
 ///
 /// `coord` is a normalized coordinate with `frac` fraction bits (1.0 = the full texture).
-/// `s = coord * size - 1/2` is formed exactly (`frac + 1` fraction bits, `i128`);
+/// `s = coord * size - 1/2` is formed exactly (`frac + 1` fraction bits; `i64`, or `i128` for
+/// |coord| >= 2^29; `frac` is clamped to 62);
 /// `i0 = floor(s)`, and the fraction of `s` is reduced to `weight_bits` by `weight_rounding`
 /// (exact when `frac + 1 <= weight_bits`). If rounding carries to `2^weight_bits`, then
 /// `i0 += 1` and `weight = 0` (the same filtered value), so `weight < 2^weight_bits` always;
@@ -48,13 +49,32 @@ pub fn wrap(
     cfg: &crate::config::TrilinearConfig,
 ) -> WrapOut {
     let size = size.max(1);
+    let wb = cfg.weight_bits.min(16);
+    let rnd = cfg.weight_rounding;
+    if frac <= 30 && coord.unsigned_abs() < (1u64 << 29) {
+        // Fast path: |s| < 2^63, all in i64.
+        let sf = frac + 1;
+        let s = 2 * coord * i64::from(size) - (1i64 << frac);
+        let i0 = s >> sf;
+        let fr = s - (i0 << sf);
+        let w = if sf >= wb {
+            crate::fixed::round_shift_right(fr, sf - wb, rnd)
+        } else {
+            fr << (wb - sf)
+        };
+        return if w >> wb != 0 {
+            finish(i0 + 1, 0, size, mode)
+        } else {
+            finish(i0, w as u32, size, mode)
+        };
+    }
+    let frac = frac.min(62);
     let sf = frac + 1;
     let s = 2 * i128::from(coord) * i128::from(size) - (1i128 << frac);
     let mut i0 = s >> sf;
     let fr = s - (i0 << sf); // in [0, 2^sf)
-    let wb = cfg.weight_bits.min(16);
     let mut w = if sf >= wb {
-        crate::fixed::round_shift_right_wide(fr, sf - wb, cfg.weight_rounding)
+        crate::fixed::round_shift_right_wide(fr, sf - wb, rnd)
     } else {
         (fr << (wb - sf)) as i64
     };
@@ -76,13 +96,17 @@ pub fn wrap(
             _ => i0.rem_euclid(2 * i128::from(size)) as i64,
         },
     };
+    finish(i0, w as u32, size, mode)
+}
+
+#[inline]
+fn finish(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
     WrapOut {
         i0: wrap_index(i0, size, mode),
         i1: wrap_index(i0.saturating_add(1), size, mode),
-        weight: w as u32,
+        weight,
     }
 }
-
 /// Wraps a texel index into `[0, size-1]` by `mode` (`size >= 1`).
 #[inline]
 #[must_use]
