@@ -1,1 +1,66 @@
-//! placeholder
+//! Float <-> fixed-point conversion (host side; `hw_model` itself is integer-only).
+//!
+//! A raw value `r` with `f` fraction bits means `r * 2^-f`; an `n`-bit unorm value `x` means
+//! `x / (2^n - 1)`.
+
+use hw_model::fixed::{Format, Rounding, SatCounter};
+
+/// `x` into `fmt`: scaled by `2^frac_bits` (exact), rounded by `fmt.rounding`, then fitted by
+/// `fmt.overflow` (each out-of-range value counted). NaN gives 0 and counts a saturation;
+/// +-infinity and values beyond `i64` saturate (counted) whatever the overflow rule.
+#[must_use]
+pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
+    if x.is_nan() {
+        sat.saturated += 1;
+        return 0;
+    }
+    let y = x * 2f64.powi(fmt.frac_bits as i32);
+    let fl = y.floor();
+    let rem = y - fl;
+    let r = match fmt.rounding {
+        Rounding::Truncate => fl,
+        Rounding::HalfUp => fl + if rem >= 0.5 { 1.0 } else { 0.0 },
+        Rounding::HalfEven => {
+            let odd = (fl * 0.5).floor() != fl * 0.5;
+            fl + if rem > 0.5 || (rem == 0.5 && odd) {
+                1.0
+            } else {
+                0.0
+            }
+        }
+    };
+    // 2^63 is exactly representable; anything at or beyond it does not fit i64.
+    const LIM: f64 = 9_223_372_036_854_775_808.0;
+    if r >= LIM {
+        sat.saturated += 1;
+        return fmt.max_raw();
+    }
+    if r < -LIM {
+        sat.saturated += 1;
+        return fmt.min_raw();
+    }
+    fmt.fit(r as i64, sat)
+}
+
+/// `raw * 2^-frac_bits` (exact for |raw| <= 2^53).
+#[must_use]
+pub fn from_raw(raw: i64, frac_bits: u32) -> f64 {
+    raw as f64 * 2f64.powi(-(frac_bits as i32))
+}
+
+/// `x` (clamped to [0, 1]; NaN gives 0) as a `bits`-wide unorm, rounded half to even.
+#[must_use]
+pub fn to_unorm(x: f64, bits: u32) -> u32 {
+    let max = ((1u64 << bits.min(32)) - 1) as f64;
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    (x * max).round_ties_even() as u32
+}
+
+/// A `bits`-wide unorm raw value as a float in [0, 1] (0 for `bits == 0`).
+#[must_use]
+pub fn from_unorm(x: u32, bits: u32) -> f64 {
+    if bits == 0 {
+        return 0.0;
+    }
+    f64::from(x) / ((1u64 << bits.min(32)) - 1) as f64
+}

@@ -15,6 +15,7 @@ pub mod maps;
 pub mod pipeline;
 pub mod probe;
 pub mod raster;
+pub mod reference;
 pub mod render;
 pub mod report;
 pub mod scene;

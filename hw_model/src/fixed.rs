@@ -149,16 +149,21 @@ impl Format {
 }
 
 /// The one rounding routine: `x / 2^shift`, rounded by `mode`. Exact for every `i64` input
-/// (no intermediate overflow); `shift` may be up to 63.
+/// and every `shift` (no intermediate overflow); a shift of 64 or more yields 0 or -1 before
+/// rounding, exactly as the infinite-precision quotient does.
 #[inline]
 #[must_use]
 pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     if shift == 0 {
         return x;
     }
+    if shift >= 64 {
+        return round_shift_right_wide(i128::from(x), shift, mode);
+    }
     let floor = x >> shift;
-    let rem = x & ((1i64 << shift) - 1);
-    let half = 1i64 << (shift - 1);
+    // Remainder and half as unsigned so that shift = 63 does not overflow.
+    let rem = (x as u64) & ((1u64 << shift) - 1);
+    let half = 1u64 << (shift - 1);
     match mode {
         Rounding::Truncate => floor,
         Rounding::HalfUp => floor + i64::from(rem >= half),
@@ -166,16 +171,24 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     }
 }
 
-/// `round_shift_right` for `i128` accumulators, result saturated to `i64`.
+/// `round_shift_right` for `i128` accumulators, result saturated to `i64`. Exact for every
+/// `i128` input and every `shift` (shifts of 128 or more behave as the exact quotient).
 #[inline]
 #[must_use]
 pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
     let v = if shift == 0 {
         x
+    } else if shift >= 128 {
+        // |x| / 2^shift <= 1/2: the floor is 0 or -1 and rounding to nearest always gives 0
+        // (the one exact tie, i128::MIN at shift 128, rounds up by HalfUp and to even 0).
+        match mode {
+            Rounding::Truncate => -i128::from(x < 0),
+            Rounding::HalfUp | Rounding::HalfEven => 0,
+        }
     } else {
         let floor = x >> shift;
-        let rem = x & ((1i128 << shift) - 1);
-        let half = 1i128 << (shift - 1);
+        let rem = (x as u128) & ((1u128 << shift) - 1);
+        let half = 1u128 << (shift - 1);
         match mode {
             Rounding::Truncate => floor,
             Rounding::HalfUp => floor + i128::from(rem >= half),

@@ -1,1 +1,80 @@
-//! placeholder: implemented by the hw_model work.
+//! Modulate unit (GL_MODULATE, colour x texel) and unsigned-normalized width conversion.
+//!
+//! A `n`-bit unorm raw value `x` means `x / (2^n - 1)`. Both functions compute the exact
+//! rational result with ONE integer division and round it by the given mode; a hardware
+//! divide-by-constant (multiply by a precomputed reciprocal of `2^n - 1` with enough bits, or
+//! the `(x + (x >> n) + 1) >> n` identity at equal widths) produces the same integer, so the
+//! ERROR BOUND is the rounding alone: <= 1/2 LSB of the output (< 1 LSB for Truncate).
+
+use crate::config::ColorConfig;
+use crate::cost::UnitCost;
+use crate::fixed::Rounding;
+
+/// `num / den` rounded by `mode` (`den > 0`).
+#[inline]
+#[must_use]
+fn div_round(num: u64, den: u64, mode: Rounding) -> u64 {
+    let q = num / den;
+    let r = num - q * den;
+    match mode {
+        Rounding::Truncate => q,
+        Rounding::HalfUp => q + u64::from(2 * r >= den),
+        Rounding::HalfEven => q + u64::from(2 * r > den || (2 * r == den && q & 1 == 1)),
+    }
+}
+
+#[inline]
+fn unorm_max(bits: u32) -> u64 {
+    (1u64 << bits.min(32)) - 1
+}
+
+/// Unorm product `round(a b (2^o - 1) / ((2^a_bits - 1)(2^b_bits - 1)))`; widths 1..=16
+/// (a zero width gives 0; wider widths are clamped to 16). Inputs above their maximum are
+/// clamped to it.
+#[inline]
+#[must_use]
+pub fn modulate(
+    a: u32,
+    a_bits: u32,
+    b: u32,
+    b_bits: u32,
+    out_bits: u32,
+    rounding: Rounding,
+) -> u32 {
+    if a_bits == 0 || b_bits == 0 || out_bits == 0 {
+        return 0;
+    }
+    let (ma, mb, mo) = (
+        unorm_max(a_bits.min(16)),
+        unorm_max(b_bits.min(16)),
+        unorm_max(out_bits.min(16)),
+    );
+    let num = u64::from(a).min(ma) * u64::from(b).min(mb) * mo;
+    div_round(num, ma * mb, rounding) as u32
+}
+
+/// Unorm width conversion `round(x (2^to - 1) / (2^from - 1))`; widths 1..=32 (a zero width
+/// gives 0). `x` above its maximum is clamped to it.
+#[inline]
+#[must_use]
+pub fn unorm_convert(x: u32, from_bits: u32, to_bits: u32, rounding: Rounding) -> u32 {
+    if from_bits == 0 || to_bits == 0 {
+        return 0;
+    }
+    let (mf, mt) = (unorm_max(from_bits), unorm_max(to_bits));
+    if mf == mt {
+        return u64::from(x).min(mf) as u32;
+    }
+    div_round(u64::from(x).min(mf) * mt, mf, rounding) as u32
+}
+
+/// Cost of one modulate (4 channels in parallel): per channel a multiply and a
+/// divide-by-constant (multiply + shift).
+#[must_use]
+pub fn modulate_cost(cfg: &ColorConfig) -> UnitCost {
+    UnitCost {
+        ops: 4 * 3,
+        cycles: cfg.modulate_cycles,
+        texels: 0,
+    }
+}

@@ -1,1 +1,164 @@
-//! placeholder: implemented by the hw_model work.
+//! Reciprocal unit: LUT seed plus Newton-Raphson refinement `y' = y (2 - m y)` (the classic
+//! scheme of e.g. Flynn 1970 / Oberman & Flynn 1997), as used for 1/w and 1/area.
+//!
+//! Datapath (M = `recip_mantissa_bits`, L = `recip_lut_bits`, N = `recip_iterations`,
+//! G = [`GUARD_BITS`], P = M + G working fraction bits):
+//! 1. Normalize: `x = m * 2^n`, `m` in [1, 2), by a leading-zero count. `m` is rounded to P
+//!    fraction bits by `recip_rounding` (exact when `x` has at most P + 1 significant bits);
+//!    a carry to 2.0 renormalizes.
+//! 2. Seed: the top L fraction bits of `m` index a table whose entry i is
+//!    `2^(L+1) / (2^(L+1) + 2i + 1)` (the reciprocal of the interval midpoint, which minimizes
+//!    `max |1 - m y|` over the interval) rounded to P fraction bits, computed in integers at
+//!    [`Reciprocal::new`].
+//! 3. N steps `t = m*y`, `d = 2 - t`, `y = y*d`, each product rounded to P fraction bits by
+//!    `recip_rounding`.
+//! 4. `y` is rounded to M + 1 significant bits by `recip_rounding` into [`Recip`].
+//!
+//! ERROR BOUND (relative, `e` = |1/x - result| * x): let `e_0 = 2^-(L+1) + 2^-P` and
+//! `e_{k+1} = e_k^2 + 4 * 2^-P`; then `e <= e_N + 2^-M` (in result ulps, where one ulp is
+//! `2^-shift`: at most `2^(M+1) e_N + 1`, or `+ 0.5` for the round-to-nearest modes). The seed
+//! error halves per LUT bit and squares per iteration, so texram16 (L=8, N=1, M=24) is limited by
+//! the seed (~2^-19) and two iterations reach the rounding floor. Measured figures are in
+//! `tests/unit_reciprocal.rs`.
+
+use crate::config::ReciprocalConfig;
+use crate::cost::UnitCost;
+use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
+
+/// Guard bits carried by the working precision beyond `recip_mantissa_bits`.
+pub const GUARD_BITS: u32 = 3;
+
+/// A reciprocal `mant * 2^-shift`; `mant` has exactly `recip_mantissa_bits + 1` bits (top bit set).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Recip {
+    /// Normalized mantissa in `[2^M, 2^(M+1))`.
+    pub mant: u64,
+    /// Binary exponent: the value is `mant * 2^-shift`.
+    pub shift: i32,
+}
+
+/// The reciprocal unit: its config and the seed table built from it.
+#[derive(Clone, Debug)]
+pub struct Reciprocal {
+    cfg: ReciprocalConfig,
+    /// Seed entries with P fraction bits, values in (1/2, 1).
+    lut: Vec<u64>,
+    /// Working fraction bits P.
+    p: u32,
+}
+
+impl Reciprocal {
+    /// Builds the unit and its seed table (integer arithmetic only). Widths outside the ranges
+    /// of `HwConfig::validate` are clamped to them.
+    #[must_use]
+    pub fn new(cfg: &ReciprocalConfig) -> Self {
+        let mut cfg = cfg.clone();
+        cfg.recip_lut_bits = cfg.recip_lut_bits.clamp(1, 16);
+        cfg.recip_iterations = cfg.recip_iterations.min(4);
+        cfg.recip_mantissa_bits = cfg.recip_mantissa_bits.clamp(8, 30);
+        let l = cfg.recip_lut_bits;
+        let p = cfg.recip_mantissa_bits + GUARD_BITS;
+        let lut = (0..(1u64 << l))
+            .map(|i| {
+                // 2^P * 2^(L+1) / (2^(L+1) + 2i + 1), rounded to nearest (ties cannot occur:
+                // the denominator is odd).
+                let num = 1u128 << (p + l + 1);
+                let den = u128::from((1u64 << (l + 1)) + 2 * i + 1);
+                ((2 * num + den) / (2 * den)) as u64
+            })
+            .collect();
+        Self { cfg, lut, p }
+    }
+
+    /// The (range-clamped) config the unit was built from.
+    #[must_use]
+    pub fn config(&self) -> &ReciprocalConfig {
+        &self.cfg
+    }
+
+    /// `1/x` for an integer mantissa `x` (the caller tracks its binary point). `x == 0`
+    /// returns the largest value `(2^(M+1) - 1) * 2^0` (at least 1/x for every x >= 1) and
+    /// counts a saturation.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, x: u64, sat: &mut SatCounter) -> Recip {
+        let m_bits = self.cfg.recip_mantissa_bits;
+        if x == 0 {
+            sat.saturated += 1;
+            return Recip {
+                mant: (1u64 << (m_bits + 1)) - 1,
+                shift: 0,
+            };
+        }
+        let p = self.p;
+        let rnd = self.cfg.recip_rounding;
+        let mut n = 63 - x.leading_zeros();
+        // m with P fraction bits, in [2^P, 2^(P+1)).
+        let mut m: i64 = if n <= p {
+            (x << (p - n)) as i64
+        } else {
+            round_shift_right_wide(i128::from(x), n - p, rnd)
+        };
+        if m >> (p + 1) != 0 {
+            m >>= 1;
+            n += 1;
+        }
+        let l = self.cfg.recip_lut_bits;
+        // Top L fraction bits of m (m has only P; a wider index sees zeros below them).
+        let top = if l <= p { m >> (p - l) } else { m << (l - p) };
+        let idx = (top & ((1i64 << l) - 1)) as usize;
+        let mut y = self.lut[idx] as i64;
+        let two = 2i64 << p;
+        for _ in 0..self.cfg.recip_iterations {
+            let t = round_shift_right_wide(i128::from(m) * i128::from(y), p, rnd);
+            let d = two - t;
+            y = round_shift_right_wide(i128::from(y) * i128::from(d), p, rnd);
+        }
+        // Normalize y (positive, about 2^P / m) to M + 1 significant bits.
+        let b = 64 - (y as u64).leading_zeros();
+        let drop = b - (m_bits + 1);
+        let mut mant = crate::fixed::round_shift_right(y, drop, rnd) as u64;
+        let mut shift = (p + n) as i32 - drop as i32;
+        if mant >> (m_bits + 1) != 0 {
+            mant >>= 1;
+            shift -= 1;
+        }
+        Recip { mant, shift }
+    }
+
+    /// Cost of one evaluation: normalize, LUT, 3 ops per iteration, final round.
+    #[must_use]
+    pub fn cost(&self) -> UnitCost {
+        UnitCost {
+            ops: 3 + 3 * self.cfg.recip_iterations,
+            cycles: self.cfg.recip_lut_cycles
+                + self.cfg.recip_iterations * self.cfg.recip_iteration_cycles,
+            texels: 0,
+        }
+    }
+}
+
+/// `x * r` reduced to `frac_bits` fraction bits with ONE rounding by `mode` (x is an integer,
+/// the product is exact in `i128` for |x| < 2^96); results beyond `i64` saturate.
+#[inline]
+#[must_use]
+pub fn apply(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
+    let prod = x.saturating_mul(i128::from(r.mant));
+    let sh = r.shift - frac_bits as i32;
+    if sh >= 0 {
+        round_shift_right_wide(prod, sh as u32, mode)
+    } else {
+        let up = (-sh) as u32;
+        if up >= 64 {
+            if prod == 0 {
+                0
+            } else if prod > 0 {
+                i64::MAX
+            } else {
+                i64::MIN
+            }
+        } else {
+            round_shift_right_wide(prod.saturating_mul(1i128 << up), 0, mode)
+        }
+    }
+}

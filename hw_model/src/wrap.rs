@@ -13,3 +13,124 @@ pub enum WrapMode {
     /// Coordinates reflect every period (GL_MIRRORED_REPEAT).
     Mirror,
 }
+
+/// Output of the address unit for one axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct WrapOut {
+    /// Wrapped index of the first texel, in `[0, size-1]`.
+    pub i0: u32,
+    /// Wrapped index of the second texel (`i0 + 1` before wrapping), in `[0, size-1]`.
+    pub i1: u32,
+    /// Weight of `i1` with `weight_bits` fraction bits, in `[0, 2^weight_bits - 1]`.
+    pub weight: u32,
+}
+
+/// Texel address of one axis (texel centres at half-integers, see `trilinear`).
+///
+/// `coord` is a normalized coordinate with `frac` fraction bits (1.0 = the full texture).
+/// `s = coord * size - 1/2` is formed exactly (`frac + 1` fraction bits; `i64`, or `i128` for
+/// |coord| >= 2^29; `frac` is clamped to 62);
+/// `i0 = floor(s)`, and the fraction of `s` is reduced to `weight_bits` by `weight_rounding`
+/// (exact when `frac + 1 <= weight_bits`). If rounding carries to `2^weight_bits`, then
+/// `i0 += 1` and `weight = 0` (the same filtered value), so `weight < 2^weight_bits` always;
+/// with `weight_bits = 0` the weight is always 0 (HalfUp/HalfEven then select the nearest texel
+/// `round(s)`, Truncate selects `floor(s)`). `i1 = i0 + 1`; both are then wrapped by `mode`:
+/// Repeat = Euclidean `mod size`; ClampToEdge = clamp to `[0, size-1]`; Mirror =
+/// GL_MIRRORED_REPEAT on indices (`m = i mod 2 size; if m >= size { 2 size - 1 - m }`).
+/// `size == 0` is treated as 1. Error of `weight` vs the exact fraction: < 2^-weight_bits for
+/// Truncate, <= 2^-(weight_bits+1) for the nearest modes (modulo the carry, which moves both).
+#[inline]
+#[must_use]
+pub fn wrap(
+    coord: i64,
+    frac: u32,
+    size: u32,
+    mode: WrapMode,
+    cfg: &crate::config::TrilinearConfig,
+) -> WrapOut {
+    let size = size.max(1);
+    let wb = cfg.weight_bits.min(16);
+    let rnd = cfg.weight_rounding;
+    if frac <= 30 && coord.unsigned_abs() < (1u64 << 29) {
+        // Fast path: |s| < 2^63, all in i64.
+        let sf = frac + 1;
+        let s = 2 * coord * i64::from(size) - (1i64 << frac);
+        let i0 = s >> sf;
+        let fr = s - (i0 << sf);
+        let w = if sf >= wb {
+            crate::fixed::round_shift_right(fr, sf - wb, rnd)
+        } else {
+            fr << (wb - sf)
+        };
+        return if w >> wb != 0 {
+            finish(i0 + 1, 0, size, mode)
+        } else {
+            finish(i0, w as u32, size, mode)
+        };
+    }
+    let frac = frac.min(62);
+    let sf = frac + 1;
+    let s = 2 * i128::from(coord) * i128::from(size) - (1i128 << frac);
+    let mut i0 = s >> sf;
+    let fr = s - (i0 << sf); // in [0, 2^sf)
+    let mut w = if sf >= wb {
+        crate::fixed::round_shift_right_wide(fr, sf - wb, rnd)
+    } else {
+        (fr << (wb - sf)) as i64
+    };
+    if w >> wb != 0 {
+        i0 += 1;
+        w = 0;
+    }
+    // Bring huge indices into i64 without changing the wrapped result.
+    let i0 = match i64::try_from(i0) {
+        Ok(v) => v,
+        Err(_) => match mode {
+            WrapMode::ClampToEdge => {
+                if i0 < 0 {
+                    i64::MIN
+                } else {
+                    i64::MAX - 1
+                }
+            }
+            _ => i0.rem_euclid(2 * i128::from(size)) as i64,
+        },
+    };
+    finish(i0, w as u32, size, mode)
+}
+
+#[inline]
+fn finish(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
+    WrapOut {
+        i0: wrap_index(i0, size, mode),
+        i1: wrap_index(i0.saturating_add(1), size, mode),
+        weight,
+    }
+}
+/// Wraps a texel index into `[0, size-1]` by `mode` (`size >= 1`).
+#[inline]
+#[must_use]
+pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
+    let n = i64::from(size.max(1));
+    if i >= 0 && i < n {
+        return i as u32;
+    }
+    match mode {
+        WrapMode::Repeat => i.rem_euclid(n) as u32,
+        WrapMode::ClampToEdge => i.clamp(0, n - 1) as u32,
+        WrapMode::Mirror => {
+            let m = i.rem_euclid(2 * n);
+            (if m >= n { 2 * n - 1 - m } else { m }) as u32
+        }
+    }
+}
+
+/// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps.
+#[must_use]
+pub fn wrap_cost() -> crate::cost::UnitCost {
+    crate::cost::UnitCost {
+        ops: 5,
+        cycles: 0,
+        texels: 0,
+    }
+}

@@ -1,0 +1,143 @@
+//! LOD unit vs log2 in f64: exhaustive over all (du/dx, dv/dx) in 0..4096^2 (2^24 cases),
+//! seeded random otherwise; exact on powers of two and Pythagorean lengths.
+
+use hw_model::config::{HwConfig, LodConfig};
+use hw_model::fixed::SatCounter;
+use hw_model::lod::{lod, lod_zero};
+use texsim::reference::lod_f64;
+
+struct SplitMix(u64);
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+}
+
+fn cfg(f: u32) -> LodConfig {
+    let mut c = HwConfig::texram16().lod;
+    c.lod_frac_bits = f;
+    c
+}
+
+/// Checks `got` against `x = lambda * 2^F` (f64): equal to floor(x), or 1 below it only when
+/// x is within `near` of an integer from above (or f64 put x just below an integer).
+/// Returns whether it was the 1-below case.
+/// Largest distance above an integer at which a 1-LSB-low result is accepted (in LSBs).
+const NEAR: f64 = 1e-3;
+thread_local! { static MAXD: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) }; }
+
+fn check(got: i64, x: f64, ctx: &str) -> bool {
+    let fl = x.floor();
+    let g = got as f64;
+    if g == fl {
+        return false;
+    }
+    if g == fl + 1.0 && fl + 1.0 - x < 1e-9 {
+        return false;
+    }
+    assert!(
+        g == fl - 1.0 && x - fl < NEAR,
+        "{ctx}: got {got}, exact {x}"
+    );
+    MAXD.with(|m| m.set(m.get().max(x - fl)));
+    true
+}
+
+#[test]
+fn exhaustive_12_bit_pairs() {
+    let c = cfg(16);
+    let scale = 65536.0;
+    let mut low = 0u32;
+    for a in 0i64..4096 {
+        for b in 0i64..4096 {
+            let mut sat = SatCounter::default();
+            let got = lod([a, b, 0, 0], 0, &c, &mut sat);
+            if a == 0 && b == 0 {
+                assert_eq!(got, lod_zero(16));
+                continue;
+            }
+            let x = lod_f64([a as f64, b as f64, 0.0, 0.0]) * scale;
+            if check(got, x, &format!("({a},{b})")) {
+                low += 1;
+            }
+        }
+    }
+    let d = MAXD.with(|m| m.get());
+    println!("exhaustive 2^24, F=16: {low} results 1 LSB below floor, all within {d:.2e} LSB above an integer");
+    assert!(low < 1000);
+}
+
+#[test]
+fn random_all_widths() {
+    let mut rng = SplitMix(0x10d_0001);
+    let mut low = 0u32;
+    for k in 0..1_500_000u32 {
+        let f = k % 17;
+        let c = cfg(f);
+        let frac = [0, 4, 8, 16, 24][(k / 17 % 5) as usize];
+        let bits = 1 + (rng.next() % 40) as u32;
+        let mut d = [0i64; 4];
+        for x in &mut d {
+            *x = (rng.next() >> (64 - bits)) as i64 - (1i64 << (bits - 1));
+        }
+        let mut sat = SatCounter::default();
+        let got = lod(d, frac, &c, &mut sat);
+        let s = 2f64.powi(-(frac as i32));
+        let lam = lod_f64([
+            d[0] as f64 * s,
+            d[1] as f64 * s,
+            d[2] as f64 * s,
+            d[3] as f64 * s,
+        ]);
+        if lam <= -32.0 {
+            assert_eq!(got, lod_zero(f));
+            continue;
+        }
+        if check(
+            got,
+            lam * 2f64.powi(f as i32),
+            &format!("{d:?} frac={frac} F={f}"),
+        ) {
+            low += 1;
+        }
+        assert_eq!(sat, SatCounter::default());
+    }
+    println!("random 1.5M: {low} results 1 LSB below floor");
+}
+
+#[test]
+fn exact_cases() {
+    let mut sat = SatCounter::default();
+    for f in [0, 4, 8, 16] {
+        let c = cfg(f);
+        for k in 0..40i64 {
+            for frac in [0u32, 8, 16] {
+                let v = 1i64 << k;
+                let want = (k - i64::from(frac)) << f;
+                assert_eq!(lod([v, 0, 0, 0], frac, &c, &mut sat), want.max(lod_zero(f)));
+                assert_eq!(
+                    lod([0, -v, v / 2, 0], frac, &c, &mut sat),
+                    want.max(lod_zero(f))
+                );
+                assert_eq!(
+                    lod([3 * v, 4 * v, 0, 0], frac, &c, &mut sat) >> f,
+                    (k - i64::from(frac)) + 2
+                );
+            }
+        }
+        assert_eq!(lod([0; 4], 0, &c, &mut sat), -(32 << f));
+        // sqrt(2): lambda = 1/2 exactly.
+        assert_eq!(lod([1, 1, 0, 0], 0, &c, &mut sat), (1 << f) >> 1);
+    }
+    // rho = 2^-40: clamped to -32 and counted.
+    let c = cfg(8);
+    assert_eq!(lod([1, 0, 0, 0], 40, &c, &mut sat), lod_zero(8));
+    assert_eq!(sat.saturated, 1);
+    // Extreme inputs do not overflow.
+    let m = lod([i64::MIN, i64::MIN, i64::MAX, 0], 0, &c, &mut sat);
+    assert_eq!(m, (63 << 8) + 128);
+}

@@ -1,0 +1,172 @@
+//! Wrap unit vs an exact integer model (floor division, rational weight rounding, independent
+//! wrap formulas): exhaustive over a coordinate/size/mode/width grid, seeded random beyond it,
+//! and vs the f64 twin.
+
+use hw_model::config::{HwConfig, TrilinearConfig};
+use hw_model::fixed::Rounding;
+use hw_model::wrap::{wrap, WrapMode, WrapOut};
+use texsim::reference::wrap_f64;
+
+struct SplitMix(u64);
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+}
+
+const MODES: [WrapMode; 3] = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
+const ROUNDINGS: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+fn model_index(i: i128, n: i128, mode: WrapMode) -> u32 {
+    (match mode {
+        WrapMode::Repeat => ((i % n) + n) % n,
+        WrapMode::ClampToEdge => i.max(0).min(n - 1),
+        WrapMode::Mirror => {
+            let period = i.div_euclid(n);
+            let r = i.rem_euclid(n);
+            if period % 2 == 0 {
+                r
+            } else {
+                n - 1 - r
+            }
+        }
+    }) as u32
+}
+
+/// Exact model: s = (coord * size - 1/2) as a rational with denominator 2^(frac+1).
+fn model(coord: i64, frac: u32, size: u32, mode: WrapMode, wb: u32, rnd: Rounding) -> WrapOut {
+    let den = 1i128 << (frac + 1);
+    let num = i128::from(coord) * i128::from(size) * 2 - (1i128 << frac);
+    let mut i0 = num.div_euclid(den);
+    let r = num.rem_euclid(den); // fraction = r / den
+                                 // weight = round(r * 2^wb / den)
+    let wn = r << wb;
+    let q = wn / den;
+    let rr = wn % den;
+    let mut w = match rnd {
+        Rounding::Truncate => q,
+        Rounding::HalfUp => q + i128::from(2 * rr >= den),
+        Rounding::HalfEven => q + i128::from(2 * rr > den || (2 * rr == den && q % 2 == 1)),
+    };
+    if w == 1i128 << wb {
+        i0 += 1;
+        w = 0;
+    }
+    let n = i128::from(size);
+    WrapOut {
+        i0: model_index(i0, n, mode),
+        i1: model_index(i0 + 1, n, mode),
+        weight: w as u32,
+    }
+}
+
+fn tcfg(wb: u32, rnd: Rounding) -> TrilinearConfig {
+    let mut c = HwConfig::texram16().trilinear;
+    c.weight_bits = wb;
+    c.weight_rounding = rnd;
+    c
+}
+
+#[test]
+fn exhaustive_grid() {
+    let mut n = 0u64;
+    for wb in [0u32, 1, 4, 8, 9, 16] {
+        for rnd in ROUNDINGS {
+            let c = tcfg(wb, rnd);
+            for mode in MODES {
+                for size in 1u32..=40 {
+                    for coord in -1200i64..1200 {
+                        let got = wrap(coord, 8, size, mode, &c);
+                        let want = model(coord, 8, size, mode, wb, rnd);
+                        assert_eq!(
+                            got, want,
+                            "coord={coord} size={size} {mode:?} wb={wb} {rnd:?}"
+                        );
+                        assert!(got.i0 < size && got.i1 < size && got.weight < (1 << wb).max(1));
+                        n += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(n > 1_000_000);
+}
+
+#[test]
+fn random_wide() {
+    let mut rng = SplitMix(0x3a_0001);
+    for k in 0..1_000_000u32 {
+        let wb = (rng.next() % 17) as u32;
+        let rnd = ROUNDINGS[(k % 3) as usize];
+        let mode = MODES[(k / 3 % 3) as usize];
+        let frac = 4 + (rng.next() % 21) as u32;
+        let size = 1 + (rng.next() % 70_000) as u32;
+        let bits = 1 + (rng.next() % 44) as u32;
+        let coord = (rng.next() >> (64 - bits)) as i64 - (1i64 << (bits - 1));
+        let c = tcfg(wb, rnd);
+        let got = wrap(coord, frac, size, mode, &c);
+        assert_eq!(
+            got,
+            model(coord, frac, size, mode, wb, rnd),
+            "coord={coord} frac={frac} size={size}"
+        );
+    }
+    // Extreme coordinates do not overflow and still wrap exactly.
+    let c = tcfg(8, Rounding::HalfEven);
+    for coord in [i64::MIN, i64::MAX, i64::MIN + 1, i64::MAX - 1] {
+        for mode in MODES {
+            for size in [1u32, 3, 256, u32::MAX] {
+                assert_eq!(
+                    wrap(coord, 4, size, mode, &c),
+                    model(coord, 4, size, mode, 8, Rounding::HalfEven)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn nearest_like_with_zero_weight_bits() {
+    let c = tcfg(0, Rounding::HalfUp);
+    // coord = (i + 0.5)/size +- a bit selects texel i.
+    for size in 1u32..20 {
+        for i in 0..size {
+            for delta in [-100i64, 0, 100] {
+                let coord = ((2 * i64::from(i) + 1) << 15) / i64::from(size) + delta;
+                let o = wrap(coord, 16, size, WrapMode::ClampToEdge, &c);
+                assert_eq!((o.i0, o.weight), (i, 0));
+            }
+        }
+    }
+}
+
+#[test]
+fn twin_agrees() {
+    let mut rng = SplitMix(0x3a_0002);
+    for k in 0..300_000u32 {
+        let wb = [4u32, 8, 16][(k % 3) as usize];
+        let rnd = ROUNDINGS[(k / 3 % 3) as usize];
+        let mode = MODES[(k / 9 % 3) as usize];
+        let size = 1 + (rng.next() % 5000) as u32;
+        let coord = (rng.next() % (1 << 22)) as i64 - (1 << 21);
+        let got = wrap(coord, 16, size, mode, &tcfg(wb, rnd));
+        let (a, b, w) = wrap_f64(coord as f64 / 65536.0, size, mode);
+        let wq = f64::from(got.weight) / f64::from(1u32 << wb);
+        let tol = if rnd == Rounding::Truncate { 1.0 } else { 0.5 } * 2f64.powi(-(wb as i32));
+        // Compare the filtered value of a 1-D texture t(i) in [0, 1): |hw - float| <= tol.
+        let t = |i: u32| f64::from((i.wrapping_mul(2_654_435_761)) >> 16) / 65536.0;
+        let hw = t(got.i0) + (t(got.i1) - t(got.i0)) * wq;
+        let fl = t(a) + (t(b) - t(a)) * w;
+        assert!(
+            (hw - fl).abs() <= tol + 1e-12,
+            "coord={coord} size={size} {mode:?}: {hw} vs {fl}"
+        );
+        if (a, b) == (got.i0, got.i1) && w < 1.0 - tol {
+            assert!((wq - w).abs() <= tol + 1e-12, "w {wq} vs {w}");
+        }
+    }
+}
