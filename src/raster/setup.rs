@@ -340,7 +340,7 @@ fn make_tri(
         let mnf = vs.iter().map(|v| v.xf[axis]).fold(f64::INFINITY, f64::min);
         let mxf = vs.iter().map(|v| v.xf[axis]).fold(f64::NEG_INFINITY, f64::max);
         let (lof, hif) = pixel_range_float(mnf, mxf, limit);
-        let lo = lo.min(lof);
+        let lo = lo.min(lof).min(i64::from(limit));
         let hi = hi.max(hif).max(lo);
         bbox[axis] = lo as u32;
         bbox[axis + 2] = hi as u32;
