@@ -1,0 +1,493 @@
+//! Triangle setup: homogeneous clipping (Sutherland-Hodgman against the near/far planes and a
+//! guard band), perspective divide, viewport transform, snapping to the sub-pixel grid,
+//! orientation and back-face culling. Conventions are in the parent module header.
+
+use hw_model::config::RasterConfig;
+
+/// Largest supported viewport side; larger `width`/`height` are clamped to it.
+pub const MAX_VIEWPORT: u32 = 8192;
+/// Guard band: clip-space `|x|, |y| <= GUARD_BAND * w` is kept unclipped.
+pub const GUARD_BAND: f64 = 4.0;
+/// Smallest `w` kept by clipping (the `w > epsilon` plane).
+pub const W_EPSILON: f64 = 1e-12;
+
+/// A triangle to draw: indices into the clip-space vertex array.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawTri {
+    pub v: [u32; 3],
+    /// Drop the triangle if it is back-facing (clockwise in NDC).
+    pub cull_back: bool,
+}
+
+/// A set-up screen-space triangle (post-clip), ready for traversal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScreenTri {
+    /// Snapped positions, units of 2^-subpixel_bits pixel, y down.
+    pub xy: [[i64; 2]; 3],
+    /// Unsnapped screen positions in pixels (for the float twin).
+    pub xy_f: [[f64; 2]; 3],
+    /// `depth_bits` unorm depth per vertex.
+    pub z: [u32; 3],
+    /// Depth in [0, 1] per vertex.
+    pub z_f: [f64; 3],
+    /// 1 / w_clip per (post-clip) vertex.
+    pub inv_w: [f64; 3],
+    /// Index into `draws` of the source triangle.
+    pub src: u32,
+    /// Each vertex as clip-space-linear barycentrics of the source triangle's vertices.
+    pub src_bary: [[f64; 3]; 3],
+    /// `E0 + E1 + E2` of the snapped triangle, > 0.
+    pub area2: i64,
+    /// The same from `xy_f`; negative for slivers whose snapping flipped them (float traversal
+    /// then negates its edges), zero if the float triangle is degenerate (not drawn in float).
+    pub area2_f: f64,
+    /// x0, y0, x1, y1 (exclusive) of pixels possibly covered (fixed or float), in the viewport.
+    pub bbox: [u32; 4],
+}
+
+/// Setup counters. Every input triangle lands in exactly one of `non_finite`, `clipped_away`,
+/// `culled`, `degenerate`, or produces at least one output triangle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SetupStats {
+    /// Input triangles (`draws.len()`).
+    pub input: u64,
+    /// Back-facing with `cull_back` (for clipped triangles: all pieces rejected, one culled).
+    pub culled: u64,
+    /// Zero snapped area (all pieces).
+    pub degenerate: u64,
+    /// A NaN/infinite coordinate (input or produced by clipping), or an index out of range.
+    pub non_finite: u64,
+    /// Entirely outside the view volume (off-screen, behind the camera, beyond far).
+    pub clipped_away: u64,
+    /// Input triangles that were partly clipped (counted in addition to their outcome).
+    pub clipped: u64,
+    /// Output triangles (`tris.len()`).
+    pub output: u64,
+}
+
+/// Result of [`setup`].
+#[derive(Clone, Debug)]
+pub struct Setup {
+    pub tris: Vec<ScreenTri>,
+    pub width: u32,
+    pub height: u32,
+    pub subpixel_bits: u32,
+    pub depth_bits: u32,
+    pub stats: SetupStats,
+}
+
+impl ScreenTri {
+    /// Exact edge values at the centre of pixel (px, py), in units of 2^-2*subpixel_bits
+    /// pixel^2 (saturated to `i64` for absurd pixel positions far outside the viewport).
+    #[must_use]
+    pub fn edges_fixed(&self, px: i64, py: i64, subpixel_bits: u32) -> [i64; 3] {
+        let s = subpixel_bits.clamp(1, 12);
+        let h = 1i128 << (s - 1);
+        let x = (i128::from(px) << s) + h;
+        let y = (i128::from(py) << s) + h;
+        let mut e = [0i64; 3];
+        for (i, out) in e.iter_mut().enumerate() {
+            let j = (i + 1) % 3;
+            let k = (i + 2) % 3;
+            let [xj, yj] = self.xy[j].map(i128::from);
+            let [xk, yk] = self.xy[k].map(i128::from);
+            let v = (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
+            *out = v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64;
+        }
+        e
+    }
+
+    /// Float edge values at the point (px + 0.5, py + 0.5) from `xy_f`, evaluated with each
+    /// edge's endpoints in canonical order (bit-exact negation across shared edges).
+    #[must_use]
+    pub fn edges_float(&self, px: f64, py: f64) -> [f64; 3] {
+        let x = px + 0.5;
+        let y = py + 0.5;
+        let mut e = [0.0; 3];
+        for (i, out) in e.iter_mut().enumerate() {
+            *out = edge_float(self.xy_f[(i + 1) % 3], self.xy_f[(i + 2) % 3], x, y);
+        }
+        e
+    }
+}
+
+/// `cross(b - a, p - a)` with (a, b) put in lexicographic order first and the sign restored, so
+/// that `edge_float(a, b, ..) == -edge_float(b, a, ..)` bit for bit.
+#[must_use]
+pub(crate) fn edge_float(a: [f64; 2], b: [f64; 2], x: f64, y: f64) -> f64 {
+    let swap = (b[0], b[1]) < (a[0], a[1]);
+    let (p, q) = if swap { (b, a) } else { (a, b) };
+    let e = (q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0]);
+    if swap {
+        -e
+    } else {
+        e
+    }
+}
+
+/// A clip-space vertex with its barycentrics in the source triangle.
+#[derive(Clone, Copy, Debug, Default)]
+struct ClipVert {
+    p: [f64; 4],
+    b: [f64; 3],
+}
+
+/// Number of clip planes (w-epsilon, near, far, +-x guard, +-y guard).
+const PLANES: usize = 7;
+/// A triangle clipped by 7 planes has at most 3 + 7 vertices.
+const MAX_POLY: usize = 3 + PLANES;
+
+/// Signed distance (inside >= 0) of `p` to clip plane `plane`.
+fn plane_dist(plane: usize, p: &[f64; 4]) -> f64 {
+    let [x, y, z, w] = *p;
+    match plane {
+        0 => w - W_EPSILON,
+        1 => z + w,
+        2 => w - z,
+        3 => GUARD_BAND * w - x,
+        4 => GUARD_BAND * w + x,
+        5 => GUARD_BAND * w - y,
+        _ => GUARD_BAND * w + y,
+    }
+}
+
+/// Bit set of the clip planes (bits 0..7) and view-volume sides (bits 7..11: x <= w, x >= -w,
+/// y <= w, y >= -w) that `p` is outside of.
+fn outcode(p: &[f64; 4]) -> u32 {
+    let mut c = 0;
+    for plane in 0..PLANES {
+        if plane_dist(plane, p) < 0.0 {
+            c |= 1 << plane;
+        }
+    }
+    let [x, y, _, w] = *p;
+    let sides = [w - x, w + x, w - y, w + y];
+    for (i, d) in sides.iter().enumerate() {
+        if *d < 0.0 {
+            c |= 1 << (PLANES + i);
+        }
+    }
+    c
+}
+
+/// A fixed-capacity polygon (no allocation per triangle).
+#[derive(Clone, Copy)]
+struct Poly {
+    v: [ClipVert; MAX_POLY],
+    n: usize,
+}
+
+impl Poly {
+    fn push(&mut self, v: ClipVert) {
+        if self.n < MAX_POLY {
+            self.v[self.n] = v;
+            self.n += 1;
+        }
+    }
+}
+
+/// Point where segment (a -> b) crosses the plane, from the inside endpoint `a` (`da >= 0`)
+/// towards the outside one (`db < 0`).
+fn intersect(a: &ClipVert, da: f64, b: &ClipVert, db: f64) -> ClipVert {
+    let t = da / (da - db);
+    let mut r = ClipVert::default();
+    for c in 0..4 {
+        r.p[c] = a.p[c] + t * (b.p[c] - a.p[c]);
+    }
+    for c in 0..3 {
+        r.b[c] = a.b[c] + t * (b.b[c] - a.b[c]);
+    }
+    r
+}
+
+/// Sutherland-Hodgman against one plane.
+fn clip_plane(input: &Poly, plane: usize) -> Poly {
+    let mut out = Poly {
+        v: [ClipVert::default(); MAX_POLY],
+        n: 0,
+    };
+    for i in 0..input.n {
+        let cur = &input.v[i];
+        let next = &input.v[(i + 1) % input.n];
+        let dc = plane_dist(plane, &cur.p);
+        let dn = plane_dist(plane, &next.p);
+        let cin = dc >= 0.0;
+        let nin = dn >= 0.0;
+        if cin {
+            out.push(*cur);
+        }
+        if cin != nin {
+            let v = if cin {
+                intersect(cur, dc, next, dn)
+            } else {
+                intersect(next, dn, cur, dc)
+            };
+            out.push(v);
+        }
+    }
+    out
+}
+
+/// A post-divide vertex.
+#[derive(Clone, Copy, Debug, Default)]
+struct ScreenVert {
+    xs: [i64; 2],
+    xf: [f64; 2],
+    z: u32,
+    zf: f64,
+    inv_w: f64,
+    b: [f64; 3],
+}
+
+/// Parameters of the viewport transform and snapping.
+struct Viewport {
+    w: f64,
+    h: f64,
+    scale: f64,
+    zmax: f64,
+}
+
+impl Viewport {
+    /// Divide, viewport-transform and snap; `None` if anything is non-finite.
+    fn project(&self, v: &ClipVert) -> Option<ScreenVert> {
+        let [x, y, z, w] = v.p;
+        let inv_w = 1.0 / w;
+        let xn = x * inv_w;
+        let yn = y * inv_w;
+        let zn = z * inv_w;
+        let px = (xn + 1.0) * 0.5 * self.w;
+        let py = (1.0 - yn) * 0.5 * self.h;
+        let zf = ((zn + 1.0) * 0.5).clamp(0.0, 1.0);
+        let all = [inv_w, px, py, zf, v.b[0], v.b[1], v.b[2]];
+        if !all.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        // |px|, |py| <= 2.5 * MAX_VIEWPORT (guard band), so the casts are exact.
+        let sx = (px * self.scale).round_ties_even() as i64;
+        let sy = (py * self.scale).round_ties_even() as i64;
+        let zu = (zf * self.zmax).round_ties_even() as u32;
+        Some(ScreenVert {
+            xs: [sx, sy],
+            xf: [px, py],
+            z: zu,
+            zf,
+            inv_w,
+            b: v.b,
+        })
+    }
+}
+
+/// What happened to one input triangle.
+enum Outcome {
+    NonFinite,
+    ClippedAway,
+    Produced { culled: bool, degenerate: bool, clipped: bool, n: usize },
+}
+
+/// `cross(b - a, c - a)` on snapped positions.
+fn cross_fixed(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> i64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+fn cross_float(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Pixel range [lo, hi) whose centres may lie in [min, max] (snapped units).
+fn pixel_range_fixed(min: i64, max: i64, s: u32, limit: u32) -> (i64, i64) {
+    let h = 1i64 << (s - 1);
+    let step = 1i64 << s;
+    let lo = -((-(min - h)).div_euclid(step));
+    let hi = (max - h).div_euclid(step) + 1;
+    (lo.max(0), hi.min(i64::from(limit)))
+}
+
+/// Pixel range [lo, hi) whose centres may lie in [min, max] (pixels).
+fn pixel_range_float(min: f64, max: f64, limit: u32) -> (i64, i64) {
+    // Finite and within the guard band, so the casts are exact.
+    let lo = (min - 0.5).ceil() as i64;
+    let hi = (max - 0.5).floor() as i64 + 1;
+    (lo.max(0), hi.min(i64::from(limit)))
+}
+
+fn make_tri(
+    vs: [ScreenVert; 3],
+    src: u32,
+    cull_back: bool,
+    s: u32,
+    width: u32,
+    height: u32,
+) -> Result<ScreenTri, bool> {
+    let mut vs = vs;
+    let mut area2 = cross_fixed(vs[0].xs, vs[1].xs, vs[2].xs);
+    if area2 == 0 {
+        return Err(false);
+    }
+    if area2 < 0 {
+        // Counter-clockwise in NDC = clockwise in y-down screen space: front-facing.
+        vs.swap(1, 2);
+        area2 = -area2;
+    } else if cull_back {
+        return Err(true);
+    }
+    let area2_f = cross_float(vs[0].xf, vs[1].xf, vs[2].xf);
+    let mut bbox = [0u32; 4];
+    for axis in 0..2 {
+        let limit = if axis == 0 { width } else { height };
+        let mn = vs.iter().map(|v| v.xs[axis]).min().unwrap_or(0);
+        let mx = vs.iter().map(|v| v.xs[axis]).max().unwrap_or(0);
+        let (lo, hi) = pixel_range_fixed(mn, mx, s, limit);
+        let mnf = vs.iter().map(|v| v.xf[axis]).fold(f64::INFINITY, f64::min);
+        let mxf = vs.iter().map(|v| v.xf[axis]).fold(f64::NEG_INFINITY, f64::max);
+        let (lof, hif) = pixel_range_float(mnf, mxf, limit);
+        let lo = lo.min(lof).min(i64::from(limit));
+        let hi = hi.max(hif).max(lo);
+        bbox[axis] = lo as u32;
+        bbox[axis + 2] = hi as u32;
+    }
+    Ok(ScreenTri {
+        xy: vs.map(|v| v.xs),
+        xy_f: vs.map(|v| v.xf),
+        z: vs.map(|v| v.z),
+        z_f: vs.map(|v| v.zf),
+        inv_w: vs.map(|v| v.inv_w),
+        src,
+        src_bary: vs.map(|v| v.b),
+        area2,
+        area2_f,
+        bbox,
+    })
+}
+
+/// Sets up every triangle of `draws` (see the module header for the conventions).
+/// `width`/`height` are clamped to `0..=MAX_VIEWPORT`, the config widths to their valid ranges.
+#[must_use]
+pub fn setup(
+    clip: &[[f64; 4]],
+    draws: &[DrawTri],
+    width: u32,
+    height: u32,
+    cfg: &RasterConfig,
+) -> Setup {
+    let width = width.min(MAX_VIEWPORT);
+    let height = height.min(MAX_VIEWPORT);
+    let s = cfg.subpixel_bits.clamp(1, 12);
+    let depth_bits = cfg.depth_bits.clamp(8, 30);
+    let vp = Viewport {
+        w: f64::from(width),
+        h: f64::from(height),
+        scale: f64::from(1u32 << s),
+        zmax: f64::from((1u32 << depth_bits) - 1),
+    };
+    let mut stats = SetupStats {
+        input: draws.len() as u64,
+        ..SetupStats::default()
+    };
+    let mut tris = Vec::with_capacity(draws.len());
+    for (src, d) in draws.iter().enumerate() {
+        let src = src as u32;
+        let outcome = setup_one(clip, d, src, &vp, s, width, height, &mut tris);
+        match outcome {
+            Outcome::NonFinite => stats.non_finite += 1,
+            Outcome::ClippedAway => stats.clipped_away += 1,
+            Outcome::Produced {
+                culled,
+                degenerate,
+                clipped,
+                n,
+            } => {
+                if clipped {
+                    stats.clipped += 1;
+                }
+                if n == 0 {
+                    if culled {
+                        stats.culled += 1;
+                    } else if degenerate {
+                        stats.degenerate += 1;
+                    } else {
+                        stats.clipped_away += 1;
+                    }
+                }
+            }
+        }
+    }
+    stats.output = tris.len() as u64;
+    Setup {
+        tris,
+        width,
+        height,
+        subpixel_bits: s,
+        depth_bits,
+        stats,
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn setup_one(
+    clip: &[[f64; 4]],
+    d: &DrawTri,
+    src: u32,
+    vp: &Viewport,
+    s: u32,
+    width: u32,
+    height: u32,
+    tris: &mut Vec<ScreenTri>,
+) -> Outcome {
+    let mut poly = Poly {
+        v: [ClipVert::default(); MAX_POLY],
+        n: 3,
+    };
+    for (i, &idx) in d.v.iter().enumerate() {
+        let Some(p) = clip.get(idx as usize) else {
+            return Outcome::NonFinite;
+        };
+        if !p.iter().all(|c| c.is_finite()) {
+            return Outcome::NonFinite;
+        }
+        let mut b = [0.0; 3];
+        b[i] = 1.0;
+        poly.v[i] = ClipVert { p: *p, b };
+    }
+    let codes = [0, 1, 2].map(|i| outcode(&poly.v[i].p));
+    if codes[0] & codes[1] & codes[2] != 0 {
+        return Outcome::ClippedAway;
+    }
+    let clip_mask = (1u32 << PLANES) - 1;
+    let clipped = (codes[0] | codes[1] | codes[2]) & clip_mask != 0;
+    if clipped {
+        // Every plane, even those no input vertex is outside of: an edge's cut then depends
+        // only on its endpoints, identically in both triangles that share it.
+        for plane in 0..PLANES {
+            poly = clip_plane(&poly, plane);
+            if poly.n < 3 {
+                return Outcome::ClippedAway;
+            }
+        }
+    }
+    let mut sv = [ScreenVert::default(); MAX_POLY];
+    for i in 0..poly.n {
+        match vp.project(&poly.v[i]) {
+            Some(v) => sv[i] = v,
+            None => return Outcome::NonFinite,
+        }
+    }
+    let mut culled = false;
+    let mut degenerate = false;
+    let mut n = 0;
+    for i in 1..poly.n - 1 {
+        match make_tri([sv[0], sv[i], sv[i + 1]], src, d.cull_back, s, width, height) {
+            Ok(t) => {
+                tris.push(t);
+                n += 1;
+            }
+            Err(true) => culled = true,
+            Err(false) => degenerate = true,
+        }
+    }
+    Outcome::Produced {
+        culled,
+        degenerate,
+        clipped,
+        n,
+    }
+}

@@ -1,0 +1,551 @@
+//! Scanline traversal (Pineda edge functions, solved per row for the exact span) into a
+//! visibility buffer, with the top-left fill rule and a strictly-less depth test; parallel over
+//! horizontal bands. Conventions are in the parent module header.
+
+use super::setup::{ScreenTri, Setup};
+use rayon::prelude::*;
+
+/// No triangle covers this pixel.
+pub const NO_TRI: u32 = u32::MAX;
+/// Rows per parallel band.
+pub const BAND_ROWS: u32 = 16;
+
+/// Which coverage and depth model traversal uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coverage {
+    /// Snapped positions, exact integer edges and depth.
+    Fixed,
+    /// Unsnapped `xy_f`, f64 edges and depth (the float twin).
+    Float,
+}
+
+/// Per-pixel index of the visible triangle.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct VisBuffer {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major, top row first: index into `setup.tris`, or [`NO_TRI`].
+    pub tri: Vec<u32>,
+}
+
+/// Traversal counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct RasterStats {
+    /// Non-empty spans (one row of one triangle).
+    pub spans: u64,
+    /// Covered samples before the depth test.
+    pub fragments: u64,
+    /// Fragments rejected by the depth test.
+    pub depth_fails: u64,
+    /// Pixels with a triangle at the end.
+    pub visible: u64,
+}
+
+impl RasterStats {
+    fn add(mut self, o: RasterStats) -> RasterStats {
+        self.spans += o.spans;
+        self.fragments += o.fragments;
+        self.depth_fails += o.depth_fails;
+        self.visible += o.visible;
+        self
+    }
+}
+
+/// `floor(a / b)` for `b > 0`.
+fn floor_div(a: i64, b: i64) -> i64 {
+    a.div_euclid(b)
+}
+
+/// `ceil(a / b)` for `b > 0`.
+fn ceil_div(a: i64, b: i64) -> i64 {
+    -((-a).div_euclid(b))
+}
+
+/// One fixed edge `E(px) = c(py) + step * px` with `c(py) = a * (Y - yj) - b * (h - xj)`.
+#[derive(Clone, Copy)]
+struct FixedEdge {
+    a: i64,
+    b: i64,
+    xj: i64,
+    yj: i64,
+    /// Smallest passing value: 0 on top-left edges, 1 otherwise.
+    t: i64,
+    step: i64,
+}
+
+/// A triangle prepared for fixed traversal.
+struct FixedTri {
+    e: [FixedEdge; 3],
+    s: u32,
+    h: i64,
+    x0: i64,
+    x1: i64,
+    z: [i128; 3],
+    /// Denominator of the rounded depth `(2N + area2) / (2 area2)`.
+    den: i64,
+    /// Per-pixel quotient/remainder step of the depth numerator.
+    dq: i128,
+    dr: i64,
+}
+
+impl FixedTri {
+    fn new(t: &ScreenTri, s: u32, width: u32) -> Self {
+        let h = 1i64 << (s - 1);
+        let e = [0usize, 1, 2].map(|i| {
+            let [xj, yj] = t.xy[(i + 1) % 3];
+            let [xk, yk] = t.xy[(i + 2) % 3];
+            let a = xk - xj;
+            let b = yk - yj;
+            let top_left = b < 0 || (b == 0 && a > 0);
+            FixedEdge {
+                a,
+                b,
+                xj,
+                yj,
+                t: i64::from(!top_left),
+                step: -(b << s),
+            }
+        });
+        let z = t.z.map(i128::from);
+        let den = 2 * t.area2;
+        let dm: i128 = 2 * (0..3).map(|i| i128::from(e[i].step) * z[i]).sum::<i128>();
+        let den128 = i128::from(den);
+        Self {
+            e,
+            s,
+            h,
+            x0: i64::from(t.bbox[0]),
+            x1: i64::from(t.bbox[2].min(width)),
+            z,
+            den,
+            dq: dm.div_euclid(den128),
+            dr: dm.rem_euclid(den128) as i64,
+        }
+    }
+
+    /// Exact span [xl, xr) of row `py` and the edge values at `xl`.
+    fn span(&self, py: i64) -> (i64, i64, [i64; 3]) {
+        let y = (py << self.s) + self.h;
+        let mut xl = self.x0;
+        let mut xr = self.x1;
+        let mut c = [0i64; 3];
+        for (e, ci) in self.e.iter().zip(c.iter_mut()) {
+            *ci = e.a * (y - e.yj) - e.b * (self.h - e.xj);
+            if e.step == 0 {
+                if *ci < e.t {
+                    return (xl, xl, c);
+                }
+            } else if e.step > 0 {
+                xl = xl.max(ceil_div(e.t - *ci, e.step));
+            } else {
+                xr = xr.min(floor_div(*ci - e.t, -e.step) + 1);
+            }
+        }
+        let ev = [0, 1, 2].map(|i| c[i] + self.e[i].step * xl);
+        (xl, xr, ev)
+    }
+
+    /// Depth walker at the span start: (quotient, remainder, dq, dr) with `dq`, `dr` zero for
+    /// one-pixel spans (the step is only bounded between two covered pixels).
+    fn depth_start(&self, ev: &[i64; 3], len: i64) -> (i64, i64, i64, i64) {
+        let n: i128 = (0..3).map(|i| i128::from(ev[i]) * self.z[i]).sum();
+        let den = i128::from(self.den);
+        let m = 2 * n + den / 2;
+        let q = m.div_euclid(den) as i64;
+        let r = m.rem_euclid(den) as i64;
+        if len >= 2 {
+            (q, r, self.dq as i64, self.dr)
+        } else {
+            (q, r, 0, 0)
+        }
+    }
+}
+
+/// One float edge in canonical order: `E = sign * (dx * (y - p1) - dy * (x - p0))`.
+#[derive(Clone, Copy)]
+struct FloatEdge {
+    p: [f64; 2],
+    dx: f64,
+    dy: f64,
+    neg: bool,
+    top_left: bool,
+    /// -1: E decreases with x, 0: horizontal, 1: increases.
+    dir: i8,
+}
+
+impl FloatEdge {
+    #[inline]
+    fn eval(&self, x: f64, y: f64) -> f64 {
+        let e = self.dx * (y - self.p[1]) - self.dy * (x - self.p[0]);
+        if self.neg {
+            -e
+        } else {
+            e
+        }
+    }
+
+    #[inline]
+    fn passes(&self, px: i64, y: f64) -> bool {
+        let e = self.eval(px as f64 + 0.5, y);
+        e > 0.0 || (e == 0.0 && self.top_left)
+    }
+}
+
+/// A triangle prepared for float traversal.
+struct FloatTri {
+    e: [FloatEdge; 3],
+    x0: i64,
+    x1: i64,
+    z: [f64; 3],
+    area2: f64,
+}
+
+impl FloatTri {
+    /// Prepares `t`; if the unsnapped triangle has the opposite orientation to the snapped one
+    /// (`area2_f < 0`, slivers only) every edge is negated so that it is positive inside.
+    fn new(t: &ScreenTri, width: u32) -> Self {
+        let flip = t.area2_f < 0.0;
+        let e = [0usize, 1, 2].map(|i| {
+            let j = t.xy_f[(i + 1) % 3];
+            let k = t.xy_f[(i + 2) % 3];
+            let swap = (k[0], k[1]) < (j[0], j[1]);
+            let (p, q) = if swap { (k, j) } else { (j, k) };
+            let (a, b) = if flip {
+                (j[0] - k[0], j[1] - k[1])
+            } else {
+                (k[0] - j[0], k[1] - j[1])
+            };
+            FloatEdge {
+                p,
+                dx: q[0] - p[0],
+                dy: q[1] - p[1],
+                neg: swap != flip,
+                top_left: b < 0.0 || (b == 0.0 && a > 0.0),
+                dir: if b < 0.0 {
+                    1
+                } else if b > 0.0 {
+                    -1
+                } else {
+                    0
+                },
+            }
+        });
+        Self {
+            e,
+            x0: i64::from(t.bbox[0]),
+            x1: i64::from(t.bbox[2].min(width)),
+            z: t.z_f,
+            area2: t.area2_f.abs(),
+        }
+    }
+
+    /// Span [xl, xr) of row `py`: a division guess per edge, refined by evaluating the edge
+    /// (monotone in x under round-to-nearest), so it equals the per-pixel test exactly.
+    fn span(&self, py: i64) -> (i64, i64) {
+        let y = py as f64 + 0.5;
+        let mut xl = self.x0;
+        let mut xr = self.x1;
+        for e in &self.e {
+            if xl >= xr {
+                break;
+            }
+            if e.dir == 0 {
+                if !e.passes(xl, y) {
+                    return (xl, xl);
+                }
+                continue;
+            }
+            let x = e.p[0] + e.dx * (y - e.p[1]) / e.dy - 0.5;
+            if e.dir > 0 {
+                xl = first_pass(xl, xr, x.ceil() as i64, |px| e.passes(px, y));
+            } else {
+                xr = last_pass(xl, xr, x.floor() as i64, |px| e.passes(px, y));
+            }
+        }
+        (xl, xr)
+    }
+
+    #[inline]
+    fn depth(&self, px: i64, y: f64) -> f64 {
+        let x = px as f64 + 0.5;
+        let n: f64 = (0..3).map(|i| self.e[i].eval(x, y) * self.z[i]).sum();
+        n / self.area2
+    }
+}
+
+/// Smallest px in [lo, hi) with `f(px)` (f monotone false..true), or `hi`; starts at `g`.
+fn first_pass(lo: i64, hi: i64, g: i64, f: impl Fn(i64) -> bool) -> i64 {
+    if lo >= hi {
+        return hi;
+    }
+    let mut g = g.clamp(lo, hi - 1);
+    if f(g) {
+        while g > lo && f(g - 1) {
+            g -= 1;
+        }
+        g
+    } else {
+        loop {
+            g += 1;
+            if g >= hi || f(g) {
+                return g;
+            }
+        }
+    }
+}
+
+/// One past the largest px in [lo, hi) with `f(px)` (f monotone true..false), or `lo`.
+fn last_pass(lo: i64, hi: i64, g: i64, f: impl Fn(i64) -> bool) -> i64 {
+    if lo >= hi {
+        return lo;
+    }
+    let mut g = g.clamp(lo, hi - 1);
+    if f(g) {
+        while g + 1 < hi && f(g + 1) {
+            g += 1;
+        }
+        g + 1
+    } else {
+        loop {
+            if g <= lo {
+                return lo;
+            }
+            g -= 1;
+            if f(g) {
+                return g + 1;
+            }
+        }
+    }
+}
+
+/// Triangle indices per band, in submission order (counting sort, flat).
+struct Bins {
+    start: Vec<usize>,
+    ids: Vec<u32>,
+}
+
+fn bin(setup: &Setup, bands: usize) -> Bins {
+    let band_range = |t: &ScreenTri| -> Option<(usize, usize)> {
+        let y0 = t.bbox[1];
+        let y1 = t.bbox[3].min(setup.height);
+        if y0 >= y1 || t.bbox[0] >= t.bbox[2].min(setup.width) {
+            return None;
+        }
+        Some(((y0 / BAND_ROWS) as usize, ((y1 - 1) / BAND_ROWS) as usize))
+    };
+    let mut start = vec![0usize; bands + 1];
+    for t in &setup.tris {
+        if let Some((b0, b1)) = band_range(t) {
+            for c in &mut start[b0 + 1..=b1 + 1] {
+                *c += 1;
+            }
+        }
+    }
+    for b in 0..bands {
+        start[b + 1] += start[b];
+    }
+    let mut fill = start.clone();
+    let mut ids = vec![0u32; start[bands]];
+    for (i, t) in setup.tris.iter().enumerate() {
+        if let Some((b0, b1)) = band_range(t) {
+            for f in &mut fill[b0..=b1] {
+                ids[*f] = i as u32;
+                *f += 1;
+            }
+        }
+    }
+    Bins { start, ids }
+}
+
+/// What a band does with its spans.
+enum Sink<'a> {
+    Vis {
+        tri: &'a mut [u32],
+        depth_test: bool,
+    },
+    Count(&'a mut [u32]),
+}
+
+/// Traverses the triangles of one band (rows [y0, y1)) into `sink` (rows of this band only).
+fn band(setup: &Setup, ids: &[u32], y0: u32, y1: u32, coverage: Coverage, sink: Sink) -> RasterStats {
+    let w = setup.width as usize;
+    let mut st = RasterStats::default();
+    let s = setup.subpixel_bits.clamp(1, 12);
+    match sink {
+        Sink::Count(cnt) => {
+            for_spans(setup, ids, y0, y1, coverage, s, |_, py, xl, xr, _| {
+                st.spans += 1;
+                st.fragments += (xr - xl) as u64;
+                let row = (py as usize - y0 as usize) * w;
+                for c in &mut cnt[row + xl as usize..row + xr as usize] {
+                    *c += 1;
+                }
+            });
+        }
+        Sink::Vis { tri, depth_test } => {
+            let n = ((y1 - y0) as usize) * w;
+            match coverage {
+                Coverage::Fixed => {
+                    let zmax = (1u32 << setup.depth_bits.clamp(8, 30)) - 1;
+                    let mut depth = vec![zmax; if depth_test { n } else { 0 }];
+                    for_spans(setup, ids, y0, y1, coverage, s, |id, py, xl, xr, span| {
+                        st.spans += 1;
+                        st.fragments += (xr - xl) as u64;
+                        let row = (py as usize - y0 as usize) * w;
+                        let Prep::Fixed(ft, ev) = span else { return };
+                        if !depth_test {
+                            tri[row + xl as usize..row + xr as usize].fill(id);
+                            return;
+                        }
+                        let (mut q, mut r, dq, dr) = ft.depth_start(ev, xr - xl);
+                        for px in xl..xr {
+                            let i = row + px as usize;
+                            let zq = q.clamp(0, i64::from(zmax)) as u32;
+                            if zq < depth[i] {
+                                depth[i] = zq;
+                                tri[i] = id;
+                            } else {
+                                st.depth_fails += 1;
+                            }
+                            r += dr;
+                            q += dq;
+                            if r >= ft.den {
+                                r -= ft.den;
+                                q += 1;
+                            }
+                        }
+                    });
+                }
+                Coverage::Float => {
+                    let mut depth = vec![1.0f64; if depth_test { n } else { 0 }];
+                    for_spans(setup, ids, y0, y1, coverage, s, |id, py, xl, xr, span| {
+                        st.spans += 1;
+                        st.fragments += (xr - xl) as u64;
+                        let row = (py as usize - y0 as usize) * w;
+                        if !depth_test {
+                            tri[row + xl as usize..row + xr as usize].fill(id);
+                            return;
+                        }
+                        let Prep::Float(ft) = span else { return };
+                        let y = py as f64 + 0.5;
+                        for px in xl..xr {
+                            let i = row + px as usize;
+                            let z = ft.depth(px, y);
+                            if z < depth[i] {
+                                depth[i] = z;
+                                tri[i] = id;
+                            } else {
+                                st.depth_fails += 1;
+                            }
+                        }
+                    });
+                }
+            }
+            st.visible = tri.iter().filter(|&&t| t != NO_TRI).count() as u64;
+        }
+    }
+    st
+}
+
+/// A prepared triangle handed to a span callback (fixed: with the edge values at `xl`).
+enum Prep<'a> {
+    Fixed(&'a FixedTri, &'a [i64; 3]),
+    Float(&'a FloatTri),
+}
+
+/// Calls `f(id, py, xl, xr, prep)` for every non-empty span of the band's triangles, in
+/// submission order.
+fn for_spans(
+    setup: &Setup,
+    ids: &[u32],
+    y0: u32,
+    y1: u32,
+    coverage: Coverage,
+    s: u32,
+    mut f: impl FnMut(u32, i64, i64, i64, Prep<'_>),
+) {
+    for &id in ids {
+        let t = &setup.tris[id as usize];
+        let ya = t.bbox[1].max(y0);
+        let yb = t.bbox[3].min(y1);
+        match coverage {
+            Coverage::Fixed => {
+                let ft = FixedTri::new(t, s, setup.width);
+                for py in ya..yb {
+                    let py = i64::from(py);
+                    let (xl, xr, ev) = ft.span(py);
+                    if xl < xr {
+                        f(id, py, xl, xr, Prep::Fixed(&ft, &ev));
+                    }
+                }
+            }
+            Coverage::Float => {
+                if !(t.area2_f.abs() > 0.0) {
+                    continue;
+                }
+                let ft = FloatTri::new(t, setup.width);
+                for py in ya..yb {
+                    let py = i64::from(py);
+                    let (xl, xr) = ft.span(py);
+                    if xl < xr {
+                        f(id, py, xl, xr, Prep::Float(&ft));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Runs `band` over all bands in parallel; `out` has one entry per pixel.
+fn run(setup: &Setup, coverage: Coverage, out: &mut [u32], vis: Option<bool>) -> RasterStats {
+    let w = setup.width as usize;
+    let h = setup.height;
+    if w == 0 || h == 0 {
+        return RasterStats::default();
+    }
+    let bands = h.div_ceil(BAND_ROWS) as usize;
+    let bins = bin(setup, bands);
+    out.par_chunks_mut(BAND_ROWS as usize * w)
+        .enumerate()
+        .map(|(b, rows)| {
+            let y0 = b as u32 * BAND_ROWS;
+            let y1 = (y0 + BAND_ROWS).min(h);
+            let ids = &bins.ids[bins.start[b]..bins.start[b + 1]];
+            let sink = match vis {
+                Some(depth_test) => Sink::Vis {
+                    tri: rows,
+                    depth_test,
+                },
+                None => Sink::Count(rows),
+            };
+            band(setup, ids, y0, y1, coverage, sink)
+        })
+        .reduce(RasterStats::default, RasterStats::add)
+}
+
+/// Rasterizes `setup.tris` in submission order into a visibility buffer. With `depth_test`,
+/// a fragment is kept if its depth is strictly less than the stored one (cleared to the far
+/// value); without, later triangles overwrite earlier ones.
+#[must_use]
+pub fn rasterize(setup: &Setup, coverage: Coverage, depth_test: bool) -> (VisBuffer, RasterStats) {
+    let n = setup.width as usize * setup.height as usize;
+    let mut tri = vec![NO_TRI; n];
+    let stats = run(setup, coverage, &mut tri, Some(depth_test));
+    (
+        VisBuffer {
+            width: setup.width,
+            height: setup.height,
+            tri,
+        },
+        stats,
+    )
+}
+
+/// How many triangles cover each pixel (no depth test), row-major.
+#[must_use]
+pub fn coverage_count(setup: &Setup, coverage: Coverage) -> Vec<u32> {
+    let n = setup.width as usize * setup.height as usize;
+    let mut cnt = vec![0u32; n];
+    let _ = run(setup, coverage, &mut cnt, None);
+    cnt
+}
