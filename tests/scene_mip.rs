@@ -24,15 +24,18 @@ fn random_texture(rng: &mut SplitMix, w: u32, h: u32) -> TextureImage {
     let texels = (0..w * h)
         .map(|_| std::array::from_fn(|_| rng.below(65536) as u16))
         .collect();
-    TextureImage { name: "rand".into(), width: w, height: h, texels, prebuilt_levels: None }
+    TextureImage {
+        name: "rand".into(),
+        width: w,
+        height: h,
+        texels,
+        prebuilt_levels: None,
+    }
 }
 
 #[test]
 fn chain_sizes_pot_and_npot() {
-    assert_eq!(
-        chain_sizes(8, 2),
-        vec![(8, 2), (4, 1), (2, 1), (1, 1)]
-    );
+    assert_eq!(chain_sizes(8, 2), vec![(8, 2), (4, 1), (2, 1), (1, 1)]);
     assert_eq!(chain_sizes(1024, 1024).len(), 11);
     assert_eq!(chain_sizes(5, 3), vec![(5, 3), (2, 1), (1, 1)]);
     assert_eq!(chain_sizes(7, 1), vec![(7, 1), (3, 1), (1, 1)]);
@@ -95,11 +98,20 @@ fn model_next(src: &[Vec<f64>], w: usize, h: usize, ch: usize) -> (Vec<Vec<f64>>
 fn box_filter_matches_independent_model() {
     let mut rng = SplitMix(42);
     for case in 0..60 {
-        let (w, h) = if case < 4 { ([1, 2, 3, 4][case], [4, 3, 2, 1][case]) } else { (1 + rng.below(40) as u32, 1 + rng.below(40) as u32) };
+        let (w, h) = if case < 4 {
+            ([1, 2, 3, 4][case], [4, 3, 2, 1][case])
+        } else {
+            (1 + rng.below(40) as u32, 1 + rng.below(40) as u32)
+        };
         let tex = random_texture(&mut rng, w, h);
         let chain = build_mip_chain(&tex);
         let mut cur: Vec<Vec<f64>> = (0..4)
-            .map(|c| tex.texels.iter().map(|t| f64::from(t[c]) / 65535.0).collect())
+            .map(|c| {
+                tex.texels
+                    .iter()
+                    .map(|t| f64::from(t[c]) / 65535.0)
+                    .collect()
+            })
             .collect();
         let (mut cw, mut chh) = (w as usize, h as usize);
         for (li, level) in chain.levels.iter().enumerate() {
@@ -114,7 +126,12 @@ fn box_filter_matches_independent_model() {
                 for c in 0..4 {
                     let err = (f64::from(t[c]) - cur[c][i]).abs();
                     // f32 accumulation over <= 11 levels: a few ulps of 1.0 per level.
-                    assert!(err < 1e-6, "case {case} level {li} texel {i}: {} vs {}", t[c], cur[c][i]);
+                    assert!(
+                        err < 1e-6,
+                        "case {case} level {li} texel {i}: {} vs {}",
+                        t[c],
+                        cur[c][i]
+                    );
                 }
             }
         }
@@ -125,22 +142,42 @@ fn box_filter_matches_independent_model() {
 fn box_filter_known_values() {
     // 3x1 row [0, 3, 6]/65535-scaled: NPOT -> one texel = mean of all three.
     let v = |x: u16| [x, x, x, 65535];
-    let tex = TextureImage { name: "t".into(), width: 3, height: 1, texels: vec![v(0), v(30000), v(60000)], prebuilt_levels: None };
+    let tex = TextureImage {
+        name: "t".into(),
+        width: 3,
+        height: 1,
+        texels: vec![v(0), v(30000), v(60000)],
+        prebuilt_levels: None,
+    };
     let chain = build_mip_chain(&tex);
     assert_eq!(chain.levels.len(), 2);
     let got = chain.levels[1].texels[0];
     assert!((f64::from(got[0]) - 30000.0 / 65535.0).abs() < 1e-7);
     assert_eq!(got[3], 1.0);
     // 2x2 -> exact mean.
-    let tex = TextureImage { name: "t".into(), width: 2, height: 2, texels: vec![v(0), v(65535), v(65535), v(65535)], prebuilt_levels: None };
+    let tex = TextureImage {
+        name: "t".into(),
+        width: 2,
+        height: 2,
+        texels: vec![v(0), v(65535), v(65535), v(65535)],
+        prebuilt_levels: None,
+    };
     let chain = build_mip_chain(&tex);
     assert!((chain.levels[1].texels[0][0] - 0.75).abs() < 1e-7);
 }
 
 #[test]
 fn quantize_lossless_for_exact_16_bit_data() {
-    let all: Vec<[u16; 4]> = (0..=65535u32).map(|x| [x as u16, (65535 - x) as u16, (x * 7 % 65536) as u16, 65535]).collect();
-    let tex = TextureImage { name: "all".into(), width: 256, height: 256, texels: all.clone(), prebuilt_levels: None };
+    let all: Vec<[u16; 4]> = (0..=65535u32)
+        .map(|x| [x as u16, (65535 - x) as u16, (x * 7 % 65536) as u16, 65535])
+        .collect();
+    let tex = TextureImage {
+        name: "all".into(),
+        width: 256,
+        height: 256,
+        texels: all.clone(),
+        prebuilt_levels: None,
+    };
     let q = quantize_chain(&build_mip_chain(&tex), 16);
     assert_eq!(q.texel_bits, 16);
     assert_eq!(q.levels[0].texels, all);
@@ -158,7 +195,8 @@ fn quantize_rounds_half_even_to_n_bits() {
             let t = f64::from(x) * max as f64;
             let lo = t.floor();
             let frac = t - lo;
-            let mut r = if frac > 0.5 { lo + 1.0 } else if frac < 0.5 { lo } else if lo as i64 % 2 == 0 { lo } else { lo + 1.0 };
+            let round_up = frac > 0.5 || (frac == 0.5 && lo as i64 % 2 == 1);
+            let mut r = if round_up { lo + 1.0 } else { lo };
             r = r.clamp(0.0, max as f64);
             assert_eq!(q, r as u64, "x {x} bits {bits}");
         }
@@ -186,7 +224,12 @@ fn mesa_texture_hashes_match_the_anchor() {
     assert_eq!(levels.len(), 11);
     let l0 = fnv1a64(FNV_OFFSET, levels[0].2.iter().flatten().copied());
     assert_eq!(format!("{l0:016x}"), "866f6b8675eaa619");
-    let all = fnv1a64(FNV_OFFSET, levels.iter().flat_map(|(_, _, t)| t.iter().flatten().copied()));
+    let all = fnv1a64(
+        FNV_OFFSET,
+        levels
+            .iter()
+            .flat_map(|(_, _, t)| t.iter().flatten().copied()),
+    );
     assert_eq!(format!("{all:016x}"), "05230205964a4066");
 
     // The built-in scenes carry exactly these bytes (x257) and the 16-bit chain is lossless.
@@ -196,10 +239,13 @@ fn mesa_texture_hashes_match_the_anchor() {
         let q = quantize_chain(&build_mip_chain(tex), 16);
         assert_eq!(q.levels.len(), 11);
         let bytes = |t: &Vec<[u16; 4]>| -> Vec<u8> {
-            t.iter().flatten().map(|&c| {
-                assert_eq!(c % 257, 0);
-                (c / 257) as u8
-            }).collect()
+            t.iter()
+                .flatten()
+                .map(|&c| {
+                    assert_eq!(c % 257, 0);
+                    (c / 257) as u8
+                })
+                .collect()
         };
         let h0 = fnv1a64(FNV_OFFSET, bytes(&q.levels[0].texels).into_iter());
         assert_eq!(format!("{h0:016x}"), "866f6b8675eaa619", "{name}");

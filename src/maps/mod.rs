@@ -96,7 +96,11 @@ pub fn downsample(src: &MipLevel) -> MipLevel {
             texels.push(acc.map(|a| a * inv));
         }
     }
-    MipLevel { width: nw, height: nh, texels }
+    MipLevel {
+        width: nw,
+        height: nh,
+        texels,
+    }
 }
 
 fn level_from_u16(width: u32, height: u32, texels: &[[u16; 4]]) -> MipLevel {
@@ -121,16 +125,20 @@ pub fn build_mip_chain(tex: &TextureImage) -> MipChain {
     let expected0 = tex.width as usize * tex.height as usize;
     if tex.width == 0 || tex.height == 0 || tex.texels.len() != expected0 {
         // Not a valid image (`scene::validate` rejects these); give a defined 1x1 black chain.
-        levels.push(MipLevel { width: 1, height: 1, texels: vec![[0.0; 4]] });
+        levels.push(MipLevel {
+            width: 1,
+            height: 1,
+            texels: vec![[0.0; 4]],
+        });
         return MipChain { levels };
     }
     levels.push(level_from_u16(tex.width, tex.height, &tex.texels));
     let prebuilt = tex.prebuilt_levels.as_deref().unwrap_or(&[]);
     let mut use_prebuilt = true;
     for (li, &(w, h)) in sizes.iter().enumerate().skip(1) {
-        let pre = prebuilt.get(li - 1).filter(|(pw, ph, t)| {
-            *pw == w && *ph == h && t.len() == w as usize * h as usize
-        });
+        let pre = prebuilt
+            .get(li - 1)
+            .filter(|(pw, ph, t)| *pw == w && *ph == h && t.len() == w as usize * h as usize);
         let level = match pre {
             Some((pw, ph, t)) if use_prebuilt => level_from_u16(*pw, *ph, t),
             _ => {

@@ -100,21 +100,34 @@ fn w1_plane() -> Scene {
     const S: f32 = 256.0;
     let mesh = Mesh {
         name: "w1-plane".into(),
-        positions: vec![[-S, 0.0, 1.0], [S, 0.0, 1.0], [S, 0.0, 1.0 - 2.0 * S], [-S, 0.0, 1.0 - 2.0 * S]],
+        positions: vec![
+            [-S, 0.0, 1.0],
+            [S, 0.0, 1.0],
+            [S, 0.0, 1.0 - 2.0 * S],
+            [-S, 0.0, 1.0 - 2.0 * S],
+        ],
         normals: vec![[0.0, 1.0, 0.0]; 4],
         uvs: vec![[0.0, 0.0], [16.0, 0.0], [16.0, 16.0], [0.0, 16.0]],
         indices: vec![[0, 1, 2], [0, 2, 3]],
         material: 0,
     };
     // glFrustum(-top, top, -top, top, 0.1, 1000) with top = n tan 30 deg: 60 deg, aspect 1.
-    mesa_scene("w1-plane", mesh, camera_from_view(w1_view(), 60.0, 0.1, 1000.0))
+    mesa_scene(
+        "w1-plane",
+        mesh,
+        camera_from_view(w1_view(), 60.0, 0.1, 1000.0),
+    )
 }
 
 fn w2_mesh() -> Scene {
     let mut mesh = shapes::torus(1.0, 0.4, 256, 128, 2.0);
     mesh.name = "w2-mesh".into();
     // glFrustum with top = 1 * tan 22.5 deg: 45 deg, aspect 1, near 1, far 10.
-    mesa_scene("w2-mesh", mesh, camera_from_view(w2_view(), 45.0, 1.0, 10.0))
+    mesa_scene(
+        "w2-mesh",
+        mesh,
+        camera_from_view(w2_view(), 45.0, 1.0, 10.0),
+    )
 }
 
 fn demo() -> Result<Scene> {
@@ -133,11 +146,31 @@ fn demo() -> Result<Scene> {
     let mut ball = shapes::sphere(0.7, 64, 32);
     ball.name = "sphere".into();
     ball.material = 2;
-    super::geometry::transform_mesh(&mut ball, &DMat4::from_translation(DVec3::new(-1.6, 0.7, -4.5)));
+    super::geometry::transform_mesh(
+        &mut ball,
+        &DMat4::from_translation(DVec3::new(-1.6, 0.7, -4.5)),
+    );
     let materials = vec![
-        Material { name: "ground".into(), kd: [1.0; 3], texture: Some(0), ..Material::default() },
-        Material { name: "torus".into(), kd: [1.0; 3], texture: Some(1), cull_back: true, ..Material::default() },
-        Material { name: "sphere".into(), kd: [1.0; 3], texture: Some(2), cull_back: true, ..Material::default() },
+        Material {
+            name: "ground".into(),
+            kd: [1.0; 3],
+            texture: Some(0),
+            ..Material::default()
+        },
+        Material {
+            name: "torus".into(),
+            kd: [1.0; 3],
+            texture: Some(1),
+            cull_back: true,
+            ..Material::default()
+        },
+        Material {
+            name: "sphere".into(),
+            kd: [1.0; 3],
+            texture: Some(2),
+            cull_back: true,
+            ..Material::default()
+        },
     ];
     let mut ground_tex = procedural("noise-checker", 256)?;
     ground_tex.name = "demo-ground".into();

@@ -114,7 +114,10 @@ pub fn fit_light(camera: &Camera) -> Light {
     } else {
         DVec3::new(0.5, -1.0, -0.5).normalize()
     };
-    Light::Directional { direction: [d.x as f32, d.y as f32, d.z as f32], color: [0.85; 3] }
+    Light::Directional {
+        direction: [d.x as f32, d.y as f32, d.z as f32],
+        color: [0.85; 3],
+    }
 }
 
 /// Applies an affine transform to a mesh in place (normals by the inverse transpose,
@@ -125,7 +128,11 @@ pub fn transform_mesh(mesh: &mut Mesh, m: &DMat4) {
         *p = [q.x as f32, q.y as f32, q.z as f32];
     }
     let lin = DMat3::from_mat4(*m);
-    let nm = if lin.determinant().abs() > 0.0 { lin.inverse().transpose() } else { lin };
+    let nm = if lin.determinant().abs() > 0.0 {
+        lin.inverse().transpose()
+    } else {
+        lin
+    };
     for n in &mut mesh.normals {
         let q = (nm * DVec3::from(n.map(f64::from))).normalize_or_zero();
         *n = if q != DVec3::ZERO && q.is_finite() {
@@ -166,12 +173,20 @@ pub fn validate(scene: &Scene) -> Result<()> {
         }
     }
     let cam = &scene.camera;
-    let cam_ok = cam.eye.iter().chain(&cam.target).chain(&cam.up).all(|c| c.is_finite());
+    let cam_ok = cam
+        .eye
+        .iter()
+        .chain(&cam.target)
+        .chain(&cam.up)
+        .all(|c| c.is_finite());
     if !cam_ok {
         return Err(Error::field("camera", "eye/target/up must be finite"));
     }
     if !(cam.fov_y_deg > 0.0 && cam.fov_y_deg < 180.0) {
-        return Err(Error::field("camera.fov_y_deg", format!("{} is outside (0, 180)", cam.fov_y_deg)));
+        return Err(Error::field(
+            "camera.fov_y_deg",
+            format!("{} is outside (0, 180)", cam.fov_y_deg),
+        ));
     }
     if !(cam.near > 0.0 && cam.far > cam.near && cam.far.is_finite()) {
         return Err(Error::field(
@@ -190,7 +205,10 @@ pub fn validate(scene: &Scene) -> Result<()> {
                 return Err(Error::field("camera.target", "equals camera.eye"));
             }
             if f.cross(DVec3::from(cam.up)).length() <= 1e-12 * f.length() {
-                return Err(Error::field("camera.up", "is zero or parallel to the view direction"));
+                return Err(Error::field(
+                    "camera.up",
+                    "is zero or parallel to the view direction",
+                ));
             }
         }
     }
@@ -208,7 +226,10 @@ pub fn validate(scene: &Scene) -> Result<()> {
     for (ti, t) in scene.textures.iter().enumerate() {
         let what = format!("textures[{ti}] '{}'", t.name);
         if t.width == 0 || t.height == 0 || t.width > 65536 || t.height > 65536 {
-            return Err(Error::field(&what, format!("bad size {}x{}", t.width, t.height)));
+            return Err(Error::field(
+                &what,
+                format!("bad size {}x{}", t.width, t.height),
+            ));
         }
         if t.texels.len() != t.width as usize * t.height as usize {
             return Err(Error::field(&what, "texel count does not match its size"));
@@ -216,7 +237,10 @@ pub fn validate(scene: &Scene) -> Result<()> {
         if let Some(levels) = &t.prebuilt_levels {
             let sizes = crate::maps::chain_sizes(t.width, t.height);
             if levels.len() + 1 != sizes.len() {
-                return Err(Error::field(&what, "prebuilt MIP level count does not reach 1x1"));
+                return Err(Error::field(
+                    &what,
+                    "prebuilt MIP level count does not reach 1x1",
+                ));
             }
             for (li, ((w, h, tx), &(ew, eh))) in levels.iter().zip(&sizes[1..]).enumerate() {
                 if (*w, *h) != (ew, eh) || tx.len() != ew as usize * eh as usize {
@@ -238,28 +262,51 @@ pub fn validate(scene: &Scene) -> Result<()> {
             }
         }
         if !finite3(&m.kd) {
-            return Err(Error::field(&format!("materials[{mi}] '{}'.kd", m.name), "must be finite"));
+            return Err(Error::field(
+                &format!("materials[{mi}] '{}'.kd", m.name),
+                "must be finite",
+            ));
         }
     }
     for (mi, mesh) in scene.meshes.iter().enumerate() {
         let what = |f: &str| format!("meshes[{mi}] '{}'.{f}", mesh.name);
         let n = mesh.positions.len();
         if let Some(i) = mesh.positions.iter().position(|p| !finite3(p)) {
-            return Err(Error::field(&what("positions"), format!("vertex {i} is not finite")));
+            return Err(Error::field(
+                &what("positions"),
+                format!("vertex {i} is not finite"),
+            ));
         }
         if mesh.normals.len() != n {
-            return Err(Error::field(&what("normals"), "need one normal per position"));
+            return Err(Error::field(
+                &what("normals"),
+                "need one normal per position",
+            ));
         }
         if let Some(i) = mesh.normals.iter().position(|p| !finite3(p)) {
-            return Err(Error::field(&what("normals"), format!("normal {i} is not finite")));
+            return Err(Error::field(
+                &what("normals"),
+                format!("normal {i} is not finite"),
+            ));
         }
         if !mesh.uvs.is_empty() && mesh.uvs.len() != n {
-            return Err(Error::field(&what("uvs"), "need none or one uv per position"));
+            return Err(Error::field(
+                &what("uvs"),
+                "need none or one uv per position",
+            ));
         }
-        if let Some(i) = mesh.uvs.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        if let Some(i) = mesh
+            .uvs
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
             return Err(Error::field(&what("uvs"), format!("uv {i} is not finite")));
         }
-        if let Some(t) = mesh.indices.iter().position(|t| t.iter().any(|&i| i as usize >= n)) {
+        if let Some(t) = mesh
+            .indices
+            .iter()
+            .position(|t| t.iter().any(|&i| i as usize >= n))
+        {
             return Err(Error::field(
                 &what("indices"),
                 format!("triangle {t} uses a vertex index >= {n}"),
@@ -268,7 +315,11 @@ pub fn validate(scene: &Scene) -> Result<()> {
         if mesh.material >= scene.materials.len() {
             return Err(Error::field(
                 &what("material"),
-                format!("index {} out of range ({} materials)", mesh.material, scene.materials.len()),
+                format!(
+                    "index {} out of range ({} materials)",
+                    mesh.material,
+                    scene.materials.len()
+                ),
             ));
         }
     }

@@ -22,7 +22,8 @@ mod toml_scene;
 
 pub use catalogue::{builtin, w1_view, w2_view, BUILTIN};
 pub use geometry::{
-    bounding_sphere, fit_camera, fit_light, smooth_normals, transform_mesh, validate, FALLBACK_NORMAL,
+    bounding_sphere, fit_camera, fit_light, smooth_normals, transform_mesh, validate,
+    FALLBACK_NORMAL,
 };
 pub use obj::load_obj;
 pub use texture::decode_texture;
@@ -111,7 +112,10 @@ pub struct Mesh {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     /// Light travelling along `direction` (towards the scene).
-    Directional { direction: [f32; 3], color: [f32; 3] },
+    Directional {
+        direction: [f32; 3],
+        color: [f32; 3],
+    },
     /// A point light without falloff.
     Point { position: [f32; 3], color: [f32; 3] },
 }

@@ -30,9 +30,13 @@ pub(crate) struct ObjParts {
 
 /// Opens a regular file, with errors naming it.
 pub(crate) fn open_regular(path: &Path, what: &str) -> Result<File> {
-    let meta = std::fs::metadata(path).map_err(|e| Error::file(path, format!("cannot open {what}: {e}")))?;
+    let meta = std::fs::metadata(path)
+        .map_err(|e| Error::file(path, format!("cannot open {what}: {e}")))?;
     if meta.is_dir() {
-        return Err(Error::file(path, format!("is a directory, expected {what}")));
+        return Err(Error::file(
+            path,
+            format!("is a directory, expected {what}"),
+        ));
     }
     File::open(path).map_err(|e| Error::file(path, format!("cannot open {what}: {e}")))
 }
@@ -63,7 +67,11 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                 if rest.is_empty() {
                     return Err(bad("newmtl without a name"));
                 }
-                out.push(MtlEntry { name: rest.to_string(), kd: None, map_kd: None });
+                out.push(MtlEntry {
+                    name: rest.to_string(),
+                    kd: None,
+                    map_kd: None,
+                });
             }
             "Kd" => {
                 let vals: Vec<f32> = rest
@@ -86,7 +94,9 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                 if rest.is_empty() {
                     return Err(bad("map_Kd without a file name"));
                 }
-                let cur = out.last_mut().ok_or_else(|| bad("map_Kd before any newmtl"))?;
+                let cur = out
+                    .last_mut()
+                    .ok_or_else(|| bad("map_Kd before any newmtl"))?;
                 cur.map_kd = Some(rest.to_string());
             }
             _ => {}
@@ -113,10 +123,14 @@ fn parse_map_arg(arg: &str) -> (String, Option<String>, bool) {
         if opt == "-clamp" {
             clamp = toks.get(i).is_some_and(|v| v.eq_ignore_ascii_case("on"));
         }
-        let numeric = matches!(opt, "-o" | "-s" | "-t" | "-mm" | "-boost" | "-bm" | "-texres");
+        let numeric = matches!(
+            opt,
+            "-o" | "-s" | "-t" | "-mm" | "-boost" | "-bm" | "-texres"
+        );
         let mut taken = 0;
         // Leave at least one token for the file name.
-        while taken < max_args && i + 1 < toks.len() && (!numeric || toks[i].parse::<f64>().is_ok()) {
+        while taken < max_args && i + 1 < toks.len() && (!numeric || toks[i].parse::<f64>().is_ok())
+        {
             i += 1;
             taken += 1;
         }
@@ -137,9 +151,77 @@ fn find_nonfinite_vertex(path: &Path) -> Option<(usize, usize)> {
         let mut w = line.split_whitespace();
         if w.next() == Some("v") {
             vi += 1;
-            if w.take(3).any(|t| t.parse::<f32>().is_ok_and(|x| !x.is_finite())) {
+            if w.take(3)
+                .any(|t| t.parse::<f32>().is_ok_and(|x| !x.is_finite()))
+            {
                 return Some((vi, ln + 1));
             }
+        }
+    }
+    None
+}
+
+/// Finds the (1-based) line of the first statement that makes tobj fail with `err`, by
+/// re-reading the file with the same rules (numbers per statement, 1-based or negative
+/// relative indices within the counts seen so far).
+fn locate_obj_error(path: &Path, err: tobj::LoadError) -> Option<usize> {
+    use tobj::LoadError as E;
+    let mut text = Vec::new();
+    File::open(path).ok()?.read_to_end(&mut text).ok()?;
+    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
+    let in_range = |tok: &str, n: i64| {
+        tok.is_empty()
+            || tok
+                .parse::<i64>()
+                .is_ok_and(|i| (i > 0 && i <= n) || (i < 0 && -i <= n))
+    };
+    for (ln, raw) in text.split(|&b| b == b'\n').enumerate() {
+        let Ok(line) = std::str::from_utf8(raw) else {
+            return (err == E::ReadError).then_some(ln + 1);
+        };
+        let mut w = line.split_whitespace();
+        let key = w.next();
+        let floats_ok = |w: std::str::SplitWhitespace, k: usize| {
+            w.take(k).filter(|t| t.parse::<f32>().is_ok()).count() == k
+        };
+        let bad = match key {
+            Some("v") => {
+                nv += 1;
+                matches!(
+                    err,
+                    E::PositionParseError | E::ColorParseError | E::ScalingByZeroError
+                ) && !floats_ok(w, 3)
+            }
+            Some("vt") => {
+                nt += 1;
+                err == E::TexcoordParseError && !floats_ok(w, 2)
+            }
+            Some("vn") => {
+                nn += 1;
+                err == E::NormalParseError && !floats_ok(w, 3)
+            }
+            Some("f") => w.any(|v| {
+                let mut parts = v.split('/');
+                let (a, b, c) = (
+                    parts.next().unwrap_or(""),
+                    parts.next().unwrap_or(""),
+                    parts.next().unwrap_or(""),
+                );
+                let parses = |t: &str| t.is_empty() || t.parse::<i64>().is_ok();
+                match err {
+                    E::FaceParseError => {
+                        !(parses(a) && parses(b) && parses(c)) || parts.next().is_some()
+                    }
+                    E::FaceVertexOutOfBounds => !in_range(a, nv) || a.is_empty(),
+                    E::FaceTexCoordOutOfBounds => !in_range(b, nt),
+                    E::FaceNormalOutOfBounds => !in_range(c, nn),
+                    _ => false,
+                }
+            }),
+            _ => false,
+        };
+        if bad {
+            return Some(ln + 1);
         }
     }
     None
@@ -161,9 +243,14 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                 let mut store = mtl_entries.borrow_mut();
                 for e in entries {
                     map.insert(e.name.clone(), mats.len());
-                    mats.push(tobj::Material { name: e.name.clone(), ..tobj::Material::default() });
+                    mats.push(tobj::Material {
+                        name: e.name.clone(),
+                        ..tobj::Material::default()
+                    });
                     store.push(e);
-                    mtl_dirs.borrow_mut().push(full.parent().map(Path::to_path_buf).unwrap_or_default());
+                    mtl_dirs
+                        .borrow_mut()
+                        .push(full.parent().map(Path::to_path_buf).unwrap_or_default());
                 }
                 Ok((mats, map))
             }
@@ -181,7 +268,12 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
             }
         }
     };
-    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
     let mut reader = BufReader::new(file);
     let res = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         tobj::load_obj_buf(&mut reader, &opts, loader)
@@ -191,7 +283,10 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
     }
     let (models, _) = match res {
         Ok(Ok(r)) => r,
-        Ok(Err(e)) => return Err(Error::file(path, format!("malformed OBJ: {e}"))),
+        Ok(Err(e)) => {
+            let at = locate_obj_error(path, e).map_or_else(String::new, |l| format!("line {l}: "));
+            return Err(Error::file(path, format!("malformed OBJ: {at}{e}")));
+        }
         Err(_) => return Err(Error::file(path, "malformed OBJ (index out of range)")),
     };
     let mut warnings = mtl_warnings.into_inner();
@@ -203,7 +298,10 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
     let mut textures: Vec<TextureImage> = Vec::new();
     let mut tex_cache: BTreeMap<PathBuf, Option<usize>> = BTreeMap::new();
     for (e, mdir) in entries.iter().zip(&mtl_dirs) {
-        let mut m = Material { name: e.name.clone(), ..Material::default() };
+        let mut m = Material {
+            name: e.name.clone(),
+            ..Material::default()
+        };
         if let Some(kd) = e.kd {
             m.kd = kd;
         }
@@ -256,7 +354,11 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
         if tm.indices.len() < 3 {
             continue;
         }
-        let positions: Vec<[f32; 3]> = tm.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let positions: Vec<[f32; 3]> = tm
+            .positions
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
         if positions.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
             let msg = match find_nonfinite_vertex(path) {
                 Some((vi, ln)) => format!("vertex {vi} (line {ln}) is not finite"),
@@ -264,33 +366,47 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
             };
             return Err(Error::file(path, msg));
         }
-        let indices: Vec<[u32; 3]> = tm.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let indices: Vec<[u32; 3]> = tm
+            .indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
         let n = positions.len();
         if let Some(bad) = indices.iter().flatten().find(|&&i| i as usize >= n) {
-            return Err(Error::file(path, format!("face index {bad} out of range in '{}'", model.name)));
+            return Err(Error::file(
+                path,
+                format!("face index {bad} out of range in '{}'", model.name),
+            ));
         }
-        let normals = if tm.normals.len() == tm.positions.len() && tm.normals.iter().all(|c| c.is_finite()) {
-            let smooth = smooth_normals(&positions, &indices);
-            tm.normals
-                .chunks_exact(3)
-                .zip(smooth)
-                .map(|(c, s)| {
-                    let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-                    if l > 0.0 && l.is_finite() {
-                        [c[0] / l, c[1] / l, c[2] / l]
-                    } else {
-                        s
-                    }
-                })
-                .collect()
-        } else {
-            smooth_normals(&positions, &indices)
-        };
+        let normals =
+            if tm.normals.len() == tm.positions.len() && tm.normals.iter().all(|c| c.is_finite()) {
+                let smooth = smooth_normals(&positions, &indices);
+                tm.normals
+                    .chunks_exact(3)
+                    .zip(smooth)
+                    .map(|(c, s)| {
+                        let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                        if l > 0.0 && l.is_finite() {
+                            [c[0] / l, c[1] / l, c[2] / l]
+                        } else {
+                            s
+                        }
+                    })
+                    .collect()
+            } else {
+                smooth_normals(&positions, &indices)
+            };
         let uvs: Vec<[f32; 2]> = if tm.texcoords.len() == 2 * n {
             if tm.texcoords.iter().any(|c| !c.is_finite()) {
-                return Err(Error::file(path, format!("a texture coordinate of '{}' is not finite", model.name)));
+                return Err(Error::file(
+                    path,
+                    format!("a texture coordinate of '{}' is not finite", model.name),
+                ));
             }
-            tm.texcoords.chunks_exact(2).map(|c| [c[0], 1.0 - c[1]]).collect()
+            tm.texcoords
+                .chunks_exact(2)
+                .map(|c| [c[0], 1.0 - c[1]])
+                .collect()
         } else {
             Vec::new()
         };
@@ -317,7 +433,14 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                 materials.len() - 1
             });
         }
-        meshes.push(Mesh { name: model.name, positions, normals, uvs, indices, material });
+        meshes.push(Mesh {
+            name: model.name,
+            positions,
+            normals,
+            uvs,
+            indices,
+            material,
+        });
     }
     if meshes.iter().all(|m| m.indices.is_empty()) {
         return Err(Error::file(path, "no triangles (empty mesh)"));
@@ -325,7 +448,12 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
     if materials.is_empty() {
         materials.push(Material::default());
     }
-    Ok(ObjParts { meshes, materials, textures, warnings })
+    Ok(ObjParts {
+        meshes,
+        materials,
+        textures,
+        warnings,
+    })
 }
 
 /// Loads an OBJ (+ MTL) file as a scene: 1024x768, fitted camera and key light, ambient 0.15,
@@ -363,7 +491,10 @@ mod tests {
     fn map_args() {
         assert_eq!(parse_map_arg("tex.png"), ("tex.png".into(), None, false));
         assert_eq!(parse_map_arg("-s 2 2 1 -o 0.5 0 tex.png").0, "tex.png");
-        assert_eq!(parse_map_arg("-clamp on tex.png"), ("tex.png".into(), None, true));
+        assert_eq!(
+            parse_map_arg("-clamp on tex.png"),
+            ("tex.png".into(), None, true)
+        );
         assert_eq!(parse_map_arg("my tex.png").0, "my tex.png");
         assert_eq!(parse_map_arg("\"my tex.png\"").0, "my tex.png");
         assert_eq!(parse_map_arg("-bm 0.5 -s 2 tex.png").0, "tex.png");

@@ -19,7 +19,12 @@ pub fn plane(size: f32, uv_scale: f32) -> Mesh {
         name: "plane".into(),
         positions: vec![[-s, 0.0, s], [s, 0.0, s], [s, 0.0, -s], [-s, 0.0, -s]],
         normals: vec![[0.0, 1.0, 0.0]; 4],
-        uvs: vec![[0.0, 0.0], [uv_scale, 0.0], [uv_scale, uv_scale], [0.0, uv_scale]],
+        uvs: vec![
+            [0.0, 0.0],
+            [uv_scale, 0.0],
+            [uv_scale, uv_scale],
+            [0.0, uv_scale],
+        ],
         indices: vec![[0, 1, 2], [0, 2, 3]],
         material: 0,
     }
@@ -31,7 +36,10 @@ pub fn plane(size: f32, uv_scale: f32) -> Mesh {
 pub fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
     let (segs, rings) = (segments.max(3), rings.max(2));
     let r = f64::from(radius);
-    let mut m = Mesh { name: "sphere".into(), ..Mesh::default() };
+    let mut m = Mesh {
+        name: "sphere".into(),
+        ..Mesh::default()
+    };
     for i in 0..=rings {
         let th = PI * f64::from(i) / f64::from(rings);
         for j in 0..=segs {
@@ -39,7 +47,8 @@ pub fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
             let n = (th.sin() * ph.sin(), th.cos(), th.sin() * ph.cos());
             m.positions.push(f3(r * n.0, r * n.1, r * n.2));
             m.normals.push(f3(n.0, n.1, n.2));
-            m.uvs.push([j as f32 / segs as f32, i as f32 / rings as f32]);
+            m.uvs
+                .push([j as f32 / segs as f32, i as f32 / rings as f32]);
         }
     }
     let row = segs + 1;
@@ -62,14 +71,25 @@ pub fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
 pub fn torus(major: f32, minor: f32, nu: u32, nv: u32, s_repeat: f32) -> Mesh {
     let (nu, nv) = (nu.max(3), nv.max(3));
     let (rr, r) = (f64::from(major), f64::from(minor));
-    let mut m = Mesh { name: "torus".into(), ..Mesh::default() };
+    let mut m = Mesh {
+        name: "torus".into(),
+        ..Mesh::default()
+    };
     for i in 0..=nu {
         let u = 2.0 * PI * f64::from(i) / f64::from(nu);
         for j in 0..=nv {
             let a = 2.0 * PI * f64::from(j) / f64::from(nv);
-            m.positions.push(f3((rr + r * a.cos()) * u.cos(), (rr + r * a.cos()) * u.sin(), r * a.sin()));
-            m.normals.push(f3(a.cos() * u.cos(), a.cos() * u.sin(), a.sin()));
-            m.uvs.push([s_repeat * i as f32 / nu as f32, 1.0f32 * j as f32 / nv as f32]);
+            m.positions.push(f3(
+                (rr + r * a.cos()) * u.cos(),
+                (rr + r * a.cos()) * u.sin(),
+                r * a.sin(),
+            ));
+            m.normals
+                .push(f3(a.cos() * u.cos(), a.cos() * u.sin(), a.sin()));
+            m.uvs.push([
+                s_repeat * i as f32 / nu as f32,
+                1.0f32 * j as f32 / nv as f32,
+            ]);
         }
     }
     for i in 0..nu {
@@ -99,10 +119,18 @@ pub fn cube(size: f32) -> Mesh {
         ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
         ([0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
     ];
-    let mut m = Mesh { name: "cube".into(), ..Mesh::default() };
+    let mut m = Mesh {
+        name: "cube".into(),
+        ..Mesh::default()
+    };
     for (n, u, v) in faces {
         let base = m.positions.len() as u32;
-        for (su, sv, uv) in [(-1.0, -1.0, [0.0, 1.0]), (1.0, -1.0, [1.0, 1.0]), (1.0, 1.0, [1.0, 0.0]), (-1.0, 1.0, [0.0, 0.0])] {
+        for (su, sv, uv) in [
+            (-1.0, -1.0, [0.0, 1.0]),
+            (1.0, -1.0, [1.0, 1.0]),
+            (1.0, 1.0, [1.0, 0.0]),
+            (-1.0, 1.0, [0.0, 0.0]),
+        ] {
             let p: [f32; 3] = std::array::from_fn(|k| h * (n[k] + su * u[k] + sv * v[k]));
             m.positions.push(p);
             m.normals.push(n);

@@ -15,9 +15,13 @@ pub const MAX_TEXTURE_SIDE: u32 = 16384;
 /// Decodes a PNG or JPEG file (8 or 16 bit; gray, gray+alpha, RGB or RGBA) to RGBA16, top row
 /// first. Gray replicates to RGB; a missing alpha is opaque. Errors name the file.
 pub fn decode_texture(path: &Path) -> Result<TextureImage> {
-    let meta = std::fs::metadata(path).map_err(|e| Error::file(path, format!("cannot open texture: {e}")))?;
+    let meta = std::fs::metadata(path)
+        .map_err(|e| Error::file(path, format!("cannot open texture: {e}")))?;
     if meta.is_dir() {
-        return Err(Error::file(path, "is a directory, expected a PNG or JPEG texture"));
+        return Err(Error::file(
+            path,
+            "is a directory, expected a PNG or JPEG texture",
+        ));
     }
     let reader = ImageReader::open(path)
         .map_err(|e| Error::file(path, format!("cannot open texture: {e}")))?
@@ -37,7 +41,13 @@ pub fn decode_texture(path: &Path) -> Result<TextureImage> {
         ));
     }
     let texels = to_rgba16(&img);
-    Ok(TextureImage { name: path.display().to_string(), width, height, texels, prebuilt_levels: None })
+    Ok(TextureImage {
+        name: path.display().to_string(),
+        width,
+        height,
+        texels,
+        prebuilt_levels: None,
+    })
 }
 
 fn to_rgba16(img: &DynamicImage) -> Vec<[u16; 4]> {
@@ -143,7 +153,13 @@ fn expand(t: &[[u8; 4]]) -> Vec<[u16; 4]> {
 /// A texture from 8-bit level 0 only (`maps` builds the chain).
 #[must_use]
 pub fn from_rgba8(name: &str, size: u32, t: &[[u8; 4]]) -> TextureImage {
-    TextureImage { name: name.into(), width: size, height: size, texels: expand(t), prebuilt_levels: None }
+    TextureImage {
+        name: name.into(),
+        width: size,
+        height: size,
+        texels: expand(t),
+        prebuilt_levels: None,
+    }
 }
 
 /// The Mesa anchor texture with its integer-filtered chain as `prebuilt_levels` (x257).
@@ -156,7 +172,12 @@ pub fn mesa_texture(size: u32) -> TextureImage {
         width: *w,
         height: *h,
         texels: expand(t0),
-        prebuilt_levels: Some(levels[1..].iter().map(|(w, h, t)| (*w, *h, expand(t))).collect()),
+        prebuilt_levels: Some(
+            levels[1..]
+                .iter()
+                .map(|(w, h, t)| (*w, *h, expand(t)))
+                .collect(),
+        ),
     }
 }
 
@@ -168,7 +189,11 @@ pub fn checker(size: u32, checks: u32, a: [u8; 3], b: [u8; 3]) -> TextureImage {
     let mut t = Vec::with_capacity(size as usize * size as usize);
     for y in 0..size {
         for x in 0..size {
-            let c = if ((x / cell) ^ (y / cell)) & 1 == 0 { a } else { b };
+            let c = if ((x / cell) ^ (y / cell)) & 1 == 0 {
+                a
+            } else {
+                b
+            };
             t.push([c[0], c[1], c[2], 255]);
         }
     }
@@ -178,7 +203,9 @@ pub fn checker(size: u32, checks: u32, a: [u8; 3], b: [u8; 3]) -> TextureImage {
 /// Procedural texture by name (`checker`, `noise-checker`, `mesa`) and side `size`.
 pub fn procedural(kind: &str, size: u32) -> Result<TextureImage> {
     if !(1..=MAX_TEXTURE_SIDE).contains(&size) {
-        return Err(Error::field("size", format!("{size} is outside 1..={MAX_TEXTURE_SIDE}")));
+        return Err(Error::msg(format!(
+            "texture size {size} is outside 1..={MAX_TEXTURE_SIDE}"
+        )));
     }
     match kind {
         "checker" => Ok(checker(size, 8, [230, 230, 230], [40, 40, 48])),
@@ -187,9 +214,8 @@ pub fn procedural(kind: &str, size: u32) -> Result<TextureImage> {
             Ok(from_rgba8(&format!("noise-checker-{size}"), size, &t))
         }
         "mesa" => Ok(mesa_texture(size)),
-        other => Err(Error::field(
-            "procedural",
-            format!("unknown procedural texture '{other}' (known: checker, noise-checker, mesa)"),
-        )),
+        other => Err(Error::msg(format!(
+            "unknown procedural texture '{other}' (known: checker, noise-checker, mesa)"
+        ))),
     }
 }

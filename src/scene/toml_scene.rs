@@ -9,7 +9,7 @@ use serde::Deserialize;
 
 use super::geometry::{bounding_sphere, fit_camera, fit_light, transform_mesh};
 use super::obj::{load_obj_parts, open_regular};
-use super::texture::{decode_texture, procedural};
+use super::texture::{decode_texture, procedural, MAX_TEXTURE_SIDE};
 use super::{shapes, Camera, Light, Material, Mesh, Scene, WrapMode};
 use crate::{Error, Result};
 
@@ -122,7 +122,11 @@ const MAX_SEGMENTS: u32 = 4096;
 
 fn resolve(base: &Path, rel: &str) -> PathBuf {
     let p = Path::new(rel);
-    let joined = if p.is_absolute() { p.to_path_buf() } else { base.join(p) };
+    let joined = if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    };
     std::path::absolute(&joined).unwrap_or(joined)
 }
 
@@ -147,7 +151,10 @@ fn positive(field: &str, v: Option<f32>, default: f32) -> Result<f32> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(Error::field(field, format!("{v} must be a positive number")))
+        Err(Error::field(
+            field,
+            format!("{v} must be a positive number"),
+        ))
     }
 }
 
@@ -156,7 +163,10 @@ fn count(field: &str, v: Option<u32>, default: u32, min: u32) -> Result<u32> {
     if (min..=MAX_SEGMENTS).contains(&v) {
         Ok(v)
     } else {
-        Err(Error::field(field, format!("{v} is outside {min}..={MAX_SEGMENTS}")))
+        Err(Error::field(
+            field,
+            format!("{v} is outside {min}..={MAX_SEGMENTS}"),
+        ))
     }
 }
 
@@ -175,7 +185,13 @@ fn build_shape(i: usize, c: &MeshCfg, shape: &str) -> Result<Mesh> {
     let allowed: &[&str] = match shape {
         "plane" => &["size", "uv_scale"],
         "sphere" => &["radius", "segments", "rings"],
-        "torus" => &["major_radius", "minor_radius", "segments", "rings", "s_repeat"],
+        "torus" => &[
+            "major_radius",
+            "minor_radius",
+            "segments",
+            "rings",
+            "s_repeat",
+        ],
         "cube" => &["size"],
         other => {
             return Err(Error::field(
@@ -184,11 +200,20 @@ fn build_shape(i: usize, c: &MeshCfg, shape: &str) -> Result<Mesh> {
             ))
         }
     };
-    if let Some((p, _)) = used_params.iter().find(|(p, used)| *used && !allowed.contains(p)) {
-        return Err(Error::field(&f(p), format!("not a parameter of shape '{shape}'")));
+    if let Some((p, _)) = used_params
+        .iter()
+        .find(|(p, used)| *used && !allowed.contains(p))
+    {
+        return Err(Error::field(
+            &f(p),
+            format!("not a parameter of shape '{shape}'"),
+        ));
     }
     Ok(match shape {
-        "plane" => shapes::plane(positive(&f("size"), c.size, 2.0)?, positive(&f("uv_scale"), c.uv_scale, 1.0)?),
+        "plane" => shapes::plane(
+            positive(&f("size"), c.size, 2.0)?,
+            positive(&f("uv_scale"), c.uv_scale, 1.0)?,
+        ),
         "sphere" => shapes::sphere(
             positive(&f("radius"), c.radius, 1.0)?,
             count(&f("segments"), c.segments, 64, 3)?,
@@ -210,8 +235,22 @@ pub fn load_toml(path: &Path) -> Result<Scene> {
     let mut text = String::new();
     std::io::Read::read_to_string(&mut open_regular(path, "a TOML scene file")?, &mut text)
         .map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let cfg: SceneFile = toml::from_str(&text).map_err(|e| Error::file(path, e.to_string().trim_end()))?;
+    let cfg: SceneFile =
+        toml::from_str(&text).map_err(|e| Error::file(path, toml_error(&text, &e)))?;
     build(path, cfg).map_err(|e| e.context(path.display()))
+}
+
+/// One-line form of a toml error: `line L, column C (`source line`): message`.
+fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().trim_end().replace('\n', " ");
+    let Some(span) = e.span() else { return msg };
+    let start = span.start.min(text.len());
+    let before = text.get(..start).unwrap_or("");
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before[line_start..].chars().count() + 1;
+    let src = text[line_start..].lines().next().unwrap_or("").trim();
+    format!("line {line}, column {col} (`{src}`): {msg}")
 }
 
 fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
@@ -222,17 +261,35 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
     for (i, t) in cfg.textures.iter().enumerate() {
         let f = |n: &str| format!("textures[{i}].{n}");
         if tex_names.insert(t.name.clone(), textures.len()).is_some() {
-            return Err(Error::field(&f("name"), format!("duplicate texture name '{}'", t.name)));
+            return Err(Error::field(
+                &f("name"),
+                format!("duplicate texture name '{}'", t.name),
+            ));
         }
         let tex = match (&t.file, &t.procedural) {
             (Some(file), None) => {
                 if t.size.is_some() {
                     return Err(Error::field(&f("size"), "only for procedural textures"));
                 }
-                decode_texture(&resolve(&base, file)).map_err(|e| e.context(format!("field '{}'", f("file"))))?
+                decode_texture(&resolve(&base, file))
+                    .map_err(|e| e.context(format!("field '{}'", f("file"))))?
             }
-            (None, Some(kind)) => procedural(kind, t.size.unwrap_or(256)).map_err(|e| e.context(f("")))?,
-            _ => return Err(Error::field(&f("file"), "give exactly one of 'file' or 'procedural'")),
+            (None, Some(kind)) => {
+                let size = t.size.unwrap_or(256);
+                if !(1..=MAX_TEXTURE_SIDE).contains(&size) {
+                    return Err(Error::field(
+                        &f("size"),
+                        format!("{size} is outside 1..={MAX_TEXTURE_SIDE}"),
+                    ));
+                }
+                procedural(kind, size).map_err(|e| Error::field(&f("procedural"), e))?
+            }
+            _ => {
+                return Err(Error::field(
+                    &f("file"),
+                    "give exactly one of 'file' or 'procedural'",
+                ))
+            }
         };
         textures.push(tex);
     }
@@ -241,18 +298,26 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
     for (i, m) in cfg.materials.iter().enumerate() {
         let f = |n: &str| format!("materials[{i}].{n}");
         if mat_names.insert(m.name.clone(), materials.len()).is_some() {
-            return Err(Error::field(&f("name"), format!("duplicate material name '{}'", m.name)));
+            return Err(Error::field(
+                &f("name"),
+                format!("duplicate material name '{}'", m.name),
+            ));
         }
         let texture = match &m.texture {
             Some(n) => Some(*tex_names.get(n).ok_or_else(|| {
-                Error::field(&f("texture"), format!("no texture named '{n}' in [[textures]]"))
+                Error::field(
+                    &f("texture"),
+                    format!("no texture named '{n}' in [[textures]]"),
+                )
             })?),
             None => None,
         };
         let def = Material::default();
         materials.push(Material {
             name: m.name.clone(),
-            kd: m.kd.unwrap_or(if texture.is_some() { [1.0; 3] } else { def.kd }),
+            kd: m
+                .kd
+                .unwrap_or(if texture.is_some() { [1.0; 3] } else { def.kd }),
             texture,
             wrap_s: m.wrap_s.unwrap_or(def.wrap_s),
             wrap_t: m.wrap_t.unwrap_or(def.wrap_t),
@@ -266,7 +331,10 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
         let f = |n: &str| format!("meshes[{i}].{n}");
         let explicit = match &c.material {
             Some(n) => Some(*mat_names.get(n).ok_or_else(|| {
-                Error::field(&f("material"), format!("no material named '{n}' in [[materials]]"))
+                Error::field(
+                    &f("material"),
+                    format!("no material named '{n}' in [[materials]]"),
+                )
             })?),
             None => None,
         };
@@ -276,10 +344,19 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
         }
         let mut new_meshes = match (&c.obj, &c.shape) {
             (Some(obj), None) => {
-                if c.size.or(c.uv_scale).or(c.radius).or(c.major_radius).or(c.minor_radius).or(c.s_repeat).is_some()
+                if c.size
+                    .or(c.uv_scale)
+                    .or(c.radius)
+                    .or(c.major_radius)
+                    .or(c.minor_radius)
+                    .or(c.s_repeat)
+                    .is_some()
                     || c.segments.or(c.rings).is_some()
                 {
-                    return Err(Error::field(&f("obj"), "shape parameters are not allowed with 'obj'"));
+                    return Err(Error::field(
+                        &f("obj"),
+                        "shape parameters are not allowed with 'obj'",
+                    ));
                 }
                 let parts = load_obj_parts(&resolve(&base, obj))?;
                 warnings.extend(parts.warnings);
@@ -312,7 +389,12 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
                 };
                 vec![m]
             }
-            _ => return Err(Error::field(&f("obj"), "give exactly one of 'obj' or 'shape'")),
+            _ => {
+                return Err(Error::field(
+                    &f("obj"),
+                    "give exactly one of 'obj' or 'shape'",
+                ))
+            }
         };
         for m in &mut new_meshes {
             transform_mesh(m, &xf);
@@ -330,7 +412,11 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             return Err(Error::field(n, format!("{v} is outside 1..=8192")));
         }
     }
-    let background = cfg.output.as_ref().and_then(|o| o.background).unwrap_or(super::obj::OBJ_BACKGROUND);
+    let background = cfg
+        .output
+        .as_ref()
+        .and_then(|o| o.background)
+        .unwrap_or(super::obj::OBJ_BACKGROUND);
     let camera = build_camera(cfg.camera.as_ref(), &meshes, width, height)?;
     let lights = match &cfg.lights {
         None => vec![fit_light(&camera)],
@@ -349,7 +435,8 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
     });
     let scene = Scene {
         name: cfg.name.unwrap_or_else(|| {
-            path.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned())
+            path.file_stem()
+                .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned())
         }),
         width,
         height,
@@ -373,19 +460,29 @@ fn build_light(i: usize, l: &LightCfg) -> Result<Light> {
     match l.kind {
         LightKind::Directional => {
             if l.position.is_some() {
-                return Err(Error::field(&f("position"), "not used by a directional light"));
+                return Err(Error::field(
+                    &f("position"),
+                    "not used by a directional light",
+                ));
             }
-            let d = l.direction.ok_or_else(|| Error::field(&f("direction"), "required"))?;
+            let d = l
+                .direction
+                .ok_or_else(|| Error::field(&f("direction"), "required"))?;
             if d.iter().all(|c| *c == 0.0) {
                 return Err(Error::field(&f("direction"), "must not be zero"));
             }
-            Ok(Light::Directional { direction: d, color })
+            Ok(Light::Directional {
+                direction: d,
+                color,
+            })
         }
         LightKind::Point => {
             if l.direction.is_some() {
                 return Err(Error::field(&f("direction"), "not used by a point light"));
             }
-            let p = l.position.ok_or_else(|| Error::field(&f("position"), "required"))?;
+            let p = l
+                .position
+                .ok_or_else(|| Error::field(&f("position"), "required"))?;
             Ok(Light::Point { position: p, color })
         }
     }
@@ -408,8 +505,12 @@ fn build_camera(c: Option<&CameraCfg>, meshes: &[Mesh], w: u32, h: u32) -> Resul
         }
         return Ok(fit_camera(meshes, w, h));
     };
-    let eye = c.eye.ok_or_else(|| Error::field("camera.eye", "required unless camera.fit = true"))?;
-    let target = c.target.ok_or_else(|| Error::field("camera.target", "required unless camera.fit = true"))?;
+    let eye = c
+        .eye
+        .ok_or_else(|| Error::field("camera.eye", "required unless camera.fit = true"))?;
+    let target = c
+        .target
+        .ok_or_else(|| Error::field("camera.target", "required unless camera.fit = true"))?;
     let (centre, r) = bounding_sphere(meshes);
     let dist = DVec3::from(eye).distance(centre);
     let far = c.far.unwrap_or((dist + 2.0 * r).max(1e-3));
