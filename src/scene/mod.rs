@@ -3,7 +3,47 @@
 //! Loaders (`obj`, `toml_scene`) and the built-in catalogue (`builtin`) all produce a [`Scene`]
 //! that has been checked: finite positions, indices in range, at least one triangle overall.
 
+//!
+//! Texture coordinate convention: `uv = (s, t)` addresses the texture as OpenGL does with
+//! `glTexImage2D` data: `s` runs along a row, `t` across rows, and `t = 0` is texel row 0,
+//! which is the *top* row of an image file (`TextureImage` is stored top row first). OBJ files
+//! are therefore loaded with `t = 1 - v` (OBJ's v = 0 is the bottom of the image).
+
+use std::path::Path;
+
 use glam::{DMat4, DVec3};
+
+mod catalogue;
+mod geometry;
+mod obj;
+pub mod shapes;
+pub mod texture;
+mod toml_scene;
+
+pub use catalogue::{builtin, w1_view, w2_view, BUILTIN};
+pub use geometry::{
+    bounding_sphere, fit_camera, fit_light, smooth_normals, transform_mesh, validate,
+    FALLBACK_NORMAL,
+};
+pub use obj::load_obj;
+pub use texture::decode_texture;
+pub use toml_scene::load_toml;
+
+/// Loads a scene file by extension: `.obj` (with its MTL) or `.toml`. Errors name the file.
+pub fn load(path: &Path) -> crate::Result<Scene> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "obj" => load_obj(path),
+        "toml" => load_toml(path),
+        _ => Err(crate::Error::file(
+            path,
+            "unknown scene file type (expected a .obj or .toml file)",
+        )),
+    }
+}
 
 /// Texture addressing mode per axis.
 pub use hw_model::wrap::WrapMode;
@@ -19,6 +59,7 @@ pub struct TextureImage {
     pub texels: Vec<[u16; 4]>,
     /// A prebuilt MIP chain (level 1..), when the source defines its own down-filter (the Mesa
     /// anchor workloads do); otherwise `maps` builds one.
+    #[allow(clippy::type_complexity)]
     pub prebuilt_levels: Option<Vec<(u32, u32, Vec<[u16; 4]>)>>,
 }
 

@@ -1,0 +1,235 @@
+//! Built-in procedural scenes. `w1-plane` and `w2-mesh` reproduce the Mesa anchor workloads of
+//! `/work/shared/anchors/mesa/mesa_anchor.c` exactly: texture generator, integer MIP chain,
+//! geometry order, GL modelview (as `Camera::view_override`) and `glFrustum` projection.
+
+use glam::{DMat4, DVec3};
+
+use super::geometry::{fit_camera, fit_light};
+use super::texture::{checker, mesa_texture, procedural, MESA_TEX_SIZE};
+use super::{shapes, Camera, Light, Material, Mesh, Scene, WrapMode};
+use crate::{Error, Result};
+
+/// Built-in scene names with a one-line description (for `texsim scenes`).
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("demo", "textured ground plane to the horizon (minification) + lit textured torus and sphere up close"),
+    ("w1-plane", "Mesa anchor W1: 1024x1024, one textured quad receding to the horizon, unlit (GL_REPLACE)"),
+    ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
+    ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
+];
+
+/// A built-in scene by name; an unknown name is an error listing the known ones.
+pub fn builtin(name: &str) -> Result<Scene> {
+    let scene = match name {
+        "demo" => demo()?,
+        "w1-plane" => w1_plane(),
+        "w2-mesh" => w2_mesh(),
+        "sphere" => sphere()?,
+        other => {
+            let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
+            return Err(Error::msg(format!(
+                "unknown built-in scene '{other}' (known: {})",
+                known.join(", ")
+            )));
+        }
+    };
+    super::validate(&scene).map_err(|e| e.context(format!("built-in scene '{name}'")))?;
+    Ok(scene)
+}
+
+/// A camera with an exact view matrix; eye/target/up are derived from it for display only.
+fn camera_from_view(view: DMat4, fov_y_deg: f64, near: f64, far: f64) -> Camera {
+    let inv = view.inverse();
+    let eye = inv.transform_point3(DVec3::ZERO);
+    let target = eye + inv.transform_vector3(DVec3::NEG_Z);
+    let up = inv.transform_vector3(DVec3::Y);
+    Camera {
+        eye: eye.to_array(),
+        target: target.to_array(),
+        up: up.to_array(),
+        fov_y_deg,
+        near,
+        far,
+        view_override: Some(view),
+    }
+}
+
+fn mesa_material() -> Material {
+    Material {
+        name: "mesa-replace".into(),
+        kd: [1.0; 3],
+        texture: Some(0),
+        wrap_s: WrapMode::Repeat,
+        wrap_t: WrapMode::Repeat,
+        lit: false,
+        cull_back: false,
+    }
+}
+
+fn mesa_scene(name: &str, mesh: Mesh, camera: Camera) -> Scene {
+    Scene {
+        name: name.into(),
+        width: 1024,
+        height: 1024,
+        camera,
+        lights: Vec::new(),
+        ambient: [0.0; 3],
+        background: [0.0; 4],
+        meshes: vec![mesh],
+        materials: vec![mesa_material()],
+        textures: vec![mesa_texture(MESA_TEX_SIZE)],
+        hw: None,
+        warnings: Vec::new(),
+    }
+}
+
+/// The W1 modelview: `glRotated(10, 1,0,0); glTranslated(0,-1,0)`.
+#[must_use]
+pub fn w1_view() -> DMat4 {
+    DMat4::from_rotation_x(10f64.to_radians()) * DMat4::from_translation(DVec3::new(0.0, -1.0, 0.0))
+}
+
+/// The W2 modelview: `glTranslated(0,0,-3.2); glRotated(-50, 1,0,0); glRotated(20, 0,0,1)`.
+#[must_use]
+pub fn w2_view() -> DMat4 {
+    DMat4::from_translation(DVec3::new(0.0, 0.0, -3.2))
+        * DMat4::from_rotation_x((-50f64).to_radians())
+        * DMat4::from_rotation_z(20f64.to_radians())
+}
+
+fn w1_plane() -> Scene {
+    const S: f32 = 256.0;
+    let mesh = Mesh {
+        name: "w1-plane".into(),
+        positions: vec![
+            [-S, 0.0, 1.0],
+            [S, 0.0, 1.0],
+            [S, 0.0, 1.0 - 2.0 * S],
+            [-S, 0.0, 1.0 - 2.0 * S],
+        ],
+        normals: vec![[0.0, 1.0, 0.0]; 4],
+        uvs: vec![[0.0, 0.0], [16.0, 0.0], [16.0, 16.0], [0.0, 16.0]],
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        material: 0,
+    };
+    // glFrustum(-top, top, -top, top, 0.1, 1000) with top = n tan 30 deg: 60 deg, aspect 1.
+    mesa_scene(
+        "w1-plane",
+        mesh,
+        camera_from_view(w1_view(), 60.0, 0.1, 1000.0),
+    )
+}
+
+fn w2_mesh() -> Scene {
+    let mut mesh = shapes::torus(1.0, 0.4, 256, 128, 2.0);
+    mesh.name = "w2-mesh".into();
+    // glFrustum with top = 1 * tan 22.5 deg: 45 deg, aspect 1, near 1, far 10.
+    mesa_scene(
+        "w2-mesh",
+        mesh,
+        camera_from_view(w2_view(), 45.0, 1.0, 10.0),
+    )
+}
+
+fn demo() -> Result<Scene> {
+    let mut ground = shapes::plane(600.0, 100.0);
+    ground.name = "ground".into();
+    ground.material = 0;
+    let mut torus = shapes::torus(0.55, 0.22, 96, 48, 3.0);
+    torus.name = "torus".into();
+    torus.material = 1;
+    super::geometry::transform_mesh(
+        &mut torus,
+        &(DMat4::from_translation(DVec3::new(0.75, 0.95, -1.9))
+            * DMat4::from_rotation_y(35f64.to_radians())
+            * DMat4::from_rotation_x(-65f64.to_radians())),
+    );
+    let mut ball = shapes::sphere(0.7, 64, 32);
+    ball.name = "sphere".into();
+    ball.material = 2;
+    super::geometry::transform_mesh(
+        &mut ball,
+        &DMat4::from_translation(DVec3::new(-1.6, 0.7, -4.5)),
+    );
+    let materials = vec![
+        Material {
+            name: "ground".into(),
+            kd: [1.0; 3],
+            texture: Some(0),
+            ..Material::default()
+        },
+        Material {
+            name: "torus".into(),
+            kd: [1.0; 3],
+            texture: Some(1),
+            cull_back: true,
+            ..Material::default()
+        },
+        Material {
+            name: "sphere".into(),
+            kd: [1.0; 3],
+            texture: Some(2),
+            cull_back: true,
+            ..Material::default()
+        },
+    ];
+    let mut ground_tex = procedural("noise-checker", 256)?;
+    ground_tex.name = "demo-ground".into();
+    let torus_tex = checker(64, 8, [250, 200, 60], [150, 30, 40]);
+    let sphere_tex = mesa_texture(256);
+    let dir = DVec3::new(0.55, -0.75, -0.4).normalize();
+    Ok(Scene {
+        name: "demo".into(),
+        width: 1024,
+        height: 768,
+        camera: Camera {
+            eye: [0.0, 1.6, 1.2],
+            target: [0.0, 0.85, -4.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 50.0,
+            near: 0.1,
+            far: 1000.0,
+            view_override: None,
+        },
+        lights: vec![Light::Directional {
+            direction: [dir.x as f32, dir.y as f32, dir.z as f32],
+            color: [0.85, 0.82, 0.75],
+        }],
+        ambient: [0.15, 0.16, 0.2],
+        background: [0.55, 0.68, 0.86, 1.0],
+        meshes: vec![ground, torus, ball],
+        materials,
+        textures: vec![ground_tex, torus_tex, sphere_tex],
+        hw: None,
+        warnings: Vec::new(),
+    })
+}
+
+fn sphere() -> Result<Scene> {
+    let mut ball = shapes::sphere(1.0, 96, 48);
+    ball.material = 0;
+    let mut tex = procedural("checker", 256)?;
+    tex.name = "sphere-checker".into();
+    let meshes = vec![ball];
+    let camera = fit_camera(&meshes, 1024, 768);
+    let light = fit_light(&camera);
+    Ok(Scene {
+        name: "sphere".into(),
+        width: 1024,
+        height: 768,
+        camera,
+        lights: vec![light],
+        ambient: [0.15; 3],
+        background: super::obj::OBJ_BACKGROUND,
+        meshes,
+        materials: vec![Material {
+            name: "sphere".into(),
+            kd: [1.0; 3],
+            texture: Some(0),
+            cull_back: true,
+            ..Material::default()
+        }],
+        textures: vec![tex],
+        hw: None,
+        warnings: Vec::new(),
+    })
+}

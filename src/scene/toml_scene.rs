@@ -1,0 +1,527 @@
+//! TOML scene files (see `scenes/example.toml` for every field). Parsed with serde +
+//! `deny_unknown_fields`; file paths inside are relative to the scene file.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use glam::{DMat4, DVec3};
+use serde::Deserialize;
+
+use super::geometry::{bounding_sphere, fit_camera, fit_light, transform_mesh};
+use super::obj::{load_obj_parts, open_regular};
+use super::texture::{decode_texture, procedural, MAX_TEXTURE_SIDE};
+use super::{shapes, Camera, Light, Material, Mesh, Scene, WrapMode};
+use crate::{Error, Result};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    name: Option<String>,
+    output: Option<OutputCfg>,
+    camera: Option<CameraCfg>,
+    ambient: Option<[f32; 3]>,
+    hw: Option<String>,
+    lights: Option<Vec<LightCfg>>,
+    #[serde(default)]
+    textures: Vec<TextureCfg>,
+    #[serde(default)]
+    materials: Vec<MaterialCfg>,
+    #[serde(default)]
+    meshes: Vec<MeshCfg>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OutputCfg {
+    width: Option<u32>,
+    height: Option<u32>,
+    background: Option<[f32; 4]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraCfg {
+    #[serde(default)]
+    fit: bool,
+    eye: Option<[f64; 3]>,
+    target: Option<[f64; 3]>,
+    up: Option<[f64; 3]>,
+    fov_y_deg: Option<f64>,
+    near: Option<f64>,
+    far: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum LightKind {
+    Directional,
+    Point,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightCfg {
+    kind: LightKind,
+    direction: Option<[f32; 3]>,
+    position: Option<[f32; 3]>,
+    color: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TextureCfg {
+    name: String,
+    file: Option<String>,
+    procedural: Option<String>,
+    size: Option<u32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialCfg {
+    name: String,
+    kd: Option<[f32; 3]>,
+    texture: Option<String>,
+    wrap_s: Option<WrapMode>,
+    wrap_t: Option<WrapMode>,
+    lit: Option<bool>,
+    cull_back: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ScaleCfg {
+    Uniform(f64),
+    Axes([f64; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshCfg {
+    obj: Option<String>,
+    shape: Option<String>,
+    material: Option<String>,
+    translate: Option<[f64; 3]>,
+    rotate_deg: Option<[f64; 3]>,
+    scale: Option<ScaleCfg>,
+    // Shape parameters.
+    size: Option<f32>,
+    uv_scale: Option<f32>,
+    radius: Option<f32>,
+    segments: Option<u32>,
+    rings: Option<u32>,
+    major_radius: Option<f32>,
+    minor_radius: Option<f32>,
+    s_repeat: Option<f32>,
+}
+
+/// Default output size of a TOML scene without `[output]` width/height.
+pub const TOML_DEFAULT_SIZE: (u32, u32) = (1024, 768);
+/// Largest shape tessellation accepted per axis.
+const MAX_SEGMENTS: u32 = 4096;
+
+fn resolve(base: &Path, rel: &str) -> PathBuf {
+    let p = Path::new(rel);
+    let joined = if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    };
+    std::path::absolute(&joined).unwrap_or(joined)
+}
+
+/// Object -> world: translate * Rz * Ry * Rx * scale (rotations applied X, then Y, then Z).
+fn mesh_transform(c: &MeshCfg) -> DMat4 {
+    let t = DVec3::from(c.translate.unwrap_or([0.0; 3]));
+    let r = c.rotate_deg.unwrap_or([0.0; 3]);
+    let s = match c.scale {
+        Some(ScaleCfg::Uniform(s)) => DVec3::splat(s),
+        Some(ScaleCfg::Axes(a)) => DVec3::from(a),
+        None => DVec3::ONE,
+    };
+    DMat4::from_translation(t)
+        * DMat4::from_rotation_z(r[2].to_radians())
+        * DMat4::from_rotation_y(r[1].to_radians())
+        * DMat4::from_rotation_x(r[0].to_radians())
+        * DMat4::from_scale(s)
+}
+
+fn positive(field: &str, v: Option<f32>, default: f32) -> Result<f32> {
+    let v = v.unwrap_or(default);
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::field(
+            field,
+            format!("{v} must be a positive number"),
+        ))
+    }
+}
+
+fn count(field: &str, v: Option<u32>, default: u32, min: u32) -> Result<u32> {
+    let v = v.unwrap_or(default);
+    if (min..=MAX_SEGMENTS).contains(&v) {
+        Ok(v)
+    } else {
+        Err(Error::field(
+            field,
+            format!("{v} is outside {min}..={MAX_SEGMENTS}"),
+        ))
+    }
+}
+
+fn build_shape(i: usize, c: &MeshCfg, shape: &str) -> Result<Mesh> {
+    let f = |name: &str| format!("meshes[{i}].{name}");
+    let used_params: &[(&str, bool)] = &[
+        ("size", c.size.is_some()),
+        ("uv_scale", c.uv_scale.is_some()),
+        ("radius", c.radius.is_some()),
+        ("segments", c.segments.is_some()),
+        ("rings", c.rings.is_some()),
+        ("major_radius", c.major_radius.is_some()),
+        ("minor_radius", c.minor_radius.is_some()),
+        ("s_repeat", c.s_repeat.is_some()),
+    ];
+    let allowed: &[&str] = match shape {
+        "plane" => &["size", "uv_scale"],
+        "sphere" => &["radius", "segments", "rings"],
+        "torus" => &[
+            "major_radius",
+            "minor_radius",
+            "segments",
+            "rings",
+            "s_repeat",
+        ],
+        "cube" => &["size"],
+        other => {
+            return Err(Error::field(
+                &f("shape"),
+                format!("unknown shape '{other}' (known: plane, sphere, torus, cube)"),
+            ))
+        }
+    };
+    if let Some((p, _)) = used_params
+        .iter()
+        .find(|(p, used)| *used && !allowed.contains(p))
+    {
+        return Err(Error::field(
+            &f(p),
+            format!("not a parameter of shape '{shape}'"),
+        ));
+    }
+    Ok(match shape {
+        "plane" => shapes::plane(
+            positive(&f("size"), c.size, 2.0)?,
+            positive(&f("uv_scale"), c.uv_scale, 1.0)?,
+        ),
+        "sphere" => shapes::sphere(
+            positive(&f("radius"), c.radius, 1.0)?,
+            count(&f("segments"), c.segments, 64, 3)?,
+            count(&f("rings"), c.rings, 32, 2)?,
+        ),
+        "torus" => shapes::torus(
+            positive(&f("major_radius"), c.major_radius, 1.0)?,
+            positive(&f("minor_radius"), c.minor_radius, 0.4)?,
+            count(&f("segments"), c.segments, 96, 3)?,
+            count(&f("rings"), c.rings, 48, 3)?,
+            positive(&f("s_repeat"), c.s_repeat, 2.0)?,
+        ),
+        _ => shapes::cube(positive(&f("size"), c.size, 1.0)?),
+    })
+}
+
+/// Loads a TOML scene. Errors name the file and the field (toml's message carries the line).
+pub fn load_toml(path: &Path) -> Result<Scene> {
+    let mut text = String::new();
+    std::io::Read::read_to_string(&mut open_regular(path, "a TOML scene file")?, &mut text)
+        .map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let cfg: SceneFile =
+        toml::from_str(&text).map_err(|e| Error::file(path, toml_error(&text, &e)))?;
+    build(path, cfg).map_err(|e| e.context(path.display()))
+}
+
+/// One-line form of a toml error: `line L, column C (`source line`): message`.
+fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().trim_end().replace('\n', " ");
+    let Some(span) = e.span() else { return msg };
+    let start = span.start.min(text.len());
+    let before = text.get(..start).unwrap_or("");
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before[line_start..].chars().count() + 1;
+    let src = text[line_start..].lines().next().unwrap_or("").trim();
+    format!("line {line}, column {col} (`{src}`): {msg}")
+}
+
+fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut warnings = Vec::new();
+    let mut textures = Vec::new();
+    let mut tex_names: BTreeMap<String, usize> = BTreeMap::new();
+    for (i, t) in cfg.textures.iter().enumerate() {
+        let f = |n: &str| format!("textures[{i}].{n}");
+        if tex_names.insert(t.name.clone(), textures.len()).is_some() {
+            return Err(Error::field(
+                &f("name"),
+                format!("duplicate texture name '{}'", t.name),
+            ));
+        }
+        let tex = match (&t.file, &t.procedural) {
+            (Some(file), None) => {
+                if t.size.is_some() {
+                    return Err(Error::field(&f("size"), "only for procedural textures"));
+                }
+                decode_texture(&resolve(&base, file))
+                    .map_err(|e| e.context(format!("field '{}'", f("file"))))?
+            }
+            (None, Some(kind)) => {
+                let size = t.size.unwrap_or(256);
+                if !(1..=MAX_TEXTURE_SIDE).contains(&size) {
+                    return Err(Error::field(
+                        &f("size"),
+                        format!("{size} is outside 1..={MAX_TEXTURE_SIDE}"),
+                    ));
+                }
+                procedural(kind, size).map_err(|e| Error::field(&f("procedural"), e))?
+            }
+            _ => {
+                return Err(Error::field(
+                    &f("file"),
+                    "give exactly one of 'file' or 'procedural'",
+                ))
+            }
+        };
+        textures.push(tex);
+    }
+    let mut materials = Vec::new();
+    let mut mat_names: BTreeMap<String, usize> = BTreeMap::new();
+    for (i, m) in cfg.materials.iter().enumerate() {
+        let f = |n: &str| format!("materials[{i}].{n}");
+        if mat_names.insert(m.name.clone(), materials.len()).is_some() {
+            return Err(Error::field(
+                &f("name"),
+                format!("duplicate material name '{}'", m.name),
+            ));
+        }
+        let texture = match &m.texture {
+            Some(n) => Some(*tex_names.get(n).ok_or_else(|| {
+                Error::field(
+                    &f("texture"),
+                    format!("no texture named '{n}' in [[textures]]"),
+                )
+            })?),
+            None => None,
+        };
+        let def = Material::default();
+        materials.push(Material {
+            name: m.name.clone(),
+            kd: m
+                .kd
+                .unwrap_or(if texture.is_some() { [1.0; 3] } else { def.kd }),
+            texture,
+            wrap_s: m.wrap_s.unwrap_or(def.wrap_s),
+            wrap_t: m.wrap_t.unwrap_or(def.wrap_t),
+            lit: m.lit.unwrap_or(def.lit),
+            cull_back: m.cull_back.unwrap_or(def.cull_back),
+        });
+    }
+    let mut default_mat: Option<usize> = None;
+    let mut meshes = Vec::new();
+    for (i, c) in cfg.meshes.iter().enumerate() {
+        let f = |n: &str| format!("meshes[{i}].{n}");
+        let explicit = match &c.material {
+            Some(n) => Some(*mat_names.get(n).ok_or_else(|| {
+                Error::field(
+                    &f("material"),
+                    format!("no material named '{n}' in [[materials]]"),
+                )
+            })?),
+            None => None,
+        };
+        let xf = mesh_transform(c);
+        if !xf.is_finite() {
+            return Err(Error::field(&f("translate"), "transform is not finite"));
+        }
+        let mut new_meshes = match (&c.obj, &c.shape) {
+            (Some(obj), None) => {
+                if c.size
+                    .or(c.uv_scale)
+                    .or(c.radius)
+                    .or(c.major_radius)
+                    .or(c.minor_radius)
+                    .or(c.s_repeat)
+                    .is_some()
+                    || c.segments.or(c.rings).is_some()
+                {
+                    return Err(Error::field(
+                        &f("obj"),
+                        "shape parameters are not allowed with 'obj'",
+                    ));
+                }
+                let parts = load_obj_parts(&resolve(&base, obj))?;
+                warnings.extend(parts.warnings);
+                let tex_off = textures.len();
+                textures.extend(parts.textures);
+                let mat_off = materials.len();
+                if explicit.is_none() {
+                    materials.extend(parts.materials.into_iter().map(|mut m| {
+                        m.texture = m.texture.map(|t| t + tex_off);
+                        m
+                    }));
+                }
+                parts
+                    .meshes
+                    .into_iter()
+                    .map(|mut m| {
+                        m.material = explicit.unwrap_or(m.material + mat_off);
+                        m
+                    })
+                    .collect()
+            }
+            (None, Some(shape)) => {
+                let mut m = build_shape(i, c, shape)?;
+                m.material = match explicit {
+                    Some(e) => e,
+                    None => *default_mat.get_or_insert_with(|| {
+                        materials.push(Material::default());
+                        materials.len() - 1
+                    }),
+                };
+                vec![m]
+            }
+            _ => {
+                return Err(Error::field(
+                    &f("obj"),
+                    "give exactly one of 'obj' or 'shape'",
+                ))
+            }
+        };
+        for m in &mut new_meshes {
+            transform_mesh(m, &xf);
+        }
+        meshes.extend(new_meshes);
+    }
+    if meshes.is_empty() {
+        return Err(Error::field("meshes", "the scene has no [[meshes]]"));
+    }
+    let (def_w, def_h) = TOML_DEFAULT_SIZE;
+    let width = cfg.output.as_ref().and_then(|o| o.width).unwrap_or(def_w);
+    let height = cfg.output.as_ref().and_then(|o| o.height).unwrap_or(def_h);
+    for (n, v) in [("output.width", width), ("output.height", height)] {
+        if !(1..=8192).contains(&v) {
+            return Err(Error::field(n, format!("{v} is outside 1..=8192")));
+        }
+    }
+    let background = cfg
+        .output
+        .as_ref()
+        .and_then(|o| o.background)
+        .unwrap_or(super::obj::OBJ_BACKGROUND);
+    let camera = build_camera(cfg.camera.as_ref(), &meshes, width, height)?;
+    let lights = match &cfg.lights {
+        None => vec![fit_light(&camera)],
+        Some(ls) => ls
+            .iter()
+            .enumerate()
+            .map(|(i, l)| build_light(i, l))
+            .collect::<Result<Vec<_>>>()?,
+    };
+    let hw = cfg.hw.map(|h| {
+        if h.ends_with(".toml") || h.contains('/') || h.contains('\\') {
+            resolve(&base, &h).display().to_string()
+        } else {
+            h
+        }
+    });
+    let scene = Scene {
+        name: cfg.name.unwrap_or_else(|| {
+            path.file_stem()
+                .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned())
+        }),
+        width,
+        height,
+        camera,
+        lights,
+        ambient: cfg.ambient.unwrap_or([super::obj::OBJ_AMBIENT; 3]),
+        background,
+        meshes,
+        materials,
+        textures,
+        hw,
+        warnings,
+    };
+    super::validate(&scene)?;
+    Ok(scene)
+}
+
+fn build_light(i: usize, l: &LightCfg) -> Result<Light> {
+    let f = |n: &str| format!("lights[{i}].{n}");
+    let color = l.color.unwrap_or([1.0; 3]);
+    match l.kind {
+        LightKind::Directional => {
+            if l.position.is_some() {
+                return Err(Error::field(
+                    &f("position"),
+                    "not used by a directional light",
+                ));
+            }
+            let d = l
+                .direction
+                .ok_or_else(|| Error::field(&f("direction"), "required"))?;
+            if d.iter().all(|c| *c == 0.0) {
+                return Err(Error::field(&f("direction"), "must not be zero"));
+            }
+            Ok(Light::Directional {
+                direction: d,
+                color,
+            })
+        }
+        LightKind::Point => {
+            if l.direction.is_some() {
+                return Err(Error::field(&f("direction"), "not used by a point light"));
+            }
+            let p = l
+                .position
+                .ok_or_else(|| Error::field(&f("position"), "required"))?;
+            Ok(Light::Point { position: p, color })
+        }
+    }
+}
+
+fn build_camera(c: Option<&CameraCfg>, meshes: &[Mesh], w: u32, h: u32) -> Result<Camera> {
+    let Some(c) = c.filter(|c| !c.fit) else {
+        if let Some(c) = c {
+            let given = [
+                ("camera.eye", c.eye.is_some()),
+                ("camera.target", c.target.is_some()),
+                ("camera.up", c.up.is_some()),
+                ("camera.fov_y_deg", c.fov_y_deg.is_some()),
+                ("camera.near", c.near.is_some()),
+                ("camera.far", c.far.is_some()),
+            ];
+            if let Some((n, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(Error::field(n, "not used when camera.fit = true"));
+            }
+        }
+        return Ok(fit_camera(meshes, w, h));
+    };
+    let eye = c
+        .eye
+        .ok_or_else(|| Error::field("camera.eye", "required unless camera.fit = true"))?;
+    let target = c
+        .target
+        .ok_or_else(|| Error::field("camera.target", "required unless camera.fit = true"))?;
+    let (centre, r) = bounding_sphere(meshes);
+    let dist = DVec3::from(eye).distance(centre);
+    let far = c.far.unwrap_or((dist + 2.0 * r).max(1e-3));
+    let near = c.near.unwrap_or_else(|| (dist - 2.0 * r).max(far * 1e-4));
+    Ok(Camera {
+        eye,
+        target,
+        up: c.up.unwrap_or([0.0, 1.0, 0.0]),
+        fov_y_deg: c.fov_y_deg.unwrap_or(45.0),
+        near,
+        far,
+        view_override: None,
+    })
+}
