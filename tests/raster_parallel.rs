@@ -21,17 +21,33 @@ fn random_scene(seed: u64, n: usize, w: u32, h: u32) -> Setup {
     let mut v = Vec::new();
     let mut d = Vec::new();
     for i in 0..n {
-        let (cx, cy) = (rng.range(-20.0, f64::from(w) + 20.0), rng.range(-20.0, f64::from(h) + 20.0));
-        let size = if i % 50 == 0 { 300.0 } else { rng.range(1.0, 40.0) };
+        let (cx, cy) = (
+            rng.range(-20.0, f64::from(w) + 20.0),
+            rng.range(-20.0, f64::from(h) + 20.0),
+        );
+        let size = if i % 50 == 0 {
+            300.0
+        } else {
+            rng.range(1.0, 40.0)
+        };
         let z = (rng.range(-1.0, 1.0) * 8.0).round() / 8.0;
         let base = v.len() as u32;
         for _ in 0..3 {
-            let mut c = px_to_clip(cx + rng.range(-size, size), cy + rng.range(-size, size), z, w, h);
+            let mut c = px_to_clip(
+                cx + rng.range(-size, size),
+                cy + rng.range(-size, size),
+                z,
+                w,
+                h,
+            );
             let s = rng.range(0.5, 2.0);
             c = c.map(|q| q * s);
             v.push(c);
         }
-        d.push(DrawTri { v: [base, base + 1, base + 2], cull_back: i % 3 == 0 });
+        d.push(DrawTri {
+            v: [base, base + 1, base + 2],
+            cull_back: i % 3 == 0,
+        });
     }
     setup(&v, &d, w, h, &cfg(8, 24))
 }
@@ -54,7 +70,11 @@ fn identical_for_any_thread_count() {
                 assert_eq!(in_pool(threads, || coverage_count(&s, cov)), c1);
             }
             if w * h < 5000 {
-                assert_eq!(c1, brute_count(&s, cov == Coverage::Float), "brute-force model");
+                assert_eq!(
+                    c1,
+                    brute_count(&s, cov == Coverage::Float),
+                    "brute-force model"
+                );
             }
         }
     }
@@ -87,8 +107,16 @@ fn throughput_100k_triangles_1024() {
             (t3 - t2).as_secs_f64() * 1e3,
         );
         assert!(st.visible > 600_000, "{st:?}");
-        let differ = vis_fixed.tri.iter().zip(&vis_float.tri).filter(|(a, b)| a != b).count();
-        assert!(differ * 100 < vis_fixed.tri.len(), "fixed vs float differ on {differ} pixels");
+        let differ = vis_fixed
+            .tri
+            .iter()
+            .zip(&vis_float.tri)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            differ * 100 < vis_fixed.tri.len(),
+            "fixed vs float differ on {differ} pixels"
+        );
         assert!((t3 - t0).as_secs_f64() < 20.0);
     }
 }

@@ -49,4 +49,6 @@ mod traverse;
 pub use setup::{
     setup, DrawTri, ScreenTri, Setup, SetupStats, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
 };
-pub use traverse::{coverage_count, rasterize, Coverage, RasterStats, VisBuffer, BAND_ROWS, NO_TRI};
+pub use traverse::{
+    coverage_count, rasterize, Coverage, RasterStats, VisBuffer, BAND_ROWS, NO_TRI,
+};
