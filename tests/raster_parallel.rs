@@ -120,3 +120,34 @@ fn throughput_100k_triangles_1024() {
         assert!((t3 - t0).as_secs_f64() < 20.0);
     }
 }
+
+#[test]
+fn setup_identical_for_any_thread_count() {
+    let mut rng = Rng(5);
+    let (w, h) = (300u32, 200u32);
+    let mut v = Vec::new();
+    for _ in 0..30_000 {
+        // Many cross the near plane or the guard band, some are behind the camera.
+        v.push([
+            rng.range(-6.0, 6.0),
+            rng.range(-6.0, 6.0),
+            rng.range(-2.0, 2.0),
+            rng.range(-0.5, 2.0),
+        ]);
+    }
+    let d: Vec<DrawTri> = (0..10_000u32)
+        .map(|i| DrawTri {
+            v: [3 * i, 3 * i + 1, 3 * i + 2],
+            cull_back: i % 2 == 0,
+        })
+        .collect();
+    let s1 = in_pool(1, || setup(&v, &d, w, h, &cfg(8, 24)));
+    assert!(s1.stats.clipped > 1000 && s1.stats.output > 1000, "{:?}", s1.stats);
+    // Submission order is kept.
+    assert!(s1.tris.windows(2).all(|p| p[0].src <= p[1].src));
+    for threads in [2, 4] {
+        let s = in_pool(threads, || setup(&v, &d, w, h, &cfg(8, 24)));
+        assert_eq!(s.stats, s1.stats);
+        assert_eq!(s.tris, s1.tris, "threads={threads}");
+    }
+}
