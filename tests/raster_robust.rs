@@ -376,3 +376,56 @@ fn fuzz_setup_and_rasterize() {
         check_setup(&v, &d, &s);
     }
 }
+
+/// Two triangles sharing an edge that crosses the near plane, w = 0 or the guard band: every
+/// clip vertex on the shared edge is bit-identical in both (watertight after clipping).
+#[test]
+fn shared_clipped_edges_are_cut_identically() {
+    let mut rng = Rng(31337);
+    let mut checked = 0;
+    for _ in 0..3000 {
+        let mut p = || {
+            [
+                rng.range(-30.0, 30.0),
+                rng.range(-30.0, 30.0),
+                rng.range(-3.0, 3.0),
+                rng.range(-1.0, 3.0),
+            ]
+        };
+        let v = vec![p(), p(), p(), p()];
+        // Edge (0, 1) shared, traversed in opposite directions.
+        let d = [
+            DrawTri {
+                v: [0, 1, 2],
+                cull_back: false,
+            },
+            DrawTri {
+                v: [1, 0, 3],
+                cull_back: false,
+            },
+        ];
+        let s = setup(&v, &d, 97, 61, &cfg(8, 24));
+        check_setup(&v, &d, &s);
+        let on_edge = |src: u32, third: usize| -> Vec<[u64; 2]> {
+            s.tris
+                .iter()
+                .filter(|t| t.src == src)
+                .flat_map(|t| {
+                    (0..3)
+                        .filter(move |&k| t.src_bary[k][third] == 0.0)
+                        .map(move |k| t.xy_f[k].map(f64::to_bits))
+                })
+                .collect()
+        };
+        let a = on_edge(0, 2);
+        let b = on_edge(1, 2);
+        for p in &a {
+            checked += 1;
+            assert!(
+                b.contains(p) || b.is_empty(),
+                "shared-edge vertex {p:?} not in {b:?}"
+            );
+        }
+    }
+    assert!(checked > 1000, "{checked}");
+}
