@@ -142,7 +142,11 @@ fn setup_identical_for_any_thread_count() {
         })
         .collect();
     let s1 = in_pool(1, || setup(&v, &d, w, h, &cfg(8, 24)));
-    assert!(s1.stats.clipped > 1000 && s1.stats.output > 1000, "{:?}", s1.stats);
+    assert!(
+        s1.stats.clipped > 1000 && s1.stats.output > 1000,
+        "{:?}",
+        s1.stats
+    );
     // Submission order is kept.
     assert!(s1.tris.windows(2).all(|p| p[0].src <= p[1].src));
     for threads in [2, 4] {
