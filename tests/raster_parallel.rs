@@ -118,6 +118,17 @@ fn throughput_100k_triangles_1024() {
             "fixed vs float differ on {differ} pixels"
         );
         assert!((t3 - t0).as_secs_f64() < 20.0);
+        let (t4, (vis1, _)) = in_pool(1, || {
+            let t = Instant::now();
+            let s1 = setup(&clip, &d, 1024, 1024, &cfg(8, 24));
+            let r = rasterize(&s1, Coverage::Fixed, true);
+            (t.elapsed(), r)
+        });
+        eprintln!(
+            "  1 thread: setup + fixed raster {:.1} ms",
+            t4.as_secs_f64() * 1e3
+        );
+        assert_eq!(vis1, vis_fixed);
     }
 }
 
