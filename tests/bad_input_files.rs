@@ -171,6 +171,34 @@ fn texture_problems_are_warnings_in_obj() {
 }
 
 #[test]
+fn map_kd_options_spaces_and_backslashes() {
+    let dir = temp_dir("mapkd");
+    std::fs::create_dir_all(dir.join("sub dir")).unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([1, 2, 3, 255]))
+        .save(dir.join("sub dir").join("my tex.png"))
+        .unwrap();
+    image::RgbaImage::from_pixel(1, 1, image::Rgba([9, 9, 9, 255]))
+        .save(dir.join("sub dir").join("b.png"))
+        .unwrap();
+    write(
+        &dir,
+        "m.mtl",
+        b"newmtl a\nmap_Kd -clamp on -s 1 1 1 sub dir/my tex.png\nnewmtl b\nmap_Kd sub dir\\b.png\n",
+    );
+    let body = format!("mtllib m.mtl\n{TRI}vt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 3/3 2/2\n");
+    let p = write(&dir, "o.obj", body.as_bytes());
+    let s = load_obj(&p).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.textures.len(), 2);
+    let a = s.materials.iter().find(|m| m.name == "a").unwrap();
+    assert_eq!(a.wrap_s, texsim::scene::WrapMode::ClampToEdge);
+    assert_eq!(
+        s.textures[a.texture.unwrap()].texels[0],
+        [257, 514, 771, 65535]
+    );
+}
+
+#[test]
 fn textured_material_without_uvs_warns() {
     let dir = temp_dir("nouv");
     image::RgbaImage::from_pixel(2, 2, image::Rgba([1, 2, 3, 255]))

@@ -21,17 +21,33 @@ fn random_scene(seed: u64, n: usize, w: u32, h: u32) -> Setup {
     let mut v = Vec::new();
     let mut d = Vec::new();
     for i in 0..n {
-        let (cx, cy) = (rng.range(-20.0, f64::from(w) + 20.0), rng.range(-20.0, f64::from(h) + 20.0));
-        let size = if i % 50 == 0 { 300.0 } else { rng.range(1.0, 40.0) };
+        let (cx, cy) = (
+            rng.range(-20.0, f64::from(w) + 20.0),
+            rng.range(-20.0, f64::from(h) + 20.0),
+        );
+        let size = if i % 50 == 0 {
+            300.0
+        } else {
+            rng.range(1.0, 40.0)
+        };
         let z = (rng.range(-1.0, 1.0) * 8.0).round() / 8.0;
         let base = v.len() as u32;
         for _ in 0..3 {
-            let mut c = px_to_clip(cx + rng.range(-size, size), cy + rng.range(-size, size), z, w, h);
+            let mut c = px_to_clip(
+                cx + rng.range(-size, size),
+                cy + rng.range(-size, size),
+                z,
+                w,
+                h,
+            );
             let s = rng.range(0.5, 2.0);
             c = c.map(|q| q * s);
             v.push(c);
         }
-        d.push(DrawTri { v: [base, base + 1, base + 2], cull_back: i % 3 == 0 });
+        d.push(DrawTri {
+            v: [base, base + 1, base + 2],
+            cull_back: i % 3 == 0,
+        });
     }
     setup(&v, &d, w, h, &cfg(8, 24))
 }
@@ -54,7 +70,11 @@ fn identical_for_any_thread_count() {
                 assert_eq!(in_pool(threads, || coverage_count(&s, cov)), c1);
             }
             if w * h < 5000 {
-                assert_eq!(c1, brute_count(&s, cov == Coverage::Float), "brute-force model");
+                assert_eq!(
+                    c1,
+                    brute_count(&s, cov == Coverage::Float),
+                    "brute-force model"
+                );
             }
         }
     }
@@ -87,8 +107,62 @@ fn throughput_100k_triangles_1024() {
             (t3 - t2).as_secs_f64() * 1e3,
         );
         assert!(st.visible > 600_000, "{st:?}");
-        let differ = vis_fixed.tri.iter().zip(&vis_float.tri).filter(|(a, b)| a != b).count();
-        assert!(differ * 100 < vis_fixed.tri.len(), "fixed vs float differ on {differ} pixels");
+        let differ = vis_fixed
+            .tri
+            .iter()
+            .zip(&vis_float.tri)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            differ * 100 < vis_fixed.tri.len(),
+            "fixed vs float differ on {differ} pixels"
+        );
         assert!((t3 - t0).as_secs_f64() < 20.0);
+        let (t4, (vis1, _)) = in_pool(1, || {
+            let t = Instant::now();
+            let s1 = setup(&clip, &d, 1024, 1024, &cfg(8, 24));
+            let r = rasterize(&s1, Coverage::Fixed, true);
+            (t.elapsed(), r)
+        });
+        eprintln!(
+            "  1 thread: setup + fixed raster {:.1} ms",
+            t4.as_secs_f64() * 1e3
+        );
+        assert_eq!(vis1, vis_fixed);
+    }
+}
+
+#[test]
+fn setup_identical_for_any_thread_count() {
+    let mut rng = Rng(5);
+    let (w, h) = (300u32, 200u32);
+    let mut v = Vec::new();
+    for _ in 0..30_000 {
+        // Many cross the near plane or the guard band, some are behind the camera.
+        v.push([
+            rng.range(-6.0, 6.0),
+            rng.range(-6.0, 6.0),
+            rng.range(-2.0, 2.0),
+            rng.range(-0.5, 2.0),
+        ]);
+    }
+    let d: Vec<DrawTri> = (0..10_000u32)
+        .map(|i| DrawTri {
+            v: [3 * i, 3 * i + 1, 3 * i + 2],
+            cull_back: i % 2 == 0,
+        })
+        .collect();
+    let s1 = in_pool(1, || setup(&v, &d, w, h, &cfg(8, 24)));
+    assert!(
+        s1.stats.clipped > 1000 && s1.stats.output > 1000,
+        "{:?}",
+        s1.stats
+    );
+    // Submission order is kept.
+    assert!(s1.tris.windows(2).all(|p| p[0].src <= p[1].src));
+    for threads in [2, 4] {
+        let s = in_pool(threads, || setup(&v, &d, w, h, &cfg(8, 24)));
+        assert_eq!(s.stats, s1.stats);
+        assert_eq!(s.tris, s1.tris, "threads={threads}");
     }
 }

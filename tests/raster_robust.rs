@@ -11,7 +11,16 @@ use texsim::raster::{
 const BOTH: [Coverage; 2] = [Coverage::Fixed, Coverage::Float];
 
 fn one(v: &[[f64; 4]], cull_back: bool, w: u32, h: u32) -> Setup {
-    setup(v, &[DrawTri { v: [0, 1, 2], cull_back }], w, h, &cfg(8, 24))
+    setup(
+        v,
+        &[DrawTri {
+            v: [0, 1, 2],
+            cull_back,
+        }],
+        w,
+        h,
+        &cfg(8, 24),
+    )
 }
 
 /// Every invariant a set-up triangle must satisfy, plus the stats identity.
@@ -32,12 +41,18 @@ fn check_setup(clip: &[[f64; 4]], d: &[DrawTri], s: &Setup) {
             .chain(&t.inv_w)
             .chain(t.src_bary.iter().flatten())
             .chain(std::iter::once(&t.area2_f));
-        assert!(floats.into_iter().all(|v| v.is_finite()), "non-finite field in {t:?}");
+        assert!(
+            floats.into_iter().all(|v| v.is_finite()),
+            "non-finite field in {t:?}"
+        );
         assert!(t.area2 > 0);
         assert!(t.xy.iter().flatten().all(|c| c.abs() < bound));
         assert!(t.z.iter().all(|&z| u64::from(z) <= zmax));
         assert!(t.z_f.iter().all(|z| (0.0..=1.0).contains(z)));
-        assert!(t.inv_w.iter().all(|&iw| iw > 0.0 && iw <= 1.0 / W_EPSILON * 1.000001));
+        assert!(t
+            .inv_w
+            .iter()
+            .all(|&iw| iw > 0.0 && iw <= 1.0 / W_EPSILON * 1.000001));
         assert!(t.bbox[0] <= t.bbox[2] && t.bbox[2] <= s.width);
         assert!(t.bbox[1] <= t.bbox[3] && t.bbox[3] <= s.height);
         // src_bary reconstructs the clip-space vertex (linear in clip space), when the source
@@ -72,7 +87,10 @@ fn check_setup(clip: &[[f64; 4]], d: &[DrawTri], s: &Setup) {
     );
     for cov in BOTH {
         let (vis, rs) = rasterize(s, cov, true);
-        assert!(vis.tri.iter().all(|&t| t == texsim::raster::NO_TRI || (t as usize) < s.tris.len()));
+        assert!(vis
+            .tri
+            .iter()
+            .all(|&t| t == texsim::raster::NO_TRI || (t as usize) < s.tris.len()));
         assert!(rs.visible <= rs.fragments);
         let _ = coverage_count(s, cov);
     }
@@ -92,23 +110,40 @@ fn degenerate_triangles_are_skipped() {
         [[10.0, 10.0], [20.0, 10.0], [15.0, 10.0 + 1.0 / 1024.0]],
     ];
     for c in cases {
-        let v: Vec<[f64; 4]> = c.iter().map(|p| px_to_clip(p[0], p[1], 0.0, w, h)).collect();
+        let v: Vec<[f64; 4]> = c
+            .iter()
+            .map(|p| px_to_clip(p[0], p[1], 0.0, w, h))
+            .collect();
         let s = one(&v, false, w, h);
         assert_eq!(s.stats.degenerate, 1, "{c:?}: {:?}", s.stats);
         assert!(s.tris.is_empty());
-        check_setup(&v, &[DrawTri { v: [0, 1, 2], cull_back: false }], &s);
+        check_setup(
+            &v,
+            &[DrawTri {
+                v: [0, 1, 2],
+                cull_back: false,
+            }],
+            &s,
+        );
     }
 }
 
 #[test]
 fn non_finite_and_bad_indices_are_skipped() {
-    let good = [[-0.5, -0.5, 0.0, 1.0], [0.5, -0.5, 0.0, 1.0], [0.0, 0.5, 0.0, 1.0]];
+    let good = [
+        [-0.5, -0.5, 0.0, 1.0],
+        [0.5, -0.5, 0.0, 1.0],
+        [0.0, 0.5, 0.0, 1.0],
+    ];
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         for vert in 0..3 {
             for comp in 0..4 {
                 let mut v = good.to_vec();
                 v[vert][comp] = bad;
-                let d = [DrawTri { v: [0, 1, 2], cull_back: false }];
+                let d = [DrawTri {
+                    v: [0, 1, 2],
+                    cull_back: false,
+                }];
                 let s = setup(&v, &d, 32, 32, &cfg(8, 24));
                 assert_eq!(s.stats.non_finite, 1, "{bad} at {vert}.{comp}");
                 check_setup(&v, &d, &s);
@@ -116,9 +151,18 @@ fn non_finite_and_bad_indices_are_skipped() {
         }
     }
     let d = [
-        DrawTri { v: [0, 1, 3], cull_back: false },
-        DrawTri { v: [u32::MAX, 1, 2], cull_back: true },
-        DrawTri { v: [0, 1, 2], cull_back: false },
+        DrawTri {
+            v: [0, 1, 3],
+            cull_back: false,
+        },
+        DrawTri {
+            v: [u32::MAX, 1, 2],
+            cull_back: true,
+        },
+        DrawTri {
+            v: [0, 1, 2],
+            cull_back: false,
+        },
     ];
     let s = setup(&good, &d, 32, 32, &cfg(8, 24));
     assert_eq!(s.stats.non_finite, 2);
@@ -130,20 +174,47 @@ fn non_finite_and_bad_indices_are_skipped() {
 fn off_screen_and_behind_camera_are_clipped_away() {
     let cases: [[[f64; 4]; 3]; 6] = [
         // Right of the screen (x > w for all).
-        [[1.5, 0.0, 0.0, 1.0], [3.0, 0.5, 0.0, 1.0], [2.0, -0.5, 0.0, 1.0]],
+        [
+            [1.5, 0.0, 0.0, 1.0],
+            [3.0, 0.5, 0.0, 1.0],
+            [2.0, -0.5, 0.0, 1.0],
+        ],
         // Above.
-        [[0.0, 1.5, 0.0, 1.0], [0.5, 3.0, 0.0, 1.0], [-0.5, 2.0, 0.0, 1.0]],
+        [
+            [0.0, 1.5, 0.0, 1.0],
+            [0.5, 3.0, 0.0, 1.0],
+            [-0.5, 2.0, 0.0, 1.0],
+        ],
         // Behind the camera (w < 0).
-        [[0.0, 0.0, 0.5, -1.0], [0.5, 0.0, 0.5, -1.0], [0.0, 0.5, 0.5, -2.0]],
+        [
+            [0.0, 0.0, 0.5, -1.0],
+            [0.5, 0.0, 0.5, -1.0],
+            [0.0, 0.5, 0.5, -2.0],
+        ],
         // In front of the near plane (z < -w).
-        [[0.0, 0.0, -1.5, 1.0], [0.5, 0.0, -2.0, 1.0], [0.0, 0.5, -3.0, 1.0]],
+        [
+            [0.0, 0.0, -1.5, 1.0],
+            [0.5, 0.0, -2.0, 1.0],
+            [0.0, 0.5, -3.0, 1.0],
+        ],
         // Beyond the far plane.
-        [[0.0, 0.0, 1.5, 1.0], [0.5, 0.0, 2.0, 1.0], [0.0, 0.5, 3.0, 1.0]],
+        [
+            [0.0, 0.0, 1.5, 1.0],
+            [0.5, 0.0, 2.0, 1.0],
+            [0.0, 0.5, 3.0, 1.0],
+        ],
         // w = 0 everywhere.
-        [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]],
+        [
+            [0.0, 0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+        ],
     ];
     for c in cases {
-        let d = [DrawTri { v: [0, 1, 2], cull_back: false }];
+        let d = [DrawTri {
+            v: [0, 1, 2],
+            cull_back: false,
+        }];
         let s = setup(&c, &d, 40, 30, &cfg(8, 24));
         assert_eq!(s.stats.clipped_away, 1, "{c:?}: {:?}", s.stats);
         check_setup(&c, &d, &s);
@@ -155,17 +226,36 @@ fn near_plane_and_guard_band_crossings_are_clipped() {
     let (w, h) = (64u32, 64u32);
     let cases: [[[f64; 4]; 3]; 4] = [
         // One vertex behind the camera: a quad remains (two triangles).
-        [[-0.5, -0.5, 0.5, 1.0], [0.5, -0.5, 0.5, 1.0], [0.0, 0.8, 2.0, -1.0]],
+        [
+            [-0.5, -0.5, 0.5, 1.0],
+            [0.5, -0.5, 0.5, 1.0],
+            [0.0, 0.8, 2.0, -1.0],
+        ],
         // Two vertices behind the near plane: one triangle remains.
-        [[-0.5, -0.5, 0.5, 1.0], [0.5, -0.5, -3.0, 1.0], [0.0, 0.5, -3.0, 1.0]],
+        [
+            [-0.5, -0.5, 0.5, 1.0],
+            [0.5, -0.5, -3.0, 1.0],
+            [0.0, 0.5, -3.0, 1.0],
+        ],
         // Far outside the guard band on both sides.
-        [[-1e6, -0.5, 0.0, 1.0], [1e6, -0.5, 0.0, 1.0], [0.0, 1e6, 0.0, 1.0]],
+        [
+            [-1e6, -0.5, 0.0, 1.0],
+            [1e6, -0.5, 0.0, 1.0],
+            [0.0, 1e6, 0.0, 1.0],
+        ],
         // Crossing w = 0 far off to the side.
-        [[-100.0, 0.0, 0.0, -0.5], [0.5, 0.1, 0.0, 1.0], [0.0, 0.5, 0.0, 1.0]],
+        [
+            [-100.0, 0.0, 0.0, -0.5],
+            [0.5, 0.1, 0.0, 1.0],
+            [0.0, 0.5, 0.0, 1.0],
+        ],
     ];
     for c in cases {
         for cull in [false, true] {
-            let d = [DrawTri { v: [0, 1, 2], cull_back: cull }];
+            let d = [DrawTri {
+                v: [0, 1, 2],
+                cull_back: cull,
+            }];
             let s = setup(&c, &d, w, h, &cfg(12, 30));
             assert_eq!(s.stats.clipped, 1, "{c:?}: {:?}", s.stats);
             check_setup(&c, &d, &s);
@@ -181,10 +271,17 @@ fn near_plane_and_guard_band_crossings_are_clipped() {
         }
         // With culling, exactly one orientation survives.
         let rev = [c[0], c[2], c[1]];
-        let d = [DrawTri { v: [0, 1, 2], cull_back: true }];
+        let d = [DrawTri {
+            v: [0, 1, 2],
+            cull_back: true,
+        }];
         let a = setup(&c, &d, w, h, &cfg(12, 30));
         let b = setup(&rev, &d, w, h, &cfg(12, 30));
-        assert_eq!(a.tris.is_empty() as u32 + b.tris.is_empty() as u32, 1, "{c:?}");
+        assert_eq!(
+            a.tris.is_empty() as u32 + b.tris.is_empty() as u32,
+            1,
+            "{c:?}"
+        );
     }
 }
 
@@ -192,7 +289,11 @@ fn near_plane_and_guard_band_crossings_are_clipped() {
 fn back_face_culling_counts() {
     let (w, h) = (32u32, 32u32);
     // Counter-clockwise in NDC: front.
-    let ccw = [[-0.5, -0.5, 0.0, 1.0], [0.5, -0.5, 0.0, 1.0], [0.0, 0.5, 0.0, 1.0]];
+    let ccw = [
+        [-0.5, -0.5, 0.0, 1.0],
+        [0.5, -0.5, 0.0, 1.0],
+        [0.0, 0.5, 0.0, 1.0],
+    ];
     let cw = [ccw[0], ccw[2], ccw[1]];
     assert_eq!(one(&ccw, true, w, h).stats.output, 1);
     let s = one(&cw, true, w, h);
@@ -200,14 +301,24 @@ fn back_face_culling_counts() {
     assert_eq!(one(&cw, false, w, h).stats.output, 1);
     // Same pixels either way round.
     for cov in BOTH {
-        assert_eq!(coverage_count(&one(&ccw, false, w, h), cov), coverage_count(&one(&cw, false, w, h), cov));
+        assert_eq!(
+            coverage_count(&one(&ccw, false, w, h), cov),
+            coverage_count(&one(&cw, false, w, h), cov)
+        );
     }
 }
 
 #[test]
 fn odd_viewports_never_panic() {
-    let v = [[-0.9, -0.9, 0.0, 1.0], [0.9, -0.8, 0.0, 1.0], [0.0, 0.95, 0.0, 1.0]];
-    let d = [DrawTri { v: [0, 1, 2], cull_back: false }];
+    let v = [
+        [-0.9, -0.9, 0.0, 1.0],
+        [0.9, -0.8, 0.0, 1.0],
+        [0.0, 0.95, 0.0, 1.0],
+    ];
+    let d = [DrawTri {
+        v: [0, 1, 2],
+        cull_back: false,
+    }];
     for (w, h) in [(0u32, 0u32), (0, 10), (10, 0), (1, 1), (37, 23), (3, 200)] {
         let s = setup(&v, &d, w, h, &cfg(8, 24));
         check_setup(&v, &d, &s);
@@ -226,7 +337,20 @@ fn odd_viewports_never_panic() {
 #[test]
 fn fuzz_setup_and_rasterize() {
     let mut rng = Rng(77);
-    let specials = [0.0, -0.0, 1e300, -1e300, 1e-300, 1e-12, f64::NAN, f64::INFINITY, 1.0, -1.0, 4.0, 1e20];
+    let specials = [
+        0.0,
+        -0.0,
+        1e300,
+        -1e300,
+        1e-300,
+        1e-12,
+        f64::NAN,
+        f64::INFINITY,
+        1.0,
+        -1.0,
+        4.0,
+        1e20,
+    ];
     for round in 0..400 {
         let nv = 3 + rng.below(30) as usize;
         let v: Vec<[f64; 4]> = (0..nv)
@@ -251,4 +375,57 @@ fn fuzz_setup_and_rasterize() {
         let s = setup(&v, &d, w, h, &cfg(sp, 8 + (round % 23) as u32));
         check_setup(&v, &d, &s);
     }
+}
+
+/// Two triangles sharing an edge that crosses the near plane, w = 0 or the guard band: every
+/// clip vertex on the shared edge is bit-identical in both (watertight after clipping).
+#[test]
+fn shared_clipped_edges_are_cut_identically() {
+    let mut rng = Rng(31337);
+    let mut checked = 0;
+    for _ in 0..3000 {
+        let mut p = || {
+            [
+                rng.range(-30.0, 30.0),
+                rng.range(-30.0, 30.0),
+                rng.range(-3.0, 3.0),
+                rng.range(-1.0, 3.0),
+            ]
+        };
+        let v = vec![p(), p(), p(), p()];
+        // Edge (0, 1) shared, traversed in opposite directions.
+        let d = [
+            DrawTri {
+                v: [0, 1, 2],
+                cull_back: false,
+            },
+            DrawTri {
+                v: [1, 0, 3],
+                cull_back: false,
+            },
+        ];
+        let s = setup(&v, &d, 97, 61, &cfg(8, 24));
+        check_setup(&v, &d, &s);
+        let on_edge = |src: u32, third: usize| -> Vec<[u64; 2]> {
+            s.tris
+                .iter()
+                .filter(|t| t.src == src)
+                .flat_map(|t| {
+                    (0..3)
+                        .filter(move |&k| t.src_bary[k][third] == 0.0)
+                        .map(move |k| t.xy_f[k].map(f64::to_bits))
+                })
+                .collect()
+        };
+        let a = on_edge(0, 2);
+        let b = on_edge(1, 2);
+        for p in &a {
+            checked += 1;
+            assert!(
+                b.contains(p) || b.is_empty(),
+                "shared-edge vertex {p:?} not in {b:?}"
+            );
+        }
+    }
+    assert!(checked > 1000, "{checked}");
 }

@@ -3,15 +3,29 @@
 mod raster_common;
 
 use raster_common::*;
-use texsim::raster::{coverage_count, rasterize, setup, Coverage, DrawTri, ScreenTri, Setup, NO_TRI};
+use texsim::raster::{
+    coverage_count, rasterize, setup, Coverage, DrawTri, ScreenTri, Setup, NO_TRI,
+};
 
 const BOTH: [Coverage; 2] = [Coverage::Fixed, Coverage::Float];
 
 /// Set of covered pixels of a single-triangle setup (w x h = 16 x 16, vertices in pixels).
 fn covered(pts: [[f64; 2]; 3], sp: u32, cov: Coverage) -> Vec<(u32, u32)> {
     let (w, h) = (16u32, 16u32);
-    let clip: Vec<[f64; 4]> = pts.iter().map(|p| px_to_clip(p[0], p[1], 0.0, w, h)).collect();
-    let s = setup(&clip, &[DrawTri { v: [0, 1, 2], cull_back: false }], w, h, &cfg(sp, 16));
+    let clip: Vec<[f64; 4]> = pts
+        .iter()
+        .map(|p| px_to_clip(p[0], p[1], 0.0, w, h))
+        .collect();
+    let s = setup(
+        &clip,
+        &[DrawTri {
+            v: [0, 1, 2],
+            cull_back: false,
+        }],
+        w,
+        h,
+        &cfg(sp, 16),
+    );
     let c = coverage_count(&s, cov);
     let mut out = Vec::new();
     for py in 0..h {
@@ -28,7 +42,14 @@ fn covered(pts: [[f64; 2]; 3], sp: u32, cov: Coverage) -> Vec<(u32, u32)> {
 
 fn all_orders(p: [[f64; 2]; 3]) -> Vec<[[f64; 2]; 3]> {
     let [a, b, c] = p;
-    vec![[a, b, c], [b, c, a], [c, a, b], [a, c, b], [c, b, a], [b, a, c]]
+    vec![
+        [a, b, c],
+        [b, c, a],
+        [c, a, b],
+        [a, c, b],
+        [c, b, a],
+        [b, a, c],
+    ]
 }
 
 fn check_hand_case(pts: [[f64; 2]; 3], expect: &[(u32, u32)]) {
@@ -75,7 +96,18 @@ fn top_left_apex_up_and_flat_top() {
     // Flat top on pixel centres: top edge in (left corner in, right corner out), bottom apex out.
     check_hand_case(
         [[2.5, 2.5], [6.5, 2.5], [4.5, 6.5]],
-        &[(2, 2), (3, 2), (4, 2), (5, 2), (3, 3), (4, 3), (5, 3), (3, 4), (4, 4), (4, 5)],
+        &[
+            (2, 2),
+            (3, 2),
+            (4, 2),
+            (5, 2),
+            (3, 3),
+            (4, 3),
+            (5, 3),
+            (3, 4),
+            (4, 4),
+            (4, 5),
+        ],
     );
     // Flat bottom through centres is excluded; vertical left edge through centres is included,
     // the hypotenuse (a right edge) is not, nor the apex on both.
@@ -96,7 +128,10 @@ fn top_left_four_triangles_around_a_centre_vertex() {
     let c = [5.5, 5.5];
     let corners = [[1.5, 1.5], [9.5, 1.5], [9.5, 9.5], [1.5, 9.5]];
     let (w, h) = (16u32, 16u32);
-    let mut clip: Vec<[f64; 4]> = corners.iter().map(|p| px_to_clip(p[0], p[1], 0.0, w, h)).collect();
+    let mut clip: Vec<[f64; 4]> = corners
+        .iter()
+        .map(|p| px_to_clip(p[0], p[1], 0.0, w, h))
+        .collect();
     clip.push(px_to_clip(c[0], c[1], 0.0, w, h));
     let tris: Vec<[u32; 3]> = (0..4).map(|i| [4, i, (i + 1) % 4]).collect();
     for sp in [1u32, 8] {
@@ -106,14 +141,23 @@ fn top_left_four_triangles_around_a_centre_vertex() {
             for py in 0..h {
                 for px in 0..w {
                     let inside = (1..9).contains(&px) && (1..9).contains(&py);
-                    assert_eq!(cnt[(py * w + px) as usize], u32::from(inside), "({px},{py})");
+                    assert_eq!(
+                        cnt[(py * w + px) as usize],
+                        u32::from(inside),
+                        "({px},{py})"
+                    );
                 }
             }
             // The owner of the shared vertex: the triangle for which both edges through it are
             // top or left, i.e. the one to the lower right of (+eps, +eps^2): the right one.
-            let owner: Vec<usize> = (0..4).filter(|&i| covers_fixed(&s.tris[i], 5, 5, sp)).collect();
+            let owner: Vec<usize> = (0..4)
+                .filter(|&i| covers_fixed(&s.tris[i], 5, 5, sp))
+                .collect();
             assert_eq!(owner.len(), 1);
-            assert_eq!(s.tris[owner[0]].src, 1, "the right-hand triangle owns the vertex");
+            assert_eq!(
+                s.tris[owner[0]].src, 1,
+                "the right-hand triangle owns the vertex"
+            );
         }
     }
 }
@@ -141,13 +185,26 @@ fn spans_match_brute_force_and_edges() {
                 *c = c.map(|q| q * s);
             }
         }
-        let s = setup(&v, &[DrawTri { v: [0, 1, 2], cull_back: false }], w, h, &cfg(sp, 16));
+        let s = setup(
+            &v,
+            &[DrawTri {
+                v: [0, 1, 2],
+                cull_back: false,
+            }],
+            w,
+            h,
+            &cfg(sp, 16),
+        );
         if s.tris.is_empty() {
             continue;
         }
         tested += 1;
         for (cov, float) in [(Coverage::Fixed, false), (Coverage::Float, true)] {
-            assert_eq!(coverage_count(&s, cov), brute_count(&s, float), "case {case} {cov:?}");
+            assert_eq!(
+                coverage_count(&s, cov),
+                brute_count(&s, float),
+                "case {case} {cov:?}"
+            );
         }
         check_edges(&s, &s.tris[0]);
     }
@@ -166,15 +223,22 @@ fn check_edges(s: &Setup, t: &ScreenTri) {
         for px in -2..i64::from(s.width) + 2 {
             let e = t.edges_fixed(px, py, sp);
             assert_eq!(e[0] + e[1] + e[2], t.area2, "edges sum at ({px},{py})");
-            let inside_view = px >= 0 && py >= 0 && px < i64::from(s.width) && py < i64::from(s.height);
+            let inside_view =
+                px >= 0 && py >= 0 && px < i64::from(s.width) && py < i64::from(s.height);
             if !inside_view {
                 continue;
             }
             let c = cnt[(py * i64::from(s.width) + px) as usize] == 1;
             if c {
-                assert!(e.iter().all(|&v| v >= 0), "covered with a negative edge at ({px},{py})");
+                assert!(
+                    e.iter().all(|&v| v >= 0),
+                    "covered with a negative edge at ({px},{py})"
+                );
                 let [x0, y0, x1, y1] = t.bbox.map(i64::from);
-                assert!(px >= x0 && px < x1 && py >= y0 && py < y1, "covered outside bbox");
+                assert!(
+                    px >= x0 && px < x1 && py >= y0 && py < y1,
+                    "covered outside bbox"
+                );
             }
             if e.iter().all(|&v| v > 0) {
                 assert!(c, "strictly inside but not covered at ({px},{py})");
@@ -218,7 +282,9 @@ fn depth_matches_brute_force_model() {
             };
             v.push(px_to_clip(x, y, z, w, h));
         }
-        let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let tris: Vec<[u32; 3]> = (0..n as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
         let sp = [4u32, 8, 12][case % 3];
         let db = [8u32, 16, 24, 30][case % 4];
         let s = setup(&v, &draws(&tris, false), w, h, &cfg(sp, db));
@@ -235,7 +301,11 @@ fn depth_matches_brute_force_model() {
                     for py in 0..i64::from(h) {
                         for px in 0..i64::from(w) {
                             let i = (py * i64::from(w) + px) as usize;
-                            let hit = if float { covers_float(t, px, py) } else { covers_fixed(t, px, py, sp) };
+                            let hit = if float {
+                                covers_float(t, px, py)
+                            } else {
+                                covers_fixed(t, px, py, sp)
+                            };
                             if !hit {
                                 continue;
                             }
@@ -272,7 +342,10 @@ fn depth_matches_brute_force_model() {
                 assert_eq!(vis.tri, exp, "case {case} {cov:?} depth_test={depth_test}");
                 assert_eq!(stats.fragments, frags);
                 assert_eq!(stats.depth_fails, fails);
-                assert_eq!(stats.visible, exp.iter().filter(|&&t| t != NO_TRI).count() as u64);
+                assert_eq!(
+                    stats.visible,
+                    exp.iter().filter(|&&t| t != NO_TRI).count() as u64
+                );
             }
         }
     }
@@ -335,7 +408,10 @@ fn depth_ordering_near_hides_far() {
     let s = setup(&v, &draws(&tris, false), w, h, &cfg(8, 24));
     for cov in BOTH {
         let (vis, st) = rasterize(&s, cov, true);
-        assert!(vis.tri.iter().all(|&t| t == NO_TRI || s.tris[t as usize].src < 2));
+        assert!(vis
+            .tri
+            .iter()
+            .all(|&t| t == NO_TRI || s.tris[t as usize].src < 2));
         assert_eq!(st.depth_fails * 2, st.fragments);
     }
 }

@@ -32,7 +32,10 @@ fn check_convex_closed(
     let n_suspect = suspect.iter().filter(|&&m| m).count();
     let limit = if sp >= min_sp_single { 40 } else { 8 };
     eprintln!("sp={sp}: {n_suspect} float-suspect pixels");
-    assert!(n_suspect * limit < (w * h) as usize, "too many suspect pixels: {n_suspect}");
+    assert!(
+        n_suspect * limit < (w * h) as usize,
+        "too many suspect pixels: {n_suspect}"
+    );
     for cov in BOTH {
         let front = coverage_count(&setup(clip, &draws(tris, true), w, h, &c), cov);
         let back = coverage_count(&setup(clip, &draws(&reversed(tris), true), w, h, &c), cov);
@@ -75,9 +78,14 @@ fn sphere_orthographic_watertight() {
     let (p, t) = uv_sphere(64, 32);
     let (w, h) = (256u32, 192u32);
     for (k, sp) in [1u32, 4, 8, 12].into_iter().enumerate() {
-        let rot = DMat4::from_rotation_x(0.3 + 0.2 * k as f64) * DMat4::from_rotation_y(0.7 * k as f64);
+        let rot =
+            DMat4::from_rotation_x(0.3 + 0.2 * k as f64) * DMat4::from_rotation_y(0.7 * k as f64);
         // Orthographic: x, y scaled to a radius of 80 pixels, z into [-0.5, 0.5].
-        let scale = DMat4::from_scale(DVec3::new(80.0 * 2.0 / f64::from(w), 80.0 * 2.0 / f64::from(h), -0.5));
+        let scale = DMat4::from_scale(DVec3::new(
+            80.0 * 2.0 / f64::from(w),
+            80.0 * 2.0 / f64::from(h),
+            -0.5,
+        ));
         let off = DMat4::from_translation(DVec3::new(0.013, -0.021, 0.0));
         let clip = transform(&(off * scale * rot), &p);
         let centre = [
@@ -85,7 +93,17 @@ fn sphere_orthographic_watertight() {
             (1.0 + 0.021) * 0.5 * f64::from(h),
         ];
         // The inscribed polyhedron's silhouette lies between 0.99 R and R.
-        check_convex_closed(&clip, &t, w, h, sp, centre, 80.0 * 0.98 - 1.0, 80.0 + 1.0, 4);
+        check_convex_closed(
+            &clip,
+            &t,
+            w,
+            h,
+            sp,
+            centre,
+            80.0 * 0.98 - 1.0,
+            80.0 + 1.0,
+            4,
+        );
     }
 }
 
@@ -102,16 +120,39 @@ fn sphere_perspective_watertight() {
     // Silhouette of the unit sphere: a circle of radius tan(asin(1/d)) / tan(fovy/2) * h/2.
     let r = (1.0f64 / dist).asin().tan() / (fovy / 2.0).tan() * f64::from(h) / 2.0;
     for sp in [4u32, 8] {
-        check_convex_closed(&clip, &t, w, h, sp, [120.0, 120.0], r * 0.98 - 1.0, r + 1.0, 4);
+        check_convex_closed(
+            &clip,
+            &t,
+            w,
+            h,
+            sp,
+            [120.0, 120.0],
+            r * 0.98 - 1.0,
+            r + 1.0,
+            4,
+        );
     }
 }
 
 /// A disc as a fan of `n` needle triangles around its centre, each vertex with a random w.
-fn needle_fan(n: u32, centre: [f64; 2], r: f64, w: u32, h: u32, rng: &mut Rng) -> (Vec<[f64; 4]>, Vec<[u32; 3]>) {
+fn needle_fan(
+    n: u32,
+    centre: [f64; 2],
+    r: f64,
+    w: u32,
+    h: u32,
+    rng: &mut Rng,
+) -> (Vec<[f64; 4]>, Vec<[u32; 3]>) {
     let mut v = vec![px_to_clip(centre[0], centre[1], 0.1, w, h)];
     for i in 0..n {
         let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
-        v.push(px_to_clip(centre[0] + r * a.cos(), centre[1] + r * a.sin(), 0.2, w, h));
+        v.push(px_to_clip(
+            centre[0] + r * a.cos(),
+            centre[1] + r * a.sin(),
+            0.2,
+            w,
+            h,
+        ));
     }
     for c in &mut v {
         let s = rng.range(0.5, 3.0);
@@ -133,13 +174,25 @@ fn needle_fan_watertight() {
         let c = cfg(sp, 16);
         for cov in BOTH {
             let s = setup(&v, &draws(&t, false), w, h, &c);
-            assert_eq!(s.stats.output + s.stats.degenerate, u64::from(n), "{:?}", s.stats);
-            assert!(s.stats.output > 2000, "too many needles lost: {:?}", s.stats);
+            assert_eq!(
+                s.stats.output + s.stats.degenerate,
+                u64::from(n),
+                "{:?}",
+                s.stats
+            );
+            assert!(
+                s.stats.output > 2000,
+                "too many needles lost: {:?}",
+                s.stats
+            );
             let cnt = coverage_count(&s, cov);
             // Needles dropped as degenerate after snapping cover nothing in fixed (their
             // snapped area is zero) but leave float holes: excluded for the float model.
             let suspect = float_suspect_mask(&v, &t, &s);
-            let dropped: Vec<bool> = suspect.iter().map(|&m| m && cov == Coverage::Float).collect();
+            let dropped: Vec<bool> = suspect
+                .iter()
+                .map(|&m| m && cov == Coverage::Float)
+                .collect();
             let r_in = r * (std::f64::consts::PI / f64::from(n)).cos() - 1.0;
             for py in 0..h {
                 for px in 0..w {
@@ -293,7 +346,11 @@ fn camera_inside_sphere_near_and_guard_clipping() {
     let mut clipped = 0;
     for (k, fov) in [60.0f64, 120.0, 170.0, 90.0].into_iter().enumerate() {
         // Coarse spheres have triangles that cross the near plane and the guard band.
-        let (p, t) = if k % 2 == 0 { uv_sphere(48, 24) } else { uv_sphere(7, 4) };
+        let (p, t) = if k % 2 == 0 {
+            uv_sphere(48, 24)
+        } else {
+            uv_sphere(7, 4)
+        };
         let view = DMat4::look_at_rh(
             DVec3::new(0.1, -0.05 * k as f64, 0.2),
             DVec3::new(1.0, 0.3, -0.2),
@@ -309,7 +366,9 @@ fn camera_inside_sphere_near_and_guard_clipping() {
             assert!(
                 cnt.iter().all(|&c| c == 1),
                 "fov {fov} {cov:?}: counts {:?}",
-                (0..=3).map(|v| cnt.iter().filter(|&&c| c == v).count()).collect::<Vec<_>>()
+                (0..=3)
+                    .map(|v| cnt.iter().filter(|&&c| c == v).count())
+                    .collect::<Vec<_>>()
             );
             // Seen from inside, outward-wound faces are back faces.
             let culled = setup(&clip, &draws(&t, true), w, h, &cfg(8, 24));
@@ -377,7 +436,11 @@ fn ground_plane_near_and_guard_clipping() {
                 }
                 let hit = a + d * ((-1.0 - a.y) / d.y);
                 let depth = (hit - eye).dot((target - eye).normalize());
-                if hit.x.abs() < half * 0.95 && hit.z.abs() < half * 0.95 && depth > near * 1.5 && depth < far * 0.9 {
+                if hit.x.abs() < half * 0.95
+                    && hit.z.abs() < half * 0.95
+                    && depth > near * 1.5
+                    && depth < far * 0.9
+                {
                     assert_eq!(k, 1, "{cov:?} hole at ({px},{py})");
                     hits += 1;
                 }
@@ -395,7 +458,13 @@ fn grid_on_pixel_centres_matches_brute_force() {
     let n = 8u32;
     for j in 0..=n {
         for i in 0..=n {
-            v.push(px_to_clip(2.5 + 4.0 * f64::from(i), 1.5 + 4.0 * f64::from(j), 0.0, w, h));
+            v.push(px_to_clip(
+                2.5 + 4.0 * f64::from(i),
+                1.5 + 4.0 * f64::from(j),
+                0.0,
+                w,
+                h,
+            ));
         }
     }
     let mut t = Vec::new();
@@ -421,7 +490,11 @@ fn grid_on_pixel_centres_matches_brute_force() {
                 for px in 0..w {
                     let (x, y) = (f64::from(px) + 0.5, f64::from(py) + 0.5);
                     let inside = (2.5..34.5).contains(&x) && (1.5..33.5).contains(&y);
-                    assert_eq!(cnt[(py * w + px) as usize], u32::from(inside), "{cov:?} ({px},{py})");
+                    assert_eq!(
+                        cnt[(py * w + px) as usize],
+                        u32::from(inside),
+                        "{cov:?} ({px},{py})"
+                    );
                 }
             }
         }

@@ -57,9 +57,9 @@ fn example_toml_loads_everything() {
     assert_eq!(m.name, "checker");
     assert_eq!(m.texture, Some(3));
     assert_eq!(cube.indices.len(), 12);
-    // scale 0.7, translate (0.2, 0.35, -1.6): all corners within 0.35*sqrt(3) of the centre.
+    // scale 0.7, translate (-0.4, 0.35, 2.2): all corners within 0.35*sqrt(3) of the centre.
     for p in &cube.positions {
-        let d = DVec3::from(p.map(f64::from)).distance(DVec3::new(0.2, 0.35, -1.6));
+        let d = DVec3::from(p.map(f64::from)).distance(DVec3::new(-0.4, 0.35, 2.2));
         assert!((d - 0.35 * 3f64.sqrt()).abs() < 1e-5, "{d}");
     }
     validate(&s).unwrap();

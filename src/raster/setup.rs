@@ -3,6 +3,7 @@
 //! orientation and back-face culling. Conventions are in the parent module header.
 
 use hw_model::config::RasterConfig;
+use rayon::prelude::*;
 
 /// Largest supported viewport side; larger `width`/`height` are clamped to it.
 pub const MAX_VIEWPORT: u32 = 8192;
@@ -281,7 +282,12 @@ impl Viewport {
 enum Outcome {
     NonFinite,
     ClippedAway,
-    Produced { culled: bool, degenerate: bool, clipped: bool, n: usize },
+    Produced {
+        culled: bool,
+        degenerate: bool,
+        clipped: bool,
+        n: usize,
+    },
 }
 
 /// `cross(b - a, c - a)` on snapped positions.
@@ -338,7 +344,10 @@ fn make_tri(
         let mx = vs.iter().map(|v| v.xs[axis]).max().unwrap_or(0);
         let (lo, hi) = pixel_range_fixed(mn, mx, s, limit);
         let mnf = vs.iter().map(|v| v.xf[axis]).fold(f64::INFINITY, f64::min);
-        let mxf = vs.iter().map(|v| v.xf[axis]).fold(f64::NEG_INFINITY, f64::max);
+        let mxf = vs
+            .iter()
+            .map(|v| v.xf[axis])
+            .fold(f64::NEG_INFINITY, f64::max);
         let (lof, hif) = pixel_range_float(mnf, mxf, limit);
         let lo = lo.min(lof).min(i64::from(limit));
         let hi = hi.max(hif).max(lo);
@@ -379,37 +388,33 @@ pub fn setup(
         scale: f64::from(1u32 << s),
         zmax: f64::from((1u32 << depth_bits) - 1),
     };
+    // Chunks in parallel, concatenated in submission order: identical for any thread count.
+    let parts: Vec<(Vec<ScreenTri>, SetupStats)> = draws
+        .par_chunks(SETUP_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut st = SetupStats::default();
+            let mut tris = Vec::with_capacity(chunk.len());
+            for (k, d) in chunk.iter().enumerate() {
+                let src = (c * SETUP_CHUNK + k) as u32;
+                let outcome = setup_one(clip, d, src, &vp, s, width, height, &mut tris);
+                st.count(&outcome);
+            }
+            (tris, st)
+        })
+        .collect();
     let mut stats = SetupStats {
         input: draws.len() as u64,
         ..SetupStats::default()
     };
-    let mut tris = Vec::with_capacity(draws.len());
-    for (src, d) in draws.iter().enumerate() {
-        let src = src as u32;
-        let outcome = setup_one(clip, d, src, &vp, s, width, height, &mut tris);
-        match outcome {
-            Outcome::NonFinite => stats.non_finite += 1,
-            Outcome::ClippedAway => stats.clipped_away += 1,
-            Outcome::Produced {
-                culled,
-                degenerate,
-                clipped,
-                n,
-            } => {
-                if clipped {
-                    stats.clipped += 1;
-                }
-                if n == 0 {
-                    if culled {
-                        stats.culled += 1;
-                    } else if degenerate {
-                        stats.degenerate += 1;
-                    } else {
-                        stats.clipped_away += 1;
-                    }
-                }
-            }
-        }
+    let mut tris = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
+    for (t, st) in parts {
+        tris.extend(t);
+        stats.non_finite += st.non_finite;
+        stats.clipped_away += st.clipped_away;
+        stats.culled += st.culled;
+        stats.degenerate += st.degenerate;
+        stats.clipped += st.clipped;
     }
     stats.output = tris.len() as u64;
     Setup {
@@ -419,6 +424,38 @@ pub fn setup(
         subpixel_bits: s,
         depth_bits,
         stats,
+    }
+}
+
+/// Draws per parallel setup task.
+const SETUP_CHUNK: usize = 4096;
+
+impl SetupStats {
+    /// Counts one input triangle's outcome.
+    fn count(&mut self, outcome: &Outcome) {
+        match *outcome {
+            Outcome::NonFinite => self.non_finite += 1,
+            Outcome::ClippedAway => self.clipped_away += 1,
+            Outcome::Produced {
+                culled,
+                degenerate,
+                clipped,
+                n,
+            } => {
+                if clipped {
+                    self.clipped += 1;
+                }
+                if n == 0 {
+                    if culled {
+                        self.culled += 1;
+                    } else if degenerate {
+                        self.degenerate += 1;
+                    } else {
+                        self.clipped_away += 1;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -465,9 +502,9 @@ fn setup_one(
         }
     }
     let mut sv = [ScreenVert::default(); MAX_POLY];
-    for i in 0..poly.n {
-        match vp.project(&poly.v[i]) {
-            Some(v) => sv[i] = v,
+    for (out, v) in sv.iter_mut().zip(&poly.v[..poly.n]) {
+        match vp.project(v) {
+            Some(p) => *out = p,
             None => return Outcome::NonFinite,
         }
     }
@@ -475,7 +512,14 @@ fn setup_one(
     let mut degenerate = false;
     let mut n = 0;
     for i in 1..poly.n - 1 {
-        match make_tri([sv[0], sv[i], sv[i + 1]], src, d.cull_back, s, width, height) {
+        match make_tri(
+            [sv[0], sv[i], sv[i + 1]],
+            src,
+            d.cull_back,
+            s,
+            width,
+            height,
+        ) {
             Ok(t) => {
                 tris.push(t);
                 n += 1;

@@ -367,7 +367,14 @@ enum Sink<'a> {
 }
 
 /// Traverses the triangles of one band (rows [y0, y1)) into `sink` (rows of this band only).
-fn band(setup: &Setup, ids: &[u32], y0: u32, y1: u32, coverage: Coverage, sink: Sink) -> RasterStats {
+fn band(
+    setup: &Setup,
+    ids: &[u32],
+    y0: u32,
+    y1: u32,
+    coverage: Coverage,
+    sink: Sink,
+) -> RasterStats {
     let w = setup.width as usize;
     let mut st = RasterStats::default();
     let s = setup.subpixel_bits.clamp(1, 12);
@@ -480,7 +487,8 @@ fn for_spans(
                 }
             }
             Coverage::Float => {
-                if !(t.area2_f.abs() > 0.0) {
+                // Zero or NaN: nothing to draw in float.
+                if t.area2_f == 0.0 || t.area2_f.is_nan() {
                     continue;
                 }
                 let ft = FloatTri::new(t, setup.width);

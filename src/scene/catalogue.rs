@@ -131,7 +131,7 @@ fn w2_mesh() -> Scene {
 }
 
 fn demo() -> Result<Scene> {
-    let mut ground = shapes::plane(600.0, 100.0);
+    let mut ground = shapes::plane(1600.0, 200.0);
     ground.name = "ground".into();
     ground.material = 0;
     let mut torus = shapes::torus(0.55, 0.22, 96, 48, 3.0);
@@ -172,7 +172,7 @@ fn demo() -> Result<Scene> {
             ..Material::default()
         },
     ];
-    let mut ground_tex = procedural("noise-checker", 256)?;
+    let mut ground_tex = procedural("tiles", 512)?;
     ground_tex.name = "demo-ground".into();
     let torus_tex = checker(64, 8, [250, 200, 60], [150, 30, 40]);
     let sphere_tex = mesa_texture(256);
@@ -187,7 +187,7 @@ fn demo() -> Result<Scene> {
             up: [0.0, 1.0, 0.0],
             fov_y_deg: 50.0,
             near: 0.1,
-            far: 1000.0,
+            far: 2000.0,
             view_override: None,
         },
         lights: vec![Light::Directional {

@@ -309,7 +309,14 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
             let (name, fallback, clamp) = parse_map_arg(arg);
             let mut file = mdir.join(&name);
             if !file.exists() {
-                if let Some(fb) = fallback.map(|f| mdir.join(f)).filter(|f| f.exists()) {
+                // Fallbacks: Windows separators, then the last token alone.
+                let candidates = [Some(name.replace('\\', "/")), fallback];
+                if let Some(fb) = candidates
+                    .into_iter()
+                    .flatten()
+                    .map(|f| mdir.join(f))
+                    .find(|f| f.exists())
+                {
                     file = fb;
                 }
             }

@@ -200,7 +200,36 @@ pub fn checker(size: u32, checks: u32, a: [u8; 3], b: [u8; 3]) -> TextureImage {
     from_rgba8(&format!("checker-{size}"), size, &t)
 }
 
-/// Procedural texture by name (`checker`, `noise-checker`, `mesa`) and side `size`.
+/// Floor tiles of side `size`: 8 x 8 tiles in two stone colours with per-texel hash noise in
+/// [-16, 15] and dark 2-texel grout lines (fine noise, then grout, then tiles fade out as the
+/// MIP level rises, which makes level transitions easy to see).
+#[must_use]
+pub fn tiles(size: u32) -> TextureImage {
+    let cell = (size / 8).max(1);
+    let mut t = Vec::with_capacity(size as usize * size as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let h = hash2(x ^ 0x5555, y ^ 0x3333);
+            let grout = x % cell < 2 || y % cell < 2;
+            let base: [i32; 3] = if grout {
+                [28, 28, 34]
+            } else if ((x / cell) ^ (y / cell)) & 1 == 0 {
+                [214, 188, 150]
+            } else {
+                [92, 112, 138]
+            };
+            let mut p = [0u8, 0, 0, 255];
+            for k in 0..3 {
+                let n = ((h >> (8 * k)) & 31) as i32 - 16;
+                p[k] = (base[k] + n).clamp(0, 255) as u8;
+            }
+            t.push(p);
+        }
+    }
+    from_rgba8(&format!("tiles-{size}"), size, &t)
+}
+
+/// Procedural texture by name (`checker`, `noise-checker`, `mesa`, `tiles`) and side `size`.
 pub fn procedural(kind: &str, size: u32) -> Result<TextureImage> {
     if !(1..=MAX_TEXTURE_SIDE).contains(&size) {
         return Err(Error::msg(format!(
@@ -214,8 +243,9 @@ pub fn procedural(kind: &str, size: u32) -> Result<TextureImage> {
             Ok(from_rgba8(&format!("noise-checker-{size}"), size, &t))
         }
         "mesa" => Ok(mesa_texture(size)),
+        "tiles" => Ok(tiles(size)),
         other => Err(Error::msg(format!(
-            "unknown procedural texture '{other}' (known: checker, noise-checker, mesa)"
+            "unknown procedural texture '{other}' (known: checker, noise-checker, mesa, tiles)"
         ))),
     }
 }

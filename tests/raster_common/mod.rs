@@ -61,7 +61,11 @@ pub fn uv_sphere(nu: u32, nv: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
         let th = std::f64::consts::PI * f64::from(j) / f64::from(nv);
         for i in 0..nu {
             let ph = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(nu);
-            p.push(DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()));
+            p.push(DVec3::new(
+                th.sin() * ph.cos(),
+                th.cos(),
+                th.sin() * ph.sin(),
+            ));
         }
     }
     p.push(DVec3::new(0.0, -1.0, 0.0));
@@ -114,7 +118,7 @@ pub fn covers_fixed(t: &ScreenTri, px: i64, py: i64, s: u32) -> bool {
 
 /// Independent float coverage model from `edges_float` and the same perturbation rule.
 pub fn covers_float(t: &ScreenTri, px: i64, py: i64) -> bool {
-    if !(t.area2_f.abs() > 0.0) {
+    if t.area2_f == 0.0 || t.area2_f.is_nan() {
         return false;
     }
     // A flipped sliver is drawn with its own (float) orientation.
@@ -161,7 +165,7 @@ pub fn float_suspect_mask(clip: &[[f64; 4]], tris: &[[u32; 3]], s: &Setup) -> Ve
         suspect[st.src as usize] = false;
     }
     for st in &s.tris {
-        if !(st.area2_f > 0.0) {
+        if st.area2_f <= 0.0 || st.area2_f.is_nan() {
             suspect[st.src as usize] = true;
         }
     }
