@@ -8,13 +8,14 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 /// `x` into `fmt`: scaled by `2^frac_bits` (exact), rounded by `fmt.rounding`, then fitted by
 /// `fmt.overflow` (each out-of-range value counted). NaN gives 0 and counts a saturation;
 /// +-infinity and values beyond `i64` saturate (counted) whatever the overflow rule.
+#[inline]
 #[must_use]
 pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
     if x.is_nan() {
         sat.saturated += 1;
         return 0;
     }
-    let y = x * 2f64.powi(fmt.frac_bits as i32);
+    let y = x * pow2(fmt.frac_bits as i32);
     let fl = y.floor();
     let rem = y - fl;
     let r = match fmt.rounding {
@@ -43,12 +44,25 @@ pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
 }
 
 /// `raw * 2^-frac_bits` (exact for |raw| <= 2^53).
+#[inline]
 #[must_use]
 pub fn from_raw(raw: i64, frac_bits: u32) -> f64 {
-    raw as f64 * 2f64.powi(-(frac_bits as i32))
+    raw as f64 * pow2(-(frac_bits as i32))
+}
+
+/// `2^e` exactly, built from its bit pattern (no libm call in per-pixel code).
+#[inline]
+#[must_use]
+pub fn pow2(e: i32) -> f64 {
+    if (-1022..=1023).contains(&e) {
+        f64::from_bits(((1023 + e) as u64) << 52)
+    } else {
+        2f64.powi(e)
+    }
 }
 
 /// `x` (clamped to [0, 1]; NaN gives 0) as a `bits`-wide unorm, rounded half to even.
+#[inline]
 #[must_use]
 pub fn to_unorm(x: f64, bits: u32) -> u32 {
     let max = ((1u64 << bits.min(32)) - 1) as f64;

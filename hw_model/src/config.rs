@@ -162,7 +162,7 @@ impl HwConfig {
             },
             reciprocal: ReciprocalConfig {
                 recip_lut_bits: 8,
-                recip_iterations: 1,
+                recip_iterations: 2,
                 recip_mantissa_bits: 24,
                 recip_rounding: Rounding::HalfEven,
                 recip_lut_cycles: 1,
@@ -170,8 +170,8 @@ impl HwConfig {
             },
             interp: InterpConfig {
                 inv_w_bits: 24,
-                bary_bits: 16,
-                texcoord_frac_bits: 16,
+                bary_bits: 24,
+                texcoord_frac_bits: 24,
                 texcoord_int_bits: 8,
                 interp_rounding: Rounding::HalfEven,
                 bary_cycles: 2,
@@ -260,7 +260,7 @@ impl HwConfig {
         let i = &self.interp;
         check("interp.inv_w_bits", i.inv_w_bits, 4, 30)?;
         check("interp.bary_bits", i.bary_bits, 4, 30)?;
-        check("interp.texcoord_frac_bits", i.texcoord_frac_bits, 4, 24)?;
+        check("interp.texcoord_frac_bits", i.texcoord_frac_bits, 4, 28)?;
         check("interp.texcoord_int_bits", i.texcoord_int_bits, 1, 16)?;
         check("lod.lod_frac_bits", self.lod.lod_frac_bits, 0, 16)?;
         let t = &self.trilinear;

@@ -174,20 +174,35 @@ pub fn plan(material: &Material, has_uvs: bool) -> Plan {
     }
 }
 
-/// Per-fragment signals passed between stages (f64 carriers, see the module docs).
+/// Per-fragment signals passed between stages. Each signal has an `f64` carrier (always
+/// written) and, when a Fixed stage produced it, its raw fixed value (`*_x`), which a Fixed
+/// consumer reads directly; a Fixed consumer of a Float producer quantizes the carrier.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Frag {
     /// Perspective-correct barycentrics at the sample, and at the helper samples (x+1, y) and
     /// (x, y+1) when derivatives are needed.
     pub bary: [[f64; 3]; 3],
+    /// Raw barycentrics (`bary_bits` fraction bits).
+    pub bary_x: [[i64; 3]; 3],
     /// Interpolated colour (unorm, 0..1).
     pub color: [f64; 4],
+    /// Raw colour (`color_bits` unorm).
+    pub color_x: [u32; 4],
     /// Texture coordinates at the sample and the two helper samples (normalized).
     pub uv: [[f64; 2]; 3],
+    /// Raw texture coordinates (`texcoord_frac_bits`).
+    pub uv_x: [[i64; 2]; 3],
     /// Level of detail (log2 texels per pixel).
     pub lod: f64,
+    /// Raw LOD (`lod_frac_bits`).
+    pub lod_x: i64,
     /// Filtered texel (unorm).
     pub texel: [f64; 4],
+    /// Raw texel (`texel_bits` unorm).
+    pub texel_x: [u32; 4],
     /// The fragment's output colour (unorm).
     pub out: [f64; 4],
+    /// Raw output and its unorm width; `out_bits == 0` means the output is the float carrier.
+    pub out_x: [u32; 4],
+    pub out_bits: u32,
 }

@@ -266,7 +266,7 @@ pub fn run(
                 let uv = &frag.uv;
                 if fixed {
                     let f = m.uv_fmt.frac_bits;
-                    let q = |x: f64| to_raw(x, &m.uv_fmt, sat);
+                    let mut q = |x: f64| to_raw(x, &m.uv_fmt, sat);
                     let (u0, v0) = (q(uv[0][0]), q(uv[0][1]));
                     let d = [
                         (q(uv[1][0]) - u0) * i64::from(w),
