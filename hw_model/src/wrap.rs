@@ -122,7 +122,11 @@ pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
         WrapMode::Repeat => i.rem_euclid(n) as u32,
         WrapMode::ClampToEdge => i.clamp(0, n - 1) as u32,
         WrapMode::Mirror => {
-            let m = if pow2 { i & (2 * n - 1) } else { i.rem_euclid(2 * n) };
+            let m = if pow2 {
+                i & (2 * n - 1)
+            } else {
+                i.rem_euclid(2 * n)
+            };
             (if m >= n { 2 * n - 1 - m } else { m }) as u32
         }
     }
