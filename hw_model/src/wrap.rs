@@ -132,9 +132,10 @@ pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
     }
 }
 
-/// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps.
+/// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps
+/// (its cycles are part of `bilinear_cycles`).
 #[must_use]
-pub fn wrap_cost() -> crate::cost::UnitCost {
+pub fn wrap_cost(_cfg: &crate::config::TrilinearConfig) -> crate::cost::UnitCost {
     crate::cost::UnitCost {
         ops: 5,
         cycles: 0,
