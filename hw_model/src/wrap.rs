@@ -115,19 +115,27 @@ pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
     if i >= 0 && i < n {
         return i as u32;
     }
+    // Power-of-two sizes reduce by masking (two's complement `&` is the Euclidean remainder).
+    let pow2 = n & (n - 1) == 0;
     match mode {
+        WrapMode::Repeat if pow2 => (i & (n - 1)) as u32,
         WrapMode::Repeat => i.rem_euclid(n) as u32,
         WrapMode::ClampToEdge => i.clamp(0, n - 1) as u32,
         WrapMode::Mirror => {
-            let m = i.rem_euclid(2 * n);
+            let m = if pow2 {
+                i & (2 * n - 1)
+            } else {
+                i.rem_euclid(2 * n)
+            };
             (if m >= n { 2 * n - 1 - m } else { m }) as u32
         }
     }
 }
 
-/// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps.
+/// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps
+/// (its cycles are part of `bilinear_cycles`).
 #[must_use]
-pub fn wrap_cost() -> crate::cost::UnitCost {
+pub fn wrap_cost(_cfg: &crate::config::TrilinearConfig) -> crate::cost::UnitCost {
     crate::cost::UnitCost {
         ops: 5,
         cycles: 0,
