@@ -13,8 +13,14 @@ fn frame(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("frame/{name}"));
         g.sample_size(10);
         for (label, im) in [("fixed", StageImpls::FIXED), ("float", StageImpls::FLOAT)] {
-            let opts = RenderOptions { hw_impls: im, reference: false, ..Default::default() };
-            g.bench_function(label, |b| b.iter(|| render(&s, &maps, &hw, &opts).expect("render")));
+            let opts = RenderOptions {
+                hw_impls: im,
+                reference: false,
+                ..Default::default()
+            };
+            g.bench_function(label, |b| {
+                b.iter(|| render(&s, &maps, &hw, &opts).expect("render"))
+            });
         }
         g.finish();
     }

@@ -140,11 +140,16 @@ pub fn run(cli: Cli) -> Result<()> {
             return Err(Error::field("--threads", "must be at least 1"));
         }
         // A second initialization (tests calling run twice) keeps the first pool: harmless.
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
     }
     match cli.command {
         None => render_cmd(&RenderArgs {
-            scene: SceneArgs { scene: Some("demo".into()), ..SceneArgs::default_out() },
+            scene: SceneArgs {
+                scene: Some("demo".into()),
+                ..SceneArgs::default_out()
+            },
             png16: false,
             coverage: CoverageArg::Shared,
             float: vec![],
@@ -160,7 +165,9 @@ pub fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Some(Command::Sweep(a)) => sweep_cmd(&a),
-        Some(Command::Hw { cmd: HwCmd::Show { preset } }) => {
+        Some(Command::Hw {
+            cmd: HwCmd::Show { preset },
+        }) => {
             print!("{}", hwconfig::to_toml(&hwconfig::resolve(&preset)?));
             Ok(())
         }
@@ -176,7 +183,10 @@ pub fn run(cli: Cli) -> Result<()> {
 
 impl SceneArgs {
     fn default_out() -> Self {
-        Self { out: PathBuf::from("out"), ..Default::default() }
+        Self {
+            out: PathBuf::from("out"),
+            ..Default::default()
+        }
     }
 
     /// Loads the scene and resolves the hardware config.
@@ -195,7 +205,11 @@ impl SceneArgs {
             sc.height = h;
         }
         scene::validate(&sc)?;
-        let spec = self.hw.clone().or_else(|| sc.hw.clone()).unwrap_or_else(|| "texram16".into());
+        let spec = self
+            .hw
+            .clone()
+            .or_else(|| sc.hw.clone())
+            .unwrap_or_else(|| "texram16".into());
         let hw = hwconfig::resolve(&spec)?;
         Ok((sc, hw))
     }
@@ -246,7 +260,10 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         "stats": &r.stats,
         "warnings": &sc.warnings,
     });
-    out.add("summary.json", serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?);
+    out.add(
+        "summary.json",
+        serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
+    );
     let written = out.write_to(&a.scene.out)?;
     print!("{}", crate::summary::text(&r.stats));
     println!("wrote:");
@@ -269,7 +286,11 @@ fn stage_images(r: &Rendered, png16: bool, out: &mut OutputSet) -> Result<()> {
         let heat = report::heatmap(&r.hw_image, rf, 8, Some(&r.mask));
         let hwp = report::image_to_pixmap(&r.hw_image);
         let rfp = report::image_to_pixmap(rf);
-        let sheet = report::sheet(&[("hardware", &hwp), ("reference", &rfp), ("error (8-bit LSB)", &heat)]);
+        let sheet = report::sheet(&[
+            ("hardware", &hwp),
+            ("reference", &rfp),
+            ("error (8-bit LSB)", &heat),
+        ]);
         out.add("error.png", report::encode_pixmap(&heat)?);
         out.add("sheet.png", report::encode_pixmap(&sheet)?);
     }
@@ -300,11 +321,17 @@ pub fn parse_axis(s: &str) -> Result<Axis> {
         };
         let (a, b) = (parse(a)?, parse(b)?);
         if b < a || b - a > 4096 {
-            return Err(Error::field("--vary", format!("range {a}..{b} in '{s}' is empty or too long")));
+            return Err(Error::field(
+                "--vary",
+                format!("range {a}..{b} in '{s}' is empty or too long"),
+            ));
         }
         (a..=b).map(|v| v.to_string()).collect()
     } else {
-        vals.split(',').map(|v| v.trim().to_string()).filter(|v| !v.is_empty()).collect()
+        vals.split(',')
+            .map(|v| v.trim().to_string())
+            .filter(|v| !v.is_empty())
+            .collect()
     };
     if values.is_empty() {
         return Err(Error::field("--vary", format!("'{s}' has no values")));
@@ -332,13 +359,18 @@ pub fn grid(axes: &[Axis]) -> Vec<Vec<(String, String)>> {
 
 fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let (sc, base) = a.scene.load()?;
-    let axes: Vec<Axis> = a.vary.iter().map(|s| parse_axis(s)).collect::<Result<_>>()?;
+    let axes: Vec<Axis> = a
+        .vary
+        .iter()
+        .map(|s| parse_axis(s))
+        .collect::<Result<_>>()?;
     let settings = grid(&axes);
     // Validate every setting before rendering anything.
     let configs: Vec<HwConfig> = settings
         .iter()
         .map(|row| {
-            row.iter().try_fold(base.clone(), |c, (f, v)| hwconfig::set_field(&c, f, v))
+            row.iter()
+                .try_fold(base.clone(), |c, (f, v)| hwconfig::set_field(&c, f, v))
         })
         .collect::<Result<_>>()?;
     for w in &sc.warnings {

@@ -25,19 +25,37 @@ pub fn resolve(spec: &str) -> Result<HwConfig> {
 
 /// Parses a hw config TOML text (see [`resolve`]).
 pub fn parse(text: &str) -> Result<HwConfig> {
-    let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| Error::msg(e.message().to_string()))?;
+    let mut table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| Error::msg(e.message().to_string()))?;
     let base_name = match table.remove("base") {
         None => "texram16".to_string(),
         Some(toml::Value::String(s)) => s,
-        Some(v) => return Err(Error::field("base", format!("expected a preset name, found {v}"))),
+        Some(v) => {
+            return Err(Error::field(
+                "base",
+                format!("expected a preset name, found {v}"),
+            ))
+        }
     };
     let base = HwConfig::preset(&base_name).ok_or_else(|| {
-        Error::field("base", format!("unknown preset '{base_name}' (presets: {})", PRESETS.join(", ")))
+        Error::field(
+            "base",
+            format!(
+                "unknown preset '{base_name}' (presets: {})",
+                PRESETS.join(", ")
+            ),
+        )
     })?;
     let mut merged = to_table(&base);
     merge(&mut merged, table, "")?;
-    if !merged.contains_key("name") || merged.get("name") == Some(&toml::Value::String(base_name.clone())) {
-        merged.insert("name".into(), toml::Value::String(format!("{base_name}+custom")));
+    if !merged.contains_key("name")
+        || merged.get("name") == Some(&toml::Value::String(base_name.clone()))
+    {
+        merged.insert(
+            "name".into(),
+            toml::Value::String(format!("{base_name}+custom")),
+        );
     }
     let cfg: HwConfig = toml::Value::Table(merged)
         .try_into()
@@ -56,11 +74,18 @@ fn to_table(c: &HwConfig) -> toml::Table {
 /// Merges `over` into `into`; every key of `over` must exist in `into` with the same shape.
 fn merge(into: &mut toml::Table, over: toml::Table, prefix: &str) -> Result<()> {
     for (k, v) in over {
-        let path = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+        let path = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
         match (into.get_mut(&k), v) {
             (Some(toml::Value::Table(dst)), toml::Value::Table(src)) => merge(dst, src, &path)?,
             (Some(toml::Value::Table(_)), other) => {
-                return Err(Error::field(&path, format!("expected a table, found {other}")))
+                return Err(Error::field(
+                    &path,
+                    format!("expected a table, found {other}"),
+                ))
             }
             (Some(dst), v) => *dst = v,
             (None, _) => return Err(Error::field(&path, "unknown field")),
@@ -79,7 +104,11 @@ pub fn fields(c: &HwConfig) -> Vec<(String, String)> {
     let mut out = Vec::new();
     fn walk(t: &toml::Table, prefix: &str, out: &mut Vec<(String, String)>) {
         for (k, v) in t {
-            let path = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+            let path = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
             match v {
                 toml::Value::Table(s) => walk(s, &path, out),
                 toml::Value::String(s) => out.push((path, s.clone())),
@@ -103,12 +132,21 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
     let path = match matches.as_slice() {
         [one] => (*one).clone(),
         [] => {
-            let names: Vec<&str> = all.iter().filter_map(|(p, _)| p.rsplit('.').next()).collect();
-            return Err(Error::field(name, format!("no such hw config field (fields: {})", names.join(", "))));
+            let names: Vec<&str> = all
+                .iter()
+                .filter_map(|(p, _)| p.rsplit('.').next())
+                .collect();
+            return Err(Error::field(
+                name,
+                format!("no such hw config field (fields: {})", names.join(", ")),
+            ));
         }
         many => {
             let names: Vec<&str> = many.iter().map(|s| s.as_str()).collect();
-            return Err(Error::field(name, format!("ambiguous, use one of {}", names.join(", "))));
+            return Err(Error::field(
+                name,
+                format!("ambiguous, use one of {}", names.join(", ")),
+            ));
         }
     };
     let mut table = to_table(c);

@@ -7,8 +7,8 @@
 //! Frame flow: scene -> geometry (float) -> raster (fixed setup + scanline traversal into a
 //! visibility buffer) -> per-pixel planned stages (each Fixed or Float) -> images + metrics.
 
-pub mod error;
 pub mod cli;
+pub mod error;
 pub mod fixedpoint;
 pub mod hwconfig;
 pub mod maps;

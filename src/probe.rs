@@ -17,7 +17,10 @@ fn wrap_mode(s: &str) -> Result<WrapMode> {
         "repeat" => Ok(WrapMode::Repeat),
         "clamp-to-edge" | "clamp" => Ok(WrapMode::ClampToEdge),
         "mirror" => Ok(WrapMode::Mirror),
-        _ => Err(Error::field("--wrap", format!("'{s}' is not repeat, clamp-to-edge or mirror"))),
+        _ => Err(Error::field(
+            "--wrap",
+            format!("'{s}' is not repeat, clamp-to-edge or mirror"),
+        )),
     }
 }
 
@@ -51,27 +54,58 @@ pub fn probe_report(
     let levels: Vec<Level> = fixed
         .levels
         .iter()
-        .map(|l| Level { width: l.width, height: l.height, texels: &l.texels })
+        .map(|l| Level {
+            width: l.width,
+            height: l.height,
+            texels: &l.texels,
+        })
         .collect();
     let levels_f: Vec<LevelF> = chain
         .levels
         .iter()
-        .map(|l| LevelF { width: l.width, height: l.height, texels: &l.texels })
+        .map(|l| LevelF {
+            width: l.width,
+            height: l.height,
+            texels: &l.texels,
+        })
         .collect();
     let i = &hw.interp;
     let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding);
     let lfb = hw.lod.lod_frac_bits;
     let lod_fmt = Format::signed(8, lfb, Rounding::Truncate);
     let mut sat = SatCounter::default();
-    let (ur, vr, lr) = (to_raw(u, &uv_fmt, &mut sat), to_raw(v, &uv_fmt, &mut sat), to_raw(lod, &lod_fmt, &mut sat));
+    let (ur, vr, lr) = (
+        to_raw(u, &uv_fmt, &mut sat),
+        to_raw(v, &uv_fmt, &mut sat),
+        to_raw(lod, &lod_fmt, &mut sat),
+    );
     let mut tr = TrilinearTrace::default();
-    let out = trilinear(&levels, ur, vr, uv_fmt.frac_bits, lr, lfb, wrap, &hw.trilinear, Some(&mut tr));
+    let out = trilinear(
+        &levels,
+        ur,
+        vr,
+        uv_fmt.frac_bits,
+        lr,
+        lfb,
+        wrap,
+        &hw.trilinear,
+        Some(&mut tr),
+    );
     let fl = trilinear_f64(&levels_f, u, v, lod, wrap);
     let scale = ((1u64 << tb) - 1) as f64;
 
     let mut o = String::new();
-    let _ = writeln!(o, "texture {} ({}x{}, {} levels), hw '{}'", tex.name, tex.width, tex.height, chain.levels.len(), hw.name);
     let _ = writeln!(
+        o,
+        "texture {} ({}x{}, {} levels), hw '{}'",
+        tex.name,
+        tex.width,
+        tex.height,
+        chain.levels.len(),
+        hw.name
+    );
+    let _ =
+        writeln!(
         o,
         "input: u={u} v={v} lod={lod} -> fixed u={} v={} ({} frac bits), lod={} ({} frac bits){}",
         from_raw(ur, uv_fmt.frac_bits),
@@ -89,7 +123,11 @@ pub fn probe_report(
             b.level, b.weights[0], b.weights[1], hw.trilinear.weight_bits
         );
         for k in 0..4 {
-            let _ = writeln!(o, "  ({:>4},{:>4}) = {:?}", b.coords[k].0, b.coords[k].1, b.texels[k]);
+            let _ = writeln!(
+                o,
+                "  ({:>4},{:>4}) = {:?}",
+                b.coords[k].0, b.coords[k].1, b.texels[k]
+            );
         }
         let _ = writeln!(o, "  bilinear = {:?}", b.result);
     }
@@ -97,7 +135,10 @@ pub fn probe_report(
         let _ = writeln!(o, "level blend weight = {} (of 2^{lfb})", tr.level_weight);
     }
     let _ = writeln!(o, "fixed  = {:?} (texel_bits {tb})", out);
-    let fixed_n: Vec<String> = out.iter().map(|&x| format!("{:.6}", f64::from(x) / scale)).collect();
+    let fixed_n: Vec<String> = out
+        .iter()
+        .map(|&x| format!("{:.6}", f64::from(x) / scale))
+        .collect();
     let float_n: Vec<String> = fl.iter().map(|x| format!("{x:.6}")).collect();
     let diff: Vec<String> = out
         .iter()

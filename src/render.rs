@@ -7,13 +7,13 @@
 //! do not depend on triangle order, and the hardware and reference passes see the same
 //! fragments by default (shared coverage).
 
+use crate::fixedpoint::to_unorm;
 use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
-use crate::pipeline::stages::{run, Counters, Machine, TriAttrs};
+use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{plan, Frag, Impl, Plan, StageImpls, StageKind};
 use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
 use crate::report::{compare, ErrorMetrics, Image};
 use crate::scene::{Light, Scene};
-use crate::fixedpoint::to_unorm;
 use glam::DVec3;
 use hw_model::fixed::SatCounter;
 use hw_model::{HwConfig, UnitCost};
@@ -33,14 +33,25 @@ impl Maps {
     #[must_use]
     pub fn new(scene: &Scene, texel_bits: u32) -> Self {
         let float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
-        let fixed = float.par_iter().map(|c| quantize_chain(c, texel_bits)).collect();
+        let fixed = float
+            .par_iter()
+            .map(|c| quantize_chain(c, texel_bits))
+            .collect();
         Self { float, fixed }
     }
 
     /// Re-quantizes for another texel width if needed (sweeps reuse the float chains).
     pub fn ensure_texel_bits(&mut self, texel_bits: u32) {
-        if self.fixed.first().is_some_and(|f| f.texel_bits != texel_bits) {
-            self.fixed = self.float.par_iter().map(|c| quantize_chain(c, texel_bits)).collect();
+        if self
+            .fixed
+            .first()
+            .is_some_and(|f| f.texel_bits != texel_bits)
+        {
+            self.fixed = self
+                .float
+                .par_iter()
+                .map(|c| quantize_chain(c, texel_bits))
+                .collect();
         }
     }
 }
@@ -81,7 +92,10 @@ impl Geometry {
                 let p = DVec3::from(p.map(f64::from));
                 g.clip.push((vp * p.extend(1.0)).to_array());
                 let c = if mat.lit {
-                    let nrm = mesh.normals.get(vi).map_or(DVec3::Z, |n| DVec3::from(n.map(f64::from)));
+                    let nrm = mesh
+                        .normals
+                        .get(vi)
+                        .map_or(DVec3::Z, |n| DVec3::from(n.map(f64::from)));
                     kd * lighting(scene, p, nrm.normalize_or_zero())
                 } else {
                     kd
@@ -91,7 +105,10 @@ impl Geometry {
             }
             g.plans.push(plan(mat, !mesh.uvs.is_empty()));
             for t in &mesh.indices {
-                g.draws.push(DrawTri { v: t.map(|i| base + i), cull_back: mat.cull_back });
+                g.draws.push(DrawTri {
+                    v: t.map(|i| base + i),
+                    cull_back: mat.cull_back,
+                });
                 g.draw_plan.push(mi as u32);
             }
         }
@@ -104,12 +121,14 @@ fn lighting(scene: &Scene, p: DVec3, n: DVec3) -> DVec3 {
     let mut e = DVec3::from(scene.ambient.map(f64::from));
     for l in &scene.lights {
         let (dir, col) = match l {
-            Light::Directional { direction, color } => {
-                (-DVec3::from(direction.map(f64::from)).normalize_or_zero(), color)
-            }
-            Light::Point { position, color } => {
-                ((DVec3::from(position.map(f64::from)) - p).normalize_or_zero(), color)
-            }
+            Light::Directional { direction, color } => (
+                -DVec3::from(direction.map(f64::from)).normalize_or_zero(),
+                color,
+            ),
+            Light::Point { position, color } => (
+                (DVec3::from(position.map(f64::from)) - p).normalize_or_zero(),
+                color,
+            ),
         };
         e += DVec3::from(col.map(f64::from)) * n.dot(dir).max(0.0);
     }
@@ -138,7 +157,11 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        Self { hw_impls: StageImpls::FIXED, reference: true, coverage: CoverageMode::Shared }
+        Self {
+            hw_impls: StageImpls::FIXED,
+            reference: true,
+            coverage: CoverageMode::Shared,
+        }
     }
 }
 
@@ -228,13 +251,13 @@ fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatC
                 let w = t.src_bary[k];
                 let mut c = [0.0; 3];
                 let mut uv = [0.0; 2];
-                for (j, &vi) in d.v.iter().enumerate() {
+                for (&wj, &vi) in w.iter().zip(&d.v) {
                     let vi = vi as usize;
-                    for ch in 0..3 {
-                        c[ch] += w[j] * geo.color[vi][ch];
+                    for (acc, &x) in c.iter_mut().zip(&geo.color[vi]) {
+                        *acc += wj * x;
                     }
-                    for ax in 0..2 {
-                        uv[ax] += w[j] * geo.uv[vi][ax];
+                    for (acc, &x) in uv.iter_mut().zip(&geo.uv[vi]) {
+                        *acc += wj * x;
                     }
                 }
                 (c, uv)
@@ -259,17 +282,20 @@ fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatC
     (attrs, sat)
 }
 
-/// Shades every covered pixel of `vis` with `impls`; returns the image and the counters.
-fn shade(
-    vis: &VisBuffer,
-    setup: &Setup,
-    attrs: &[TriAttrs],
-    geo: &Geometry,
-    m: &Machine,
-    costs: &[[UnitCost; 6]],
-    impls: &StageImpls,
-    background: [u16; 4],
-) -> (Image, Counters) {
+/// What the shading pass reads: the visible triangles and everything prepared for them.
+struct ShadeInput<'a> {
+    vis: &'a VisBuffer,
+    setup: &'a Setup,
+    attrs: &'a [TriAttrs],
+    geo: &'a Geometry,
+    m: &'a Machine<'a>,
+    /// Cost of each stage kind, per plan.
+    costs: &'a [[UnitCost; 6]],
+}
+
+/// Shades every covered pixel with `impls`; returns the image and the counters.
+fn shade(inp: &ShadeInput, impls: &StageImpls, background: [u16; 4]) -> (Image, Counters) {
+    let vis = inp.vis;
     let w = vis.width as usize;
     let mut img = Image::new(vis.width, vis.height, background);
     let counters = img
@@ -284,11 +310,23 @@ fn shade(
                 if t == NO_TRI {
                     continue;
                 }
-                let a = &attrs[t as usize];
+                let a = &inp.attrs[t as usize];
                 let pi = a.plan as usize;
-                let plan = &geo.plans[pi];
-                run(plan, &costs[pi], impls, m, &setup.tris[t as usize], a, x as i64, y as i64, &mut frag, &mut c);
-                *out = frag.out.map(|v| to_unorm(v, 16) as u16);
+                let tri = &inp.setup.tris[t as usize];
+                let plan = &inp.geo.plans[pi];
+                run(
+                    plan,
+                    &inp.costs[pi],
+                    impls,
+                    inp.m,
+                    tri,
+                    a,
+                    x as i64,
+                    y as i64,
+                    &mut frag,
+                    &mut c,
+                );
+                *out = output16(&frag);
             }
             c
         })
@@ -325,7 +363,15 @@ pub fn render(
 
     let bg = scene.background.map(|c| to_unorm(f64::from(c), 16) as u16);
     let t = Instant::now();
-    let (hw_image, counters) = shade(&vis, &setup, &attrs, &geo, &m, &costs, &opts.hw_impls, bg);
+    let inp = ShadeInput {
+        vis: &vis,
+        setup: &setup,
+        attrs: &attrs,
+        geo: &geo,
+        m: &m,
+        costs: &costs,
+    };
+    let (hw_image, counters) = shade(&inp, &opts.hw_impls, bg);
     tm.shade_hw_ms = ms(t);
     tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
 
@@ -350,7 +396,7 @@ pub fn render(
             }
         };
         let t = Instant::now();
-        let (img, _) = shade(rv, &setup, &attrs, &geo, &m, &costs, &StageImpls::FLOAT, bg);
+        let (img, _) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg);
         tm.shade_ref_ms = ms(t);
         tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
         e8 = Some(compare(&hw_image, &img, 8, Some(&mask)));
@@ -399,7 +445,7 @@ pub fn render(
             height: scene.height,
             triangles: scene.triangle_count() as u64,
             coverage: opts.coverage,
-            setup: setup.stats.clone(),
+            setup: setup.stats,
             raster: raster_stats,
             covered_pixels: covered,
             input_saturated: input_sat.saturated,

@@ -29,7 +29,11 @@ pub fn text(s: &RenderStats) -> String {
         s.raster.fragments, s.raster.depth_fails, s.covered_pixels, s.raster.spans
     );
     if let (Some(e8), Some(e16)) = (&s.error_8bit, &s.error_16bit) {
-        let _ = writeln!(o, "error, hardware vs float reference ({:?} coverage):", s.coverage);
+        let _ = writeln!(
+            o,
+            "error, hardware vs float reference ({:?} coverage):",
+            s.coverage
+        );
         o.push_str(&format_metrics_table(&[("8-bit", e8), ("16-bit", e16)]));
     }
     let _ = writeln!(
@@ -42,7 +46,11 @@ pub fn text(s: &RenderStats) -> String {
             o,
             "{:<10} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
             st.stage.name(),
-            if st.invocations == 0 { "-" } else { imp_name(st.imp) },
+            if st.invocations == 0 {
+                "-"
+            } else {
+                imp_name(st.imp)
+            },
             st.invocations,
             st.saturated,
             st.wrapped,
@@ -51,7 +59,11 @@ pub fn text(s: &RenderStats) -> String {
         );
     }
     if s.input_saturated > 0 {
-        let _ = writeln!(o, "vertex attributes saturated on input: {}", s.input_saturated);
+        let _ = writeln!(
+            o,
+            "vertex attributes saturated on input: {}",
+            s.input_saturated
+        );
     }
     let c = &s.cycles;
     let _ = writeln!(
@@ -97,7 +109,12 @@ impl SweepRow {
             settings,
             error_8bit: s.error_8bit.clone(),
             error_16bit: s.error_16bit.clone(),
-            saturated: s.stages.iter().map(|x| x.saturated + x.wrapped).sum::<u64>() + s.input_saturated,
+            saturated: s
+                .stages
+                .iter()
+                .map(|x| x.saturated + x.wrapped)
+                .sum::<u64>()
+                + s.input_saturated,
             texels: s.stages.iter().map(|x| x.texels).sum(),
             cycles: s.cycles.total,
             cycles_per_pixel: s.cycles.per_covered_pixel,
@@ -108,7 +125,8 @@ impl SweepRow {
 }
 
 const HEADER: [&str; 11] = [
-    "max8", "mean8", "rmse8", "psnr8_db", "exact8_%", "max16", "rmse16", "sat", "cycles", "cyc/px", "hw_ms",
+    "max8", "mean8", "rmse8", "psnr8_db", "exact8_%", "max16", "rmse16", "sat", "cycles", "cyc/px",
+    "hw_ms",
 ];
 
 fn cells(r: &SweepRow) -> Vec<String> {
@@ -137,8 +155,9 @@ fn cells(r: &SweepRow) -> Vec<String> {
 #[must_use]
 pub fn sweep_table(rows: &[SweepRow]) -> String {
     let mut grid: Vec<Vec<String>> = Vec::with_capacity(rows.len() + 1);
-    let set_names: Vec<String> =
-        rows.first().map_or(vec![], |r| r.settings.iter().map(|(f, _)| f.clone()).collect());
+    let set_names: Vec<String> = rows.first().map_or(vec![], |r| {
+        r.settings.iter().map(|(f, _)| f.clone()).collect()
+    });
     let mut head = set_names.clone();
     head.extend(HEADER.iter().map(|s| s.to_string()));
     grid.push(head);
@@ -148,11 +167,21 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
         grid.push(line);
     }
     let ncol = grid[0].len();
-    let widths: Vec<usize> =
-        (0..ncol).map(|c| grid.iter().map(|l| l.get(c).map_or(0, |s| s.len())).max().unwrap_or(0)).collect();
+    let widths: Vec<usize> = (0..ncol)
+        .map(|c| {
+            grid.iter()
+                .map(|l| l.get(c).map_or(0, |s| s.len()))
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
     let mut o = String::new();
     for l in &grid {
-        let cols: Vec<String> = l.iter().zip(&widths).map(|(s, w)| format!("{s:>w$}")).collect();
+        let cols: Vec<String> = l
+            .iter()
+            .zip(&widths)
+            .map(|(s, w)| format!("{s:>w$}"))
+            .collect();
         let _ = writeln!(o, "{}", cols.join("  "));
     }
     o

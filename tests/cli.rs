@@ -19,22 +19,44 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
 }
 
 #[test]
 fn render_writes_every_output() {
     let d = tmp("render");
-    let o = texsim(&["render", "--scene", "demo", "--width", "160", "--height", "120", "--out", "o", "--png16"], &d);
+    let o = texsim(
+        &[
+            "render", "--scene", "demo", "--width", "160", "--height", "120", "--out", "o",
+            "--png16",
+        ],
+        &d,
+    );
     assert!(o.status.success(), "{}", text(&o));
-    for f in ["hw.png", "ref.png", "error.png", "sheet.png", "summary.json", "hw16.png", "ref16.png"] {
+    for f in [
+        "hw.png",
+        "ref.png",
+        "error.png",
+        "sheet.png",
+        "summary.json",
+        "hw16.png",
+        "ref16.png",
+    ] {
         assert!(d.join("o").join(f).is_file(), "missing {f}");
     }
     let j: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("o/summary.json")).unwrap()).unwrap();
     assert!(j["stats"]["error_8bit"]["max_abs_lsb"].is_u64());
     assert!(j["stats"]["cycles"]["total"].as_u64().unwrap() > 0);
-    assert!(text(&o).contains("PSNR") || text(&o).contains("psnr"), "{}", text(&o));
+    assert!(
+        text(&o).contains("PSNR") || text(&o).contains("psnr"),
+        "{}",
+        text(&o)
+    );
 }
 
 #[test]
@@ -46,19 +68,93 @@ fn bad_inputs_fail_cleanly_and_write_nothing() {
         (vec!["render", "missing.obj", "--out", "o"], "missing.obj"),
         (vec!["render", "broken.toml", "--out", "o"], "broken.toml"),
         (vec!["render", "--scene", "nope", "--out", "o"], "nope"),
-        (vec!["render", "--scene", "demo", "--hw", "hw_bad.toml", "--out", "o"], "weight_bits"),
-        (vec!["render", "--scene", "demo", "--hw", "nosuchpreset", "--out", "o"], "nosuchpreset"),
-        (vec!["render", "--scene", "demo", "--width", "0", "--out", "o"], "width"),
-        (vec!["render", "--scene", "demo", "--isolate", "foo", "--out", "o"], "foo"),
-        (vec!["sweep", "--scene", "demo", "--vary", "no_such_field=1..2", "--out", "o"], "no_such_field"),
-        (vec!["sweep", "--scene", "demo", "--vary", "weight_bits=1..99", "--out", "o"], "weight_bits"),
-        (vec!["probe", "--texture", "nothere.png", "--u", "0.5", "--v", "0.5", "--lod", "0"], "nothere.png"),
+        (
+            vec![
+                "render",
+                "--scene",
+                "demo",
+                "--hw",
+                "hw_bad.toml",
+                "--out",
+                "o",
+            ],
+            "weight_bits",
+        ),
+        (
+            vec![
+                "render",
+                "--scene",
+                "demo",
+                "--hw",
+                "nosuchpreset",
+                "--out",
+                "o",
+            ],
+            "nosuchpreset",
+        ),
+        (
+            vec!["render", "--scene", "demo", "--width", "0", "--out", "o"],
+            "width",
+        ),
+        (
+            vec![
+                "render",
+                "--scene",
+                "demo",
+                "--isolate",
+                "foo",
+                "--out",
+                "o",
+            ],
+            "foo",
+        ),
+        (
+            vec![
+                "sweep",
+                "--scene",
+                "demo",
+                "--vary",
+                "no_such_field=1..2",
+                "--out",
+                "o",
+            ],
+            "no_such_field",
+        ),
+        (
+            vec![
+                "sweep",
+                "--scene",
+                "demo",
+                "--vary",
+                "weight_bits=1..99",
+                "--out",
+                "o",
+            ],
+            "weight_bits",
+        ),
+        (
+            vec![
+                "probe",
+                "--texture",
+                "nothere.png",
+                "--u",
+                "0.5",
+                "--v",
+                "0.5",
+                "--lod",
+                "0",
+            ],
+            "nothere.png",
+        ),
     ];
     for (args, needle) in cases {
         let o = texsim(&args, &d);
         assert!(!o.status.success(), "{args:?} succeeded");
         let t = text(&o);
-        assert!(t.contains(needle), "{args:?}: message does not name '{needle}': {t}");
+        assert!(
+            t.contains(needle),
+            "{args:?}: message does not name '{needle}': {t}"
+        );
         assert!(!t.contains("panicked"), "{args:?} panicked: {t}");
         assert!(!d.join("o").exists(), "{args:?} wrote output");
     }
@@ -75,7 +171,19 @@ fn hw_show_round_trips_and_sweep_writes_table() {
     assert!(String::from_utf8_lossy(&o2.stdout).contains("weight_bits = 8"));
 
     let o = texsim(
-        &["sweep", "--scene", "demo", "--width", "96", "--height", "72", "--vary", "weight_bits=2..4", "--out", "s"],
+        &[
+            "sweep",
+            "--scene",
+            "demo",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--vary",
+            "weight_bits=2..4",
+            "--out",
+            "s",
+        ],
         &d,
     );
     assert!(o.status.success(), "{}", text(&o));

@@ -75,7 +75,24 @@ fn texram16_exhaustive_24_bit() {
     for x in 1u64..(1 << 24) {
         check(&unit, &cfg, x, bound, &mut max);
     }
-    println!("texram16 (L=8,N=1,M=24) exhaustive 2^24: max err {max:.3} ulps (bound {bound:.3})");
+    println!("texram16 (L=8,N=2,M=24) exhaustive 2^24: max err {max:.3} ulps (bound {bound:.3})");
+    assert!(
+        max <= 1.0,
+        "two iterations from an 8-bit seed should be within 1 ulp"
+    );
+}
+
+#[test]
+fn one_iteration_exhaustive_24_bit_is_seed_limited() {
+    let mut cfg = HwConfig::texram16().reciprocal;
+    cfg.recip_iterations = 1;
+    let unit = Reciprocal::new(&cfg);
+    let bound = bound_ulps(&cfg);
+    let mut max = 0.0;
+    for x in 1u64..(1 << 24) {
+        check(&unit, &cfg, x, bound, &mut max);
+    }
+    println!("(L=8,N=1,M=24) exhaustive 2^24: max err {max:.3} ulps (bound {bound:.3})");
     assert!(max > 1.0, "seed-limited config should show > 1 ulp error");
 }
 

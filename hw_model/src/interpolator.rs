@@ -37,6 +37,9 @@ pub fn perspective_bary(
     sat: &mut SatCounter,
 ) -> [i64; 3] {
     let one = 1i64 << cfg.bary_bits;
+    if let Some(p) = perspective_bary_narrow(edge, inv_w, one, cfg, recip, sat) {
+        return p;
+    }
     let q = [
         i128::from(edge[0]) * i128::from(inv_w[0]),
         i128::from(edge[1]) * i128::from(inv_w[1]),
@@ -72,6 +75,44 @@ pub fn perspective_bary(
     p
 }
 
+/// The same datapath as [`perspective_bary`] when every `q_i` and their sum fit `i64`
+/// (the common case): identical bits, without `i128` arithmetic. `None` when they do not fit.
+#[inline]
+fn perspective_bary_narrow(
+    edge: [i64; 3],
+    inv_w: [i64; 3],
+    one: i64,
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+) -> Option<[i64; 3]> {
+    let q0 = edge[0].checked_mul(inv_w[0])?;
+    let q1 = edge[1].checked_mul(inv_w[1])?;
+    let q2 = edge[2].checked_mul(inv_w[2])?;
+    let d = q0.checked_add(q1)?.checked_add(q2)?;
+    if d <= 0 {
+        return None;
+    }
+    // d < 2^63 has at most 63 significant bits; the wide path keeps the top 62.
+    let bl = 64 - d.leading_zeros();
+    let s = bl.saturating_sub(62);
+    let r = recip.eval((d >> s) as u64, sat);
+    let r = Recip {
+        mant: r.mant,
+        shift: r.shift + s as i32,
+    };
+    let mut p = [0i64; 3];
+    for (i, q) in [(1usize, q1), (2, q2)] {
+        let v = apply(r, i128::from(q), cfg.bary_bits, cfg.interp_rounding);
+        if !(-BARY_LIMIT..=BARY_LIMIT).contains(&v) {
+            return None;
+        }
+        p[i] = v;
+    }
+    p[0] = one - p[1] - p[2];
+    Some(p)
+}
+
 /// `a0 + p1 (a1 - a0) + p2 (a2 - a0)` accumulated exactly in `i128`, then ONE reduction
 /// from `out.frac_bits + bary_bits` to `out` (round by `out.rounding`, fit by `out.overflow`,
 /// as [`Format::requantize`]). `attr` and the result share `out.frac_bits`. Error: at most
@@ -85,11 +126,22 @@ pub fn interpolate(
     out: &Format,
     sat: &mut SatCounter,
 ) -> i64 {
+    let from = out.frac_bits + bary_bits;
+    // Exact i64 fast path (same accumulator value, same single reduction).
+    let narrow = (|| {
+        let a0 = attr[0];
+        let t0 = a0.checked_mul(1i64.checked_shl(bary_bits)?)?;
+        let t1 = bary[1].checked_mul(attr[1].checked_sub(a0)?)?;
+        let t2 = bary[2].checked_mul(attr[2].checked_sub(a0)?)?;
+        t0.checked_add(t1)?.checked_add(t2)
+    })();
+    if let Some(acc) = narrow {
+        return out.requantize(acc, from, sat);
+    }
     let a0 = i128::from(attr[0]);
     let acc = (a0 << bary_bits)
         + i128::from(bary[1]) * (i128::from(attr[1]) - a0)
         + i128::from(bary[2]) * (i128::from(attr[2]) - a0);
-    let from = out.frac_bits + bary_bits;
     if let Ok(narrow) = i64::try_from(acc) {
         out.requantize(narrow, from, sat)
     } else {

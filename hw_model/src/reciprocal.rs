@@ -98,6 +98,8 @@ impl Reciprocal {
         // m with P fraction bits, in [2^P, 2^(P+1)).
         let mut m: i64 = if n <= p {
             (x << (p - n)) as i64
+        } else if n < 63 {
+            crate::fixed::round_shift_right(x as i64, n - p, rnd)
         } else {
             round_shift_right_wide(i128::from(x), n - p, rnd)
         };
@@ -112,9 +114,7 @@ impl Reciprocal {
         let mut y = self.lut[idx] as i64;
         let two = 2i64 << p;
         for _ in 0..self.cfg.recip_iterations {
-            let t = round_shift_right_wide(i128::from(m) * i128::from(y), p, rnd);
-            let d = two - t;
-            y = round_shift_right_wide(i128::from(y) * i128::from(d), p, rnd);
+            y = nr_step(m, y, two, p, rnd);
         }
         // Normalize y (positive, about 2^P / m) to M + 1 significant bits.
         let b = 64 - (y as u64).leading_zeros();
@@ -140,13 +140,34 @@ impl Reciprocal {
     }
 }
 
+/// One Newton-Raphson step `y (2 - m y)` with each product rounded to `p` fraction bits.
+/// Operands are below 2^(p+2), so for p <= 29 the products fit `i64` (same bits as `i128`).
+#[inline]
+fn nr_step(m: i64, y: i64, two: i64, p: u32, rnd: Rounding) -> i64 {
+    if p <= 29 {
+        let t = crate::fixed::round_shift_right(m * y, p, rnd);
+        crate::fixed::round_shift_right(y * (two - t), p, rnd)
+    } else {
+        let t = round_shift_right_wide(i128::from(m) * i128::from(y), p, rnd);
+        round_shift_right_wide(i128::from(y) * i128::from(two - t), p, rnd)
+    }
+}
+
 /// `x * r` reduced to `frac_bits` fraction bits with ONE rounding by `mode` (x is an integer,
 /// the product is exact in `i128` for |x| < 2^96); results beyond `i64` saturate.
 #[inline]
 #[must_use]
 pub fn apply(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
-    let prod = x.saturating_mul(i128::from(r.mant));
     let sh = r.shift - frac_bits as i32;
+    // Exact i64 fast path: same product, same single rounding.
+    if sh >= 0 {
+        if let (Ok(x64), Ok(m64)) = (i64::try_from(x), i64::try_from(r.mant)) {
+            if let Some(prod) = x64.checked_mul(m64) {
+                return crate::fixed::round_shift_right(prod, sh as u32, mode);
+            }
+        }
+    }
+    let prod = x.saturating_mul(i128::from(r.mant));
     if sh >= 0 {
         round_shift_right_wide(prod, sh as u32, mode)
     } else {

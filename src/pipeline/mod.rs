@@ -61,13 +61,16 @@ impl StageKind {
 
     /// Parses a stage name.
     pub fn parse(s: &str) -> crate::Result<StageKind> {
-        Self::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
-            let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
-            crate::Error::msg(format!(
-                "unknown stage '{s}' (stages: {})",
-                names.join(", ")
-            ))
-        })
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
+                crate::Error::msg(format!(
+                    "unknown stage '{s}' (stages: {})",
+                    names.join(", ")
+                ))
+            })
     }
 
     /// Position in [`StageKind::ALL`].

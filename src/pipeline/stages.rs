@@ -7,14 +7,14 @@ use super::{Frag, Impl, Plan, StageImpls, StageKind};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
-use crate::reference::{
-    interpolate_f64, lod_f64, perspective_bary_f64, trilinear_f64, LevelF,
-};
+use crate::reference::{interpolate_f64, lod_f64, perspective_bary_f64, trilinear_f64, LevelF};
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
-use hw_model::interpolator::{interpolate, interpolate_cost, perspective_bary, perspective_bary_cost};
+use hw_model::interpolator::{
+    interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
+};
 use hw_model::lod::{lod, lod_cost};
-use hw_model::modulate::{modulate, modulate_cost};
+use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
 use hw_model::reciprocal::Reciprocal;
 use hw_model::trilinear::{trilinear, trilinear_cost, Level};
 use hw_model::UnitCost;
@@ -77,7 +77,11 @@ impl<'a> Machine<'a> {
                 .map(|c| {
                     c.levels
                         .iter()
-                        .map(|l| Level { width: l.width, height: l.height, texels: &l.texels })
+                        .map(|l| Level {
+                            width: l.width,
+                            height: l.height,
+                            texels: &l.texels,
+                        })
                         .collect()
                 })
                 .collect(),
@@ -86,7 +90,11 @@ impl<'a> Machine<'a> {
                 .map(|c| {
                     c.levels
                         .iter()
-                        .map(|l| LevelF { width: l.width, height: l.height, texels: &l.texels })
+                        .map(|l| LevelF {
+                            width: l.width,
+                            height: l.height,
+                            texels: &l.texels,
+                        })
                         .collect()
                 })
                 .collect(),
@@ -174,14 +182,16 @@ fn column_f<const N: usize>(v: &[[f64; N]; 3], c: usize) -> [f64; 3] {
 
 #[inline]
 fn unorm(raw: u32, bits: u32) -> f64 {
-    f64::from(raw) / ((1u64 << bits) - 1) as f64
+    f64::from(raw) / f64::from(max_unorm(bits))
 }
 
 /// Sample offsets of the fragment and its two helper samples (x+1, y) and (x, y+1).
 const OFFSETS: [(i64, i64); 3] = [(0, 0), (1, 0), (0, 1)];
 
 /// Runs `plan` on one fragment at pixel (`px`, `py`) of `tri`, each stage by its twin in
-/// `impls`; the result is in `frag.out`.
+/// `impls`; the result is in `frag.out` (and `frag.out_x` when the last stage was Fixed).
+/// A Fixed stage reads the raw value of a Fixed producer and quantizes the carrier of a Float
+/// one; `costs` holds the plan's cost per stage kind.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn run(
@@ -197,8 +207,17 @@ pub fn run(
     c: &mut Counters,
 ) {
     let samples = if plan.derivatives { 3 } else { 1 };
+    let hw = m.hw;
+    let cb = hw.color.color_bits;
+    let tb = hw.trilinear.texel_bits;
+    let bb = hw.interp.bary_bits;
+    let fb = m.uv_fmt.frac_bits;
+    let lfb = hw.lod.lod_frac_bits;
+    let fixed_in = |k: StageKind| impls.of(k) == Impl::Fixed;
     frag.color = plan.const_color;
     frag.out = plan.const_color;
+    frag.out_bits = 0;
+    let mut color_from_stage = false;
     for &kind in &plan.stages {
         let k = kind.index();
         c.invocations[k] += 1;
@@ -210,44 +229,57 @@ pub fn run(
         let sat = &mut c.sat[k];
         match kind {
             StageKind::Bary => {
-                let sub = m.hw.raster.subpixel_bits;
-                let bb = m.hw.interp.bary_bits;
+                let sub = hw.raster.subpixel_bits;
                 for (s, &(dx, dy)) in OFFSETS.iter().enumerate().take(samples) {
-                    frag.bary[s] = if fixed {
+                    if fixed {
                         let e = tri.edges_fixed(px + dx, py + dy, sub);
-                        let b = perspective_bary(e, a.inv_w_x, &m.hw.interp, &m.recip, sat);
-                        b.map(|r| from_raw(r, bb))
+                        let b = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
+                        frag.bary_x[s] = b;
+                        frag.bary[s] = b.map(|r| from_raw(r, bb));
                     } else {
                         let e = tri.edges_float((px + dx) as f64, (py + dy) as f64);
-                        perspective_bary_f64(e, a.inv_w_f)
-                    };
+                        frag.bary[s] = perspective_bary_f64(e, a.inv_w_f);
+                    }
                 }
             }
             StageKind::Color => {
+                color_from_stage = true;
                 if fixed {
-                    let bb = m.hw.interp.bary_bits;
-                    let b = frag.bary[0].map(|x| to_raw(x, &m.bary_fmt, sat));
-                    let cb = m.hw.color.color_bits;
+                    let b = if fixed_in(StageKind::Bary) {
+                        frag.bary_x[0]
+                    } else {
+                        frag.bary[0].map(|x| to_raw(x, &m.bary_fmt, sat))
+                    };
                     for ch in 0..3 {
-                        let r = interpolate(b, bb, column(&a.color_x, ch), &m.color_fmt, sat);
-                        frag.color[ch] = unorm(r as u32, cb);
+                        let r =
+                            interpolate(b, bb, column(&a.color_x, ch), &m.color_fmt, sat) as u32;
+                        frag.color_x[ch] = r;
+                        frag.color[ch] = unorm(r, cb);
                     }
+                    frag.color_x[3] = max_unorm(cb);
+                    frag.out_x = frag.color_x;
+                    frag.out_bits = cb;
                 } else {
                     for ch in 0..3 {
                         frag.color[ch] = interpolate_f64(frag.bary[0], column_f(&a.color_f, ch));
                     }
+                    frag.out_bits = 0;
                 }
                 frag.color[3] = 1.0;
                 frag.out = frag.color;
             }
             StageKind::Texcoord => {
+                let raw_bary = fixed_in(StageKind::Bary);
                 for s in 0..samples {
                     if fixed {
-                        let bb = m.hw.interp.bary_bits;
-                        let b = frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat));
-                        let fb = m.uv_fmt.frac_bits;
+                        let b = if raw_bary {
+                            frag.bary_x[s]
+                        } else {
+                            frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat))
+                        };
                         for ax in 0..2 {
                             let r = interpolate(b, bb, column(&a.uv_x, ax), &m.uv_fmt, sat);
+                            frag.uv_x[s][ax] = r;
                             frag.uv[s][ax] = from_raw(r, fb);
                         }
                     } else {
@@ -259,24 +291,25 @@ pub fn run(
             }
             StageKind::Lod => {
                 let Some(t) = plan.texture else { continue };
-                let (w, h) = match m.tex_float[t].first() {
-                    Some(l) => (l.width, l.height),
-                    None => continue,
+                let Some(l0) = m.tex_float[t].first() else {
+                    continue;
                 };
-                let uv = &frag.uv;
+                let (w, h) = (l0.width, l0.height);
                 if fixed {
-                    let f = m.uv_fmt.frac_bits;
-                    let mut q = |x: f64| to_raw(x, &m.uv_fmt, sat);
-                    let (u0, v0) = (q(uv[0][0]), q(uv[0][1]));
+                    if !fixed_in(StageKind::Texcoord) {
+                        quantize_uv(frag, m, samples, sat);
+                    }
+                    let uv = &frag.uv_x;
                     let d = [
-                        (q(uv[1][0]) - u0) * i64::from(w),
-                        (q(uv[1][1]) - v0) * i64::from(h),
-                        (q(uv[2][0]) - u0) * i64::from(w),
-                        (q(uv[2][1]) - v0) * i64::from(h),
+                        (uv[1][0] - uv[0][0]) * i64::from(w),
+                        (uv[1][1] - uv[0][1]) * i64::from(h),
+                        (uv[2][0] - uv[0][0]) * i64::from(w),
+                        (uv[2][1] - uv[0][1]) * i64::from(h),
                     ];
-                    let l = lod(d, f, &m.hw.lod, sat);
-                    frag.lod = from_raw(l, m.hw.lod.lod_frac_bits);
+                    frag.lod_x = lod(d, fb, &hw.lod, sat);
+                    frag.lod = from_raw(frag.lod_x, lfb);
                 } else {
+                    let uv = &frag.uv;
                     let (wf, hf) = (f64::from(w), f64::from(h));
                     frag.lod = lod_f64([
                         (uv[1][0] - uv[0][0]) * wf,
@@ -288,44 +321,91 @@ pub fn run(
             }
             StageKind::Trilinear => {
                 let Some(t) = plan.texture else { continue };
-                let [u, v] = frag.uv[0];
-                frag.texel = if fixed {
-                    let tc = &m.hw.trilinear;
-                    let lfb = m.hw.lod.lod_frac_bits;
-                    let l = to_raw(frag.lod, &m.lod_fmt, sat);
+                if fixed {
+                    if !fixed_in(StageKind::Texcoord) && !fixed_in(StageKind::Lod) {
+                        quantize_uv(frag, m, 1, sat);
+                    }
+                    let l = if fixed_in(StageKind::Lod) {
+                        frag.lod_x
+                    } else {
+                        to_raw(frag.lod, &m.lod_fmt, sat)
+                    };
+                    let [u, v] = frag.uv_x[0];
                     let r = trilinear(
                         &m.tex_fixed[t],
-                        to_raw(u, &m.uv_fmt, sat),
-                        to_raw(v, &m.uv_fmt, sat),
-                        m.uv_fmt.frac_bits,
+                        u,
+                        v,
+                        fb,
                         l,
                         lfb,
                         plan.wrap,
-                        tc,
+                        &hw.trilinear,
                         None,
                     );
-                    r.map(|x| unorm(u32::from(x), tc.texel_bits))
+                    frag.texel_x = r.map(u32::from);
+                    frag.texel = frag.texel_x.map(|x| unorm(x, tb));
+                    frag.out_x = frag.texel_x;
+                    frag.out_bits = tb;
                 } else {
-                    trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap)
-                };
+                    let [u, v] = frag.uv[0];
+                    frag.texel = trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap);
+                    frag.out_bits = 0;
+                }
                 frag.out = frag.texel;
             }
             StageKind::Modulate => {
                 if fixed {
-                    let cb = m.hw.color.color_bits;
-                    let tb = m.hw.trilinear.texel_bits;
-                    let rnd = m.hw.color.color_rounding;
+                    let rnd = hw.color.color_rounding;
+                    let col = if color_from_stage && fixed_in(StageKind::Color) {
+                        frag.color_x
+                    } else {
+                        frag.color.map(|x| to_unorm(x, cb))
+                    };
+                    let tex = if fixed_in(StageKind::Trilinear) {
+                        frag.texel_x
+                    } else {
+                        frag.texel.map(|x| to_unorm(x, tb))
+                    };
                     for ch in 0..4 {
-                        let x = to_unorm(frag.color[ch], cb);
-                        let y = to_unorm(frag.texel[ch], tb);
-                        frag.out[ch] = unorm(modulate(x, cb, y, tb, cb, rnd), cb);
+                        frag.out_x[ch] = modulate(col[ch], cb, tex[ch], tb, cb, rnd);
+                        frag.out[ch] = unorm(frag.out_x[ch], cb);
                     }
+                    frag.out_bits = cb;
                 } else {
                     for ch in 0..4 {
                         frag.out[ch] = frag.color[ch] * frag.texel[ch];
                     }
+                    frag.out_bits = 0;
                 }
             }
         }
+    }
+}
+
+/// Quantizes the float texture coordinates of the first `samples` samples into the machine's
+/// format (a Fixed consumer after a Float texcoord stage).
+fn quantize_uv(frag: &mut Frag, m: &Machine, samples: usize, sat: &mut SatCounter) {
+    for s in 0..samples {
+        for ax in 0..2 {
+            frag.uv_x[s][ax] = to_raw(frag.uv[s][ax], &m.uv_fmt, sat);
+        }
+    }
+}
+
+#[inline]
+const fn max_unorm(bits: u32) -> u32 {
+    ((1u64 << bits) - 1) as u32
+}
+
+/// The fragment's output as a 16-bit unorm pixel: exact integer conversion of a Fixed
+/// stage's raw output, rounded conversion of a float carrier.
+#[inline]
+#[must_use]
+pub fn output16(frag: &Frag) -> [u16; 4] {
+    if frag.out_bits == 0 {
+        frag.out.map(|v| to_unorm(v, 16) as u16)
+    } else {
+        frag.out_x
+            .map(|v| unorm_convert(v, frag.out_bits, 16, Rounding::HalfEven) as u16)
     }
 }
