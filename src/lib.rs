@@ -15,5 +15,6 @@ pub mod raster;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod shading;
 
 pub use error::{Error, Result};

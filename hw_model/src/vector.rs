@@ -233,3 +233,21 @@ pub fn normalize_cost(cfg: &VectorConfig, rsqrt_cost: UnitCost) -> UnitCost {
 pub fn madd_cost(cfg: &VectorConfig) -> UnitCost {
     UnitCost { ops: 12, cycles: cfg.madd_cycles, texels: 0 }
 }
+
+/// Decodes a filtered offset texel (unsigned, `texel_bits` bits, value `t / 2^texel_bits`)
+/// stored with bias 1/2 and range `R = 2^offset_int_bits` (`f = (t/2^bits - 1/2) * 2R`, the
+/// encoding of `texsim::shading::bump`) into offset format, rounded once, saturating.
+/// For texram16 (16-bit texels, s3.12 offsets) this is exactly `t - 2^15`.
+#[must_use]
+pub fn offset_from_texel(t: u64, texel_bits: u32, cfg: &VectorConfig, sat: &mut SatCounter) -> i64 {
+    let bits = texel_bits.clamp(1, 32);
+    let centered = i64::try_from(t.min(u64::from(u32::MAX))).unwrap_or(0) - (1i64 << (bits - 1));
+    // f_raw = centered * 2^(I + 1 + O - bits)
+    let sh = cfg.offset_int_bits as i32 + 1 + cfg.offset_frac_bits as i32 - bits as i32;
+    let raw = if sh >= 0 {
+        centered << sh
+    } else {
+        round_shift_right_wide(i128::from(centered), (-sh) as u32, cfg.vector_rounding)
+    };
+    offset_format(cfg).fit(raw, sat)
+}
