@@ -14,7 +14,9 @@
 //! - `squaring`: left-to-right binary exponentiation on G-bit values, each product rounded by
 //!   `pow_rounding`; ERROR BOUND (absolute): `2 n 2^-G + 2^-(P+1)`.
 //!
-//! Both measured against the exact power of the quantized input in `tests/frames_pow.rs`.
+//! Both measured against the exact power of the quantized input in `tests/frames_pow.rs`
+//! (exponents 1..=1024): texram16 log-exp max 15.6 ulp of 2^-16 (L = 8; 2.1 ulp at L = 10),
+//! squaring max 1.7 ulp (8 guard bits); the bounds above hold with ratio <= 1.
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
