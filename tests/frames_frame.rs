@@ -24,7 +24,11 @@ fn unif(s: &mut u64) -> f64 {
 
 fn rand_dir(s: &mut u64) -> DVec3 {
     loop {
-        let v = DVec3::new(2.0 * unif(s) - 1.0, 2.0 * unif(s) - 1.0, 2.0 * unif(s) - 1.0);
+        let v = DVec3::new(
+            2.0 * unif(s) - 1.0,
+            2.0 * unif(s) - 1.0,
+            2.0 * unif(s) - 1.0,
+        );
         let l = v.length();
         if l > 0.1 && l <= 1.0 {
             return v / l;
@@ -52,7 +56,9 @@ fn ortho_err(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     for v in [a, b, c] {
         e = e.max((v.length() - 1.0).abs());
     }
-    e.max(a.dot(b).abs()).max(a.dot(c).abs()).max(b.dot(c).abs())
+    e.max(a.dot(b).abs())
+        .max(a.dot(c).abs())
+        .max(b.dot(c).abs())
 }
 
 fn units() -> ShadingUnits {
@@ -101,10 +107,21 @@ fn main_frame_random_orthonormal_and_matches_twin() {
             flag_mismatch += 1;
             continue;
         }
-        let sin = if rfb { 0.8 } else { d(&mq).normalize().cross(rn).length() };
-        let ce = (n - rn).abs().max_element().max((e1 - re1).abs().max_element()).max((e2 - re2).abs().max_element());
+        let sin = if rfb {
+            0.8
+        } else {
+            d(&mq).normalize().cross(rn).length()
+        };
+        let ce = (n - rn)
+            .abs()
+            .max_element()
+            .max((e1 - re1).abs().max_element())
+            .max((e2 - re2).abs().max_element());
         worst_c = worst_c.max(ce / main_bound(sin));
-        assert!(ce <= main_bound(sin), "case {i}: component err {ce} sin {sin}");
+        assert!(
+            ce <= main_bound(sin),
+            "case {i}: component err {ce} sin {sin}"
+        );
     }
     println!(
         "main frame: ortho err {:.2} ulp, component err {:.2} of bound, fallback flag mismatches {flag_mismatch}",
@@ -158,12 +175,21 @@ fn main_frame_continuity_away_from_cone() {
             let ang = k as f64 * step;
             let n = (start * ang.cos() + axis.cross(start) * ang.sin()).normalize();
             let fx = main_direction_frame(&q(n), &q(m), &u, &mut sat);
-            let cur = (d(&fx.n), d(&fx.e1), d(&fx.e2), fx.fallback, m.cross(n).length());
+            let cur = (
+                d(&fx.n),
+                d(&fx.e1),
+                d(&fx.e2),
+                fx.fallback,
+                m.cross(n).length(),
+            );
             if let Some(p) = prev {
                 let sin = p.4.min(cur.4);
                 if p.3 != cur.3 {
                     crossings += 1;
-                    assert!(sin < 1.5 * thr, "flag switched away from the cone: sin {sin}");
+                    assert!(
+                        sin < 1.5 * thr,
+                        "flag switched away from the cone: sin {sin}"
+                    );
                 } else if sin >= 2.0 * thr && !cur.3 {
                     let dist = (cur.1 - p.1).length().max((cur.2 - p.2).length());
                     let lim = 1.5 * step * (1.0 + 1.0 / sin) + 8.0 * ulp() / sin;
@@ -198,7 +224,10 @@ fn unit_and_natural_frames_match_twin() {
         let uf = unit_frame(&q(n_i), &q(du), &q(dv), &u, &mut sat);
         assert_eq!((uf.n, uf.t_u, uf.t_v), (fr.n, fr.t_u, fr.t_v));
     }
-    println!("unit/natural frame max component err {:.3} ulp", worst / ulp());
+    println!(
+        "unit/natural frame max component err {:.3} ulp",
+        worst / ulp()
+    );
     assert!(worst <= 0.61 * ulp());
 }
 

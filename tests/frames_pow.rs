@@ -34,7 +34,11 @@ fn inputs(p: u32, s: &mut u64, count: usize) -> Vec<u64> {
     let mut v = vec![0, 1, 2, one / 2, one - 1, one];
     while v.len() < count {
         let r = splitmix(s);
-        let x = if r & 1 == 0 { one - (r >> 1) % (one / 64 + 1) } else { (r >> 1) % (one + 1) };
+        let x = if r & 1 == 0 {
+            one - (r >> 1) % (one / 64 + 1)
+        } else {
+            (r >> 1) % (one + 1)
+        };
         v.push(x);
     }
     v
@@ -66,23 +70,35 @@ fn log_exp_within_bound_all_exponents() {
     let cfg = PowConfig::texram16();
     let exps: Vec<u32> = (1..=1024).collect();
     let (w, r) = measure(&cfg, 1200, &exps);
-    println!("pow log-exp texram16: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}", w * 65536.0);
+    println!(
+        "pow log-exp texram16: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}",
+        w * 65536.0
+    );
     assert!(r <= 1.0);
 }
 
 #[test]
 fn squaring_within_bound_all_exponents() {
-    let cfg = PowConfig { pow_method: PowMethod::Squaring, ..PowConfig::texram16() };
+    let cfg = PowConfig {
+        pow_method: PowMethod::Squaring,
+        ..PowConfig::texram16()
+    };
     let exps: Vec<u32> = (1..=1024).collect();
     let (w, r) = measure(&cfg, 1200, &exps);
-    println!("pow squaring texram16: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}", w * 65536.0);
+    println!(
+        "pow squaring texram16: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}",
+        w * 65536.0
+    );
     assert!(r <= 1.0);
 }
 
 #[test]
 fn pow_edges_and_saturation() {
     for method in [PowMethod::LogExp, PowMethod::Squaring] {
-        let cfg = PowConfig { pow_method: method, ..PowConfig::texram16() };
+        let cfg = PowConfig {
+            pow_method: method,
+            ..PowConfig::texram16()
+        };
         let u = Pow::new(&cfg);
         let one = 1u64 << 16;
         let mut sat = SatCounter::default();
@@ -94,21 +110,33 @@ fn pow_edges_and_saturation() {
         assert_eq!(u.pow(one + 5, 2, &mut sat), one);
         assert_eq!(sat.saturated, 1, "input above 1.0 counted");
         let _ = u.pow(one / 2, 1 << 11, &mut sat);
-        assert_eq!(sat.saturated, 2, "exponent beyond pow_exponent_bits counted");
+        assert_eq!(
+            sat.saturated, 2,
+            "exponent beyond pow_exponent_bits counted"
+        );
     }
 }
 
 #[test]
 fn pow_error_table() {
-    let exps: Vec<u32> = [1u32, 2, 3, 5, 8, 13, 20, 32, 50, 64, 100, 128, 200, 256, 500, 512, 1000, 1024]
-        .to_vec();
+    let exps: Vec<u32> = [
+        1u32, 2, 3, 5, 8, 13, 20, 32, 50, 64, 100, 128, 200, 256, 500, 512, 1000, 1024,
+    ]
+    .to_vec();
     println!("pow max abs error in ulp of 2^-16 (P=16, guard 8), exponents 1..1024 sampled");
     println!("pow_lut_bits | log-exp err | err/bound | cycles");
     for l in [4u32, 6, 8, 10, 12] {
-        let cfg = PowConfig { pow_lut_bits: l, ..PowConfig::texram16() };
+        let cfg = PowConfig {
+            pow_lut_bits: l,
+            ..PowConfig::texram16()
+        };
         let (w, r) = measure(&cfg, 3000, &exps);
         assert!(r <= 1.0, "L={l}: {r}");
-        println!("{l:12} | {:11.2} | {r:9.3} | {}", w * 65536.0, pow_cost(&cfg).cycles);
+        println!(
+            "{l:12} | {:11.2} | {r:9.3} | {}",
+            w * 65536.0,
+            pow_cost(&cfg).cycles
+        );
     }
     println!("pow_guard_bits | squaring err | err/bound | cycles");
     for gb in [0u32, 4, 8, 12] {
@@ -119,6 +147,10 @@ fn pow_error_table() {
         };
         let (w, r) = measure(&cfg, 3000, &exps);
         assert!(r <= 1.0, "guard={gb}: {r}");
-        println!("{gb:14} | {:12.2} | {r:9.3} | {}", w * 65536.0, pow_cost(&cfg).cycles);
+        println!(
+            "{gb:14} | {:12.2} | {r:9.3} | {}",
+            w * 65536.0,
+            pow_cost(&cfg).cycles
+        );
     }
 }

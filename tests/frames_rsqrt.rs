@@ -47,7 +47,10 @@ fn max_err_mantissas(cfg: &RsqrtConfig, stride: u64) -> f64 {
 fn rsqrt_exhaustive_texram16() {
     let cfg = RsqrtConfig::texram16();
     let worst = max_err_mantissas(&cfg, 1);
-    println!("rsqrt texram16 exhaustive max rel err {worst:.3e} bound {:.3e}", bound(&cfg));
+    println!(
+        "rsqrt texram16 exhaustive max rel err {worst:.3e} bound {:.3e}",
+        bound(&cfg)
+    );
     assert!(worst <= bound(&cfg), "{worst} > {}", bound(&cfg));
     assert!(worst < 6.0e-6);
 }
@@ -61,7 +64,12 @@ fn rsqrt_random_inputs_all_roundings() {
         let u = Rsqrt::new(&cfg);
         assert!(u.eval(0).is_none());
         // Truncation rounds the input and every product down: allow the one-sided extra.
-        let bnd = bound(&cfg) * if rounding == Rounding::Truncate { 1.5 } else { 1.0 };
+        let bnd = bound(&cfg)
+            * if rounding == Rounding::Truncate {
+                1.5
+            } else {
+                1.0
+            };
         let mut worst = 0.0f64;
         for i in 0..400_000u32 {
             let r = splitmix(&mut s);
@@ -78,11 +86,17 @@ fn rsqrt_random_inputs_all_roundings() {
 
 #[test]
 fn rsqrt_exact_powers_of_four() {
-    let u = Rsqrt::new(&RsqrtConfig { rsqrt_iterations: 3, ..RsqrtConfig::texram16() });
+    let u = Rsqrt::new(&RsqrtConfig {
+        rsqrt_iterations: 3,
+        ..RsqrtConfig::texram16()
+    });
     for k in 0..32 {
         let o = u.eval(1u64 << (2 * k)).expect("nonzero");
         let got = o.mant as f64 * (-f64::from(o.shift)).exp2();
-        assert!((got * f64::from(1u32 << k) - 1.0).abs() < 1e-7, "k={k} got {got}");
+        assert!(
+            (got * f64::from(1u32 << k) - 1.0).abs() < 1e-7,
+            "k={k} got {got}"
+        );
     }
 }
 
@@ -102,7 +116,10 @@ fn rsqrt_error_table() {
             assert!(w <= bound(&cfg), "L={l} it={it}: {w} > {}", bound(&cfg));
             row.push_str(&format!(" {w:.3e} |"));
         }
-        let c = rsqrt_cost(&RsqrtConfig { rsqrt_lut_bits: l, ..RsqrtConfig::texram16() });
+        let c = rsqrt_cost(&RsqrtConfig {
+            rsqrt_lut_bits: l,
+            ..RsqrtConfig::texram16()
+        });
         row.push_str(&format!(" {} cyc", c.cycles));
         println!("{row}");
     }
@@ -110,7 +127,10 @@ fn rsqrt_error_table() {
 
 #[test]
 fn rsqrt_config_validation_names_field() {
-    let cfg = RsqrtConfig { rsqrt_lut_bits: 0, ..RsqrtConfig::texram16() };
+    let cfg = RsqrtConfig {
+        rsqrt_lut_bits: 0,
+        ..RsqrtConfig::texram16()
+    };
     let e = cfg.validate().expect_err("lut bits 0");
     assert!(e.field.contains("rsqrt_lut_bits"));
     assert!(RsqrtConfig::texram16().validate().is_ok());

@@ -1,7 +1,10 @@
 //! Blinn-Phong fixed unit against its f64 twin, including grazing light/view and l = -v.
+#![allow(clippy::needless_range_loop)]
 
 use glam::DVec3;
-use hw_model::blinn_phong::{blinn_phong, blinn_phong_cost, BlinnPhongInput, ShadingConfig, ShadingUnits};
+use hw_model::blinn_phong::{
+    blinn_phong, blinn_phong_cost, BlinnPhongInput, ShadingConfig, ShadingUnits,
+};
 use hw_model::pow::PowMethod;
 use hw_model::SatCounter;
 use texsim::shading::reference as r;
@@ -20,7 +23,11 @@ fn unif(s: &mut u64) -> f64 {
 
 fn rand_dir(s: &mut u64) -> DVec3 {
     loop {
-        let v = DVec3::new(2.0 * unif(s) - 1.0, 2.0 * unif(s) - 1.0, 2.0 * unif(s) - 1.0);
+        let v = DVec3::new(
+            2.0 * unif(s) - 1.0,
+            2.0 * unif(s) - 1.0,
+            2.0 * unif(s) - 1.0,
+        );
         let l = v.length();
         if l > 0.1 && l <= 1.0 {
             return v / l;
@@ -63,10 +70,22 @@ fn run(method: PowMethod, cases: u32) -> f64 {
         let shininess = 1 + (splitmix(&mut s) % 1024) as u32;
         let col = |s: &mut u64| [0; 3].map(|_: u64| splitmix(s) % (1 << C));
         let (kd, ks, light) = (col(&mut s), col(&mut s), col(&mut s));
-        let inp = BlinnPhongInput { n: nq, l: lq, v: vq, shininess, kd, ks, light };
+        let inp = BlinnPhongInput {
+            n: nq,
+            l: lq,
+            v: vq,
+            shininess,
+            kd,
+            ks,
+            light,
+        };
         let out = blinn_phong(&inp, &u, &mut sat);
         let f = |c: [u64; 3]| c.map(|x| x as f64 * cu);
-        let (nd, ld, vd) = (r::from_vec3x(&nq, F), r::from_vec3x(&lq, F), r::from_vec3x(&vq, F));
+        let (nd, ld, vd) = (
+            r::from_vec3x(&nq, F),
+            r::from_vec3x(&lq, F),
+            r::from_vec3x(&vq, F),
+        );
         let (want, hz) = r::blinn_phong(nd, ld, vd, shininess, f(kd), f(ks), f(light));
         assert_eq!(hz, out.h_zero, "case {i}");
         if i % 8 == 3 {
@@ -75,7 +94,11 @@ fn run(method: PowMethod, cases: u32) -> f64 {
         // Bound: ks * (pow bound at x + s x^(s-1) * 2.5 ulp (n.h error)) + kd * 1 ulp (n.l,
         // plus the twin's exact normalization of the quantized inputs) + 1 colour ulp.
         let ndl = nd.dot(ld).max(0.0);
-        let x = if hz || ndl == 0.0 { 0.0 } else { nd.dot((ld + vd).normalize()).clamp(0.0, 1.0) };
+        let x = if hz || ndl == 0.0 {
+            0.0
+        } else {
+            nd.dot((ld + vd).normalize()).clamp(0.0, 1.0)
+        };
         let sf = f64::from(shininess);
         let pow_b = x.powf(sf) * ((sf * (0.1803 * 2f64.powi(-16) + 2f64.powi(-24))).exp2() - 1.0)
             + 2.0 * sf * 2f64.powi(-24)
@@ -85,7 +108,11 @@ fn run(method: PowMethod, cases: u32) -> f64 {
             let got = out.color[k] as f64 * cu;
             let lt = f(light)[k];
             // Near a boundary (n.l ~ 0) the spec term may switch on/off: allow the full term.
-            let switch = if ndl < 1.5 * ulp { f(ks)[k] * x.powf(sf) } else { 0.0 };
+            let switch = if ndl < 1.5 * ulp {
+                f(ks)[k] * x.powf(sf)
+            } else {
+                0.0
+            };
             let b = lt * (f(ks)[k] * (pow_b + sens) + f(kd)[k] * ulp + switch) + cu;
             let e = (got - want[k]).abs();
             worst_ratio = worst_ratio.max(e / b);

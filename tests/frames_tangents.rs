@@ -33,7 +33,10 @@ fn check_valid(t: &[[f32; 4]], normals: &[[f32; 3]]) {
         if let Some(&n) = normals.get(i) {
             let nn = DVec3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2]));
             if nn.length() > 0.0 {
-                assert!(v(*tt).dot(nn.normalize()).abs() < 1e-5, "vertex {i} not tangent");
+                assert!(
+                    v(*tt).dot(nn.normalize()).abs() < 1e-5,
+                    "vertex {i} not tangent"
+                );
             }
         }
     }
@@ -41,7 +44,12 @@ fn check_valid(t: &[[f32; 4]], normals: &[[f32; 3]]) {
 
 #[test]
 fn planar_quad_and_derivatives() {
-    let pos = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 3.0, 0.0], [0.0, 3.0, 0.0]];
+    let pos = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 3.0, 0.0],
+        [0.0, 3.0, 0.0],
+    ];
     let nor = [[0.0, 0.0, 1.0]; 4];
     let uv = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
     let idx = [[0, 1, 2], [0, 2, 3]];
@@ -73,15 +81,28 @@ fn mirrored_uvs_on_a_quad() {
         [2.0, 1.0, 0.0],
     ];
     let nor = [[0.0, 0.0, 1.0]; 6];
-    let uv = [[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [0.0, 1.0]];
+    let uv = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 0.0],
+        [0.0, 1.0],
+        [1.0, 1.0],
+        [0.0, 1.0],
+    ];
     let idx = [[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]];
     let t = generate_tangents(&pos, &nor, &uv, &idx);
     check_valid(&t, &nor);
     for i in [0, 3] {
-        assert!((v(t[i]) - DVec3::X).length() < 1e-6 && t[i][3] == 1.0, "left {i}");
+        assert!(
+            (v(t[i]) - DVec3::X).length() < 1e-6 && t[i][3] == 1.0,
+            "left {i}"
+        );
     }
     for i in [2, 5] {
-        assert!((v(t[i]) + DVec3::X).length() < 1e-6 && t[i][3] == -1.0, "right {i}");
+        assert!(
+            (v(t[i]) + DVec3::X).length() < 1e-6 && t[i][3] == -1.0,
+            "right {i}"
+        );
         // Bitangent w (N x T) is +y on both sides: v grows along +y everywhere.
         let b = f64::from(t[i][3]) * DVec3::Z.cross(v(t[i]));
         assert!((b - DVec3::Y).length() < 1e-6);
@@ -94,10 +115,23 @@ fn mirrored_uvs_on_a_quad() {
 
 #[test]
 fn uv_degenerate_and_garbage_input() {
-    let pos = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [f32::NAN, 0.0, 0.0]];
-    let nor = [[0.0, 0.0, 1.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [f32::NAN; 3]];
+    let pos = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [f32::NAN, 0.0, 0.0],
+    ];
+    let nor = [
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [f32::NAN; 3],
+    ];
     // All UVs equal; UVs collinear; out-of-range index; NaN position.
-    for uv in [[[0.5f32, 0.5]; 4], [[0.0, 0.0], [0.5, 0.5], [1.0, 1.0], [0.2, 0.2]]] {
+    for uv in [
+        [[0.5f32, 0.5]; 4],
+        [[0.0, 0.0], [0.5, 0.5], [1.0, 1.0], [0.2, 0.2]],
+    ] {
         let t = generate_tangents(&pos, &nor, &uv, &[[0, 1, 2], [0, 1, 9], [0, 1, 3]]);
         check_valid(&t, &nor);
         assert_eq!(t.len(), 4);
@@ -109,7 +143,11 @@ fn uv_degenerate_and_garbage_input() {
     assert!(generate_tangents(&[], &[], &[], &[[0, 1, 2]]).is_empty());
 }
 
-fn uv_sphere(segs: u32, rings: u32, shared_pole: bool) -> (Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[u32; 3]>) {
+fn uv_sphere(
+    segs: u32,
+    rings: u32,
+    shared_pole: bool,
+) -> (Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[u32; 3]>) {
     let (mut p, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new());
     // Grid (segs + 1) x (rings + 1) with u seam duplicated; poles either per segment or shared.
     let id = |i: u32, j: u32| j * (segs + 1) + i;
@@ -124,8 +162,16 @@ fn uv_sphere(segs: u32, rings: u32, shared_pole: bool) -> (Vec<[f32; 3]>, Vec<[f
     for j in 0..rings {
         for i in 0..segs {
             let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            let (a, b) = if shared_pole && j == 0 { (id(0, 0), id(0, 0)) } else { (a, b) };
-            let (c, d) = if shared_pole && j + 1 == rings { (id(0, rings), id(0, rings)) } else { (c, d) };
+            let (a, b) = if shared_pole && j == 0 {
+                (id(0, 0), id(0, 0))
+            } else {
+                (a, b)
+            };
+            let (c, d) = if shared_pole && j + 1 == rings {
+                (id(0, rings), id(0, rings))
+            } else {
+                (c, d)
+            };
             if a != b {
                 idx.push([a, b, c]);
             }
@@ -151,7 +197,10 @@ fn sphere_poles_with_spherical_uvs() {
             let q = DVec3::new(f64::from(pp[0]), f64::from(pp[1]), f64::from(pp[2]));
             let east = DVec3::new(-q.y, q.x, 0.0);
             if east.length() > 0.3 {
-                assert!(v(t[i]).dot(east.normalize()) > 0.95, "shared={shared} vertex {i}");
+                assert!(
+                    v(t[i]).dot(east.normalize()) > 0.95,
+                    "shared={shared} vertex {i}"
+                );
             }
         }
     }
@@ -162,12 +211,22 @@ fn random_meshes_never_nan() {
     let mut s = 5u64;
     for _ in 0..2000 {
         let nv = 3 + (splitmix(&mut s) % 20) as usize;
-        let pos: Vec<[f32; 3]> = (0..nv).map(|_| [unif(&mut s), unif(&mut s), unif(&mut s)]).collect();
+        let pos: Vec<[f32; 3]> = (0..nv)
+            .map(|_| [unif(&mut s), unif(&mut s), unif(&mut s)])
+            .collect();
         let nor: Vec<[f32; 3]> = (0..nv)
-            .map(|i| if i % 7 == 0 { [0.0; 3] } else { [unif(&mut s) - 0.5, unif(&mut s) - 0.5, unif(&mut s) - 0.5] })
+            .map(|i| {
+                if i % 7 == 0 {
+                    [0.0; 3]
+                } else {
+                    [unif(&mut s) - 0.5, unif(&mut s) - 0.5, unif(&mut s) - 0.5]
+                }
+            })
             .collect();
         // Quantized UVs so that many triangles are UV-degenerate.
-        let uv: Vec<[f32; 2]> = (0..nv).map(|_| [(unif(&mut s) * 3.0).floor(), (unif(&mut s) * 3.0).floor()]).collect();
+        let uv: Vec<[f32; 2]> = (0..nv)
+            .map(|_| [(unif(&mut s) * 3.0).floor(), (unif(&mut s) * 3.0).floor()])
+            .collect();
         let idx: Vec<[u32; 3]> = (0..nv)
             .map(|_| [0; 3].map(|_: u32| (splitmix(&mut s) % nv as u64) as u32))
             .collect();

@@ -1,8 +1,9 @@
 //! Vector unit (dot, cross, normalize, madd, offset decode) against an f64 model, seeded random.
+#![allow(clippy::needless_range_loop)]
 
 use hw_model::rsqrt::{Rsqrt, RsqrtConfig};
 use hw_model::vector::{
-    cross3, dot3, madd, normalize3, offset_from_texel, offset_format, vector_format, wide_format,
+    cross3, dot3, madd, normalize3, offset_format, offset_from_texel, vector_format, wide_format,
     VectorConfig,
 };
 use hw_model::SatCounter;
@@ -40,7 +41,10 @@ fn dot_and_cross_half_ulp() {
         let d = dot3(&a, &b, &cfg, &mut sat) as f64 * ulp(f);
         if sat.saturated > before {
             n_sat += 1;
-            assert!(exact >= 2.0 - ulp(f) || exact < -2.0, "spurious saturation {exact}");
+            assert!(
+                exact >= 2.0 - ulp(f) || exact < -2.0,
+                "spurious saturation {exact}"
+            );
             assert_eq!(d, exact.clamp(-2.0, 2.0 - ulp(f)));
         } else {
             assert!((d - exact).abs() <= 0.5 * ulp(f), "dot {d} vs {exact}");
@@ -87,13 +91,21 @@ fn normalize_error_bound() {
         }
         let out = normalize3(&v, [0; 3], &rs, &cfg, &mut sat);
         assert!(!out.zero);
-        let len = v.iter().map(|&c| (c as f64) * (c as f64)).sum::<f64>().sqrt();
+        let len = v
+            .iter()
+            .map(|&c| (c as f64) * (c as f64))
+            .sum::<f64>()
+            .sqrt();
         for j in 0..3 {
             let e = (out.v[j] as f64 * ulp(f) - v[j] as f64 / len).abs();
             worst = worst.max(e);
         }
     }
-    println!("normalize max component error {:.3} ulp (bound {:.3})", worst / ulp(f), bound / ulp(f));
+    println!(
+        "normalize max component error {:.3} ulp (bound {:.3})",
+        worst / ulp(f),
+        bound / ulp(f)
+    );
     assert!(worst <= bound, "{worst} > {bound}");
     assert_eq!(sat.saturated, 0);
     let z = normalize3(&[0; 3], [0, 0, 1 << f], &rs, &cfg, &mut sat);

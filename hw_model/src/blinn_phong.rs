@@ -39,7 +39,11 @@ impl ShadeConfig {
     /// Texram-style default: 16-bit colours.
     #[must_use]
     pub fn texram16() -> Self {
-        Self { shade_color_bits: 16, shade_rounding: Rounding::HalfEven, shade_cycles: 1 }
+        Self {
+            shade_color_bits: 16,
+            shade_rounding: Rounding::HalfEven,
+            shade_cycles: 1,
+        }
     }
 }
 
@@ -97,7 +101,11 @@ impl ShadingUnits {
     /// Builds the LUTs (call once per frame, not per pixel).
     #[must_use]
     pub fn new(cfg: &ShadingConfig) -> Self {
-        Self { cfg: cfg.clone(), rsqrt: Rsqrt::new(&cfg.rsqrt), pow: Pow::new(&cfg.pow) }
+        Self {
+            cfg: cfg.clone(),
+            rsqrt: Rsqrt::new(&cfg.rsqrt),
+            pow: Pow::new(&cfg.pow),
+        }
     }
 }
 
@@ -140,7 +148,11 @@ pub fn blinn_phong(
     let c = units.cfg.shade.shade_color_bits;
     let one_f = 1i64 << f;
     let ndl = dot3(&inp.n, &inp.l, vc, sat).clamp(0, one_f);
-    let sum = [inp.l[0] + inp.v[0], inp.l[1] + inp.v[1], inp.l[2] + inp.v[2]];
+    let sum = [
+        inp.l[0] + inp.v[0],
+        inp.l[1] + inp.v[1],
+        inp.l[2] + inp.v[2],
+    ];
     let h_zero = sum == [0; 3];
     let spec: i64 = if h_zero || ndl == 0 {
         0
@@ -151,14 +163,13 @@ pub fn blinn_phong(
         units.pow.pow(x as u64, inp.shininess, sat) as i64
     };
     let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
-    let mut color = [0u64; 3];
-    for i in 0..3 {
+    let color = [0usize, 1, 2].map(|i| {
         let acc = i128::from(inp.kd[i]) * i128::from(ndl) * (1i128 << p)
             + i128::from(inp.ks[i]) * i128::from(spec) * (1i128 << f);
         let lit = acc * i128::from(inp.light[i]);
         let r = round_shift_right_wide(lit, c + f + p, units.cfg.shade.shade_rounding);
-        color[i] = out_fmt.fit(r, sat) as u64;
-    }
+        out_fmt.fit(r, sat) as u64
+    });
     BlinnPhongOut { color, h_zero }
 }
 
@@ -169,8 +180,16 @@ pub fn blinn_phong_cost(units: &ShadingUnits) -> UnitCost {
     let c = &units.cfg;
     dot_cost(&c.vector)
         .times(2)
-        .plus(UnitCost { ops: 3, cycles: 1, texels: 0 })
+        .plus(UnitCost {
+            ops: 3,
+            cycles: 1,
+            texels: 0,
+        })
         .plus(normalize_cost(&c.vector, rsqrt_cost(&c.rsqrt)))
         .plus(pow_cost(&c.pow))
-        .plus(UnitCost { ops: 12, cycles: c.shade.shade_cycles, texels: 0 })
+        .plus(UnitCost {
+            ops: 12,
+            cycles: c.shade.shade_cycles,
+            texels: 0,
+        })
 }

@@ -186,7 +186,13 @@ pub fn main_direction_frame(
     let c64 = c.map(|x| x as i64);
     let e1 = normalize3(&c64, [1i64 << f, 0, 0], rs, vc, sat).v;
     let e2 = cross3(&n, &e1, vc, sat);
-    MainFrame { n, e1, e2, fallback, zero_normal: nn.zero }
+    MainFrame {
+        n,
+        e1,
+        e2,
+        fallback,
+        zero_normal: nn.zero,
+    }
 }
 
 fn neg(v: &Vec3x, fmt: &Format, sat: &mut SatCounter) -> Vec3x {
@@ -305,7 +311,10 @@ pub fn perturb_normal(
     let of = offset_format(vc);
     let lfb = units.cfg.frame.frame_len_frac_bits;
     let g = |f: i64, l: i64, sat: &mut SatCounter| {
-        of.fit(round_shift_right_wide(i128::from(f) * i128::from(l), lfb, vc.vector_rounding), sat)
+        of.fit(
+            round_shift_right_wide(i128::from(f) * i128::from(l), lfb, vc.vector_rounding),
+            sat,
+        )
     };
     let g_u = g(f_u, fr.len_u, sat);
     let g_v = g(f_v, fr.len_v, sat);
@@ -337,7 +346,11 @@ pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
 pub fn perturb_cost(units: &ShadingUnits) -> UnitCost {
     let c = &units.cfg;
     let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt));
-    UnitCost { ops: 2, cycles: c.frame.frame_len_cycles, texels: 0 }
-        .plus(madd_cost(&c.vector))
-        .plus(nz)
+    UnitCost {
+        ops: 2,
+        cycles: c.frame.frame_len_cycles,
+        texels: 0,
+    }
+    .plus(madd_cost(&c.vector))
+    .plus(nz)
 }

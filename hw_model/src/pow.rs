@@ -155,7 +155,12 @@ impl Pow {
                 rnd(acc)
             })
             .collect();
-        Self { log_t, exp_t, cfg, g }
+        Self {
+            log_t,
+            exp_t,
+            cfg,
+            g,
+        }
     }
 
     /// The (clamped) configuration in use.
@@ -195,7 +200,11 @@ impl Pow {
 
     fn lerp(&self, t: &[i64], idx: usize, w: i64, wbits: u32) -> i64 {
         let (a, b) = (t[idx], t[idx + 1]);
-        a + round_shift_right_wide(i128::from(b - a) * i128::from(w), wbits, self.cfg.pow_rounding)
+        a + round_shift_right_wide(
+            i128::from(b - a) * i128::from(w),
+            wbits,
+            self.cfg.pow_rounding,
+        )
     }
 
     fn log_exp(&self, x: u64, n: u32) -> u64 {
@@ -248,7 +257,11 @@ pub fn pow_cost(cfg: &PowConfig) -> UnitCost {
         },
         PowMethod::Squaring => {
             let m = 2 * cfg.pow_exponent_bits - 1;
-            UnitCost { ops: m, cycles: m * cfg.pow_mul_cycles, texels: 0 }
+            UnitCost {
+                ops: m,
+                cycles: m * cfg.pow_mul_cycles,
+                texels: 0,
+            }
         }
     }
 }

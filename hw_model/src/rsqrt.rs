@@ -60,7 +60,12 @@ impl RsqrtConfig {
     /// Checks the widths; the error names the field.
     pub fn validate(&self) -> Result<(), ConfigError> {
         range("rsqrt.rsqrt_mantissa_bits", self.rsqrt_mantissa_bits, 8, 30)?;
-        range("rsqrt.rsqrt_lut_bits", self.rsqrt_lut_bits, 1, 16.min(self.rsqrt_mantissa_bits))?;
+        range(
+            "rsqrt.rsqrt_lut_bits",
+            self.rsqrt_lut_bits,
+            1,
+            16.min(self.rsqrt_mantissa_bits),
+        )?;
         range("rsqrt.rsqrt_iterations", self.rsqrt_iterations, 0, 4)?;
         Ok(())
     }
@@ -190,10 +195,17 @@ impl Rsqrt {
         for _ in 0..self.iterations {
             let y2 = i128::from(round_shift_right_wide(y * y, w, self.rounding));
             let t = i128::from(round_shift_right_wide(mw * y2, w, self.rounding));
-            y = i128::from(round_shift_right_wide(y * (three - t), w + 1, self.rounding));
+            y = i128::from(round_shift_right_wide(
+                y * (three - t),
+                w + 1,
+                self.rounding,
+            ));
         }
         let out = round_shift_right_wide(y, RSQRT_GUARD_BITS, self.rounding).clamp(1, 1i64 << b);
-        RsqrtOut { mant: out as u64, shift: b as i32 + k }
+        RsqrtOut {
+            mant: out as u64,
+            shift: b as i32 + k,
+        }
     }
 }
 

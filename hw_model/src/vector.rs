@@ -76,13 +76,21 @@ pub fn vector_format(cfg: &VectorConfig) -> Format {
 /// The bump offset format: signed `offset_int_bits`.`offset_frac_bits`, saturating.
 #[must_use]
 pub fn offset_format(cfg: &VectorConfig) -> Format {
-    Format::signed(cfg.offset_int_bits, cfg.offset_frac_bits, cfg.vector_rounding)
+    Format::signed(
+        cfg.offset_int_bits,
+        cfg.offset_frac_bits,
+        cfg.vector_rounding,
+    )
 }
 
 /// The unnormalized perturbed-normal format: signed (offset_int_bits+2).F, saturating.
 #[must_use]
 pub fn wide_format(cfg: &VectorConfig) -> Format {
-    Format::signed(cfg.offset_int_bits + 2, cfg.vector_frac_bits, cfg.vector_rounding)
+    Format::signed(
+        cfg.offset_int_bits + 2,
+        cfg.vector_frac_bits,
+        cfg.vector_rounding,
+    )
 }
 
 /// Exact dot product of raw vectors (fraction bits add).
@@ -152,17 +160,30 @@ pub fn normalize3(
     cfg: &VectorConfig,
     sat: &mut SatCounter,
 ) -> Normalized {
-    let s: u128 = v.iter().map(|&c| (i128::from(c) * i128::from(c)) as u128).sum();
+    let s: u128 = v
+        .iter()
+        .map(|&c| (i128::from(c) * i128::from(c)) as u128)
+        .sum();
     if s == 0 {
         sat.saturated += 1;
-        return Normalized { v: fallback, zero: true };
+        return Normalized {
+            v: fallback,
+            zero: true,
+        };
     }
     let bits = 128 - s.leading_zeros();
-    let j = if bits > 62 { (bits - 62).div_ceil(2) } else { 0 };
+    let j = if bits > 62 {
+        (bits - 62).div_ceil(2)
+    } else {
+        0
+    };
     let s_red = (s >> (2 * j)) as u64;
     let Some(r) = rsqrt.eval(s_red) else {
         sat.saturated += 1;
-        return Normalized { v: fallback, zero: true };
+        return Normalized {
+            v: fallback,
+            zero: true,
+        };
     };
     // 1/sqrt(s) = mant * 2^-(shift + j), so out_raw = v_raw * mant * 2^(F - j - shift).
     let f = cfg.vector_frac_bits as i32;
@@ -178,7 +199,10 @@ pub fn normalize3(
         };
         out[i] = fmt.fit(q, sat);
     }
-    Normalized { v: out, zero: false }
+    Normalized {
+        v: out,
+        zero: false,
+    }
 }
 
 /// Bump multiply-add `n + g_u t_u + g_v t_v`: `n`, `t_u`, `t_v` in vector format, `g_u`, `g_v`
@@ -209,13 +233,21 @@ pub fn madd(
 /// Cost of one dot product.
 #[must_use]
 pub fn dot_cost(cfg: &VectorConfig) -> UnitCost {
-    UnitCost { ops: 5, cycles: cfg.dot_cycles, texels: 0 }
+    UnitCost {
+        ops: 5,
+        cycles: cfg.dot_cycles,
+        texels: 0,
+    }
 }
 
 /// Cost of one cross product.
 #[must_use]
 pub fn cross_cost(cfg: &VectorConfig) -> UnitCost {
-    UnitCost { ops: 9, cycles: cfg.cross_cycles, texels: 0 }
+    UnitCost {
+        ops: 9,
+        cycles: cfg.cross_cycles,
+        texels: 0,
+    }
 }
 
 /// Cost of one normalize: dot (|v|^2), rsqrt, three scaling multiplies.
@@ -231,7 +263,11 @@ pub fn normalize_cost(cfg: &VectorConfig, rsqrt_cost: UnitCost) -> UnitCost {
 /// Cost of one bump multiply-add.
 #[must_use]
 pub fn madd_cost(cfg: &VectorConfig) -> UnitCost {
-    UnitCost { ops: 12, cycles: cfg.madd_cycles, texels: 0 }
+    UnitCost {
+        ops: 12,
+        cycles: cfg.madd_cycles,
+        texels: 0,
+    }
 }
 
 /// Decodes a filtered offset texel (unsigned, `texel_bits` bits, value `t / 2^texel_bits`)

@@ -37,7 +37,9 @@ impl OffsetEncoding {
     /// `R = 2^offset_int_bits`, matching `hw_model::vector::offset_format`.
     #[must_use]
     pub fn for_offset_int_bits(bits: u32) -> Self {
-        Self { range: (bits.min(30) as f32).exp2() }
+        Self {
+            range: (bits.min(30) as f32).exp2(),
+        }
     }
 
     /// Encodes one offset into a unorm channel; `true` if it was clamped.
@@ -74,7 +76,10 @@ fn check_size(name: &str, w: u32, h: u32, len: usize) -> Result<()> {
         return Err(Error::field(name, format!("empty image {w}x{h}")));
     }
     if (w as usize).checked_mul(h as usize) != Some(len) {
-        return Err(Error::field(name, format!("{len} values for a {w}x{h} image")));
+        return Err(Error::field(
+            name,
+            format!("{len} values for a {w}x{h} image"),
+        ));
     }
     Ok(())
 }
@@ -83,10 +88,16 @@ fn check_size(name: &str, w: u32, h: u32, len: usize) -> Result<()> {
 pub fn height_to_offsets(heights: &[f32], w: u32, h: u32, p: &BumpParams) -> Result<Vec<[f32; 2]>> {
     check_size("bump height map", w, h, heights.len())?;
     if !p.scale.is_finite() {
-        return Err(Error::field("bump_scale", format!("{} is not finite", p.scale)));
+        return Err(Error::field(
+            "bump_scale",
+            format!("{} is not finite", p.scale),
+        ));
     }
     if let Some(i) = heights.iter().position(|x| !x.is_finite()) {
-        return Err(Error::field("bump height map", format!("texel {i} is not finite")));
+        return Err(Error::field(
+            "bump height map",
+            format!("texel {i} is not finite"),
+        ));
     }
     let (wu, hu) = (w as usize, h as usize);
     let at = |x: usize, y: usize| heights[y * wu + x];
@@ -107,10 +118,17 @@ pub fn height_to_offsets(heights: &[f32], w: u32, h: u32, p: &BumpParams) -> Res
 /// Heights in `[0, 1]` from one channel (0..=3) of a texture image.
 pub fn heights_from_texture(img: &TextureImage, channel: usize) -> Result<Vec<f32>> {
     if channel > 3 {
-        return Err(Error::field("bump channel", format!("{channel} is not in 0..=3")));
+        return Err(Error::field(
+            "bump channel",
+            format!("{channel} is not in 0..=3"),
+        ));
     }
     check_size(&img.name, img.width, img.height, img.texels.len())?;
-    Ok(img.texels.iter().map(|t| f32::from(t[channel]) / 65535.0).collect())
+    Ok(img
+        .texels
+        .iter()
+        .map(|t| f32::from(t[channel]) / 65535.0)
+        .collect())
 }
 
 /// Encodes offsets into the level-0 image `(c_u, c_v, 0, 1)`.
@@ -126,7 +144,12 @@ pub fn offsets_to_image(offsets: &[[f32; 2]], w: u32, h: u32, enc: &OffsetEncodi
             [cu, cv, 0.0, 1.0]
         })
         .collect();
-    BumpImage { width: w, height: h, texels, clamped }
+    BumpImage {
+        width: w,
+        height: h,
+        texels,
+        clamped,
+    }
 }
 
 /// Height-map texture (channel 0) -> encoded bump image.
@@ -136,7 +159,8 @@ pub fn bump_image_from_height(
     enc: &OffsetEncoding,
 ) -> Result<BumpImage> {
     let hts = heights_from_texture(img, 0)?;
-    let offs = height_to_offsets(&hts, img.width, img.height, p).map_err(|e| e.context(&img.name))?;
+    let offs =
+        height_to_offsets(&hts, img.width, img.height, p).map_err(|e| e.context(&img.name))?;
     Ok(offsets_to_image(&offs, img.width, img.height, enc))
 }
 

@@ -64,7 +64,11 @@ pub fn to_vec3x(v: DVec3, frac: u32) -> Vec3x {
 /// A raw vector with `frac` fraction bits as float.
 #[must_use]
 pub fn from_vec3x(v: &Vec3x, frac: u32) -> DVec3 {
-    DVec3::new(from_fixed(v[0], frac), from_fixed(v[1], frac), from_fixed(v[2], frac))
+    DVec3::new(
+        from_fixed(v[0], frac),
+        from_fixed(v[1], frac),
+        from_fixed(v[2], frac),
+    )
 }
 
 /// `v/|v|`, or `fallback` (and `true`) for a zero or non-finite length.
@@ -116,7 +120,15 @@ pub fn main_direction_frame(
 #[must_use]
 pub fn main_frame(n_i: DVec3, m: DVec3, min_sin_bits: u32) -> FrameF {
     let (n, e1, e2, fallback, zero_normal) = main_direction_frame(n_i, m, min_sin_bits);
-    FrameF { n, t_u: -e1, t_v: -e2, len_u: 1.0, len_v: 1.0, fallback, zero_normal }
+    FrameF {
+        n,
+        t_u: -e1,
+        t_v: -e2,
+        len_u: 1.0,
+        len_v: 1.0,
+        fallback,
+        zero_normal,
+    }
 }
 
 /// Frame 2: normalized interpolated normal and directions, lengths 1; zero directions fall
@@ -132,7 +144,15 @@ pub fn unit_frame(n_i: DVec3, d_u: DVec3, d_v: DVec3, min_sin_bits: u32) -> Fram
         f.zero_normal = zero_normal;
         return f;
     }
-    FrameF { n, t_u: su, t_v: sv, len_u: 1.0, len_v: 1.0, fallback: false, zero_normal }
+    FrameF {
+        n,
+        t_u: su,
+        t_v: sv,
+        len_u: 1.0,
+        len_v: 1.0,
+        fallback: false,
+        zero_normal,
+    }
 }
 
 /// Frame 1: as [`unit_frame`] with the separately interpolated lengths.
@@ -193,7 +213,7 @@ pub fn natural_vertex(
 ) -> Option<NaturalVertex> {
     let (nh, z) = normalize_or(n, DVec3::ZERO);
     let geo = p_u.cross(p_v).length();
-    if z || !(geo > 0.0 && geo.is_finite()) {
+    if z || !geo.is_finite() || geo <= 0.0 {
         return None;
     }
     let su = nh.cross(p_v);

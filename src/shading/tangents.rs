@@ -29,11 +29,7 @@ fn v3(p: [f32; 3]) -> DVec3 {
     DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
 }
 
-fn accumulate(
-    positions: &[[f32; 3]],
-    uvs: &[[f32; 2]],
-    indices: &[[u32; 3]],
-) -> Vec<Acc> {
+fn accumulate(positions: &[[f32; 3]], uvs: &[[f32; 2]], indices: &[[u32; 3]]) -> Vec<Acc> {
     let mut acc = vec![Acc::default(); positions.len()];
     if uvs.len() != positions.len() {
         return acc;
@@ -50,7 +46,7 @@ fn accumulate(
         let (du1, dv1, du2, dv2) = (u1 - u0, w1 - w0, u2 - u0, w2 - w0);
         let det = du1 * dv2 - du2 * dv1;
         let s = du1.abs().max(dv1.abs()).max(du2.abs()).max(dv2.abs());
-        if !(det.abs() > DET_EPS * s * s) || !det.is_finite() {
+        if !det.is_finite() || det.abs() <= DET_EPS * s * s {
             continue;
         }
         let t = (e1 * dv2 - e2 * dv1) / det;
@@ -121,7 +117,11 @@ pub fn generate_tangents(
                 let tl = t.length();
                 if tl > 1e-6 * a.t[g].length() && tl.is_finite() {
                     let t = t / tl;
-                    let w = if n.cross(t).dot(a.b[g]) < 0.0 { -1.0 } else { 1.0 };
+                    let w = if n.cross(t).dot(a.b[g]) < 0.0 {
+                        -1.0
+                    } else {
+                        1.0
+                    };
                     out = Some((t, w));
                 }
             }
