@@ -281,3 +281,80 @@ fn perturbed_normal_matches_twin() {
     assert!(worst_n <= 8.0 * ulp(), "natural {worst_n}");
     assert_eq!(sat.saturated, 0);
 }
+
+/// Earth-like sphere with m = the axis: finite and orthonormal everywhere; the fallback is
+/// taken exactly inside the documented cone around the poles; e1 points east elsewhere.
+#[test]
+fn sphere_poles_with_axis_main_direction() {
+    let u = units();
+    let thr = (-f64::from(u.cfg.frame.frame_min_sin_bits)).exp2();
+    let mut sat = SatCounter::default();
+    let m = q(DVec3::Z);
+    for j in 0..=400 {
+        let th = std::f64::consts::PI * f64::from(j) / 400.0;
+        for i in 0..64 {
+            let phi = std::f64::consts::TAU * f64::from(i) / 64.0;
+            let n = DVec3::new(th.sin() * phi.cos(), th.sin() * phi.sin(), th.cos());
+            let fx = main_direction_frame(&q(n), &m, &u, &mut sat);
+            let (fn_, e1, e2) = (d(&fx.n), d(&fx.e1), d(&fx.e2));
+            assert!(ortho_err(fn_, e1, e2) <= ORTHO_BOUND_ULP * ulp());
+            let sin = th.sin();
+            if sin < 0.9 * thr {
+                assert!(fx.fallback, "inside the cone: th {th}");
+            } else if sin > 1.1 * thr {
+                assert!(!fx.fallback, "outside the cone: th {th}");
+                let east = DVec3::new(-phi.sin(), phi.cos(), 0.0);
+                // e1 = m x n / |m x n| is east; error grows as ulp / sin near the cone.
+                assert!(
+                    (e1 - east).length() <= 4.0 * ulp() + 3.0 * ulp() / sin,
+                    "th {th}"
+                );
+            }
+        }
+    }
+}
+
+/// The paper's remark: interpolating vectors of different lengths directly turns the direction
+/// faster near the shorter one; interpolating directions and lengths separately does not.
+#[test]
+fn separate_length_interpolation() {
+    let (a, b) = (DVec3::X, DVec3::Y);
+    let (la, lb) = (1.0, 4.0);
+    let half = [0.5, 0.5, 0.0];
+    let direct = r::interpolate3(half, [a * la, b * lb, DVec3::ZERO]).normalize();
+    let dir = r::interpolate3(half, [a, b, DVec3::ZERO]).normalize();
+    let len = r::interpolate1(half, [la, lb, 0.0]);
+    let bisector = (a + b).normalize();
+    assert!((dir - bisector).length() < 1e-12);
+    assert!((len - 2.5).abs() < 1e-12);
+    assert!(
+        direct.angle_between(b) < 0.25,
+        "direct interpolation is pulled to the long end"
+    );
+    let fr = r::natural_frame(DVec3::Z, dir, DVec3::Y, len, 1.0, 6);
+    assert!((fr.t_u - bisector).length() < 1e-12 && fr.len_u == 2.5);
+}
+
+/// Offsets scaled by large natural lengths saturate the offset format: counted, output finite.
+#[test]
+fn natural_length_saturation_is_counted() {
+    let u = units();
+    let lfb = u.cfg.frame.frame_len_frac_bits;
+    let o = u.cfg.vector.offset_frac_bits;
+    let mut sat = SatCounter::default();
+    let fr = natural_frame(
+        &q(DVec3::Z),
+        &q(-DVec3::X),
+        &q(-DVec3::Y),
+        r::to_fixed(200.0, lfb),
+        r::to_fixed(1000.0, lfb),
+        &u,
+        &mut sat,
+    );
+    assert_eq!(sat.saturated, 1, "length 1000 exceeds u8.8");
+    let p = perturb_normal(&fr, r::to_fixed(0.5, o), 0, &u, &mut sat);
+    assert_eq!(sat.saturated, 2, "0.5 * 200 exceeds the s3.12 offset range");
+    // The offset saturates to 8 - 2^-12 and multiplies t_u = -x.
+    let want = DVec3::new(-(8.0 - (-12f64).exp2()), 0.0, 1.0).normalize();
+    assert!((d(&p.v) - want).length() < 4.0 * ulp());
+}

@@ -193,3 +193,62 @@ pub fn blinn_phong_cost(units: &ShadingUnits) -> UnitCost {
             texels: 0,
         })
 }
+
+/// Everything one bump-mapped, Blinn-Phong-lit pixel needs (already interpolated).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BumpPixel {
+    /// Interpolated normal (vector format or any common scale).
+    pub n_i: Vec3x,
+    /// Interpolated directions of `s_u`, `s_v` (natural and unit frames).
+    pub d_u: Vec3x,
+    pub d_v: Vec3x,
+    /// Interpolated lengths of `s_u`, `s_v` (natural frame; len format raw).
+    pub len_u: i64,
+    pub len_v: i64,
+    /// Main direction (main frame).
+    pub m: Vec3x,
+    /// The two filtered offset channels as returned by the texture unit.
+    pub offset_texels: [u64; 2],
+    /// Bits of those texel channels.
+    pub texel_bits: u32,
+}
+
+/// Result of [`bump_shade`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BumpShadeOut {
+    pub color: [u64; 3],
+    /// The perturbed unit normal.
+    pub normal: Vec3x,
+    /// The frame used a fallback (main-direction cone or zero tangent direction).
+    pub frame_fallback: bool,
+    /// The interpolated normal was zero.
+    pub zero_normal: bool,
+    /// `l + v` was zero.
+    pub h_zero: bool,
+}
+
+/// One pixel: decode the offsets, build the frame of `frame_kind`, perturb the normal, shade
+/// with one light. `sh.n` is ignored: the perturbed normal replaces it.
+#[must_use]
+pub fn bump_shade(
+    px: &BumpPixel,
+    sh: &BlinnPhongInput,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> BumpShadeOut {
+    let vc = &units.cfg.vector;
+    let f_u = crate::vector::offset_from_texel(px.offset_texels[0], px.texel_bits, vc, sat);
+    let f_v = crate::vector::offset_from_texel(px.offset_texels[1], px.texel_bits, vc, sat);
+    let fr = crate::frame::build_frame(
+        &px.n_i, &px.d_u, &px.d_v, px.len_u, px.len_v, &px.m, units, sat,
+    );
+    let n = crate::frame::perturb_normal(&fr, f_u, f_v, units, sat).v;
+    let bp = blinn_phong(&BlinnPhongInput { n, ..*sh }, units, sat);
+    BumpShadeOut {
+        color: bp.color,
+        normal: n,
+        frame_fallback: fr.fallback,
+        zero_normal: fr.zero_normal,
+        h_zero: bp.h_zero,
+    }
+}

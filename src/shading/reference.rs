@@ -292,3 +292,28 @@ pub fn blinn_phong(
     }
     (c, h_zero)
 }
+
+/// Float twin of `hw_model::blinn_phong::bump_shade`: offsets `f_u`, `f_v` already decoded
+/// (`bump::OffsetEncoding::decode`), frame of `kind`, perturb, Blinn-Phong.
+/// Returns `(colour, perturbed normal, frame fallback, h_zero)`.
+#[must_use]
+#[allow(clippy::too_many_arguments)]
+pub fn bump_shade(
+    kind: FrameKind,
+    n_i: DVec3,
+    d_u: DVec3,
+    d_v: DVec3,
+    lens: [f64; 2],
+    m: DVec3,
+    offsets: [f64; 2],
+    min_sin_bits: u32,
+    l: DVec3,
+    v: DVec3,
+    shininess: u32,
+    colors: [[f64; 3]; 3],
+) -> ([f64; 3], DVec3, bool, bool) {
+    let fr = build_frame(kind, n_i, d_u, d_v, lens[0], lens[1], m, min_sin_bits);
+    let n = perturb_normal(&fr, offsets[0], offsets[1]);
+    let (c, hz) = blinn_phong(n, l, v, shininess, colors[0], colors[1], colors[2]);
+    (c, n, fr.fallback, hz)
+}
