@@ -1,5 +1,6 @@
 //! End to end per pixel: offsets texels -> frame -> perturbed normal -> Blinn-Phong, fixed
 //! against the f64 twin for all three frame kinds.
+#![allow(clippy::needless_range_loop)]
 
 use glam::DVec3;
 use hw_model::blinn_phong::{bump_shade, BlinnPhongInput, BumpPixel, ShadingConfig, ShadingUnits};
