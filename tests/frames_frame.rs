@@ -358,3 +358,28 @@ fn natural_length_saturation_is_counted() {
     let want = DVec3::new(-(8.0 - (-12f64).exp2()), 0.0, 1.0).normalize();
     assert!((d(&p.v) - want).length() < 4.0 * ulp());
 }
+
+/// The paper's natural-frame identities, checked numerically (the converted text was intact
+/// here): `s_u x s_v = p_u x p_v` with `s_u = n^ x p_v`, `s_v = p_u x n^`, and the normal of the
+/// displaced surface `p + f n^` is `n + f_u s_u + f_v s_v` to first order (Blinn 1978).
+#[test]
+fn natural_frame_identities() {
+    let mut s = 3u64;
+    for _ in 0..1000 {
+        let pu = rand_dir(&mut s) * (0.2 + unif(&mut s));
+        let pv = rand_dir(&mut s) * (0.2 + unif(&mut s));
+        let n = pu.cross(pv);
+        if n.length() < 0.05 {
+            continue;
+        }
+        let nh = n.normalize();
+        let (su, sv) = (nh.cross(pv), pu.cross(nh));
+        assert!((su.cross(sv) - n).length() < 1e-12);
+        // Displaced plane p(u, v) = u pu + v pv + f(u, v) nh with f = a u + b v (small slopes).
+        let (a, b) = (0.3 * unif(&mut s) - 0.15, 0.3 * unif(&mut s) - 0.15);
+        let exact = (pu + a * nh).cross(pv + b * nh);
+        let paper = n + a * su + b * sv;
+        // Exact up to the second-order term a b (nh x nh) = 0: identical for a plane.
+        assert!((exact - paper).length() < 1e-12);
+    }
+}
