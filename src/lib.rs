@@ -19,6 +19,7 @@ pub mod reference;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod shading;
 pub mod summary;
 
 pub use error::{Error, Result};

@@ -7,14 +7,19 @@
 //! (`clippy::float_arithmetic` is denied); conversions to and from float live in `texsim`.
 #![deny(clippy::float_arithmetic)]
 
+pub mod blinn_phong;
 pub mod config;
 pub mod cost;
 pub mod fixed;
+pub mod frame;
 pub mod interpolator;
 pub mod lod;
 pub mod modulate;
+pub mod pow;
 pub mod reciprocal;
+pub mod rsqrt;
 pub mod trilinear;
+pub mod vector;
 pub mod wrap;
 
 pub use config::{ConfigError, HwConfig};

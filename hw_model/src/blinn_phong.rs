@@ -1,0 +1,254 @@
+//! Blinn-Phong shading in fixed point (Blinn 1977; the model Schilling 1997, Appendix A,
+//! builds on): `c = light * (kd * max(0, n.l) + ks * max(0, n.h)^s)`, `h = (l + v)/|l + v|`,
+//! the specular term is zero where `n.l <= 0`.
+//!
+//! Directional and point lights are handled by the caller, which passes the unit vector `l`
+//! towards the light (per pixel for a point light) and `v` towards the eye, in vector format.
+//! Colours are unsigned normalized with `shade_color_bits`; the sum saturates at 1.0 (counted).
+//! `l = -v` exactly (h undefined) gives no specular term and sets `h_zero`.
+//!
+//! Also defines the bundle [`ShadingConfig`] of all bump/shading unit configs and
+//! [`ShadingUnits`], the units with their tables built once.
+//!
+//! ERROR BOUND (absolute, per channel, texram16, against the float twin evaluated on the same
+//! quantized `n`, `l`, `v`, colours): `ks * (pow bound + s * 2^-F * 1.6) + kd * 2^-F + 2^-C`,
+//! measured in `tests/frames_shade.rs`.
+
+use crate::config::ConfigError;
+use crate::cost::UnitCost;
+use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
+use crate::frame::FrameConfig;
+use crate::pow::{pow_cost, Pow, PowConfig};
+use crate::rsqrt::{range, rsqrt_cost, Rsqrt, RsqrtConfig};
+use crate::vector::{dot3, dot_cost, normalize3, normalize_cost, Vec3x, VectorConfig};
+use serde::{Deserialize, Serialize};
+
+/// Shading output configuration.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadeConfig {
+    /// Bits per colour channel of `kd`, `ks`, light and result (unsigned normalized). 4..=16.
+    pub shade_color_bits: u32,
+    /// Rounding of the final colour.
+    pub shade_rounding: Rounding,
+    /// Cycles of the colour multiply-adds (3 channels in parallel).
+    pub shade_cycles: u32,
+}
+
+impl ShadeConfig {
+    /// Texram-style default: 16-bit colours.
+    #[must_use]
+    pub fn texram16() -> Self {
+        Self {
+            shade_color_bits: 16,
+            shade_rounding: Rounding::HalfEven,
+            shade_cycles: 1,
+        }
+    }
+}
+
+/// All bump-mapping and shading unit configs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadingConfig {
+    pub rsqrt: RsqrtConfig,
+    pub vector: VectorConfig,
+    pub frame: FrameConfig,
+    pub pow: PowConfig,
+    pub shade: ShadeConfig,
+}
+
+impl ShadingConfig {
+    /// Texram-style defaults of every unit.
+    #[must_use]
+    pub fn texram16() -> Self {
+        Self {
+            rsqrt: RsqrtConfig::texram16(),
+            vector: VectorConfig::texram16(),
+            frame: FrameConfig::texram16(),
+            pow: PowConfig::texram16(),
+            shade: ShadeConfig::texram16(),
+        }
+    }
+
+    /// Checks every unit and the cross-unit constraint `rsqrt_mantissa_bits >=
+    /// vector_frac_bits + 2` (the normalizer needs two guard bits); the error names the field.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.rsqrt.validate()?;
+        self.vector.validate()?;
+        self.frame.validate()?;
+        self.pow.validate()?;
+        range("shade.shade_color_bits", self.shade.shade_color_bits, 4, 16)?;
+        if self.rsqrt.rsqrt_mantissa_bits < self.vector.vector_frac_bits + 2 {
+            return Err(ConfigError {
+                field: "rsqrt.rsqrt_mantissa_bits".into(),
+                what: "must be at least vector.vector_frac_bits + 2".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The shading units with their tables built once from a [`ShadingConfig`].
+#[derive(Clone, Debug)]
+pub struct ShadingUnits {
+    pub cfg: ShadingConfig,
+    pub rsqrt: Rsqrt,
+    pub pow: Pow,
+}
+
+impl ShadingUnits {
+    /// Builds the LUTs (call once per frame, not per pixel).
+    #[must_use]
+    pub fn new(cfg: &ShadingConfig) -> Self {
+        Self {
+            cfg: cfg.clone(),
+            rsqrt: Rsqrt::new(&cfg.rsqrt),
+            pow: Pow::new(&cfg.pow),
+        }
+    }
+}
+
+/// Inputs of one Blinn-Phong evaluation (vectors in vector format, colours unorm raw).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlinnPhongInput {
+    /// Unit (perturbed) normal.
+    pub n: Vec3x,
+    /// Unit vector towards the light.
+    pub l: Vec3x,
+    /// Unit vector towards the eye.
+    pub v: Vec3x,
+    /// Specular exponent.
+    pub shininess: u32,
+    pub kd: [u64; 3],
+    pub ks: [u64; 3],
+    /// Light colour.
+    pub light: [u64; 3],
+}
+
+/// Result of one Blinn-Phong evaluation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlinnPhongOut {
+    /// Colour, unorm raw with `shade_color_bits`.
+    pub color: [u64; 3],
+    /// `l + v` was zero: no specular term.
+    pub h_zero: bool,
+}
+
+/// One Blinn-Phong evaluation (see the module doc for the formula and rounding).
+#[must_use]
+pub fn blinn_phong(
+    inp: &BlinnPhongInput,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> BlinnPhongOut {
+    let vc = &units.cfg.vector;
+    let f = vc.vector_frac_bits;
+    let p = units.cfg.pow.pow_frac_bits.clamp(8, 24);
+    let c = units.cfg.shade.shade_color_bits;
+    let one_f = 1i64 << f;
+    let ndl = dot3(&inp.n, &inp.l, vc, sat).clamp(0, one_f);
+    let sum = [
+        inp.l[0] + inp.v[0],
+        inp.l[1] + inp.v[1],
+        inp.l[2] + inp.v[2],
+    ];
+    let h_zero = sum == [0; 3];
+    let spec: i64 = if h_zero || ndl == 0 {
+        0
+    } else {
+        let h = normalize3(&sum, [0; 3], &units.rsqrt, vc, sat).v;
+        let ndh = dot3(&inp.n, &h, vc, sat).clamp(0, one_f);
+        let x = Format::unsigned(1, p, vc.vector_rounding).requantize(ndh, f, sat);
+        units.pow.pow(x as u64, inp.shininess, sat) as i64
+    };
+    let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
+    let color = [0usize, 1, 2].map(|i| {
+        let acc = i128::from(inp.kd[i]) * i128::from(ndl) * (1i128 << p)
+            + i128::from(inp.ks[i]) * i128::from(spec) * (1i128 << f);
+        let lit = acc * i128::from(inp.light[i]);
+        let r = round_shift_right_wide(lit, c + f + p, units.cfg.shade.shade_rounding);
+        out_fmt.fit(r, sat) as u64
+    });
+    BlinnPhongOut { color, h_zero }
+}
+
+/// Cost of one evaluation: two dots, the half-vector add and normalize, the power, and the
+/// colour multiply-adds.
+#[must_use]
+pub fn blinn_phong_cost(units: &ShadingUnits) -> UnitCost {
+    let c = &units.cfg;
+    dot_cost(&c.vector)
+        .times(2)
+        .plus(UnitCost {
+            ops: 3,
+            cycles: 1,
+            texels: 0,
+        })
+        .plus(normalize_cost(&c.vector, rsqrt_cost(&c.rsqrt)))
+        .plus(pow_cost(&c.pow))
+        .plus(UnitCost {
+            ops: 12,
+            cycles: c.shade.shade_cycles,
+            texels: 0,
+        })
+}
+
+/// Everything one bump-mapped, Blinn-Phong-lit pixel needs (already interpolated).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BumpPixel {
+    /// Interpolated normal (vector format or any common scale).
+    pub n_i: Vec3x,
+    /// Interpolated directions of `s_u`, `s_v` (natural and unit frames).
+    pub d_u: Vec3x,
+    pub d_v: Vec3x,
+    /// Interpolated lengths of `s_u`, `s_v` (natural frame; len format raw).
+    pub len_u: i64,
+    pub len_v: i64,
+    /// Main direction (main frame).
+    pub m: Vec3x,
+    /// The two filtered offset channels as returned by the texture unit.
+    pub offset_texels: [u64; 2],
+    /// Bits of those texel channels.
+    pub texel_bits: u32,
+}
+
+/// Result of [`bump_shade`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BumpShadeOut {
+    pub color: [u64; 3],
+    /// The perturbed unit normal.
+    pub normal: Vec3x,
+    /// The frame used a fallback (main-direction cone or zero tangent direction).
+    pub frame_fallback: bool,
+    /// The interpolated normal was zero.
+    pub zero_normal: bool,
+    /// `l + v` was zero.
+    pub h_zero: bool,
+}
+
+/// One pixel: decode the offsets, build the frame of `frame_kind`, perturb the normal, shade
+/// with one light. `sh.n` is ignored: the perturbed normal replaces it.
+#[must_use]
+pub fn bump_shade(
+    px: &BumpPixel,
+    sh: &BlinnPhongInput,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> BumpShadeOut {
+    let vc = &units.cfg.vector;
+    let f_u = crate::vector::offset_from_texel(px.offset_texels[0], px.texel_bits, vc, sat);
+    let f_v = crate::vector::offset_from_texel(px.offset_texels[1], px.texel_bits, vc, sat);
+    let fr = crate::frame::build_frame(
+        &px.n_i, &px.d_u, &px.d_v, px.len_u, px.len_v, &px.m, units, sat,
+    );
+    let n = crate::frame::perturb_normal(&fr, f_u, f_v, units, sat).v;
+    let bp = blinn_phong(&BlinnPhongInput { n, ..*sh }, units, sat);
+    BumpShadeOut {
+        color: bp.color,
+        normal: n,
+        frame_fallback: fr.fallback,
+        zero_normal: fr.zero_normal,
+        h_zero: bp.h_zero,
+    }
+}

@@ -1,0 +1,8 @@
+//! Bump mapping and per-pixel shading, host side: the float twins of the fixed-point units in
+//! `hw_model::{rsqrt, vector, frame, pow, blinn_phong}` (Schilling 1997, "Antialiasing of
+//! Bump-Maps", local coordinate systems; Blinn-Phong), bump-map preparation and tangent
+//! generation.
+
+pub mod bump;
+pub mod reference;
+pub mod tangents;

@@ -1,0 +1,147 @@
+//! Blinn-Phong fixed unit against its f64 twin, including grazing light/view and l = -v.
+#![allow(clippy::needless_range_loop)]
+
+use glam::DVec3;
+use hw_model::blinn_phong::{
+    blinn_phong, blinn_phong_cost, BlinnPhongInput, ShadingConfig, ShadingUnits,
+};
+use hw_model::pow::PowMethod;
+use hw_model::SatCounter;
+use texsim::shading::reference as r;
+
+fn splitmix(s: &mut u64) -> u64 {
+    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *s;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+fn unif(s: &mut u64) -> f64 {
+    (splitmix(s) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+fn rand_dir(s: &mut u64) -> DVec3 {
+    loop {
+        let v = DVec3::new(
+            2.0 * unif(s) - 1.0,
+            2.0 * unif(s) - 1.0,
+            2.0 * unif(s) - 1.0,
+        );
+        let l = v.length();
+        if l > 0.1 && l <= 1.0 {
+            return v / l;
+        }
+    }
+}
+
+const F: u32 = 14;
+const C: u32 = 16;
+
+fn run(method: PowMethod, cases: u32) -> f64 {
+    let mut cfg = ShadingConfig::texram16();
+    cfg.pow.pow_method = method;
+    let u = ShadingUnits::new(&cfg);
+    let mut s = 77u64;
+    let mut sat = SatCounter::default();
+    let mut worst_ratio = 0.0f64;
+    let cu = (-f64::from(C)).exp2();
+    let ulp = (-f64::from(F)).exp2();
+    for i in 0..cases {
+        let n = rand_dir(&mut s);
+        let mut l = rand_dir(&mut s);
+        let mut v = rand_dir(&mut s);
+        match i % 4 {
+            // Grazing light: n.l in [-1e-3, 1e-3].
+            1 => {
+                let t = (l - n * n.dot(l)).normalize();
+                l = (t + n * (2e-3 * unif(&mut s) - 1e-3)).normalize();
+            }
+            // Grazing view.
+            2 => {
+                let t = (v - n * n.dot(v)).normalize();
+                v = (t + n * (2e-3 * unif(&mut s) - 1e-3)).normalize();
+            }
+            // l = -v exactly (after quantization).
+            3 if i % 8 == 3 => v = -l,
+            _ => {}
+        }
+        let (nq, lq, vq) = (r::to_vec3x(n, F), r::to_vec3x(l, F), r::to_vec3x(v, F));
+        let shininess = 1 + (splitmix(&mut s) % 1024) as u32;
+        let col = |s: &mut u64| [0; 3].map(|_: u64| splitmix(s) % (1 << C));
+        let (kd, ks, light) = (col(&mut s), col(&mut s), col(&mut s));
+        let inp = BlinnPhongInput {
+            n: nq,
+            l: lq,
+            v: vq,
+            shininess,
+            kd,
+            ks,
+            light,
+        };
+        let out = blinn_phong(&inp, &u, &mut sat);
+        let f = |c: [u64; 3]| c.map(|x| x as f64 * cu);
+        let (nd, ld, vd) = (
+            r::from_vec3x(&nq, F),
+            r::from_vec3x(&lq, F),
+            r::from_vec3x(&vq, F),
+        );
+        let (want, hz) = r::blinn_phong(nd, ld, vd, shininess, f(kd), f(ks), f(light));
+        assert_eq!(hz, out.h_zero, "case {i}");
+        if i % 8 == 3 {
+            assert!(out.h_zero);
+        }
+        // Bound: ks * (pow bound at x + s x^(s-1) * 2.5 ulp (n.h error)) + kd * 1 ulp (n.l,
+        // plus the twin's exact normalization of the quantized inputs) + 1 colour ulp.
+        let ndl = nd.dot(ld).max(0.0);
+        let x = if hz || ndl == 0.0 {
+            0.0
+        } else {
+            nd.dot((ld + vd).normalize()).clamp(0.0, 1.0)
+        };
+        let sf = f64::from(shininess);
+        let pow_b = x.powf(sf) * ((sf * (0.1803 * 2f64.powi(-16) + 2f64.powi(-24))).exp2() - 1.0)
+            + 2.0 * sf * 2f64.powi(-24)
+            + 2f64.powi(-17);
+        let sens = sf * x.powf(sf - 1.0) * 2.5 * ulp;
+        for k in 0..3 {
+            let got = out.color[k] as f64 * cu;
+            let lt = f(light)[k];
+            // Near a boundary (n.l ~ 0) the spec term may switch on/off: allow the full term.
+            let switch = if ndl < 1.5 * ulp {
+                f(ks)[k] * x.powf(sf)
+            } else {
+                0.0
+            };
+            let b = lt * (f(ks)[k] * (pow_b + sens) + f(kd)[k] * ulp + switch) + cu;
+            let e = (got - want[k]).abs();
+            worst_ratio = worst_ratio.max(e / b);
+            assert!(e <= b, "case {i} ch {k}: {got} vs {} (bound {b})", want[k]);
+        }
+    }
+    worst_ratio
+}
+
+#[test]
+fn blinn_phong_log_exp_matches_twin() {
+    let w = run(PowMethod::LogExp, 1_000_000);
+    println!("blinn-phong log-exp: max err/bound {w:.3}");
+}
+
+#[test]
+fn blinn_phong_squaring_matches_twin() {
+    let w = run(PowMethod::Squaring, 300_000);
+    println!("blinn-phong squaring: max err/bound {w:.3}");
+}
+
+#[test]
+fn point_and_directional_light_vectors() {
+    let p = DVec3::new(1.0, 2.0, 3.0);
+    let l = r::light_dir_point(DVec3::new(1.0, 2.0, 5.0), p);
+    assert!((l - DVec3::Z).length() < 1e-12);
+    let d = r::light_dir_directional(DVec3::new(0.0, -2.0, 0.0));
+    assert!((d - DVec3::Y).length() < 1e-12);
+    let u = ShadingUnits::new(&ShadingConfig::texram16());
+    assert!(blinn_phong_cost(&u).cycles > 0);
+    assert!(ShadingConfig::texram16().validate().is_ok());
+}
