@@ -19,15 +19,21 @@ impl Error {
     }
     /// A problem with a file: `path: what`.
     pub fn file(path: &Path, what: impl fmt::Display) -> Self {
-        Self { msg: format!("{}: {what}", path.display()) }
+        Self {
+            msg: format!("{}: {what}", path.display()),
+        }
     }
     /// A problem with a named field or option: `field 'name': what`.
     pub fn field(name: &str, what: impl fmt::Display) -> Self {
-        Self { msg: format!("field '{name}': {what}") }
+        Self {
+            msg: format!("field '{name}': {what}"),
+        }
     }
     /// Prefixes context (e.g. the file that held a bad field).
     pub fn context(self, ctx: impl fmt::Display) -> Self {
-        Self { msg: format!("{ctx}: {}", self.msg) }
+        Self {
+            msg: format!("{ctx}: {}", self.msg),
+        }
     }
     /// The message text.
     pub fn message(&self) -> &str {

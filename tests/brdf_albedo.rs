@@ -21,9 +21,13 @@ fn model(nu: f64, nv: f64, rs: f64, rd: f64) -> AshikhminShirley {
 fn quadrature_matches_closed_form_at_normal_incidence() {
     let a = std::f64::consts::FRAC_1_SQRT_2;
     for n in [0.0, 1.0, 10.0, 100.0, 1000.0, 10000.0, 100000.0] {
-        let closed = (n + 1.0) * (2.0 * (1.0 - a.powf(n + 3.0)) / (n + 3.0) - (1.0 - a.powf(n + 1.0)) / (n + 1.0));
+        let closed = (n + 1.0)
+            * (2.0 * (1.0 - a.powf(n + 3.0)) / (n + 3.0) - (1.0 - a.powf(n + 1.0)) / (n + 1.0));
         let q = model(n, n, 1.0, 0.0).albedo_quadrature(dir_from_angles(0.0, 0.0), 32);
-        assert!((q - closed).abs() < 1e-4, "n {n}: quadrature {q} closed {closed}");
+        assert!(
+            (q - closed).abs() < 1e-4,
+            "n {n}: quadrature {q} closed {closed}"
+        );
     }
 }
 
@@ -33,10 +37,17 @@ fn quadrature_matches_closed_form_at_normal_incidence() {
 /// 5e-3 for res 6 (the grid test's tolerance; reached only at 89 deg with n <= 1).
 #[test]
 fn quadrature_convergence() {
-    let cases: Vec<(f64, f64, f64)> = [(0.0, 0.0), (1.0, 1.0), (10.0, 10.0), (1.0, 10000.0), (1000.0, 1000.0), (100000.0, 100000.0)]
-        .iter()
-        .flat_map(|&(u, v)| [0.0, 30.0, 60.0, 80.0, 85.0, 89.0].map(move |t| (u, v, t)))
-        .collect();
+    let cases: Vec<(f64, f64, f64)> = [
+        (0.0, 0.0),
+        (1.0, 1.0),
+        (10.0, 10.0),
+        (1.0, 10000.0),
+        (1000.0, 1000.0),
+        (100000.0, 100000.0),
+    ]
+    .iter()
+    .flat_map(|&(u, v)| [0.0, 30.0, 60.0, 80.0, 85.0, 89.0].map(move |t| (u, v, t)))
+    .collect();
     let worst = cases
         .par_iter()
         .map(|&(nu, nv, t)| {
@@ -50,7 +61,10 @@ fn quadrature_convergence() {
             (e32, e8)
         })
         .reduce(|| (0.0, 0.0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
-    println!("worst quadrature error vs res 64: res32 {:.2e} res6 {:.2e}", worst.0, worst.1);
+    println!(
+        "worst quadrature error vs res 64: res32 {:.2e} res6 {:.2e}",
+        worst.0, worst.1
+    );
 }
 
 /// Energy conservation: directional albedo <= 1 for nu, nv in {1..1e4}, Rs, Rd in {0, .5, 1},
@@ -88,9 +102,15 @@ fn energy_conservation_grid() {
         for rs in [0.0, 0.5, 1.0] {
             for rd in [0.0, 0.5, 1.0] {
                 let a = rs * a1 + (1.0 - rs) * a0 + rd * (1.0 - rs) * d;
-                assert!(a <= 1.0 + 5e-3 && a >= 0.0, "nu {nu} nv {nv} rs {rs} rd {rd} theta {t} phi {phi}: {a}");
+                assert!(
+                    (0.0..=1.0 + 5e-3).contains(&a),
+                    "nu {nu} nv {nv} rs {rs} rd {rd} theta {t} phi {phi}: {a}"
+                );
                 if a > max.0 {
-                    max = (a, format!("nu {nu} nv {nv} rs {rs} rd {rd} theta {t} phi {phi}"));
+                    max = (
+                        a,
+                        format!("nu {nu} nv {nv} rs {rs} rd {rd} theta {t} phi {phi}"),
+                    );
                 }
             }
         }
@@ -108,7 +128,10 @@ fn energy_conservation_grid() {
     println!("albedo excerpt: nu nv theta | Rs=1,Rd=0 | Rs=.05,Rd=1");
     for &(nu, nv, t, phi, a1, a0, d) in &rows {
         if phi == 0.0 && nu == nv && [0.0, 45.0, 75.0, 89.0].contains(&t) {
-            println!("{nu:>6} {nv:>6} {t:>3} | {a1:.4} | {:.4}", 0.05 * a1 + 0.95 * a0 + 0.95 * d);
+            println!(
+                "{nu:>6} {nv:>6} {t:>3} | {a1:.4} | {:.4}",
+                0.05 * a1 + 0.95 * a0 + 0.95 * d
+            );
         }
     }
 }
@@ -156,13 +179,22 @@ fn figure2_furnace_specular() {
 #[test]
 fn figure4_coupled_diffuse() {
     let p = model(10000.0, 10000.0, 0.05, 1.0);
-    let curve: Vec<(f64, f64)> = (0..=170).into_par_iter().map(|i| {
-        let t = 0.5 * f64::from(i);
-        (t, p.albedo_quadrature(dir_from_angles(t, 0.0), 16))
-    }).collect();
-    let (tmin, amin) = curve.iter().copied().fold((0.0, 2.0), |m, c| if c.1 < m.1 { c } else { m });
+    let curve: Vec<(f64, f64)> = (0..=170)
+        .into_par_iter()
+        .map(|i| {
+            let t = 0.5 * f64::from(i);
+            (t, p.albedo_quadrature(dir_from_angles(t, 0.0), 16))
+        })
+        .collect();
+    let (tmin, amin) = curve
+        .iter()
+        .copied()
+        .fold((0.0, 2.0), |m, c| if c.1 < m.1 { c } else { m });
     println!("figure 4: minimum {amin:.4} at theta {tmin}");
-    assert!((amin - 0.74).abs() < 0.02 && (60.0..=85.0).contains(&tmin), "{amin} at {tmin}");
+    assert!(
+        (amin - 0.74).abs() < 0.02 && (60.0..=85.0).contains(&tmin),
+        "{amin} at {tmin}"
+    );
     assert!((curve[0].1 - 0.970).abs() < 0.005, "centre {}", curve[0].1);
     assert!(curve.iter().all(|&(_, a)| a <= 1.0));
     for t in [0.0, 40.0, 80.0] {
@@ -190,6 +222,9 @@ fn monte_carlo_matches_quadrature() {
         let k1 = dir_from_angles(t, 17.0);
         let q = p.albedo_quadrature(k1, 32);
         let mc = p.albedo_mc(k1, 200_000, 1000 + i as u64);
-        assert!((mc.albedo - q).abs() < 4.0 * mc.std_error + 3e-4, "{nu} {nv} {rs} {rd} {t}: mc {mc:?} quad {q}");
+        assert!(
+            (mc.albedo - q).abs() < 4.0 * mc.std_error + 3e-4,
+            "{nu} {nv} {rs} {rd} {t}: mc {mc:?} quad {q}"
+        );
     }
 }

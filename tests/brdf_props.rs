@@ -4,7 +4,9 @@
 
 use glam::DVec3;
 use std::f64::consts::PI;
-use texsim::brdf::{albedo_report, dir_from_angles, eval_report, sample_report, AshikhminShirley, Dots};
+use texsim::brdf::{
+    albedo_report, dir_from_angles, eval_report, sample_report, AshikhminShirley, Dots,
+};
 
 struct Rng(u64);
 impl Rng {
@@ -40,7 +42,7 @@ impl Rng {
     }
     fn exponent(&mut self) -> f64 {
         const E: [f64; 10] = [0.0, 1e-3, 0.5, 1.0, 10.0, 100.0, 1000.0, 1e4, 1e5, 1e6];
-        if self.u64() % 2 == 0 {
+        if self.u64() & 1 == 0 {
             E[(self.u64() % 10) as usize]
         } else {
             10f64.powf(6.0 * self.f())
@@ -68,7 +70,10 @@ fn reciprocity() {
         let p = r.model();
         let (k1, k2) = (r.upper(), r.upper());
         let (a, b) = (p.eval(k1, k2), p.eval(k2, k1));
-        assert!((a - b).abs() <= 1e-9 * a.abs().max(b.abs()) + 1e-300, "{p:?} {k1} {k2}: {a} vs {b}");
+        assert!(
+            (a - b).abs() <= 1e-9 * a.abs().max(b.abs()) + 1e-300,
+            "{p:?} {k1} {k2}: {a} vs {b}"
+        );
     }
 }
 
@@ -86,7 +91,13 @@ fn finite_and_non_negative_everywhere() {
             2 => r.dir(),
             _ => r.upper(),
         };
-        for v in [p.eval(k1, k2), p.specular(k1, k2), p.diffuse(k1, k2), p.pdf(k1, k2), p.pdf_mixture(k1, k2)] {
+        for v in [
+            p.eval(k1, k2),
+            p.specular(k1, k2),
+            p.diffuse(k1, k2),
+            p.pdf(k1, k2),
+            p.pdf_mixture(k1, k2),
+        ] {
             assert!(v.is_finite() && v >= 0.0, "{p:?} {k1} {k2}: {v}");
         }
         let xi = [r.f(), r.f()];
@@ -97,17 +108,28 @@ fn finite_and_non_negative_everywhere() {
             _ => xi,
         };
         let h = p.sample_h(xi[0], xi[1]);
-        assert!(h.is_finite() && (h.length() - 1.0).abs() < 1e-12 && h.z >= 0.0, "{p:?} {xi:?} {h}");
+        assert!(
+            h.is_finite() && (h.length() - 1.0).abs() < 1e-12 && h.z >= 0.0,
+            "{p:?} {xi:?} {h}"
+        );
         assert!(p.pdf_h(h).is_finite());
         if let Some((k, pdf)) = p.sample(k1, xi) {
-            assert!(k.z > 0.0 && pdf.is_finite() && pdf > 0.0, "{p:?} {k1} {k} {pdf}");
+            assert!(
+                k.z > 0.0 && pdf.is_finite() && pdf > 0.0,
+                "{p:?} {k1} {k} {pdf}"
+            );
         }
     }
     let p = AshikhminShirley::new(0.0, 0.0, 0.0, 1.0).expect("valid");
     assert_eq!(p.eval(DVec3::Z, -DVec3::Z), 0.0, "k1 = -k2");
     let g = dir_from_angles(90.0, 0.0);
     assert_eq!(p.eval(g, g), 0.0, "exactly grazing gives 0");
-    assert!(p.eval(dir_from_angles(90.0 - 1e-14, 0.0), dir_from_angles(90.0 - 1e-14, 180.0 - 1e-9)).is_finite());
+    assert!(p
+        .eval(
+            dir_from_angles(90.0 - 1e-14, 0.0),
+            dir_from_angles(90.0 - 1e-14, 180.0 - 1e-9)
+        )
+        .is_finite());
 }
 
 /// The dot-product form (the fixed unit's twin) equals the vector form.
@@ -122,7 +144,7 @@ fn eval_from_dots_matches_eval() {
             let (s, df) = p.eval_from_dots(&d);
             s + df
         });
-        assert!((v - w).abs() <= 1e-12 * v, "{v} {w}");
+        assert!((v - w).abs() <= 1e-12 * v, "{v} {w}"); // same formula, same rounding
     }
 }
 
@@ -170,17 +192,34 @@ fn fresnel_and_diffuse_constant() {
 /// Parameter validation names the field; reports validate and end with the number.
 #[test]
 fn validation_and_reports() {
-    assert!(AshikhminShirley::new(-1.0, 1.0, 0.0, 0.0).err().is_some_and(|e| e.message().contains("'nu'")));
-    assert!(AshikhminShirley::new(1.0, f64::NAN, 0.0, 0.0).err().is_some_and(|e| e.message().contains("'nv'")));
-    assert!(AshikhminShirley::new(1.0, 1.0, 1.5, 0.0).err().is_some_and(|e| e.message().contains("'rs'")));
+    assert!(AshikhminShirley::new(-1.0, 1.0, 0.0, 0.0)
+        .err()
+        .is_some_and(|e| e.message().contains("'nu'")));
+    assert!(AshikhminShirley::new(1.0, f64::NAN, 0.0, 0.0)
+        .err()
+        .is_some_and(|e| e.message().contains("'nv'")));
+    assert!(AshikhminShirley::new(1.0, 1.0, 1.5, 0.0)
+        .err()
+        .is_some_and(|e| e.message().contains("'rs'")));
     let p = AshikhminShirley::new(100.0, 100.0, 1.0, 0.0).expect("valid");
     let rep = albedo_report(&p, 0.0, None).expect("report");
-    let last: f64 = rep.lines().last().and_then(|l| l.trim().parse().ok()).expect("number on last line");
-    assert!((last - p.albedo_quadrature(DVec3::Z, 32)).abs() < 1e-6, "{rep}");
+    let last: f64 = rep
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .expect("number on last line");
+    assert!(
+        (last - p.albedo_quadrature(DVec3::Z, 32)).abs() < 1e-6,
+        "{rep}"
+    );
     assert!(albedo_report(&p, 90.0, None).is_err());
     assert!(albedo_report(&p, f64::NAN, None).is_err());
     let e = eval_report(&p, DVec3::Z, dir_from_angles(10.0, 0.0)).expect("report");
-    let last: f64 = e.lines().last().and_then(|l| l.trim().parse().ok()).expect("number");
+    let last: f64 = e
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .expect("number");
     assert!((last - p.eval(DVec3::Z, dir_from_angles(10.0, 0.0))).abs() < 1e-5 * last);
     assert!(eval_report(&p, DVec3::ZERO, DVec3::Z).is_err());
     let s = sample_report(&p, dir_from_angles(30.0, 0.0), 20_000, 5).expect("report");

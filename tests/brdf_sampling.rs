@@ -28,7 +28,14 @@ const GL4: [(f64, f64); 4] = [
 
 /// Composite 4-point Gauss-Legendre of `f` over the cells between consecutive `edges`.
 fn gl(edges: &[f64], mut f: impl FnMut(f64) -> f64) -> f64 {
-    edges.windows(2).map(|w| GL4.iter().map(|&(x, wt)| wt * (w[1] - w[0]) * f(w[0] + x * (w[1] - w[0]))).sum::<f64>()).sum()
+    edges
+        .windows(2)
+        .map(|w| {
+            GL4.iter()
+                .map(|&(x, wt)| wt * (w[1] - w[0]) * f(w[0] + x * (w[1] - w[0])))
+                .sum::<f64>()
+        })
+        .sum()
 }
 
 /// Polar-angle cell edges on [0, top]: geometric from 1e-6 (resolves lobes of any width up to
@@ -45,8 +52,17 @@ fn uniform_edges(a: f64, b: f64, n: usize) -> Vec<f64> {
     (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect()
 }
 
-const CASES: [(f64, f64); 9] =
-    [(0.0, 0.0), (1.0, 1.0), (10.0, 10.0), (10.0, 100.0), (100.0, 10.0), (1.0, 10000.0), (10000.0, 1.0), (1000.0, 1000.0), (100000.0, 10.0)];
+const CASES: [(f64, f64); 9] = [
+    (0.0, 0.0),
+    (1.0, 1.0),
+    (10.0, 10.0),
+    (10.0, 100.0),
+    (100.0, 10.0),
+    (1.0, 10000.0),
+    (10000.0, 1.0),
+    (1000.0, 1000.0),
+    (100000.0, 10.0),
+];
 
 /// Eq. 5 integrates to 1 over the hemisphere: integral of p_h sin(theta) dtheta dphi by
 /// composite Gauss-Legendre (geometric cells in theta, 2048 cells in phi so that the lobe of the
@@ -58,7 +74,11 @@ fn half_vector_pdf_integrates_to_one() {
     let ph = uniform_edges(0.0, 2.0 * PI, 2048);
     for (nu, nv) in CASES {
         let p = AshikhminShirley::new(nu, nv, 1.0, 0.0).expect("valid");
-        let total = gl(&ph, |phi| gl(&th, |t| p.pdf_h(dir_from_angles(t.to_degrees(), phi.to_degrees())) * t.sin()));
+        let total = gl(&ph, |phi| {
+            gl(&th, |t| {
+                p.pdf_h(dir_from_angles(t.to_degrees(), phi.to_degrees())) * t.sin()
+            })
+        });
         assert!((total - 1.0).abs() < 1e-4, "nu {nu} nv {nv}: {total}");
     }
 }
@@ -73,15 +93,28 @@ fn half_vector_pdf_integrates_to_one() {
 fn direction_pdf_integrates_to_one_over_sphere() {
     let al = geometric_edges(PI);
     let be = uniform_edges(0.0, 2.0 * PI, 512);
-    for (nu, nv) in [(1.0, 1.0), (10.0, 100.0), (1000.0, 1000.0), (100.0, 10000.0)] {
+    for (nu, nv) in [
+        (1.0, 1.0),
+        (10.0, 100.0),
+        (1000.0, 1000.0),
+        (100.0, 10000.0),
+    ] {
         let p = AshikhminShirley::new(nu, nv, 1.0, 0.0).expect("valid");
         // (The strongly anisotropic case skips 80 deg: there the k2 = -k1 singularity carries
         // p_h ~ 0.2 and the product rule's error reaches 4e-3.)
-        let thetas: &[f64] = if nv > 1000.0 { &[0.0, 30.0, 60.0] } else { &[0.0, 30.0, 60.0, 80.0] };
+        let thetas: &[f64] = if nv > 1000.0 {
+            &[0.0, 30.0, 60.0]
+        } else {
+            &[0.0, 30.0, 60.0, 80.0]
+        };
         for &theta in thetas {
             let k1 = dir_from_angles(theta, 20.0);
             let r = DVec3::new(-k1.x, -k1.y, k1.z);
-            let t1 = if theta == 0.0 { DVec3::X } else { (DVec3::Z - r * r.z).normalize() };
+            let t1 = if theta == 0.0 {
+                DVec3::X
+            } else {
+                (DVec3::Z - r * r.z).normalize()
+            };
             let t2 = r.cross(t1);
             let total = gl(&be, |b| {
                 let (sb, cb) = b.sin_cos();
@@ -90,7 +123,10 @@ fn direction_pdf_integrates_to_one_over_sphere() {
                     p.pdf(k1, sa * cb * t1 + sa * sb * t2 + ca * r) * sa
                 })
             });
-            assert!((total - 1.0).abs() < 2e-3, "nu {nu} nv {nv} theta {theta}: {total}");
+            assert!(
+                (total - 1.0).abs() < 2e-3,
+                "nu {nu} nv {nv} theta {theta}: {total}"
+            );
         }
     }
 }
@@ -124,7 +160,13 @@ fn half_vector_chi_square() {
                 0.5 * PI * (quad + 1) as f64 - first(0.5 * PI - psi)
             }
         };
-        let dphi = |quad: usize, psi: f64| if quad % 2 == 0 { jac(psi) } else { jac(0.5 * PI - psi) };
+        let dphi = |quad: usize, psi: f64| {
+            if quad % 2 == 0 {
+                jac(psi)
+            } else {
+                jac(0.5 * PI - psi)
+            }
+        };
         let mut edges = Vec::with_capacity(NP + 1);
         for quad in 0..4 {
             for i in 0..q {
@@ -133,14 +175,20 @@ fn half_vector_chi_square() {
         }
         edges.push(2.0 * PI);
         let e_of = |phi: f64| nu * phi.cos().powi(2) + nv * phi.sin().powi(2);
-        let ej: Vec<f64> = (0..NP).map(|j| e_of(0.5 * (edges[j] + edges[j + 1]))).collect();
+        let ej: Vec<f64> = (0..NP)
+            .map(|j| e_of(0.5 * (edges[j] + edges[j + 1])))
+            .collect();
         let mu_edge = |j: usize, k: usize| (k as f64 / NC as f64).powf(1.0 / (ej[j] + 1.0));
         let norm = ((nu + 1.0) * (nv + 1.0)).sqrt() / (2.0 * PI);
         let mut expected = vec![0.0; NP * NC];
         for j in 0..NP {
             // Integrate in psi: a smooth change of variables that follows the lobe.
             let (quad, i) = (j / q, j % q);
-            let sub = uniform_edges(0.5 * PI * i as f64 / q as f64, 0.5 * PI * (i + 1) as f64 / q as f64, 8);
+            let sub = uniform_edges(
+                0.5 * PI * i as f64 / q as f64,
+                0.5 * PI * (i + 1) as f64 / q as f64,
+                8,
+            );
             for k in 0..NC {
                 let (lo, hi) = (mu_edge(j, k), mu_edge(j, k + 1));
                 expected[j * NC + k] = gl(&sub, |psi| {
@@ -150,7 +198,10 @@ fn half_vector_chi_square() {
             }
         }
         let total: f64 = expected.iter().sum::<f64>() / N as f64;
-        assert!((total - 1.0).abs() < 1e-6, "expected probabilities sum {total}");
+        assert!(
+            (total - 1.0).abs() < 1e-6,
+            "expected probabilities sum {total}"
+        );
         let mut observed = vec![0.0; NP * NC];
         for _ in 0..N {
             let h = p.sample_h(rng.f(), rng.f());
@@ -167,7 +218,10 @@ fn half_vector_chi_square() {
         let dof = (groups - 1) as f64;
         let (c95, c999) = (wilson_hilferty(dof, Z_95), wilson_hilferty(dof, Z_999));
         println!("h chi2 nu {nu} nv {nv}: {stat:.1} dof {dof} crit95 {c95:.1} crit99.9 {c999:.1}");
-        assert!(stat < c999, "nu {nu} nv {nv}: chi2 {stat} >= {c999} (dof {dof})");
+        assert!(
+            stat < c999,
+            "nu {nu} nv {nv}: chi2 {stat} >= {c999} (dof {dof})"
+        );
     }
 }
 
@@ -186,7 +240,10 @@ fn merged_chi2(obs: &[f64], exp: &[f64]) -> (f64, usize) {
         l.0 += o;
         l.1 += e;
     }
-    (groups.iter().map(|&(o, e)| (o - e) * (o - e) / e).sum(), groups.len())
+    (
+        groups.iter().map(|&(o, e)| (o - e) * (o - e) / e).sum(),
+        groups.len(),
+    )
 }
 
 /// A sampler with a wrong exponent must be rejected by the same test: sanity that the
@@ -215,10 +272,19 @@ fn chi_square_detects_a_wrong_sampler() {
 /// the mirror direction over the whole sphere (library implementation, see its module doc).
 #[test]
 fn reflected_direction_chi_square() {
-    for (nu, nv, theta, seed) in [(10.0, 10.0, 30.0, 1u64), (10.0, 100.0, 45.0, 2), (100.0, 100.0, 70.0, 3), (1.0, 1.0, 60.0, 4), (1000.0, 300.0, 20.0, 5)] {
+    for (nu, nv, theta, seed) in [
+        (10.0, 10.0, 30.0, 1u64),
+        (10.0, 100.0, 45.0, 2),
+        (100.0, 100.0, 70.0, 3),
+        (1.0, 1.0, 60.0, 4),
+        (1000.0, 300.0, 20.0, 5),
+    ] {
         let p = AshikhminShirley::new(nu, nv, 0.5, 0.5).expect("valid");
         let r = chi2_k2(&p, dir_from_angles(theta, 33.0), 200_000, seed);
-        println!("k2 chi2 nu {nu} nv {nv} theta {theta}: {:.1} dof {} crit99.9 {:.1} total {:.6}", r.statistic, r.dof, r.critical_999, r.total_probability);
+        println!(
+            "k2 chi2 nu {nu} nv {nv} theta {theta}: {:.1} dof {} crit99.9 {:.1} total {:.6}",
+            r.statistic, r.dof, r.critical_999, r.total_probability
+        );
         assert!((r.total_probability - 1.0).abs() < 2e-3, "{r:?}");
         assert!(r.passed, "nu {nu} nv {nv} theta {theta}: {r:?}");
     }
@@ -234,7 +300,10 @@ fn sample_pdf_matches_pdf() {
             let k1 = dir_from_angles(89.0 * rng.f(), 360.0 * rng.f());
             if let Some((k2, pdf)) = p.sample(k1, [rng.f(), rng.f()]) {
                 let q = p.pdf(k1, k2);
-                assert!((pdf - q).abs() <= 1e-6 * pdf, "{nu} {nv} {k1} {k2}: {pdf} vs {q}");
+                assert!(
+                    (pdf - q).abs() <= 1e-6 * pdf,
+                    "{nu} {nv} {k1} {k2}: {pdf} vs {q}"
+                );
             }
         }
     }

@@ -10,7 +10,8 @@
 //! 2. `a = hu^2`, `b = hv^2`, `s = a + b` exactly (`2D` fraction bits). For a unit `h`,
 //!    `s = 1 - (h.n)^2`; using `s` instead of `1 - (h.n)^2` (eq. 18) avoids the cancellation as
 //!    `h -> n`. Exponent `E = (nu a + nv b) / s` by a restoring divider to `aniso_ratio_bits`
-//!    fraction bits (truncated; it is a weighted average of nu, nv so it never overflows).
+//!    fraction bits plus a guard bit, rounded to nearest (a weighted average of nu, nv, so it
+//!    never overflows). `h.n` itself is only checked for `> 0`.
 //! 3. Power `(n.h)^E = (1 - s)^(E/2) = 2^-X` with `X = E L / 2`, `L = -log2(1 - s)`:
 //!    for `s < 1/2`, `L = s g(s)` with `g(s) = -log2(1-s)/s` from a `2^pow_lut_bits + 1` entry
 //!    ROM with linear interpolation (keeps relative precision as `s -> 0`); for `s >= 1/2`,
@@ -19,26 +20,28 @@
 //!    (pseudo-float, so the tail keeps relative precision; `X >= 100` flushes to 0).
 //!    ROM entries are `pow_frac_bits`-bit roundings of values computed here in integer
 //!    arithmetic to ~2^-55 (the ROM contents are a pure function of the index).
-//! 4. Schlick Fresnel `Rs + (1 - Rs)(1 - k.h)^5` (eq. 11): three multiplies, each rounded to
-//!    `fresnel_bits`.
+//! 4. Schlick Fresnel `Rs + (1 - Rs)(1 - k.h)^5` (eq. 11): `1 - k.h` exact, three multiplies, a
+//!    multiply and an add, each rounded to a `fresnel_bits` mantissa (pseudo-float: `F` keeps
+//!    relative precision when small, e.g. low `Rs` with `k.h -> 1`).
 //! 5. `1 / ((k.h) max(n.k1, n.k2))`: the exact `2D`-bit product is normalized and its mantissa
 //!    inverted by a restoring divider to `aniso_recip_bits` bits (pseudo-float).
 //! 6. Specular `sqrt((nu+1)(nv+1))/8 * P * F / den`, a chain of pseudo-float multiplies with
 //!    `pow_frac_bits`-bit mantissas (the square root is an exact integer square root, a
 //!    per-material constant: see [`aniso_phong_material_cost`]).
-//! 7. Diffuse `28/23 Rd (1 - Rs) (1 - (1 - n.k1/2)^5)(1 - (1 - n.k2/2)^5)` (eq. 16 times pi) in
-//!    `fresnel_bits` fixed point.
+//! 7. Diffuse `28/23 Rd (1 - Rs) D(n.k1) D(n.k2)` (eq. 16 times pi) with
+//!    `D(c) = 1 - (1 - c/2)^5` expanded as `x (5 - 10x + 10x^2 - 5x^3 + x^4)`, `x = c/2`
+//!    (Horner, `fresnel_bits` fraction bits; no cancellation as `c -> 0`), then pseudo-float
+//!    multiplies with `fresnel_bits` mantissas.
 //! 8. Sum, rounded to `aniso_out_mant_bits`; values `>= 2^aniso_out_exp_max` saturate (counted).
 //!
 //! Guards: if `h.n <= 0`, `k.h <= 0`, `n.k1 <= 0` or `n.k2 <= 0` the output is zero: the caller
 //! passes zeros for `k1 = -k2` (no halfway vector) and for directions below the horizon. At
 //! `h = n` (`s = 0`, eq. 18's 0/0) the power is exactly 1. `0^0 = 1` (`nu = nv = 0`).
 //!
-//! Accuracy (texram16, measured by `tests/brdf_fixed.rs` on 2^21 random unit-vector inputs
-//! against the f64 model evaluated from the SAME quantized dot products, away from the
-//! saturation range): `|fixed - ref| <= 2e-4 |ref| + 2^-13` in units of `pi rho` (the absolute
-//! term covers the `fresnel_bits` fixed-point diffuse and Fresnel; the relative term the
-//! pseudo-float chain and the power with exponents up to 10^5).
+//! Accuracy (texram16; `tests/brdf_fixed.rs`, 2^21 random unit-vector inputs with integer
+//! exponents 0..1e5, against the reference evaluated from the SAME quantized dot products):
+//! `|fixed - ref| <= 2e-4 ref` for `ref >= 1e-15` in units of `pi rho` (measured worst 6.7e-5),
+//! excluding saturated outputs (`>= 2^24`, only at extreme grazing, < 0.1% of those inputs).
 
 use crate::cost::UnitCost;
 use crate::fixed::{round_shift_right, round_shift_right_wide, Rounding, SatCounter};
@@ -130,13 +133,28 @@ impl AnisoPhongConfig {
         check("aniso_dot_frac_bits", self.aniso_dot_frac_bits, 6, 15)?;
         check("exponent_max_bits", self.exponent_max_bits, 1, 20)?;
         check("aniso_ratio_bits", self.aniso_ratio_bits, 4, 24)?;
-        check("pow_lut_bits", self.pow_lut_bits, 2, (2 * self.aniso_dot_frac_bits - 1).min(16))?;
-        check("pow_frac_bits", self.pow_frac_bits, self.pow_lut_bits.max(8), 30)?;
+        check(
+            "pow_lut_bits",
+            self.pow_lut_bits,
+            2,
+            (2 * self.aniso_dot_frac_bits - 1).min(16),
+        )?;
+        check(
+            "pow_frac_bits",
+            self.pow_frac_bits,
+            self.pow_lut_bits.max(8),
+            30,
+        )?;
         check("fresnel_bits", self.fresnel_bits, 4, 24)?;
         check("aniso_recip_bits", self.aniso_recip_bits, 4, 30)?;
         check("aniso_out_mant_bits", self.aniso_out_mant_bits, 2, 30)?;
         check("aniso_out_exp_max", self.aniso_out_exp_max, 1, 60)?;
-        check("aniso_div_bits_per_cycle", self.aniso_div_bits_per_cycle, 1, 64)?;
+        check(
+            "aniso_div_bits_per_cycle",
+            self.aniso_div_bits_per_cycle,
+            1,
+            64,
+        )?;
         Ok(())
     }
 }
@@ -217,16 +235,27 @@ fn pf_norm(m: u128, e: i32, bits: u32, rnd: Rounding) -> PseudoFloat {
             r >>= 1;
             e2 += 1;
         }
-        PseudoFloat { mant: r as u64, exp: e2 }
+        PseudoFloat {
+            mant: r as u64,
+            exp: e2,
+        }
     } else {
         let sh = bits - len;
-        PseudoFloat { mant: (m << sh) as u64, exp: e - sh as i32 }
+        PseudoFloat {
+            mant: (m << sh) as u64,
+            exp: e - sh as i32,
+        }
     }
 }
 
 #[must_use]
 fn pf_mul(a: PseudoFloat, b: PseudoFloat, bits: u32, rnd: Rounding) -> PseudoFloat {
-    pf_norm(u128::from(a.mant) * u128::from(b.mant), a.exp + b.exp, bits, rnd)
+    pf_norm(
+        u128::from(a.mant) * u128::from(b.mant),
+        a.exp + b.exp,
+        bits,
+        rnd,
+    )
 }
 
 #[must_use]
@@ -237,8 +266,10 @@ fn pf_add(a: PseudoFloat, b: PseudoFloat, bits: u32, rnd: Rounding) -> PseudoFlo
     if b.mant == 0 {
         return pf_norm(u128::from(a.mant), a.exp, bits, rnd);
     }
-    // Align to the smaller exponent, but never shift by more than bits + 4: beyond that the
-    // smaller operand only acts as a sticky bit below the rounding position.
+    // Normalize both, align to the smaller exponent, but never shift by more than bits + 4:
+    // beyond that the smaller operand only acts as a sticky bit below the rounding position.
+    let a = pf_norm(u128::from(a.mant), a.exp, bits, rnd);
+    let b = pf_norm(u128::from(b.mant), b.exp, bits, rnd);
     let (hi, lo) = if a.exp >= b.exp { (a, b) } else { (b, a) };
     let d = (hi.exp - lo.exp) as u32;
     let cap = bits + 4;
@@ -350,7 +381,7 @@ pub fn rom_exp2(i: u32, cfg: &AnisoPhongConfig) -> i64 {
     let one = 1i128 << Q;
     let (mut term, mut sum) = (one, one);
     for k in 1..=30i128 {
-        term = -(term * x as i128 >> Q) / k;
+        term = -((term * x as i128) >> Q) / k;
         sum += term;
     }
     q62_to(sum.max(0) as u128, cfg.pow_frac_bits, cfg.aniso_rounding)
@@ -370,7 +401,10 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
     let rnd = cfg.aniso_rounding;
     let b = cfg.pow_lut_bits;
     let sb = 2 * cfg.aniso_dot_frac_bits;
-    let one_pf = PseudoFloat { mant: 1u64 << f, exp: -(f as i32) };
+    let one_pf = PseudoFloat {
+        mant: 1u64 << f,
+        exp: -(f as i32),
+    };
     if e_raw == 0 || s == 0 {
         return one_pf;
     }
@@ -391,7 +425,11 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
         let mfrac = y - (1u64 << mf);
         let (idx, fr, fb) = if mf >= b {
             let fb = mf - b;
-            ((mfrac >> fb) as u32, (mfrac & ((1u64 << fb) - 1)) as i64, fb)
+            (
+                (mfrac >> fb) as u32,
+                (mfrac & ((1u64 << fb) - 1)) as i64,
+                fb,
+            )
         } else {
             ((mfrac << (b - mf)) as u32, 0, 0)
         };
@@ -400,7 +438,11 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
         (((k << f) - lg).max(0) as u128) << sb
     };
     // X = E * L / 2, rounded to f fraction bits.
-    let x = round_shift_right_wide((u128::from(e_raw) * l_wide) as i128, cfg.aniso_ratio_bits + sb + 1, rnd);
+    let x = round_shift_right_wide(
+        (u128::from(e_raw) * l_wide) as i128,
+        cfg.aniso_ratio_bits + sb + 1,
+        rnd,
+    );
     let xi = x >> f;
     if xi >= POW_FLUSH_X {
         return PseudoFloat::default();
@@ -413,19 +455,64 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
     pf_norm(pm.max(0) as u128, -(xi as i32) - f as i32, f, rnd)
 }
 
-/// `(1 - x)^5` in `fb` fraction bits for `x` given with `xf` fraction bits in `[0, 1]`.
+/// Schlick Fresnel `Rs + (1 - Rs)(1 - k.h)^5` (eq. 11) as a pseudo-float with `fb`-bit
+/// mantissas: `1 - k.h` is exact, each of the four multiplies and the add round to `fb` bits,
+/// so `F` keeps relative precision even when it is small (low `Rs`, `k.h -> 1`).
 #[must_use]
-fn pow5_one_minus(x: i64, xf: u32, fb: u32, rnd: Rounding, sat: &mut SatCounter) -> i64 {
+fn fresnel(kh: i64, d: u32, rs: i64, fb: u32, rnd: Rounding) -> PseudoFloat {
+    let y = PseudoFloat {
+        mant: ((1i64 << d) - kh).max(0) as u64,
+        exp: -(d as i32),
+    };
+    let y2 = pf_mul(y, y, fb, rnd);
+    let y4 = pf_mul(y2, y2, fb, rnd);
+    let y5 = pf_mul(y4, y, fb, rnd);
+    let one_minus_rs = PseudoFloat {
+        mant: ((1i64 << fb) - rs).max(0) as u64,
+        exp: -(fb as i32),
+    };
+    let t = pf_mul(one_minus_rs, y5, fb, rnd);
+    pf_add(
+        PseudoFloat {
+            mant: rs.max(0) as u64,
+            exp: -(fb as i32),
+        },
+        t,
+        fb,
+        rnd,
+    )
+}
+
+/// `1 - (1 - x)^5` for `x = n.k / 2` (eq. 16) as a pseudo-float with `fb`-bit mantissa, by the
+/// expanded form `x (5 - 10x + 10x^2 - 5x^3 + x^4)` in Horner order with `fb` fraction bits
+/// (the polynomial is in [1.9, 5] on [0, 1/2], so the result keeps relative precision as
+/// `n.k -> 0`, where `1 - (1 - x)^5` would cancel).
+#[must_use]
+fn diffuse_factor(nk: i64, d: u32, fb: u32, rnd: Rounding) -> PseudoFloat {
+    // x = nk / 2 has d + 1 fraction bits exactly; bring it to fb fraction bits.
+    let xf = d + 1;
+    let x = if xf >= fb {
+        round_shift_right(nk, xf - fb, rnd)
+    } else {
+        nk << (fb - xf)
+    };
     let one = 1i64 << fb;
-    let xq = if xf >= fb { round_shift_right(x, xf - fb, rnd) } else { x << (fb - xf) };
-    let y = (one - xq).clamp(0, one);
-    let y2 = round_shift_right(y * y, fb, rnd);
-    let y4 = round_shift_right(y2 * y2, fb, rnd);
-    let y5 = round_shift_right(y4 * y, fb, rnd);
-    if y5 > one {
-        sat.saturated += 1;
+    let mut q = x - 5 * one;
+    for c in [10i64, -10, 5] {
+        q = round_shift_right(q * x, fb, rnd) + c * one;
     }
-    y5.min(one)
+    pf_mul(
+        PseudoFloat {
+            mant: nk.max(0) as u64,
+            exp: -(xf as i32),
+        },
+        PseudoFloat {
+            mant: q.max(0) as u64,
+            exp: -(fb as i32),
+        },
+        fb,
+        rnd,
+    )
 }
 
 /// Per-material constant `sqrt((nu+1)(nv+1))` with `pow_frac_bits` fraction bits (exact floor).
@@ -449,7 +536,11 @@ fn clamp_dot(x: i32, d: u32, sat: &mut SatCounter) -> i64 {
 
 /// Evaluates the BRDF (times pi) from dot products. See the module doc for formats and guards.
 #[must_use]
-pub fn aniso_phong(inp: &AnisoPhongInputs, cfg: &AnisoPhongConfig, sat: &mut SatCounter) -> AnisoPhongOut {
+pub fn aniso_phong(
+    inp: &AnisoPhongInputs,
+    cfg: &AnisoPhongConfig,
+    sat: &mut SatCounter,
+) -> AnisoPhongOut {
     let d = cfg.aniso_dot_frac_bits;
     let f = cfg.pow_frac_bits;
     let fb = cfg.fresnel_bits;
@@ -494,27 +585,37 @@ pub fn aniso_phong(inp: &AnisoPhongInputs, cfg: &AnisoPhongConfig, sat: &mut Sat
     let e_raw = if s == 0 {
         0
     } else {
-        let num = (u128::from(nu) * u128::from(a) + u128::from(nv) * u128::from(b)) << r;
-        restoring_div(num, u128::from(s), cfg.exponent_max_bits + r + 1) as u64
+        // One guard bit, then round to nearest (ties up): |E error| <= 2^-(r+1).
+        let num = (u128::from(nu) * u128::from(a) + u128::from(nv) * u128::from(b)) << (r + 1);
+        let q = restoring_div(num, u128::from(s), cfg.exponent_max_bits + r + 2) as u64;
+        (q >> 1) + (q & 1)
     };
     let p = power(s, e_raw, cfg);
 
     // Fresnel, eq. 11.
-    let y5 = pow5_one_minus(kh, d, fb, rnd, sat);
-    let fres = rs + round_shift_right((one_f - rs) * y5, fb, rnd);
+    let fpf = fresnel(kh, d, rs, fb, rnd);
 
     // 1 / (k.h max(n.k1, n.k2)) as a pseudo-float.
     let den = (kh * nk1.max(nk2)) as u64;
     let w = cfg.aniso_recip_bits;
     let bl = 64 - den.leading_zeros();
-    let md = if bl > w { round_shift_right(den as i64, bl - w, rnd) as u64 } else { den << (w - bl) };
+    let md = if bl > w {
+        round_shift_right(den as i64, bl - w, rnd) as u64
+    } else {
+        den << (w - bl)
+    };
     let q = restoring_div(1u128 << (2 * w - 1), u128::from(md), w + 2);
-    let recip = PseudoFloat { mant: q as u64, exp: (2 * d) as i32 - bl as i32 - w as i32 + 1 };
+    let recip = PseudoFloat {
+        mant: q as u64,
+        exp: (2 * d) as i32 - bl as i32 - w as i32 + 1,
+    };
 
     // Specular: sqrt((nu+1)(nv+1))/8 * P * F * recip.
-    let c = PseudoFloat { mant: norm_sqrt(nu as u32, nv as u32, cfg), exp: -(f as i32) - 3 };
-    let fpf = PseudoFloat { mant: fres.max(0) as u64, exp: -(fb as i32) };
-    let spec = if p.mant == 0 || fres <= 0 {
+    let c = PseudoFloat {
+        mant: norm_sqrt(nu as u32, nv as u32, cfg),
+        exp: -(f as i32) - 3,
+    };
+    let spec = if p.mant == 0 || fpf.mant == 0 {
         PseudoFloat::default()
     } else {
         let t = pf_mul(c, p, f, rnd);
@@ -522,16 +623,27 @@ pub fn aniso_phong(inp: &AnisoPhongInputs, cfg: &AnisoPhongConfig, sat: &mut Sat
         pf_mul(t, recip, f, rnd)
     };
 
-    // Diffuse, eq. 16 times pi: 28/23 Rd (1 - Rs) D(n.k1) D(n.k2).
-    let dterm = |nk: i64, sat: &mut SatCounter| one_f - pow5_one_minus(nk, d + 1, fb, rnd, sat);
-    let d1 = dterm(nk1, sat);
-    let d2 = dterm(nk2, sat);
-    let k = (28i64 << fb) / 23 + i64::from(((28i64 << fb) % 23) * 2 >= 23);
-    let t = round_shift_right(rd * (one_f - rs), fb, rnd);
-    let t = round_shift_right(t * d1, fb, rnd);
-    let t = round_shift_right(t * d2, fb, rnd);
-    let diff = round_shift_right(t * k, fb, rnd);
-    let diffuse = pf_norm(diff.max(0) as u128, -(fb as i32), f, rnd);
+    // Diffuse, eq. 16 times pi: 28/23 Rd (1 - Rs) D(n.k1) D(n.k2), pseudo-floats of fb bits.
+    let k = PseudoFloat {
+        mant: ((28u64 << fb) + 11) / 23,
+        exp: -(fb as i32),
+    };
+    let rd_pf = PseudoFloat {
+        mant: rd.max(0) as u64,
+        exp: -(fb as i32),
+    };
+    let one_minus_rs = PseudoFloat {
+        mant: (one_f - rs).max(0) as u64,
+        exp: -(fb as i32),
+    };
+    let diffuse = if rd == 0 || rs == one_f {
+        PseudoFloat::default()
+    } else {
+        let t = pf_mul(rd_pf, one_minus_rs, fb, rnd);
+        let t = pf_mul(t, diffuse_factor(nk1, d, fb, rnd), fb, rnd);
+        let t = pf_mul(t, diffuse_factor(nk2, d, fb, rnd), fb, rnd);
+        pf_mul(t, k, fb, rnd)
+    };
 
     let total = pf_add(spec, diffuse, f, rnd);
     let ob = cfg.aniso_out_mant_bits;
@@ -539,11 +651,18 @@ pub fn aniso_phong(inp: &AnisoPhongInputs, cfg: &AnisoPhongConfig, sat: &mut Sat
         let y = pf_norm(u128::from(x.mant), x.exp, ob, rnd);
         if y.mant != 0 && y.exp + ob as i32 > cfg.aniso_out_exp_max as i32 {
             sat.saturated += 1;
-            return PseudoFloat { mant: (1u64 << ob) - 1, exp: cfg.aniso_out_exp_max as i32 - ob as i32 };
+            return PseudoFloat {
+                mant: (1u64 << ob) - 1,
+                exp: cfg.aniso_out_exp_max as i32 - ob as i32,
+            };
         }
         y
     };
-    AnisoPhongOut { spec: out(spec, sat), diffuse: out(diffuse, sat), total: out(total, sat) }
+    AnisoPhongOut {
+        spec: out(spec, sat),
+        diffuse: out(diffuse, sat),
+        total: out(total, sat),
+    }
 }
 
 /// Cycles of a restoring divider producing `qbits` quotient bits.
@@ -566,7 +685,10 @@ pub fn aniso_phong_cost(cfg: &AnisoPhongConfig) -> UnitCost {
     let r_div = cfg.aniso_recip_bits + 2;
     UnitCost {
         ops: muls + luts + adds + 2,
-        cycles: muls * cfg.aniso_mul_cycles + luts * cfg.aniso_lut_cycles + div_cycles(e_div, cfg) + div_cycles(r_div, cfg),
+        cycles: muls * cfg.aniso_mul_cycles
+            + luts * cfg.aniso_lut_cycles
+            + div_cycles(e_div, cfg)
+            + div_cycles(r_div, cfg),
         texels: 0,
     }
 }
@@ -576,7 +698,11 @@ pub fn aniso_phong_cost(cfg: &AnisoPhongConfig) -> UnitCost {
 #[must_use]
 pub fn aniso_phong_material_cost(cfg: &AnisoPhongConfig) -> UnitCost {
     let bits = cfg.exponent_max_bits + 1 + cfg.pow_frac_bits;
-    UnitCost { ops: bits, cycles: div_cycles(bits, cfg), texels: 0 }
+    UnitCost {
+        ops: bits,
+        cycles: div_cycles(bits, cfg),
+        texels: 0,
+    }
 }
 
 #[cfg(test)]
@@ -598,7 +724,19 @@ mod tests {
 
     #[test]
     fn isqrt_is_floor_sqrt() {
-        for v in [0u128, 1, 2, 3, 4, 15, 16, 17, 1 << 40, (1 << 80) + 12345, u128::from(u64::MAX)] {
+        for v in [
+            0u128,
+            1,
+            2,
+            3,
+            4,
+            15,
+            16,
+            17,
+            1 << 40,
+            (1 << 80) + 12345,
+            u128::from(u64::MAX),
+        ] {
             let r = isqrt(v);
             assert!(r * r <= v && (r + 1) * (r + 1) > v, "{v}");
         }

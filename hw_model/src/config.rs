@@ -251,7 +251,12 @@ impl HwConfig {
         let q = &self.reciprocal;
         check("reciprocal.recip_lut_bits", q.recip_lut_bits, 1, 16)?;
         check("reciprocal.recip_iterations", q.recip_iterations, 0, 4)?;
-        check("reciprocal.recip_mantissa_bits", q.recip_mantissa_bits, 8, 30)?;
+        check(
+            "reciprocal.recip_mantissa_bits",
+            q.recip_mantissa_bits,
+            8,
+            30,
+        )?;
         let i = &self.interp;
         check("interp.inv_w_bits", i.inv_w_bits, 4, 30)?;
         check("interp.bary_bits", i.bary_bits, 4, 30)?;

@@ -65,13 +65,25 @@ impl Format {
     /// Unsigned normalized-style format with `frac` fraction bits and `int` integer bits.
     #[must_use]
     pub const fn unsigned(int_bits: u32, frac_bits: u32, rounding: Rounding) -> Self {
-        Self { signed: false, int_bits, frac_bits, rounding, overflow: Overflow::Saturate }
+        Self {
+            signed: false,
+            int_bits,
+            frac_bits,
+            rounding,
+            overflow: Overflow::Saturate,
+        }
     }
 
     /// Signed format with `int` integer bits plus sign and `frac` fraction bits.
     #[must_use]
     pub const fn signed(int_bits: u32, frac_bits: u32, rounding: Rounding) -> Self {
-        Self { signed: true, int_bits, frac_bits, rounding, overflow: Overflow::Saturate }
+        Self {
+            signed: true,
+            int_bits,
+            frac_bits,
+            rounding,
+            overflow: Overflow::Saturate,
+        }
     }
 
     /// Total storage bits (sign + integer + fraction).
@@ -167,7 +179,9 @@ pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
         match mode {
             Rounding::Truncate => floor,
             Rounding::HalfUp => floor + i128::from(rem >= half),
-            Rounding::HalfEven => floor + i128::from(rem > half || (rem == half && (floor & 1) == 1)),
+            Rounding::HalfEven => {
+                floor + i128::from(rem > half || (rem == half && (floor & 1) == 1))
+            }
         }
     };
     v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64

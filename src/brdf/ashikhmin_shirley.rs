@@ -7,10 +7,12 @@
 //! away from the surface (`k1` toward the light, `k2` toward the viewer) and are unit vectors.
 //!
 //! Notes on the equations (checked against the paper text and verified by the tests):
-//! - Eq. 18 divides by `1 - (h.n)^2`; for a unit `h` that equals `(h.u)^2 + (h.v)^2`, which we
-//!   use instead: it has no cancellation as `h -> n`, and it makes the exponent a weighted
+//! - Eq. 18 divides by `1 - (h.n)^2`; for a unit `h` that equals `s = (h.u)^2 + (h.v)^2`, which
+//!   we use instead: it has no cancellation as `h -> n`, and it makes the exponent a weighted
 //!   average of `nu` and `nv`, so the `0/0` at `h = n` has the limit "any value in
-//!   `[min(nu,nv), max(nu,nv)]`", and `(n.h)^E = 1` there whichever value is taken.
+//!   `[min(nu,nv), max(nu,nv)]`", and `(n.h)^E = 1` there whichever value is taken. Likewise
+//!   the power is evaluated as `(n.h)^E = (1 - s)^(E/2)` (identical for a unit `h`), which keeps
+//!   full relative precision for narrow lobes and is what the fixed unit computes.
 //! - Eq. 5 is the EXACT density of the sampler of eqs. 21-22 (not only an approximation): the
 //!   Jacobian of eq. 21 gives `p(phi) = sqrt((nu+1)(nv+1)) / (2 pi ((nu+1)cos^2 + (nv+1)sin^2))`
 //!   and eq. 22 gives `(E+1) cos^E theta` in `cos theta`; their product cancels `E + 1`.
@@ -25,6 +27,9 @@
 //! Guards: directions at or below the horizon give 0; `k1 = -k2` (no halfway vector) gives 0;
 //! the specular denominator `(h.k) max(n.k1, n.k2)` is floored at [`DENOM_FLOOR`] so the value
 //! stays finite at grazing (the true lobe is unbounded there only for exponents below 1).
+
+// `!(x > 0.0)` is used on purpose: it is true for NaN, which must take the guarded path.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
 use glam::DVec3;
@@ -77,7 +82,14 @@ impl Dots {
             return None;
         }
         let h = halfway(k1, k2)?;
-        Some(Dots { hn: h.z, hu: h.x, hv: h.y, kh: k1.dot(h), nk1: k1.z, nk2: k2.z })
+        Some(Dots {
+            hn: h.z,
+            hu: h.x,
+            hv: h.y,
+            kh: k1.dot(h),
+            nk1: k1.z,
+            nk2: k2.z,
+        })
     }
 }
 
@@ -149,7 +161,12 @@ const GL4: [(f64, f64); 4] = [
 impl AshikhminShirley {
     /// Validated parameters: exponents finite in `[0, 1e6]`, `Rs` and `Rd` in `[0, 1]`.
     pub fn new(nu: f64, nv: f64, rs: f64, rd: f64) -> Result<Self> {
-        for (name, v, hi) in [("nu", nu, EXPONENT_MAX), ("nv", nv, EXPONENT_MAX), ("rs", rs, 1.0), ("rd", rd, 1.0)] {
+        for (name, v, hi) in [
+            ("nu", nu, EXPONENT_MAX),
+            ("nv", nv, EXPONENT_MAX),
+            ("rs", rs, 1.0),
+            ("rd", rd, 1.0),
+        ] {
             if !v.is_finite() || v < 0.0 || v > hi {
                 return Err(Error::field(name, format!("{v} is not in [0, {hi}]")));
             }
@@ -176,17 +193,27 @@ impl AshikhminShirley {
         self.nv + (self.nu - self.nv) * t
     }
 
-    /// `(n.h)^E`, with `0^0 = 1` and `1` at `h = n`; 0 for `h.n <= 0`.
+    /// `(n.h)^E`, evaluated as `(1 - s)^(E/2)` with `s = hu^2 + hv^2` (equal for a unit `h`;
+    /// this is also the fixed unit's formula, so the twin sees the same function of the
+    /// quantized dot products). 1 at `h = n` and for `E = 0` (`0^0 = 1`); 0 for `h.n <= 0`
+    /// unless `E = 0`.
     #[must_use]
     pub fn lobe_power(&self, hn: f64, hu: f64, hv: f64) -> f64 {
-        if !(hn > 0.0) {
-            return if self.exponent(hu, hv) == 0.0 && hn == 0.0 { 1.0 } else { 0.0 };
-        }
         let e = self.exponent(hu, hv);
         if e == 0.0 {
             return 1.0;
         }
-        hn.min(1.0).powf(e)
+        if !(hn > 0.0) {
+            return 0.0;
+        }
+        let s = hu * hu + hv * hv;
+        if !(s > 0.0) {
+            return 1.0;
+        }
+        if s >= 1.0 {
+            return 0.0;
+        }
+        (0.5 * e * (-s).ln_1p()).exp()
     }
 
     /// Half-vector density of eq. 5 (per steradian of `h`); 0 below the horizon.
@@ -202,7 +229,11 @@ impl AshikhminShirley {
     /// `[0, 1]`.
     #[must_use]
     pub fn fresnel_schlick(&self, cos: f64) -> f64 {
-        let c = if cos.is_nan() { 0.0 } else { cos.clamp(0.0, 1.0) };
+        let c = if cos.is_nan() {
+            0.0
+        } else {
+            cos.clamp(0.0, 1.0)
+        };
         self.rs + (1.0 - self.rs) * pow5_one_minus(c)
     }
 
@@ -266,8 +297,16 @@ impl AshikhminShirley {
     /// Half vector from two uniforms (eqs. 21-22 with the four-quadrant mapping of `xi1`).
     #[must_use]
     pub fn sample_h(&self, xi1: f64, xi2: f64) -> DVec3 {
-        let xi1 = if xi1.is_nan() { 0.0 } else { xi1.clamp(0.0, 1.0) };
-        let xi2 = if xi2.is_nan() { 0.0 } else { xi2.clamp(0.0, 1.0) };
+        let xi1 = if xi1.is_nan() {
+            0.0
+        } else {
+            xi1.clamp(0.0, 1.0)
+        };
+        let xi2 = if xi2.is_nan() {
+            0.0
+        } else {
+            xi2.clamp(0.0, 1.0)
+        };
         let x = 4.0 * xi1;
         let q = (x.floor() as u32).min(3);
         let t = x - f64::from(q);
@@ -309,7 +348,11 @@ impl AshikhminShirley {
         let kh = k1.dot(h);
         let k2 = (2.0 * kh * h - k1).normalize_or_zero();
         // Eq. 20 at the sampled h (equal to `self.pdf(k1, k2)`, which re-derives h from k2).
-        let pdf = if kh.abs() > 0.0 { self.pdf_h(h) / (4.0 * kh.abs()) } else { 0.0 };
+        let pdf = if kh.abs() > 0.0 {
+            self.pdf_h(h) / (4.0 * kh.abs())
+        } else {
+            0.0
+        };
         if pdf > 0.0 && pdf.is_finite() {
             Some((k2, pdf))
         } else {
@@ -354,7 +397,10 @@ impl AshikhminShirley {
     /// evaluations.
     #[must_use]
     pub fn albedo_quadrature_parts(&self, k1: DVec3, res: usize) -> (f64, f64, f64) {
-        let (s, d) = self.albedo_quadrature_with(k1, res, &mut |k2| self.specular(k1, k2), &mut |k2| self.diffuse(k1, k2));
+        let (s, d) =
+            self.albedo_quadrature_with(k1, res, &mut |k2| self.specular(k1, k2), &mut |k2| {
+                self.diffuse(k1, k2)
+            });
         (s + d, s, d)
     }
 
@@ -383,7 +429,8 @@ impl AshikhminShirley {
                 let y0 = j as f64 * cell2;
                 for (gx, wx) in GL4 {
                     for (gy, wy) in GL4 {
-                        if let Some((k2, pdf)) = self.sample(k1, [x0 + gx * cell, y0 + gy * cell2]) {
+                        if let Some((k2, pdf)) = self.sample(k1, [x0 + gx * cell, y0 + gy * cell2])
+                        {
                             col += wx * wy * spec(k2) * k2.z / pdf;
                         }
                     }

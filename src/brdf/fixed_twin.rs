@@ -5,7 +5,9 @@
 use super::ashikhmin_shirley::{AshikhminShirley, Dots};
 use crate::error::{Error, Result};
 use glam::DVec3;
-use hw_model::aniso_phong::{aniso_phong, AnisoPhongConfig, AnisoPhongInputs, AnisoPhongOut, PseudoFloat};
+use hw_model::aniso_phong::{
+    aniso_phong, AnisoPhongConfig, AnisoPhongInputs, AnisoPhongOut, PseudoFloat,
+};
 use hw_model::SatCounter;
 use std::f64::consts::PI;
 
@@ -32,7 +34,10 @@ pub fn check_params(p: &AshikhminShirley, cfg: &AnisoPhongConfig) -> Result<()> 
     let emax = ((1u64 << cfg.exponent_max_bits) - 1) as f64;
     for (name, v) in [("nu", p.nu), ("nv", p.nv)] {
         if !(v >= 0.0 && v <= emax && v.fract() == 0.0) {
-            return Err(Error::field(name, format!("{v} is not an integer in 0..={emax} (exponent_max_bits)")));
+            return Err(Error::field(
+                name,
+                format!("{v} is not an integer in 0..={emax} (exponent_max_bits)"),
+            ));
         }
     }
     for (name, v) in [("rs", p.rs), ("rd", p.rd)] {
@@ -71,7 +76,12 @@ pub fn quantize(p: &AshikhminShirley, d: &Dots, cfg: &AnisoPhongConfig) -> Aniso
 pub fn dequantize(inp: &AnisoPhongInputs, cfg: &AnisoPhongConfig) -> (AshikhminShirley, Dots) {
     let s = 1.0 / (1u64 << cfg.aniso_dot_frac_bits) as f64;
     let f = 1.0 / (1u64 << cfg.fresnel_bits) as f64;
-    let p = AshikhminShirley { nu: f64::from(inp.nu), nv: f64::from(inp.nv), rs: f64::from(inp.rs) * f, rd: f64::from(inp.rd) * f };
+    let p = AshikhminShirley {
+        nu: f64::from(inp.nu),
+        nv: f64::from(inp.nv),
+        rs: f64::from(inp.rs) * f,
+        rd: f64::from(inp.rd) * f,
+    };
     let d = Dots {
         hn: f64::from(inp.hn) * s,
         hu: f64::from(inp.hu) * s,
@@ -94,7 +104,13 @@ pub fn twin_pi_rho(inp: &AnisoPhongInputs, cfg: &AnisoPhongConfig) -> (f64, f64)
 /// The fixed unit's BRDF parts `(rho_s, rho_d)` (not times pi) for a direction pair; zeros
 /// below the horizon or for `k1 = -k2`.
 #[must_use]
-pub fn eval_fixed_parts(p: &AshikhminShirley, k1: DVec3, k2: DVec3, cfg: &AnisoPhongConfig, sat: &mut SatCounter) -> (f64, f64) {
+pub fn eval_fixed_parts(
+    p: &AshikhminShirley,
+    k1: DVec3,
+    k2: DVec3,
+    cfg: &AnisoPhongConfig,
+    sat: &mut SatCounter,
+) -> (f64, f64) {
     match Dots::from_dirs(k1, k2) {
         Some(d) => {
             let out: AnisoPhongOut = aniso_phong(&quantize(p, &d, cfg), cfg, sat);
@@ -106,7 +122,13 @@ pub fn eval_fixed_parts(p: &AshikhminShirley, k1: DVec3, k2: DVec3, cfg: &AnisoP
 
 /// The fixed unit's total BRDF `rho(k1, k2)` (rounded sum of its parts, not times pi).
 #[must_use]
-pub fn eval_fixed(p: &AshikhminShirley, k1: DVec3, k2: DVec3, cfg: &AnisoPhongConfig, sat: &mut SatCounter) -> f64 {
+pub fn eval_fixed(
+    p: &AshikhminShirley,
+    k1: DVec3,
+    k2: DVec3,
+    cfg: &AnisoPhongConfig,
+    sat: &mut SatCounter,
+) -> f64 {
     match Dots::from_dirs(k1, k2) {
         Some(d) => pf_to_f64(aniso_phong(&quantize(p, &d, cfg), cfg, sat).total) / PI,
         None => 0.0,
@@ -115,7 +137,13 @@ pub fn eval_fixed(p: &AshikhminShirley, k1: DVec3, k2: DVec3, cfg: &AnisoPhongCo
 
 /// Directional albedo `(total, specular, diffuse)` of the fixed unit by the quadrature of
 /// [`AshikhminShirley::albedo_quadrature_with`].
-pub fn albedo_fixed(p: &AshikhminShirley, k1: DVec3, res: usize, cfg: &AnisoPhongConfig, sat: &mut SatCounter) -> Result<(f64, f64, f64)> {
+pub fn albedo_fixed(
+    p: &AshikhminShirley,
+    k1: DVec3,
+    res: usize,
+    cfg: &AnisoPhongConfig,
+    sat: &mut SatCounter,
+) -> Result<(f64, f64, f64)> {
     check_params(p, cfg)?;
     let mut sat_d = SatCounter::default();
     let (s, d) = p.albedo_quadrature_with(

@@ -68,7 +68,18 @@ pub fn chi2_merged(pairs: &[(f64, f64)], min_expected: f64) -> (f64, usize) {
             None => groups.push((o, e)),
         }
     }
-    let stat = groups.iter().map(|&(o, e)| if e > 0.0 { (o - e) * (o - e) / e } else if o > 0.0 { f64::INFINITY } else { 0.0 }).sum();
+    let stat = groups
+        .iter()
+        .map(|&(o, e)| {
+            if e > 0.0 {
+                (o - e) * (o - e) / e
+            } else if o > 0.0 {
+                f64::INFINITY
+            } else {
+                0.0
+            }
+        })
+        .sum();
     (stat, groups.len())
 }
 
@@ -156,7 +167,11 @@ pub fn chi2_k2(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64) -> Ch
         }
     }
     let n = samples as f64;
-    let mut pairs: Vec<(f64, f64)> = observed.iter().zip(&expected).map(|(&o, &e)| (o, e * n)).collect();
+    let mut pairs: Vec<(f64, f64)> = observed
+        .iter()
+        .zip(&expected)
+        .map(|(&o, &e)| (o, e * n))
+        .collect();
     // Samples the sampler could not place count against a bin of expectation 0.
     pairs.push((lost, 0.0));
     let (statistic, groups) = chi2_merged(&pairs, 5.0);

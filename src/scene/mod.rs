@@ -71,7 +71,10 @@ pub struct Mesh {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     /// Light travelling along `direction` (towards the scene).
-    Directional { direction: [f32; 3], color: [f32; 3] },
+    Directional {
+        direction: [f32; 3],
+        color: [f32; 3],
+    },
     /// A point light without falloff.
     Point { position: [f32; 3], color: [f32; 3] },
 }
