@@ -325,3 +325,24 @@ fn cost_model() {
         .err()
         .is_some_and(|e| e.field == "aniso_phong.pow_lut_bits"));
 }
+
+/// `albedo_report` with the fixed unit: its last line is the fixed albedo, close to the float
+/// one (the unit's relative error is <= 2e-4, so the albedo differs by < 1e-3 incl. rounding
+/// of the printed value); non-integer exponents are rejected naming the field.
+#[test]
+fn albedo_report_with_fixed_unit() {
+    let cfg = cfg16();
+    let p = AshikhminShirley::new(100.0, 400.0, 0.05, 0.8).expect("valid");
+    let rep = texsim::brdf::albedo_report(&p, 30.0, Some(&cfg)).expect("report");
+    let last: f64 = rep
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .expect("number");
+    let float = p.albedo_quadrature(dir_from_angles(30.0, 0.0), 32);
+    assert!((last - float).abs() < 1e-3, "{rep}");
+    let bad = AshikhminShirley::new(10.5, 400.0, 0.05, 0.8).expect("valid float model");
+    assert!(texsim::brdf::albedo_report(&bad, 30.0, Some(&cfg))
+        .err()
+        .is_some_and(|e| e.message().contains("'nu'")));
+}

@@ -154,14 +154,14 @@ fn half_vector_chi_square() {
         let first = |psi: f64| (a * psi.sin()).atan2(psi.cos());
         let jac = |psi: f64| a / (psi.cos().powi(2) + a * a * psi.sin().powi(2));
         let phi_of = |quad: usize, psi: f64| {
-            if quad % 2 == 0 {
+            if quad & 1 == 0 {
                 0.5 * PI * quad as f64 + first(psi)
             } else {
                 0.5 * PI * (quad + 1) as f64 - first(0.5 * PI - psi)
             }
         };
         let dphi = |quad: usize, psi: f64| {
-            if quad % 2 == 0 {
+            if quad & 1 == 0 {
                 jac(psi)
             } else {
                 jac(0.5 * PI - psi)

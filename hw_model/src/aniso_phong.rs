@@ -43,6 +43,7 @@
 //! `|fixed - ref| <= 2e-4 ref` for `ref >= 1e-15` in units of `pi rho` (measured worst 6.7e-5),
 //! excluding saturated outputs (`>= 2^24`, only at extreme grazing, < 0.1% of those inputs).
 
+use crate::config::ConfigError;
 use crate::cost::UnitCost;
 use crate::fixed::{round_shift_right, round_shift_right_wide, Rounding, SatCounter};
 use serde::{Deserialize, Serialize};
@@ -79,26 +80,9 @@ pub struct AnisoPhongConfig {
     pub aniso_div_bits_per_cycle: u32,
 }
 
-/// A configuration value out of range: the field name and why.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct AnisoConfigError {
-    /// Dotted field path, e.g. `aniso_phong.pow_lut_bits`.
-    pub field: String,
-    /// What is wrong.
-    pub what: String,
-}
-
-impl core::fmt::Display for AnisoConfigError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "hw config field '{}': {}", self.field, self.what)
-    }
-}
-
-impl std::error::Error for AnisoConfigError {}
-
-fn check(field: &str, v: u32, lo: u32, hi: u32) -> Result<(), AnisoConfigError> {
+fn check(field: &str, v: u32, lo: u32, hi: u32) -> Result<(), ConfigError> {
     if v < lo || v > hi {
-        return Err(AnisoConfigError {
+        return Err(ConfigError {
             field: format!("aniso_phong.{field}"),
             what: format!("{v} is out of range {lo}..={hi}"),
         });
@@ -129,7 +113,7 @@ impl AnisoPhongConfig {
     }
 
     /// Checks every width against the range the model supports; the error names the field.
-    pub fn validate(&self) -> Result<(), AnisoConfigError> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         check("aniso_dot_frac_bits", self.aniso_dot_frac_bits, 6, 15)?;
         check("exponent_max_bits", self.exponent_max_bits, 1, 20)?;
         check("aniso_ratio_bits", self.aniso_ratio_bits, 4, 24)?;

@@ -30,7 +30,7 @@ fn to_raw(x: f64, frac: u32, lim: i64) -> i64 {
 /// Checks the model's parameters against the unit's formats (exponents must be integers below
 /// `2^exponent_max_bits`); the error names the field.
 pub fn check_params(p: &AshikhminShirley, cfg: &AnisoPhongConfig) -> Result<()> {
-    cfg.validate().map_err(|e| Error::msg(e.to_string()))?;
+    cfg.validate().map_err(Error::from)?;
     let emax = ((1u64 << cfg.exponent_max_bits) - 1) as f64;
     for (name, v) in [("nu", p.nu), ("nv", p.nv)] {
         if !(v >= 0.0 && v <= emax && v.fract() == 0.0) {
