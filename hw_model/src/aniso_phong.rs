@@ -571,8 +571,8 @@ pub fn aniso_phong(
     } else {
         // One guard bit, then round to nearest (ties up): |E error| <= 2^-(r+1).
         let num = (u128::from(nu) * u128::from(a) + u128::from(nv) * u128::from(b)) << (r + 1);
-        let q = restoring_div(num, u128::from(s), cfg.exponent_max_bits + r + 2) as u64;
-        (q >> 1) + (q & 1)
+        let q = restoring_div(num, u128::from(s), cfg.exponent_max_bits + r + 2) as i64;
+        round_shift_right(q, 1, Rounding::HalfUp) as u64
     };
     let p = power(s, e_raw, cfg);
 
@@ -609,6 +609,7 @@ pub fn aniso_phong(
 
     // Diffuse, eq. 16 times pi: 28/23 Rd (1 - Rs) D(n.k1) D(n.k2), pseudo-floats of fb bits.
     let k = PseudoFloat {
+        // 28/23 rounded to nearest: a hard-wired constant, not a datapath rounding.
         mant: ((28u64 << fb) + 11) / 23,
         exp: -(fb as i32),
     };
@@ -660,11 +661,12 @@ fn div_cycles(qbits: u32, cfg: &AnisoPhongConfig) -> u32 {
 /// Excludes the per-material square root ([`aniso_phong_material_cost`]).
 #[must_use]
 pub fn aniso_phong_cost(cfg: &AnisoPhongConfig) -> UnitCost {
-    // Multiplies: hu^2, hv^2, nu a, nv b; s g; E L; 2 interpolations; Fresnel 3 + 1;
-    // k.h max; 3 specular chain; diffuse 2 x 3 + 4; spec + diffuse add counted as an op.
-    let muls = 4 + 1 + 1 + 2 + 4 + 1 + 3 + 6 + 4;
+    // Multiplies: exponent 4 (hu^2, hv^2, nu a, nv b); power 4 (two ROM interpolations, s g,
+    // E L); Fresnel 4; k.h max 1; specular chain 3; diffuse 2 x 5 (Horner + x q) + 4 (chain).
+    let muls = 4 + 4 + 4 + 1 + 3 + 10 + 4;
     let luts = 4; // two entries for each of the log ROM and the exp2 ROM
-    let adds = 10;
+                  // Adds/compares: exponent 2, power 2, Fresnel 2, max 1, diffuse Horner 8 + (1 - Rs) 1, sum 1.
+    let adds = 17;
     let e_div = cfg.exponent_max_bits + cfg.aniso_ratio_bits + 1;
     let r_div = cfg.aniso_recip_bits + 2;
     UnitCost {

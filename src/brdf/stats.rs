@@ -4,7 +4,7 @@
 //!
 //! Bins cover the whole sphere of `k2` in a frame centred on the mirror direction `r` of `k1`:
 //! `24` bins in `t` where `1 - cos(angle to r) = 2 (e^(lambda t) - 1)/(e^lambda - 1)` (fine near
-//! the lobe, `lambda` from the mean exponent) times `16` bins of the azimuth around `r`. The
+//! the lobe, `lambda = ln(1 + 2 sqrt((nu+1)(nv+1)))`) times `16` bins of the azimuth around `r`. The
 //! expected probability of a bin is the integral of [`AshikhminShirley::pdf`] over it, by 8x8
 //! sub-cells of 4x4 Gauss-Legendre nodes. Bins expecting fewer than 5 samples are merged in
 //! index order. The binning resolves lobes whose anisotropy ratio `max/min` of `(n+1)` is up
