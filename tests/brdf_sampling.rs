@@ -66,8 +66,8 @@ const CASES: [(f64, f64); 9] = [
 
 /// Eq. 5 integrates to 1 over the hemisphere: integral of p_h sin(theta) dtheta dphi by
 /// composite Gauss-Legendre (geometric cells in theta, 2048 cells in phi so that the lobe of the
-/// (1, 10000) case, ~0.01 rad wide in phi, spans many nodes). Tolerance 1e-4: the quadrature's
-/// own error (the deviations are printed; a wrong normalization would be O(1)).
+/// (1, 10000) case, ~0.01 rad wide in phi, spans many nodes). Tolerance 1e-5: the quadrature's
+/// own error (measured <= 3.4e-7, in the (1, 10000) case; a wrong normalization is O(1)).
 #[test]
 fn half_vector_pdf_integrates_to_one() {
     let th = geometric_edges(PI / 2.0);
@@ -80,16 +80,17 @@ fn half_vector_pdf_integrates_to_one() {
             })
         });
         println!("p_h integral nu {nu} nv {nv}: 1 {:+.2e}", total - 1.0);
-        assert!((total - 1.0).abs() < 1e-4, "nu {nu} nv {nv}: {total}");
+        assert!((total - 1.0).abs() < 1e-5, "nu {nu} nv {nv}: {total}");
     }
 }
 
 /// Eq. 20 integrates to 1 over the whole sphere of k2 (the part below the horizon is the
 /// sampler's rejected mass): integral in a frame centred on the mirror direction, geometric
-/// cells in the angle from it, 1024 azimuth cells. Tolerance 2e-3: the density has an
+/// cells in the angle from it, 512 azimuth cells. Tolerance 2e-3: the density has an
 /// integrable 1/|k2 + k1| singularity at k2 = -k1 (half vectors orthogonal to k1) that the
 /// product rule resolves only to ~1e-3 when p_h is still large there (low exponents, oblique
-/// k1); errors of the model (a wrong Jacobian factor) would be O(1).
+/// k1); errors of the model (a wrong Jacobian factor) would be O(1). For exponents >= 100 the
+/// singularity carries no mass and the bound is 1e-6 (measured <= 2e-8).
 #[test]
 fn direction_pdf_integrates_to_one_over_sphere() {
     let al = geometric_edges(PI);
@@ -129,7 +130,7 @@ fn direction_pdf_integrates_to_one_over_sphere() {
                 total - 1.0
             );
             assert!(
-                (total - 1.0).abs() < 2e-3,
+                (total - 1.0).abs() < if nu >= 100.0 { 1e-6 } else { 2e-3 },
                 "nu {nu} nv {nv} theta {theta}: {total}"
             );
         }
