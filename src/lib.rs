@@ -7,6 +7,7 @@
 //! Frame flow: scene -> geometry (float) -> raster (fixed setup + scanline traversal into a
 //! visibility buffer) -> per-pixel planned stages (each Fixed or Float) -> images + metrics.
 
+pub mod brdf;
 pub mod cli;
 pub mod error;
 pub mod fixedpoint;

@@ -7,6 +7,7 @@
 //! (`clippy::float_arithmetic` is denied); conversions to and from float live in `texsim`.
 #![deny(clippy::float_arithmetic)]
 
+pub mod aniso_phong;
 pub mod blinn_phong;
 pub mod config;
 pub mod cost;

@@ -1,0 +1,229 @@
+//! Property tests of the Ashikhmin-Shirley reference (eqs. 10-22): reciprocity, finiteness and
+//! non-negativity over random and boundary inputs, agreement of the dot-product form with the
+//! vector form, the eq. 16 constant, the h -> n limit, and the report functions.
+
+use glam::DVec3;
+use std::f64::consts::PI;
+use texsim::brdf::{
+    albedo_report, dir_from_angles, eval_report, sample_report, AshikhminShirley, Dots,
+};
+
+struct Rng(u64);
+impl Rng {
+    fn u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn f(&mut self) -> f64 {
+        (self.u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform direction on the sphere.
+    fn dir(&mut self) -> DVec3 {
+        let z = 2.0 * self.f() - 1.0;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (s, c) = (2.0 * PI * self.f()).sin_cos();
+        DVec3::new(r * c, r * s, z)
+    }
+    /// Upper-hemisphere direction, often near the boundary cases.
+    fn upper(&mut self) -> DVec3 {
+        match self.u64() % 6 {
+            0 => DVec3::Z,
+            1 => dir_from_angles(90.0 - 1e-9 * self.f(), 360.0 * self.f()),
+            2 => dir_from_angles(89.0 + self.f(), 360.0 * self.f()),
+            3 => dir_from_angles(1e-7 * self.f(), 360.0 * self.f()),
+            _ => {
+                let d = self.dir();
+                DVec3::new(d.x, d.y, d.z.abs())
+            }
+        }
+    }
+    fn exponent(&mut self) -> f64 {
+        const E: [f64; 10] = [0.0, 1e-3, 0.5, 1.0, 10.0, 100.0, 1000.0, 1e4, 1e5, 1e6];
+        if self.u64() & 1 == 0 {
+            E[(self.u64() % 10) as usize]
+        } else {
+            10f64.powf(6.0 * self.f())
+        }
+    }
+    fn model(&mut self) -> AshikhminShirley {
+        let pick = |r: &mut Rng| match r.u64() % 4 {
+            0 => 0.0,
+            1 => 1.0,
+            _ => r.f(),
+        };
+        let (nu, nv) = (self.exponent(), self.exponent());
+        let (rs, rd) = (pick(self), pick(self));
+        AshikhminShirley::new(nu, nv, rs, rd).expect("valid parameters")
+    }
+}
+
+/// Reciprocity eval(k1,k2) == eval(k2,k1). Eq. 10 and 16 are symmetric by construction (F uses
+/// k.h, and k1.h = k2.h); the only asymmetry is f64 rounding in forming h and k.h, so the bound
+/// is relative 1e-9 (values can be up to ~1e17 at the denominator floor).
+#[test]
+fn reciprocity() {
+    let mut r = Rng(1);
+    for _ in 0..200_000 {
+        let p = r.model();
+        let (k1, k2) = (r.upper(), r.upper());
+        let (a, b) = (p.eval(k1, k2), p.eval(k2, k1));
+        assert!(
+            (a - b).abs() <= 1e-9 * a.abs().max(b.abs()) + 1e-300,
+            "{p:?} {k1} {k2}: {a} vs {b}"
+        );
+    }
+}
+
+/// Finite, non-negative, never NaN: eval, pdf, pdf_h, sample and sample_h over random and boundary
+/// inputs including directions below the horizon, k1 = -k2, h = n, exponents 0 and 1e6.
+#[test]
+fn finite_and_non_negative_everywhere() {
+    let mut r = Rng(2);
+    for i in 0..300_000 {
+        let p = r.model();
+        let k1 = if i % 3 == 0 { r.dir() } else { r.upper() };
+        let k2 = match i % 5 {
+            0 => -k1,
+            1 => DVec3::new(-k1.x, -k1.y, k1.z),
+            2 => r.dir(),
+            _ => r.upper(),
+        };
+        for v in [
+            p.eval(k1, k2),
+            p.specular(k1, k2),
+            p.diffuse(k1, k2),
+            p.pdf(k1, k2),
+            p.pdf_mixture(k1, k2),
+        ] {
+            assert!(v.is_finite() && v >= 0.0, "{p:?} {k1} {k2}: {v}");
+        }
+        let xi = [r.f(), r.f()];
+        let xi = match i % 7 {
+            0 => [0.0, 0.0],
+            1 => [1.0, 1.0],
+            2 => [0.25, 1.0 - 1e-16],
+            _ => xi,
+        };
+        let h = p.sample_h(xi[0], xi[1]);
+        assert!(
+            h.is_finite() && (h.length() - 1.0).abs() < 1e-12 && h.z >= 0.0,
+            "{p:?} {xi:?} {h}"
+        );
+        assert!(p.pdf_h(h).is_finite());
+        if let Some((k, pdf)) = p.sample(k1, xi) {
+            assert!(
+                k.z > 0.0 && pdf.is_finite() && pdf > 0.0,
+                "{p:?} {k1} {k} {pdf}"
+            );
+        }
+    }
+    let p = AshikhminShirley::new(0.0, 0.0, 0.0, 1.0).expect("valid");
+    assert_eq!(p.eval(DVec3::Z, -DVec3::Z), 0.0, "k1 = -k2");
+    let g = dir_from_angles(90.0, 0.0);
+    assert_eq!(p.eval(g, g), 0.0, "exactly grazing gives 0");
+    assert!(p
+        .eval(
+            dir_from_angles(90.0 - 1e-14, 0.0),
+            dir_from_angles(90.0 - 1e-14, 180.0 - 1e-9)
+        )
+        .is_finite());
+}
+
+/// The dot-product form (the fixed unit's twin) equals the vector form.
+#[test]
+fn eval_from_dots_matches_eval() {
+    let mut r = Rng(3);
+    for _ in 0..100_000 {
+        let p = r.model();
+        let (k1, k2) = (r.upper(), r.upper());
+        let v = p.eval(k1, k2);
+        let w = Dots::from_dirs(k1, k2).map_or(0.0, |d| {
+            let (s, df) = p.eval_from_dots(&d);
+            s + df
+        });
+        assert!((v - w).abs() <= 1e-12 * v, "{v} {w}"); // same formula, same rounding
+    }
+}
+
+/// At h = n the exponent is 0/0; the limit along any path is a weighted average of nu and nv
+/// and the power is exactly 1: the specular value is continuous there.
+#[test]
+fn h_equals_n_limit() {
+    let p = AshikhminShirley::new(10.0, 1000.0, 1.0, 0.0).expect("valid");
+    let at = p.eval(DVec3::Z, DVec3::Z);
+    // rho_s(n, n) = sqrt(11 * 1001)/(8 pi) * 1 * F(1) / (1 * 1), F(1) = Rs = 1.
+    let expect = (11.0f64 * 1001.0).sqrt() / (8.0 * PI);
+    assert!((at - expect).abs() < 1e-12 * expect, "{at} {expect}");
+    for phi in [0.0, 30.0, 90.0, 200.0] {
+        let k = dir_from_angles(1e-6, phi);
+        let near = p.eval(k, k);
+        assert!((near - at).abs() < 1e-6 * at, "phi {phi}: {near} vs {at}");
+        let e = p.exponent(k.x, k.y);
+        assert!((10.0..=1000.0).contains(&e));
+    }
+}
+
+/// Eq. 11 endpoints and eq. 16's constant: with the diffuse term alone, the cosine-weighted
+/// integral of eq. 16 over k2 is Rd (1-Rs)(1-(1-n.k1/2)^5) because integral mu(1-(1-mu/2)^5)
+/// over [0,1] is 23/56 (checked here by a 2000-point midpoint rule, error < 1e-6).
+#[test]
+fn fresnel_and_diffuse_constant() {
+    let p = AshikhminShirley::new(5.0, 5.0, 0.04, 1.0).expect("valid");
+    assert!((p.fresnel_schlick(1.0) - 0.04).abs() < 1e-15);
+    assert!((p.fresnel_schlick(0.0) - 1.0).abs() < 1e-15);
+    assert!((p.fresnel_schlick(-3.0) - 1.0).abs() < 1e-15);
+    let n = 2000;
+    let integral: f64 = (0..n)
+        .map(|i| {
+            let mu = (i as f64 + 0.5) / n as f64;
+            mu * (1.0 - (1.0 - mu / 2.0).powi(5)) / n as f64
+        })
+        .sum();
+    assert!((integral - 23.0 / 56.0).abs() < 1e-6, "{integral}");
+    let k1 = dir_from_angles(40.0, 0.0);
+    let (_, _, d) = p.albedo_quadrature_parts(k1, 4);
+    let closed = 0.96 * (1.0 - (1.0 - k1.z / 2.0).powi(5));
+    assert!((d - closed).abs() < 1e-12, "{d} {closed}");
+}
+
+/// Parameter validation names the field; reports validate and end with the number.
+#[test]
+fn validation_and_reports() {
+    assert!(AshikhminShirley::new(-1.0, 1.0, 0.0, 0.0)
+        .err()
+        .is_some_and(|e| e.message().contains("'nu'")));
+    assert!(AshikhminShirley::new(1.0, f64::NAN, 0.0, 0.0)
+        .err()
+        .is_some_and(|e| e.message().contains("'nv'")));
+    assert!(AshikhminShirley::new(1.0, 1.0, 1.5, 0.0)
+        .err()
+        .is_some_and(|e| e.message().contains("'rs'")));
+    let p = AshikhminShirley::new(100.0, 100.0, 1.0, 0.0).expect("valid");
+    let rep = albedo_report(&p, 0.0, None).expect("report");
+    let last: f64 = rep
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .expect("number on last line");
+    assert!(
+        (last - p.albedo_quadrature(DVec3::Z, 32)).abs() < 1e-6,
+        "{rep}"
+    );
+    assert!(albedo_report(&p, 90.0, None).is_err());
+    assert!(albedo_report(&p, f64::NAN, None).is_err());
+    let e = eval_report(&p, DVec3::Z, dir_from_angles(10.0, 0.0)).expect("report");
+    let last: f64 = e
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .expect("number");
+    assert!((last - p.eval(DVec3::Z, dir_from_angles(10.0, 0.0))).abs() < 1e-5 * last);
+    assert!(eval_report(&p, DVec3::ZERO, DVec3::Z).is_err());
+    let s = sample_report(&p, dir_from_angles(30.0, 0.0), 20_000, 5).expect("report");
+    assert!(s.lines().last().is_some_and(|l| l.ends_with("pass")), "{s}");
+    assert!(sample_report(&p, -DVec3::Z, 20_000, 5).is_err());
+    assert!(sample_report(&p, DVec3::Z, 10, 5).is_err());
+}
