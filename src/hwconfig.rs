@@ -47,6 +47,7 @@ pub fn parse(text: &str) -> Result<HwConfig> {
             ),
         )
     })?;
+    let given_name = table.get("name").cloned();
     let mut merged = to_table(&base);
     merge(&mut merged, table, "")?;
     if !merged.contains_key("name")

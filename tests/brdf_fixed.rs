@@ -158,19 +158,19 @@ fn texram16_matches_twin() {
     assert!(st.saturated < (1 << 21) / 1000, "{}", st.saturated);
 }
 
-/// Precision sweep (printed): datapath error vs pow_lut_bits and pow_frac_bits, and the
+/// Precision sweep (printed): datapath error vs aniso_pow_lut_bits and aniso_pow_frac_bits, and the
 /// end-to-end error vs the dot-product width. Asserts the sweep has power: a 4-bit ROM is
 /// measurably worse than the 8-bit one, and 6 dot bits are worse end-to-end than 14.
 #[test]
 fn precision_sweep() {
     let n = 1 << 15;
-    println!("pow_lut_bits pow_frac_bits | max rel err vs twin");
+    println!("aniso_pow_lut_bits aniso_pow_frac_bits | max rel err vs twin");
     let mut by_lut = Vec::new();
     for lut in [4u32, 6, 8, 10, 12] {
         for frac in [16u32, 20, 24, 28] {
             let mut cfg = AnisoPhongConfig::texram16();
-            cfg.pow_lut_bits = lut;
-            cfg.pow_frac_bits = frac;
+            cfg.aniso_pow_lut_bits = lut;
+            cfg.aniso_pow_frac_bits = frac;
             assert!(cfg.validate().is_ok());
             let st = run(&cfg, n, 7);
             println!("{lut:>12} {frac:>13} | {:.3e}", st.max_rel);
@@ -319,11 +319,11 @@ fn cost_model() {
     slow.aniso_div_bits_per_cycle = 1;
     assert!(aniso_phong_cost(&slow).cycles > c.cycles);
     let mut bad = cfg16();
-    bad.pow_lut_bits = 40;
+    bad.aniso_pow_lut_bits = 40;
     assert!(bad
         .validate()
         .err()
-        .is_some_and(|e| e.field == "aniso_phong.pow_lut_bits"));
+        .is_some_and(|e| e.field == "aniso_phong.aniso_pow_lut_bits"));
 }
 
 /// `albedo_report` with the fixed unit: its last line is the fixed albedo, close to the float

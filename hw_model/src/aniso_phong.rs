@@ -13,12 +13,12 @@
 //!    fraction bits plus a guard bit, rounded to nearest (a weighted average of nu, nv, so it
 //!    never overflows). `h.n` itself is only checked for `> 0`.
 //! 3. Power `(n.h)^E = (1 - s)^(E/2) = 2^-X` with `X = E L / 2`, `L = -log2(1 - s)`:
-//!    for `s < 1/2`, `L = s g(s)` with `g(s) = -log2(1-s)/s` from a `2^pow_lut_bits + 1` entry
+//!    for `s < 1/2`, `L = s g(s)` with `g(s) = -log2(1-s)/s` from a `2^aniso_pow_lut_bits + 1` entry
 //!    ROM with linear interpolation (keeps relative precision as `s -> 0`); for `s >= 1/2`,
 //!    `L = k - log2(m)` after normalizing `1 - s = 2^-k m` with a log2 ROM on `m in [1, 2)`.
-//!    `X` is rounded to `pow_frac_bits`, then `2^-X = 2^-floor(X) 2^-frac(X)` with an exp2 ROM
+//!    `X` is rounded to `aniso_pow_frac_bits`, then `2^-X = 2^-floor(X) 2^-frac(X)` with an exp2 ROM
 //!    (pseudo-float, so the tail keeps relative precision; `X >= 100` flushes to 0).
-//!    ROM entries are `pow_frac_bits`-bit roundings of values computed here in integer
+//!    ROM entries are `aniso_pow_frac_bits`-bit roundings of values computed here in integer
 //!    arithmetic to ~2^-55 (the ROM contents are a pure function of the index).
 //! 4. Schlick Fresnel `Rs + (1 - Rs)(1 - k.h)^5` (eq. 11): `1 - k.h` exact, three multiplies, a
 //!    multiply and an add, each rounded to a `fresnel_bits` mantissa (pseudo-float: `F` keeps
@@ -26,7 +26,7 @@
 //! 5. `1 / ((k.h) max(n.k1, n.k2))`: the exact `2D`-bit product is normalized and its mantissa
 //!    inverted by a restoring divider to `aniso_recip_bits` bits (pseudo-float).
 //! 6. Specular `sqrt((nu+1)(nv+1))/8 * P * F / den`, a chain of pseudo-float multiplies with
-//!    `pow_frac_bits`-bit mantissas (the square root is an exact integer square root, a
+//!    `aniso_pow_frac_bits`-bit mantissas (the square root is an exact integer square root, a
 //!    per-material constant: see [`aniso_phong_material_cost`]).
 //! 7. Diffuse `28/23 Rd (1 - Rs) D(n.k1) D(n.k2)` (eq. 16 times pi) with
 //!    `D(c) = 1 - (1 - c/2)^5` expanded as `x (5 - 10x + 10x^2 - 5x^3 + x^4)`, `x = c/2`
@@ -59,9 +59,9 @@ pub struct AnisoPhongConfig {
     /// Fraction bits of the exponent `E` produced by the divider.
     pub aniso_ratio_bits: u32,
     /// Index bits of the log2 / g / exp2 ROMs (each has `2^bits + 1` entries).
-    pub pow_lut_bits: u32,
+    pub aniso_pow_lut_bits: u32,
     /// Fraction bits of ROM entries, of `X`, and of the internal pseudo-float mantissas.
-    pub pow_frac_bits: u32,
+    pub aniso_pow_frac_bits: u32,
     /// Fraction bits of Fresnel, the diffuse polynomial and `Rs`, `Rd`.
     pub fresnel_bits: u32,
     /// Mantissa bits of the reciprocal of `(k.h) max(n.k1, n.k2)`.
@@ -99,8 +99,8 @@ impl AnisoPhongConfig {
             aniso_dot_frac_bits: 14,
             exponent_max_bits: 17,
             aniso_ratio_bits: 16,
-            pow_lut_bits: 8,
-            pow_frac_bits: 24,
+            aniso_pow_lut_bits: 8,
+            aniso_pow_frac_bits: 24,
             fresnel_bits: 16,
             aniso_recip_bits: 20,
             aniso_out_mant_bits: 16,
@@ -118,15 +118,15 @@ impl AnisoPhongConfig {
         check("exponent_max_bits", self.exponent_max_bits, 1, 20)?;
         check("aniso_ratio_bits", self.aniso_ratio_bits, 4, 24)?;
         check(
-            "pow_lut_bits",
-            self.pow_lut_bits,
+            "aniso_pow_lut_bits",
+            self.aniso_pow_lut_bits,
             2,
             (2 * self.aniso_dot_frac_bits - 1).min(16),
         )?;
         check(
-            "pow_frac_bits",
-            self.pow_frac_bits,
-            self.pow_lut_bits.max(8),
+            "aniso_pow_frac_bits",
+            self.aniso_pow_frac_bits,
+            self.aniso_pow_lut_bits.max(8),
             30,
         )?;
         check("fresnel_bits", self.fresnel_bits, 4, 24)?;
@@ -333,8 +333,8 @@ fn q62_to(v: u128, f: u32, rnd: Rounding) -> i64 {
 /// ROM `g(s) = -log2(1 - s) / s` at `s = i / 2^(lut_bits + 1)`, `i in 0..=2^lut_bits`.
 #[must_use]
 pub fn rom_g(i: u32, cfg: &AnisoPhongConfig) -> i64 {
-    let b = cfg.pow_lut_bits;
-    let f = cfg.pow_frac_bits;
+    let b = cfg.aniso_pow_lut_bits;
+    let f = cfg.aniso_pow_frac_bits;
     if i == 0 {
         return q62_to(LOG2E_Q62, f, cfg.aniso_rounding);
     }
@@ -349,18 +349,18 @@ pub fn rom_g(i: u32, cfg: &AnisoPhongConfig) -> i64 {
 /// ROM `log2(1 + i / 2^lut_bits)`, `i in 0..=2^lut_bits`.
 #[must_use]
 pub fn rom_log2(i: u32, cfg: &AnisoPhongConfig) -> i64 {
-    let b = cfg.pow_lut_bits;
+    let b = cfg.aniso_pow_lut_bits;
     if i >= 1u32 << b {
-        return 1i64 << cfg.pow_frac_bits;
+        return 1i64 << cfg.aniso_pow_frac_bits;
     }
     let m = u128::from((1u32 << b) + i) << (Q - b);
-    q62_to(log2_q62(m), cfg.pow_frac_bits, cfg.aniso_rounding)
+    q62_to(log2_q62(m), cfg.aniso_pow_frac_bits, cfg.aniso_rounding)
 }
 
 /// ROM `2^(-i / 2^lut_bits)`, `i in 0..=2^lut_bits`, by the Taylor series of `e^-x`.
 #[must_use]
 pub fn rom_exp2(i: u32, cfg: &AnisoPhongConfig) -> i64 {
-    let b = cfg.pow_lut_bits;
+    let b = cfg.aniso_pow_lut_bits;
     let x = (LN2_Q62 * u128::from(i)) >> b;
     let one = 1i128 << Q;
     let (mut term, mut sum) = (one, one);
@@ -368,7 +368,11 @@ pub fn rom_exp2(i: u32, cfg: &AnisoPhongConfig) -> i64 {
         term = -((term * x as i128) >> Q) / k;
         sum += term;
     }
-    q62_to(sum.max(0) as u128, cfg.pow_frac_bits, cfg.aniso_rounding)
+    q62_to(
+        sum.max(0) as u128,
+        cfg.aniso_pow_frac_bits,
+        cfg.aniso_rounding,
+    )
 }
 
 /// Linear interpolation between two ROM entries with a `fb`-bit fraction.
@@ -381,9 +385,9 @@ fn interp(a: i64, b: i64, frac: i64, fb: u32, rnd: Rounding) -> i64 {
 /// `aniso_ratio_bits` fraction bits.
 #[must_use]
 fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
-    let f = cfg.pow_frac_bits;
+    let f = cfg.aniso_pow_frac_bits;
     let rnd = cfg.aniso_rounding;
-    let b = cfg.pow_lut_bits;
+    let b = cfg.aniso_pow_lut_bits;
     let sb = 2 * cfg.aniso_dot_frac_bits;
     let one_pf = PseudoFloat {
         mant: 1u64 << f,
@@ -499,11 +503,11 @@ fn diffuse_factor(nk: i64, d: u32, fb: u32, rnd: Rounding) -> PseudoFloat {
     )
 }
 
-/// Per-material constant `sqrt((nu+1)(nv+1))` with `pow_frac_bits` fraction bits (exact floor).
+/// Per-material constant `sqrt((nu+1)(nv+1))` with `aniso_pow_frac_bits` fraction bits (exact floor).
 #[must_use]
 pub fn norm_sqrt(nu: u32, nv: u32, cfg: &AnisoPhongConfig) -> u64 {
     let p = (u128::from(nu) + 1) * (u128::from(nv) + 1);
-    isqrt(p << (2 * cfg.pow_frac_bits)) as u64
+    isqrt(p << (2 * cfg.aniso_pow_frac_bits)) as u64
 }
 
 /// Clamps a dot product to `[-1, 1]` (`2^D`), counting saturation.
@@ -526,7 +530,7 @@ pub fn aniso_phong(
     sat: &mut SatCounter,
 ) -> AnisoPhongOut {
     let d = cfg.aniso_dot_frac_bits;
-    let f = cfg.pow_frac_bits;
+    let f = cfg.aniso_pow_frac_bits;
     let fb = cfg.fresnel_bits;
     let rnd = cfg.aniso_rounding;
     let hn = clamp_dot(inp.hn, d, sat);
@@ -683,7 +687,7 @@ pub fn aniso_phong_cost(cfg: &AnisoPhongConfig) -> UnitCost {
 /// per divider step.
 #[must_use]
 pub fn aniso_phong_material_cost(cfg: &AnisoPhongConfig) -> UnitCost {
-    let bits = cfg.exponent_max_bits + 1 + cfg.pow_frac_bits;
+    let bits = cfg.exponent_max_bits + 1 + cfg.aniso_pow_frac_bits;
     UnitCost {
         ops: bits,
         cycles: div_cycles(bits, cfg),
@@ -731,13 +735,13 @@ mod tests {
     #[test]
     fn rom_endpoints() {
         let cfg = AnisoPhongConfig::texram16();
-        let one = 1i64 << cfg.pow_frac_bits;
+        let one = 1i64 << cfg.aniso_pow_frac_bits;
         assert_eq!(rom_log2(0, &cfg), 0);
-        assert_eq!(rom_log2(1 << cfg.pow_lut_bits, &cfg), one);
+        assert_eq!(rom_log2(1 << cfg.aniso_pow_lut_bits, &cfg), one);
         assert_eq!(rom_exp2(0, &cfg), one);
-        assert!((rom_exp2(1 << cfg.pow_lut_bits, &cfg) - one / 2).abs() <= 1);
+        assert!((rom_exp2(1 << cfg.aniso_pow_lut_bits, &cfg) - one / 2).abs() <= 1);
         // g(1/2) = -log2(1/2) / (1/2) = 2.
-        assert!((rom_g(1 << cfg.pow_lut_bits, &cfg) - 2 * one).abs() <= 1);
+        assert!((rom_g(1 << cfg.aniso_pow_lut_bits, &cfg) - 2 * one).abs() <= 1);
         assert!(cfg.validate().is_ok());
     }
 }

@@ -5,7 +5,10 @@
 //! (`weight_bits`, `recip_iterations`, ...) so that `texsim sweep --vary NAME=...` can address it
 //! without a path. Widths are validated by [`HwConfig::validate`], which names the field at fault.
 
+use crate::aniso_phong::AnisoPhongConfig;
+use crate::blinn_phong::ShadingConfig;
 use crate::fixed::Rounding;
+use crate::timing_config::TimingConfig;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -143,6 +146,12 @@ pub struct HwConfig {
     pub lod: LodConfig,
     pub trilinear: TrilinearConfig,
     pub color: ColorConfig,
+    /// Per-pixel shading units: rsqrt, vector ops, frames, pow, Blinn-Phong.
+    pub shading: ShadingConfig,
+    /// The Ashikhmin-Shirley anisotropic Phong unit.
+    pub aniso_phong: AnisoPhongConfig,
+    /// Timing-model parameters (never read by the functional units).
+    pub timing: TimingConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -195,6 +204,9 @@ impl HwConfig {
                 color_rounding: Rounding::HalfEven,
                 modulate_cycles: 1,
             },
+            shading: ShadingConfig::texram16(),
+            aniso_phong: AnisoPhongConfig::texram16(),
+            timing: TimingConfig::texram16(),
         }
     }
 
@@ -267,6 +279,9 @@ impl HwConfig {
         check("trilinear.weight_bits", t.weight_bits, 0, 16)?;
         check("trilinear.texel_bits", t.texel_bits, 1, 16)?;
         check("color.color_bits", self.color.color_bits, 1, 16)?;
+        self.shading.validate()?;
+        self.aniso_phong.validate()?;
+        self.timing.validate()?;
         Ok(())
     }
 }

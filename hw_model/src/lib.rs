@@ -19,6 +19,7 @@ pub mod modulate;
 pub mod pow;
 pub mod reciprocal;
 pub mod rsqrt;
+pub mod timing_config;
 pub mod trilinear;
 pub mod vector;
 pub mod wrap;
