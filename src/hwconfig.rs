@@ -50,13 +50,9 @@ pub fn parse(text: &str) -> Result<HwConfig> {
     let given_name = table.get("name").cloned();
     let mut merged = to_table(&base);
     merge(&mut merged, table, "")?;
-    if !merged.contains_key("name")
-        || merged.get("name") == Some(&toml::Value::String(base_name.clone()))
-    {
-        merged.insert(
-            "name".into(),
-            toml::Value::String(format!("{base_name}+custom")),
-        );
+    if !matches!(given_name, Some(toml::Value::String(_))) {
+        let custom = toml::Value::String(format!("{base_name}+custom"));
+        merged.insert("name".into(), custom);
     }
     let cfg: HwConfig = toml::Value::Table(merged)
         .try_into()
