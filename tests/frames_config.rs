@@ -26,7 +26,8 @@ fn texram16_valid_and_toml_roundtrip() {
 
 #[test]
 fn validation_names_the_field() {
-    let cases: Vec<(Box<dyn Fn(&mut ShadingConfig)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut ShadingConfig)>;
+    let cases: Vec<(Edit, &str)> = vec![
         (
             Box::new(|c| c.vector.vector_frac_bits = 20),
             "vector_frac_bits",
