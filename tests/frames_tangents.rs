@@ -1,3 +1,4 @@
+#![allow(clippy::type_complexity)]
 //! Tangent generation: planar, mirrored, UV-degenerate, sphere poles, garbage input, random.
 
 use glam::DVec3;

@@ -120,6 +120,9 @@ pub struct TrilinearConfig {
     pub bilinear_cycles: u32,
     /// Cycles of the blend between the two levels.
     pub level_lerp_cycles: u32,
+    /// Anisotropic footprint assembly (Texram): trilinear probes along the footprint's major
+    /// axis, averaged; 1 = plain trilinear. A power of two, at most 16.
+    pub aniso_probes: u32,
 }
 
 /// Colour datapath: vertex colour and the modulate (colour x texel) unit.
@@ -198,6 +201,7 @@ impl HwConfig {
                 weight_rounding: Rounding::Truncate,
                 bilinear_cycles: 1,
                 level_lerp_cycles: 1,
+                aniso_probes: 1,
             },
             color: ColorConfig {
                 color_bits: 16,
@@ -278,6 +282,13 @@ impl HwConfig {
         let t = &self.trilinear;
         check("trilinear.weight_bits", t.weight_bits, 0, 16)?;
         check("trilinear.texel_bits", t.texel_bits, 1, 16)?;
+        check("trilinear.aniso_probes", t.aniso_probes, 1, 16)?;
+        if !t.aniso_probes.is_power_of_two() {
+            return Err(ConfigError {
+                field: "trilinear.aniso_probes".into(),
+                what: format!("{} is not a power of two", t.aniso_probes),
+            });
+        }
         check("color.color_bits", self.color.color_bits, 1, 16)?;
         self.shading.validate()?;
         self.aniso_phong.validate()?;

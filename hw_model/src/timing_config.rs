@@ -31,9 +31,6 @@ pub struct TimingConfig {
     pub dram_page_miss_cycles: u32,
     /// Bytes per stored texel.
     pub texel_bytes: u32,
-    /// Anisotropic footprint assembly: trilinear probes along the major axis (1 = plain
-    /// trilinear; a power of two up to 16).
-    pub aniso_probes: u32,
 }
 
 impl TimingConfig {
@@ -52,7 +49,6 @@ impl TimingConfig {
             dram_page_hit_cycles: 1,
             dram_page_miss_cycles: 6,
             texel_bytes: 8,
-            aniso_probes: 1,
         }
     }
 
@@ -76,17 +72,10 @@ impl TimingConfig {
         for (f, v) in [
             ("cache_line_bytes", self.cache_line_bytes),
             ("dram_page_bytes", self.dram_page_bytes),
-            ("aniso_probes", self.aniso_probes),
         ] {
             if !v.is_power_of_two() {
                 return Err(err(f, format!("{v} is not a power of two")));
             }
-        }
-        if self.aniso_probes > 16 {
-            return Err(err(
-                "aniso_probes",
-                format!("{} is more than 16", self.aniso_probes),
-            ));
         }
         if self.cache_bytes != 0 && self.cache_bytes < self.cache_line_bytes * self.cache_ways {
             return Err(err(
