@@ -36,6 +36,77 @@ pub enum Command {
     },
     /// Sample one texture through the trilinear unit (fixed and float), showing texels and weights.
     Probe(ProbeArgs),
+    /// The Ashikhmin-Shirley anisotropic Phong BRDF: values, directional albedo, sampler statistics.
+    Brdf {
+        #[command(subcommand)]
+        cmd: BrdfCmd,
+    },
+}
+
+/// Parameters of the Ashikhmin-Shirley BRDF.
+#[derive(Args, Debug, Clone)]
+pub struct BrdfParams {
+    /// Phong exponent along the tangent u.
+    #[arg(long, default_value_t = 10.0)]
+    pub nu: f64,
+    /// Phong exponent along the bitangent v.
+    #[arg(long, default_value_t = 10.0)]
+    pub nv: f64,
+    /// Specular reflectance at normal incidence (Schlick's R_s).
+    #[arg(long, default_value_t = 0.05)]
+    pub rs: f64,
+    /// Diffuse reflectance R_d.
+    #[arg(long, default_value_t = 0.5)]
+    pub rd: f64,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum BrdfCmd {
+    /// Directional albedo at polar angle --theta (quadrature; Monte Carlo check). The last line
+    /// is the albedo alone; --fixed gives the fixed-point unit's.
+    Albedo {
+        #[command(flatten)]
+        p: BrdfParams,
+        /// Polar angle of the incident direction in degrees, [0, 90).
+        #[arg(long, default_value_t = 0.0)]
+        theta: f64,
+        /// Evaluate with the fixed-point unit of --hw.
+        #[arg(long)]
+        fixed: bool,
+        /// Hardware preset or file (for --fixed).
+        #[arg(long, default_value = "texram16")]
+        hw: String,
+    },
+    /// BRDF value for the directions (theta1, phi1) and (theta2, phi2), in degrees.
+    Eval {
+        #[command(flatten)]
+        p: BrdfParams,
+        #[arg(long, default_value_t = 30.0)]
+        theta1: f64,
+        #[arg(long, default_value_t = 0.0)]
+        phi1: f64,
+        #[arg(long, default_value_t = 30.0)]
+        theta2: f64,
+        #[arg(long, default_value_t = 180.0)]
+        phi2: f64,
+    },
+    /// Sampler statistics and a chi-square goodness-of-fit test against the pdf.
+    Sample {
+        #[command(flatten)]
+        p: BrdfParams,
+        /// Polar angle of the incident direction in degrees.
+        #[arg(long, default_value_t = 30.0)]
+        theta: f64,
+        /// Azimuth of the incident direction in degrees.
+        #[arg(long, default_value_t = 0.0)]
+        phi: f64,
+        /// Number of samples.
+        #[arg(long, default_value_t = 200_000)]
+        samples: usize,
+        /// PRNG seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 #[derive(Subcommand, Debug)]
@@ -178,6 +249,7 @@ pub fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Some(Command::Probe(a)) => crate::probe::probe_cmd(&a),
+        Some(Command::Brdf { cmd }) => brdf_cmd(&cmd),
     }
 }
 
@@ -395,6 +467,58 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     );
     for p in out.write_to(&a.scene.out)? {
         println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn brdf_model(p: &BrdfParams) -> Result<crate::brdf::ashikhmin_shirley::AshikhminShirley> {
+    crate::brdf::ashikhmin_shirley::AshikhminShirley::new(p.nu, p.nv, p.rs, p.rd)
+}
+
+fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
+    use crate::brdf::ashikhmin_shirley::dir_from_angles;
+    use crate::brdf::report::{albedo_report, eval_report, sample_report};
+    let text = match cmd {
+        BrdfCmd::Albedo {
+            p,
+            theta,
+            fixed,
+            hw,
+        } => {
+            let cfg = if *fixed {
+                Some(hwconfig::resolve(hw)?.aniso_phong)
+            } else {
+                None
+            };
+            albedo_report(&brdf_model(p)?, *theta, cfg.as_ref())?
+        }
+        BrdfCmd::Eval {
+            p,
+            theta1,
+            phi1,
+            theta2,
+            phi2,
+        } => eval_report(
+            &brdf_model(p)?,
+            dir_from_angles(*theta1, *phi1),
+            dir_from_angles(*theta2, *phi2),
+        )?,
+        BrdfCmd::Sample {
+            p,
+            theta,
+            phi,
+            samples,
+            seed,
+        } => sample_report(
+            &brdf_model(p)?,
+            dir_from_angles(*theta, *phi),
+            *samples,
+            *seed,
+        )?,
+    };
+    print!("{text}");
+    if !text.ends_with('\n') {
+        println!();
     }
     Ok(())
 }

@@ -200,3 +200,36 @@ fn scenes_lists_the_catalogue() {
         assert!(t.contains(s), "{t}");
     }
 }
+
+#[test]
+fn brdf_albedo_prints_one_number_last_and_rejects_bad_parameters() {
+    let d = std::env::temp_dir();
+    let last = |args: &[&str]| -> f64 {
+        let o = texsim(args, &d);
+        assert!(o.status.success(), "{}", text(&o));
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        out.lines()
+            .last()
+            .unwrap_or("")
+            .trim()
+            .parse()
+            .expect("last line is a number")
+    };
+    let args = [
+        "brdf", "albedo", "--nu", "100", "--nv", "10", "--rs", "1", "--rd", "0", "--theta", "45",
+    ];
+    let float = last(&args);
+    let mut fixed_args = args.to_vec();
+    fixed_args.push("--fixed");
+    let fixed = last(&fixed_args);
+    // Energy conservation, and the fixed unit within its documented 2e-4 relative bound
+    // (plus quadrature noise, identical grids on both sides).
+    assert!(float > 0.5 && float <= 1.0, "{float}");
+    assert!(
+        (fixed - float).abs() <= 1e-3 * float,
+        "fixed {fixed} float {float}"
+    );
+    let o = texsim(&["brdf", "albedo", "--nu=-1"], &d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("nu"), "{}", text(&o));
+}
