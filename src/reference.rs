@@ -21,6 +21,33 @@ pub fn perspective_bary_f64(edge: [f64; 3], inv_w: [f64; 3]) -> [f64; 3] {
     [1.0 - p1 - p2, p1, p2]
 }
 
+/// Twin of `hw_model::interpolator::perspective_bary_derivs`: `[p, p + dp/dx, p + dp/dy]`
+/// with the analytic derivatives `dp_i/dx = (a_i D - q_i S) / D^2`.
+#[inline]
+#[must_use]
+pub fn perspective_bary_derivs_f64(
+    edge: [f64; 3],
+    edge_dx: [f64; 3],
+    edge_dy: [f64; 3],
+    inv_w: [f64; 3],
+) -> [[f64; 3]; 3] {
+    let p = perspective_bary_f64(edge, inv_w);
+    let q = [edge[0] * inv_w[0], edge[1] * inv_w[1], edge[2] * inv_w[2]];
+    let d = q[0] + q[1] + q[2];
+    if d.is_nan() || d <= 0.0 {
+        return [p, p, p];
+    }
+    let mut out = [p, p, p];
+    for (k, de) in [(1usize, edge_dx), (2, edge_dy)] {
+        let a = [de[0] * inv_w[0], de[1] * inv_w[1], de[2] * inv_w[2]];
+        let sum = a[0] + a[1] + a[2];
+        let dp1 = (a[1] * d - q[1] * sum) / (d * d);
+        let dp2 = (a[2] * d - q[2] * sum) / (d * d);
+        out[k] = [1.0 - (p[1] + dp1) - (p[2] + dp2), p[1] + dp1, p[2] + dp2];
+    }
+    out
+}
+
 /// `a0 + p1 (a1 - a0) + p2 (a2 - a0)`.
 #[inline]
 #[must_use]

@@ -19,7 +19,7 @@
 use crate::config::InterpConfig;
 use crate::cost::UnitCost;
 use crate::fixed::{round_shift_right_wide, Format, SatCounter};
-use crate::reciprocal::{apply, Recip, Reciprocal};
+use crate::reciprocal::{apply, square, Recip, Reciprocal};
 
 /// Clamp of `p_1`, `p_2` (raw), far beyond any sample near the triangle.
 pub const BARY_LIMIT: i64 = 1 << 60;
@@ -73,6 +73,82 @@ pub fn perspective_bary(
     }
     p[0] = one - p[1] - p[2];
     p
+}
+
+/// Perspective-correct barycentrics and their screen-space derivatives from ONE reciprocal
+/// (analytic derivatives of p_i = q_i / D, as a plane-equation interpolator computes them):
+/// `dp_i/dx = (a_i D - q_i S) / D^2` with `a_i = (E_i(x+1) - E_i(x)) invw_i`, `S = sum a_j`
+/// (likewise for y). Returns `[p, p + dp/dx, p + dp/dy]` — the barycentrics of the sample and
+/// of its two first-order neighbours — so downstream interpolation yields texture-coordinate
+/// derivatives as plain differences. Each triple sums to exactly 1.0 (`_0 = 1 - _1 - _2`).
+///
+/// Datapath: `p` exactly as [`perspective_bary`]. For the derivatives, `D`, `q_i`, `a_i`, `S`
+/// are exact (`i128`), then all scaled by one common right shift so the largest magnitude has
+/// at most 62 bits (a scale that cancels in the ratio), `N_i = a_i D - q_i S` exactly, then
+/// `N_i` times `1/D^2` (one reciprocal shared by both axes, squared once and rounded to the
+/// reciprocal's mantissa width) rounded once to `bary_bits`. ERROR BOUND of each derivative,
+/// in LSBs of 2^-B: `|dp| 2^B (2 e_r + 2^-(M+1) + 2^-61) + 1/2` (1 for Truncate), `e_r` as in
+/// [`perspective_bary`], M = `recip_mantissa_bits`. `D <= 0` gives the saturated `p` of
+/// [`perspective_bary`] and zero derivatives (counted once).
+#[inline]
+#[must_use]
+pub fn perspective_bary_derivs(
+    edge: [i64; 3],
+    edge_dx: [i64; 3],
+    edge_dy: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+) -> [[i64; 3]; 3] {
+    let p = perspective_bary(edge, inv_w, cfg, recip, sat);
+    let q = [0, 1, 2].map(|i| i128::from(edge[i]) * i128::from(inv_w[i]));
+    let d = q[0] + q[1] + q[2];
+    if d <= 0 {
+        return [p, p, p];
+    }
+    let a_of = |de: [i64; 3]| [0, 1, 2].map(|i| i128::from(de[i]) * i128::from(inv_w[i]));
+    let (ax, ay) = (a_of(edge_dx), a_of(edge_dy));
+    let (sx, sy) = (ax[0] + ax[1] + ax[2], ay[0] + ay[1] + ay[2]);
+    let mag = [
+        d,
+        q[1].abs(),
+        q[2].abs(),
+        ax[1].abs(),
+        ax[2].abs(),
+        sx.abs(),
+    ]
+    .into_iter()
+    .chain([ay[1].abs(), ay[2].abs(), sy.abs()])
+    .max()
+    .unwrap_or(d);
+    let shift = (128 - mag.leading_zeros()).saturating_sub(62);
+    let ds = d >> shift;
+    let mut out = [p, p, p];
+    if ds <= 0 {
+        sat.saturated += 1;
+        return out;
+    }
+    let r = recip.eval(ds as u64, sat);
+    let r2 = square(r, recip.config().recip_mantissa_bits, cfg.interp_rounding);
+    for (k, a, sum) in [(1usize, ax, sx), (2, ay, sy)] {
+        let ss = sum >> shift;
+        for i in 1..3 {
+            let n = (a[i] >> shift) * ds - (q[i] >> shift) * ss;
+            // N can reach 2^125; `apply` is exact below 2^100 with this mantissa, so N keeps
+            // its top 94 bits (relative error < 2^-93) and the dropped scale 2^ns is folded
+            // into the one rounding.
+            let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94);
+            let v = apply(r2, n >> ns, cfg.bary_bits + ns, cfg.interp_rounding);
+            let dp = v.clamp(-BARY_LIMIT, BARY_LIMIT);
+            if dp != v {
+                sat.saturated += 1;
+            }
+            out[k][i] = p[i] + dp;
+        }
+        out[k][0] = (1i64 << cfg.bary_bits) - out[k][1] - out[k][2];
+    }
+    out
 }
 
 /// The same datapath as [`perspective_bary`] when every `q_i` and their sum fit `i64`
@@ -147,6 +223,20 @@ pub fn interpolate(
     } else {
         let v = round_shift_right_wide(acc, bary_bits, out.rounding);
         out.fit(v, sat)
+    }
+}
+
+/// Cost of [`perspective_bary_derivs`]: the barycentrics, one more reciprocal and its square,
+/// and per axis 3 multiplies, 2 adds, 4 multiplies and 2 subtracts for the numerators and 2
+/// reciprocal applications.
+#[must_use]
+pub fn perspective_bary_derivs_cost(cfg: &InterpConfig, recip: &Reciprocal) -> UnitCost {
+    let base = perspective_bary_cost(cfg, recip);
+    let rc = recip.cost();
+    UnitCost {
+        ops: base.ops + rc.ops + 1 + 2 * 13,
+        cycles: base.cycles + rc.cycles + 2 * cfg.bary_cycles,
+        texels: 0,
     }
 }
 

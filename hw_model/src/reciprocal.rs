@@ -153,6 +153,23 @@ fn nr_step(m: i64, y: i64, two: i64, p: u32, rnd: Rounding) -> i64 {
     }
 }
 
+/// `r * r` with its mantissa rounded once back to `m_bits + 1` significant bits (relative
+/// error of the square: `2 e_r + 2^-(m_bits+1)`).
+#[inline]
+#[must_use]
+pub fn square(r: Recip, m_bits: u32, mode: Rounding) -> Recip {
+    let sq = i128::from(r.mant) * i128::from(r.mant);
+    let b = 128 - sq.leading_zeros();
+    let drop = b.saturating_sub(m_bits + 1);
+    let mut mant = round_shift_right_wide(sq, drop, mode) as u64;
+    let mut shift = 2 * r.shift - drop as i32;
+    if mant >> (m_bits + 1) != 0 {
+        mant >>= 1;
+        shift -= 1;
+    }
+    Recip { mant, shift }
+}
+
 /// `x * r` reduced to `frac_bits` fraction bits with ONE rounding by `mode` (x is an integer,
 /// the product is exact in `i128` for |x| < 2^96); results beyond `i64` saturate.
 #[inline]

@@ -7,11 +7,15 @@ use super::{Frag, Impl, Plan, StageImpls, StageKind};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
-use crate::reference::{interpolate_f64, lod_f64, perspective_bary_f64, trilinear_f64, LevelF};
+use crate::reference::{
+    interpolate_f64, lod_f64, perspective_bary_derivs_f64, perspective_bary_f64, trilinear_f64,
+    LevelF,
+};
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::interpolator::{
     interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
+    perspective_bary_derivs, perspective_bary_derivs_cost,
 };
 use hw_model::lod::{lod, lod_cost};
 use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
@@ -117,7 +121,8 @@ impl<'a> Machine<'a> {
         let samples = if plan.derivatives { 3 } else { 1 };
         let i = &self.hw.interp;
         match kind {
-            StageKind::Bary => perspective_bary_cost(i, &self.recip).times(samples),
+            StageKind::Bary if plan.derivatives => perspective_bary_derivs_cost(i, &self.recip),
+            StageKind::Bary => perspective_bary_cost(i, &self.recip),
             StageKind::Color => interpolate_cost(i).times(3),
             StageKind::Texcoord => interpolate_cost(i).times(2 * samples),
             StageKind::Lod => lod_cost(&self.hw.lod),
@@ -185,9 +190,6 @@ fn unorm(raw: u32, bits: u32) -> f64 {
     f64::from(raw) / f64::from(max_unorm(bits))
 }
 
-/// Sample offsets of the fragment and its two helper samples (x+1, y) and (x, y+1).
-const OFFSETS: [(i64, i64); 3] = [(0, 0), (1, 0), (0, 1)];
-
 /// Runs `plan` on one fragment at pixel (`px`, `py`) of `tri`, each stage by its twin in
 /// `impls`; the result is in `frag.out` (and `frag.out_x` when the last stage was Fixed).
 /// A Fixed stage reads the raw value of a Fixed producer and quantizes the carrier of a Float
@@ -230,15 +232,33 @@ pub fn run(
         match kind {
             StageKind::Bary => {
                 let sub = hw.raster.subpixel_bits;
-                for (s, &(dx, dy)) in OFFSETS.iter().enumerate().take(samples) {
-                    if fixed {
-                        let e = tri.edges_fixed(px + dx, py + dy, sub);
-                        let b = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
-                        frag.bary_x[s] = b;
-                        frag.bary[s] = b.map(|r| from_raw(r, bb));
+                if fixed {
+                    let e = tri.edges_fixed(px, py, sub);
+                    if plan.derivatives {
+                        let ex = tri.edges_fixed(px + 1, py, sub);
+                        let ey = tri.edges_fixed(px, py + 1, sub);
+                        let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
+                        let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
+                        frag.bary_x = perspective_bary_derivs(
+                            e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat,
+                        );
                     } else {
-                        let e = tri.edges_float((px + dx) as f64, (py + dy) as f64);
-                        frag.bary[s] = perspective_bary_f64(e, a.inv_w_f);
+                        frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
+                    }
+                    for s in 0..samples {
+                        frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+                    }
+                } else {
+                    let (x, y) = (px as f64, py as f64);
+                    let e = tri.edges_float(x, y);
+                    if plan.derivatives {
+                        let ex = tri.edges_float(x + 1.0, y);
+                        let ey = tri.edges_float(x, y + 1.0);
+                        let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
+                        let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
+                        frag.bary = perspective_bary_derivs_f64(e, dx, dy, a.inv_w_f);
+                    } else {
+                        frag.bary[0] = perspective_bary_f64(e, a.inv_w_f);
                     }
                 }
             }
