@@ -177,7 +177,8 @@ pub struct SweepArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// FIELD=A..B (inclusive integer range) or FIELD=v1,v2,... ; FIELD is any HwConfig field
-    /// name (`texsim hw show texram16`). Several --vary make a grid.
+    /// name (`texsim hw show texram16`), or `hw` to switch the whole machine (presets or files;
+    /// give it first, later axes edit it). Several --vary make a grid.
     #[arg(long, required = true)]
     pub vary: Vec<String>,
 }
@@ -441,8 +442,13 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let configs: Vec<HwConfig> = settings
         .iter()
         .map(|row| {
-            row.iter()
-                .try_fold(base.clone(), |c, (f, v)| hwconfig::set_field(&c, f, v))
+            row.iter().try_fold(base.clone(), |c, (f, v)| {
+                if f == "hw" {
+                    hwconfig::resolve(v)
+                } else {
+                    hwconfig::set_field(&c, f, v)
+                }
+            })
         })
         .collect::<Result<_>>()?;
     for w in &sc.warnings {
