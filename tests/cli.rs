@@ -233,3 +233,68 @@ fn brdf_albedo_prints_one_number_last_and_rejects_bad_parameters() {
     assert!(!o.status.success());
     assert!(text(&o).contains("nu"), "{}", text(&o));
 }
+
+#[test]
+fn renders_a_real_textured_obj_with_its_mtl() {
+    let d = tmp("obj");
+    let cube = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cube.obj");
+    let o = texsim(
+        &[
+            "render",
+            cube.to_str().unwrap(),
+            "--width",
+            "200",
+            "--height",
+            "150",
+            "--out",
+            "o",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("o/summary.json")).unwrap()).unwrap();
+    let stages = j["stats"]["stages"].as_array().unwrap();
+    let tri = stages.iter().find(|s| s["stage"] == "trilinear").unwrap();
+    assert!(
+        tri["invocations"].as_u64().unwrap() > 1000,
+        "the MTL texture must be sampled: {tri}"
+    );
+    assert!(j["stats"]["error_8bit"]["max_abs_lsb"].as_u64().unwrap() <= 2);
+}
+
+#[test]
+fn renders_a_100k_triangle_obj() {
+    // A 230 x 230 grid of quads (105,800 triangles) with UVs, no normals, no MTL.
+    let d = tmp("big");
+    let n = 230usize;
+    let mut s = String::with_capacity(8 << 20);
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            let z = 0.1 * (x * 12.0).sin() * (y * 9.0).cos();
+            s.push_str(&format!("v {x} {y} {z}\nvt {x} {y}\n"));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i + 1;
+            let (b, c, e) = (a + 1, a + n + 2, a + n + 1);
+            s.push_str(&format!("f {a}/{a} {b}/{b} {c}/{c} {e}/{e}\n"));
+        }
+    }
+    std::fs::write(d.join("big.obj"), s).unwrap();
+    let t = std::time::Instant::now();
+    let o = texsim(
+        &[
+            "render", "big.obj", "--width", "512", "--height", "512", "--out", "o",
+        ],
+        &d,
+    );
+    let secs = t.elapsed().as_secs_f64();
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("105800 triangles"), "{t}");
+    println!("100k-triangle OBJ: load + render + reference + outputs in {secs:.2} s");
+    assert!(secs < 60.0, "took {secs} s");
+}
