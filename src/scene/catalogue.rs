@@ -62,6 +62,7 @@ fn mesa_material() -> Material {
         wrap_t: WrapMode::Repeat,
         lit: false,
         cull_back: false,
+        ..Material::default()
     }
 }
 
