@@ -46,6 +46,8 @@ struct MtlEntry {
     name: String,
     kd: Option<[f32; 3]>,
     map_kd: Option<String>,
+    /// `bump` / `map_Bump`: a height map (with the `-bm` multiplier as bump scale).
+    map_bump: Option<String>,
 }
 
 fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
@@ -71,6 +73,7 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     name: rest.to_string(),
                     kd: None,
                     map_kd: None,
+                    map_bump: None,
                 });
             }
             "Kd" => {
@@ -98,6 +101,15 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     .last_mut()
                     .ok_or_else(|| bad("map_Kd before any newmtl"))?;
                 cur.map_kd = Some(rest.to_string());
+            }
+            "bump" | "map_Bump" | "map_bump" => {
+                if rest.is_empty() {
+                    return Err(bad("bump map without a file name"));
+                }
+                let cur = out
+                    .last_mut()
+                    .ok_or_else(|| bad("bump map before any newmtl"))?;
+                cur.map_bump = Some(rest.to_string());
             }
             _ => {}
         }
@@ -349,6 +361,41 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                     m.wrap_s = WrapMode::ClampToEdge;
                     m.wrap_t = WrapMode::ClampToEdge;
                 }
+            }
+        }
+        if let Some(arg) = &e.map_bump {
+            let (name, _, _) = parse_map_arg(arg);
+            let toks: Vec<&str> = arg.split_whitespace().collect();
+            let bm = toks
+                .iter()
+                .position(|t| *t == "-bm")
+                .and_then(|i| toks.get(i + 1))
+                .and_then(|v| v.parse::<f32>().ok())
+                .filter(|v| v.is_finite());
+            let file = mdir.join(&name);
+            let idx = match tex_cache.get(&file) {
+                Some(i) => *i,
+                None => {
+                    let i = match decode_texture(&file) {
+                        Ok(t) => {
+                            textures.push(t);
+                            Some(textures.len() - 1)
+                        }
+                        Err(err) => {
+                            warnings.push(format!(
+                                "bump map '{name}' of material '{}' unusable ({err}); no bumps",
+                                e.name
+                            ));
+                            None
+                        }
+                    };
+                    tex_cache.insert(file.clone(), i);
+                    i
+                }
+            };
+            m.bump = idx;
+            if let Some(bm) = bm {
+                m.bump_scale = bm;
             }
         }
         materials.push(m);
