@@ -8,22 +8,22 @@
 //! fragments by default (shared coverage).
 
 use crate::fixedpoint::to_unorm;
-use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
 use crate::maps::quantize_unorm;
+use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
 use crate::pipeline::bump_stages::{BumpAttrs, BumpVertex};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{
     plan_with_bump, BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS,
 };
+use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
+use crate::report::{compare, ErrorMetrics, Image};
 use crate::scene::{FrameKind, MainDirection, Mesh, TextureImage};
+use crate::scene::{Light, Scene};
 use crate::shading::bump::{
     height_to_offsets, heights_from_texture, offsets_to_image, BumpParams, OffsetEncoding,
 };
 use crate::shading::reference as fref;
 use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
-use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
-use crate::report::{compare, ErrorMetrics, Image};
-use crate::scene::{Light, Scene};
 use glam::DVec3;
 use hw_model::fixed::SatCounter;
 use hw_model::{HwConfig, UnitCost};

@@ -56,7 +56,13 @@ fn sweep_over_frames_reports_each() {
     let d = tmp("sweep");
     let o = texsim(
         &[
-            "sweep", "--scene", "bumps", "--vary", "frame=natural,unit,main", "--out", "s",
+            "sweep",
+            "--scene",
+            "bumps",
+            "--vary",
+            "frame=natural,unit,main",
+            "--out",
+            "s",
         ],
         &d,
     );
@@ -71,14 +77,29 @@ fn sweep_over_frames_reports_each() {
     // Knobs of the shading units sweep too (and a bad value is an error naming the field).
     let o = texsim(
         &[
-            "sweep", "--scene", "bumps", "--vary", "rsqrt_lut_bits=4,8", "--vary",
-            "offset_int_bits=2,3", "--out", "k",
+            "sweep",
+            "--scene",
+            "bumps",
+            "--vary",
+            "rsqrt_lut_bits=4,8",
+            "--vary",
+            "offset_int_bits=2,3",
+            "--out",
+            "k",
         ],
         &d,
     );
     assert!(o.status.success(), "{}", text(&o));
     let o = texsim(
-        &["sweep", "--scene", "bumps", "--vary", "frame=diagonal", "--out", "x"],
+        &[
+            "sweep",
+            "--scene",
+            "bumps",
+            "--vary",
+            "frame=diagonal",
+            "--out",
+            "x",
+        ],
         &d,
     );
     assert!(!o.status.success());

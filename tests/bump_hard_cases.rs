@@ -111,17 +111,17 @@ fn check(name: &str, s: &Scene, min_within1: f64) -> Vec<Rendered> {
                 r.stats.bump.nonfinite,
                 r.stats.bump.ref_nonfinite
             );
-            assert!(r.stats.covered_pixels > 200, "{name} {kind:?}: nothing drawn");
+            assert!(
+                r.stats.covered_pixels > 200,
+                "{name} {kind:?}: nothing drawn"
+            );
             assert_eq!(r.stats.bump.nonfinite, 0, "{name} {kind:?}");
             assert_eq!(r.stats.bump.ref_nonfinite, 0, "{name} {kind:?}");
             assert_eq!(
                 r.stats.stages[StageKind::Phong.index()].invocations,
                 r.stats.covered_pixels
             );
-            assert!(
-                e8.pct_within_1lsb >= min_within1,
-                "{name} {kind:?}: {e8:?}"
-            );
+            assert!(e8.pct_within_1lsb >= min_within1, "{name} {kind:?}: {e8:?}");
             r
         })
         .collect()
@@ -179,7 +179,12 @@ fn opposite_vertex_normals_give_a_zero_interpolated_normal() {
     // Looking straight down with an odd width: the middle pixel column samples x = 0, where
     // the interpolated n_y = 1 - 2 a is below one ulp of s1.14 and rounds to zero.
     let mut m = grid(1, 1.0, 2.0);
-    m.normals = vec![[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]];
+    m.normals = vec![
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
     let mut down = cam([0.0, 2.0, 0.0], [0.0, 0.0, 0.0], 0.1);
     down.up = [0.0, 0.0, -1.0];
     let mut s = scene(
@@ -232,7 +237,10 @@ fn main_direction_parallel_to_the_normal_falls_back_everywhere() {
         );
         let e8 = r.stats.error_8bit.clone().expect("metrics");
         // Both twins fall back to the same axis (x): the images agree as in the normal case.
-        assert!(e8.max_abs_lsb <= 2 && e8.pct_within_1lsb >= 99.5, "{what} {e8:?}");
+        assert!(
+            e8.max_abs_lsb <= 2 && e8.pct_within_1lsb >= 99.5,
+            "{what} {e8:?}"
+        );
     }
 }
 

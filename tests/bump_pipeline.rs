@@ -74,7 +74,10 @@ fn each_frame_fixed_vs_float_error_is_bounded() {
         assert!(e8.pct_within_1lsb >= 99.5, "{kind:?} {e8:?}");
         assert!(e16.max_abs_lsb <= 400, "{kind:?} {e16:?}");
         assert!(e16.rmse_lsb <= 16.0, "{kind:?} {e16:?}");
-        assert!(e16.max_abs_lsb > 0, "{kind:?}: fixed path identical to float");
+        assert!(
+            e16.max_abs_lsb > 0,
+            "{kind:?}: fixed path identical to float"
+        );
         assert_eq!(r.stats.bump.nonfinite, 0);
         assert_eq!(r.stats.bump.ref_nonfinite, 0);
         // The image is not flat shading: the bumps make neighbouring pixels differ.
@@ -204,7 +207,10 @@ fn real_mesh_with_height_png_renders_in_every_frame() {
         s.materials[0].frame = Some(kind);
         let r = go(&s, &HwConfig::texram16());
         let e8 = r.stats.error_8bit.clone().expect("metrics");
-        assert!(e8.max_abs_lsb <= 2 && e8.pct_within_1lsb >= 99.5, "{kind:?} {e8:?}");
+        assert!(
+            e8.max_abs_lsb <= 2 && e8.pct_within_1lsb >= 99.5,
+            "{kind:?} {e8:?}"
+        );
         assert!(stage(&r, StageKind::Phong).invocations > 5_000);
         assert_eq!(r.stats.bump.ref_nonfinite, 0);
         assert_eq!(

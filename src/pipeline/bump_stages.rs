@@ -166,7 +166,7 @@ pub fn normal_attr_count(m: &Machine, bp: &BumpPlan, kind: FrameKind) -> u32 {
 }
 
 /// Runs bump stage `kind` (one of the five) of `plan` on `frag`.
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
 #[inline]
 pub fn run_bump_stage(
     kind: StageKind,

@@ -5,26 +5,26 @@
 
 use super::bump_stages::{self, run_bump_stage, BumpAttrs};
 use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
-use crate::scene::{FrameKind, Light};
-use crate::shading::reference as fref;
-use glam::DVec3;
-use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
-use hw_model::frame::{frame_cost, len_format, perturb_cost};
-use hw_model::rsqrt::rsqrt_cost;
-use hw_model::vector::{normalize_cost, vector_format};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
 use crate::reference::{interpolate_f64, lod_f64, perspective_bary_f64, trilinear_f64, LevelF};
+use crate::scene::{FrameKind, Light};
+use crate::shading::reference as fref;
+use glam::DVec3;
+use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
+use hw_model::frame::{frame_cost, len_format, perturb_cost};
 use hw_model::interpolator::{
     interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
 };
 use hw_model::lod::{lod, lod_cost};
 use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
 use hw_model::reciprocal::Reciprocal;
+use hw_model::rsqrt::rsqrt_cost;
 use hw_model::trilinear::{trilinear, trilinear_cost, Level};
+use hw_model::vector::{normalize_cost, vector_format};
 use hw_model::UnitCost;
 
 /// Per-stage counters of one run (summed over fragments; order-independent integer sums).
@@ -247,10 +247,11 @@ impl<'a> Machine<'a> {
             texels: 0,
         };
         match kind {
-            StageKind::Normal => {
-                interpolate_cost(&self.hw.interp).times(bump_stages::normal_attr_count(self, bp, fk))
+            StageKind::Normal => interpolate_cost(&self.hw.interp)
+                .times(bump_stages::normal_attr_count(self, bp, fk)),
+            StageKind::BumpFetch => {
+                lod_cost(&self.hw.lod).plus(trilinear_cost(&self.hw.trilinear, 2))
             }
-            StageKind::BumpFetch => lod_cost(&self.hw.lod).plus(trilinear_cost(&self.hw.trilinear, 2)),
             StageKind::Frame => frame_cost(fk, u),
             StageKind::Perturb => perturb_cost(u),
             StageKind::Phong => {

@@ -279,7 +279,11 @@ pub fn bricks_height(size: u32) -> TextureImage {
     height_image(format!("bricks-height-{size}"), size, |s, t| {
         let (rows, cols) = (16.0, 8.0);
         let r = t * rows;
-        let shift = if (r.floor() as i64) % 2 == 0 { 0.0 } else { 0.5 };
+        let shift = if (r.floor() as i64) % 2 == 0 {
+            0.0
+        } else {
+            0.5
+        };
         let c = s * cols + shift;
         // Distance to the nearest joint in brick-height units (a brick is 1 x 2 of them).
         let dy = (r - r.floor()).min(r.ceil() - r);
