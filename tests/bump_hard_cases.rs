@@ -314,3 +314,27 @@ fn offset_saturation_is_counted_and_reported() {
     let r3 = render(&s, &maps, &HwConfig::texram16(), &RenderOptions::default()).expect("r");
     assert_eq!(r3.stats.bump.offset_clamped, 0);
 }
+
+#[test]
+fn poles_of_a_sphere_with_spherical_uvs() {
+    // Looking straight down at the north pole: every pole triangle is a UV sliver with
+    // |p_u| -> 0, the natural lengths grow as 1/sin(theta) (saturating u8.8 near the pole).
+    let mut down = cam([0.0, 2.6, 0.0], [0.0, 0.0, 0.0], 0.1);
+    down.up = [0.0, 0.0, -1.0];
+    let s = scene(
+        vec![texsim::scene::shapes::sphere(1.0, 32, 16)],
+        Material {
+            main_direction: MainDirection::Pu,
+            ..bump_mat()
+        },
+        down,
+        vec![
+            sun([-0.6, -0.5, -0.2]),
+            Light::Point {
+                position: [0.5, 2.0, 0.5],
+                color: [0.5; 3],
+            },
+        ],
+    );
+    check("pole", &s, 98.0);
+}

@@ -48,6 +48,9 @@ struct MtlEntry {
     map_kd: Option<String>,
     /// `bump` / `map_Bump`: a height map (with the `-bm` multiplier as bump scale).
     map_bump: Option<String>,
+    /// `Ks` and `Ns` (used by per-pixel shading of bump-mapped materials).
+    ks: Option<[f32; 3]>,
+    ns: Option<f32>,
 }
 
 fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
@@ -74,6 +77,8 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     kd: None,
                     map_kd: None,
                     map_bump: None,
+                    ks: None,
+                    ns: None,
                 });
             }
             "Kd" => {
@@ -101,6 +106,31 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     .last_mut()
                     .ok_or_else(|| bad("map_Kd before any newmtl"))?;
                 cur.map_kd = Some(rest.to_string());
+            }
+            // Ks / Ns only matter to bump-mapped materials: malformed values are ignored
+            // (as they were before per-pixel shading existed).
+            "Ks" => {
+                let vals: Vec<f32> = rest
+                    .split_whitespace()
+                    .filter_map(|v| v.parse::<f32>().ok())
+                    .collect();
+                let ks = match vals.as_slice() {
+                    [r, g, b] => Some([*r, *g, *b]),
+                    [g] => Some([*g; 3]),
+                    _ => None,
+                };
+                if let (Some(ks), Some(cur)) = (ks, out.last_mut()) {
+                    if ks.iter().all(|c| c.is_finite() && *c >= 0.0) {
+                        cur.ks = Some(ks);
+                    }
+                }
+            }
+            "Ns" => {
+                if let (Ok(ns), Some(cur)) = (rest.parse::<f32>(), out.last_mut()) {
+                    if ns.is_finite() && ns >= 0.0 {
+                        cur.ns = Some(ns);
+                    }
+                }
             }
             "bump" | "map_Bump" | "map_bump" => {
                 if rest.is_empty() {
@@ -316,6 +346,12 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
         };
         if let Some(kd) = e.kd {
             m.kd = kd;
+        }
+        if let Some(ks) = e.ks {
+            m.ks = ks;
+        }
+        if let Some(ns) = e.ns {
+            m.shininess = ns.round().min(65535.0) as u32;
         }
         if let Some(arg) = &e.map_kd {
             let (name, fallback, clamp) = parse_map_arg(arg);
