@@ -20,7 +20,8 @@ use crate::report::{compare, ErrorMetrics, Image};
 use crate::scene::{FrameKind, MainDirection, Mesh, TextureImage};
 use crate::scene::{Light, Scene};
 use crate::shading::bump::{
-    height_to_offsets, heights_from_texture, offsets_to_image, BumpParams, OffsetEncoding,
+    height_to_offsets, heights_from_texture, normal_map_to_offsets, offsets_to_image, BumpParams,
+    OffsetEncoding,
 };
 use crate::shading::reference as fref;
 use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
@@ -47,18 +48,40 @@ pub struct Maps {
     pub bump_clamped: u64,
 }
 
-/// The distinct (height-map texture, bump scale) pairs of the scene's bump materials, in
-/// material order; offset map `k` is map `scene.textures.len() + k`.
+/// One offset map to prepare: the source texture, the bump scale, and whether the source is
+/// a tangent-space normal map (else a height map, channel 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BumpSource {
+    pub texture: usize,
+    pub scale: f32,
+    pub normal_map: bool,
+}
+
+impl BumpSource {
+    fn of(m: &crate::scene::Material) -> Option<Self> {
+        m.bump.map(|texture| Self {
+            texture,
+            scale: m.bump_scale,
+            normal_map: m.bump_normal_map,
+        })
+    }
+
+    fn same(&self, o: &Self) -> bool {
+        self.texture == o.texture
+            && self.scale.to_bits() == o.scale.to_bits()
+            && self.normal_map == o.normal_map
+    }
+}
+
+/// The distinct offset maps of the scene's bump materials, in material order; offset map `k`
+/// is map `scene.textures.len() + k`.
 #[must_use]
-pub fn bump_sources(scene: &Scene) -> Vec<(usize, f32)> {
-    let mut out: Vec<(usize, f32)> = Vec::new();
+pub fn bump_sources(scene: &Scene) -> Vec<BumpSource> {
+    let mut out: Vec<BumpSource> = Vec::new();
     for m in &scene.materials {
-        if let Some(t) = m.bump {
-            if !out
-                .iter()
-                .any(|&(ot, s)| ot == t && s.to_bits() == m.bump_scale.to_bits())
-            {
-                out.push((t, m.bump_scale));
+        if let Some(b) = BumpSource::of(m) {
+            if !out.iter().any(|o| o.same(&b)) {
+                out.push(b);
             }
         }
     }
@@ -103,12 +126,23 @@ impl Maps {
     pub fn with_offset_bits(scene: &Scene, texel_bits: u32, offset_int_bits: u32) -> Self {
         let mut float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
         let mut bump_offsets = Vec::new();
-        for (t, scale) in bump_sources(scene) {
-            let tex = &scene.textures[t];
-            let p = BumpParams { scale, v_up: false };
-            let offs = heights_from_texture(tex, 0)
-                .and_then(|h| height_to_offsets(&h, tex.width, tex.height, &p))
-                .unwrap_or_else(|_| vec![[0.0; 2]; tex.texels.len()]);
+        for b in bump_sources(scene) {
+            let tex = &scene.textures[b.texture];
+            let p = BumpParams {
+                scale: b.scale,
+                v_up: false,
+            };
+            let offs = if b.normal_map {
+                normal_map_to_offsets(tex, true).map(|(o, _)| {
+                    o.into_iter()
+                        .map(|f| f.map(|x| x * b.scale))
+                        .collect::<Vec<_>>()
+                })
+            } else {
+                heights_from_texture(tex, 0)
+                    .and_then(|h| height_to_offsets(&h, tex.width, tex.height, &p))
+            }
+            .unwrap_or_else(|_| vec![[0.0; 2]; tex.texels.len()]);
             bump_offsets.push((tex.width, tex.height, tex.name.clone(), offs));
         }
         let mut bump_clamped = 0;
@@ -233,10 +267,10 @@ impl Geometry {
                 g.color.push(c.clamp(DVec3::ZERO, DVec3::ONE).to_array());
                 g.uv.push(mesh.uvs.get(vi).map_or([0.0; 2], |t| t.map(f64::from)));
             }
-            let bump_map = mat.bump.and_then(|t| {
+            let bump_map = BumpSource::of(mat).and_then(|b| {
                 sources
                     .iter()
-                    .position(|&(st, s)| st == t && s.to_bits() == mat.bump_scale.to_bits())
+                    .position(|o| o.same(&b))
                     .map(|k| scene.textures.len() + k)
             });
             let p = plan_with_bump(mat, !mesh.uvs.is_empty(), bump_map);

@@ -338,3 +338,61 @@ fn poles_of_a_sphere_with_spherical_uvs() {
     );
     check("pole", &s, 98.0);
 }
+
+#[test]
+fn normal_map_matches_the_height_map_it_was_made_from() {
+    use texsim::shading::bump::{height_to_offsets, heights_from_texture, BumpParams};
+    let h = bricks_height(64);
+    let p = BumpParams {
+        scale: 2.0,
+        v_up: false,
+    };
+    let offs = height_to_offsets(&heights_from_texture(&h, 0).expect("heights"), 64, 64, &p)
+        .expect("offsets");
+    // OpenGL-style normal map: n = (-f_u, +f_v, 1) / |.| (green towards the top row = -t).
+    let texels = offs
+        .iter()
+        .map(|f| {
+            let (x, y, z) = (-f64::from(f[0]), f64::from(f[1]), 1.0f64);
+            let l = (x * x + y * y + z * z).sqrt();
+            let c = |v: f64| ((v / l * 0.5 + 0.5) * 65535.0).round() as u16;
+            [c(x), c(y), c(z), 65535]
+        })
+        .collect();
+    let nmap = texsim::scene::TextureImage {
+        name: "nmap".into(),
+        width: 64,
+        height: 64,
+        texels,
+        prebuilt_levels: None,
+    };
+    let base = scene(
+        vec![grid(2, 1.0, 2.0)],
+        bump_mat(),
+        cam([0.0, 1.5, 1.2], [0.0, 0.0, 0.0], 0.1),
+        vec![sun([-0.5, -0.6, -0.3])],
+    );
+    let mut nm = base.clone();
+    nm.textures.push(nmap);
+    nm.materials[0].bump = Some(1);
+    nm.materials[0].bump_scale = 1.0;
+    nm.materials[0].bump_normal_map = true;
+    for kind in [FrameKind::Unit, FrameKind::Main] {
+        let a = go(&base, kind);
+        let b = go(&nm, kind);
+        let e = texsim::report::compare(&a.hw_image, &b.hw_image, 8, Some(&a.mask));
+        eprintln!("normal map vs height map {kind:?}: {e:?}");
+        assert!(
+            e.max_abs_lsb <= 2 && e.pct_within_1lsb >= 99.0,
+            "{kind:?} {e:?}"
+        );
+        // A flipped green channel would tilt v the wrong way: clearly different.
+        let mut flipped = nm.clone();
+        for t in &mut flipped.textures[1].texels {
+            t[1] = 65535 - t[1];
+        }
+        let c = go(&flipped, kind);
+        let e2 = texsim::report::compare(&a.hw_image, &c.hw_image, 8, Some(&a.mask));
+        assert!(e2.max_abs_lsb > 10, "{kind:?} flipped {e2:?}");
+    }
+}

@@ -60,8 +60,14 @@ fn bad_bump_fields_are_errors_naming_the_field() {
     for (fields, needle) in [
         ("bump = \"missing.png\"", "bump"),
         ("bump = \"bricks\"\nframe = \"diagonal\"", "diagonal"),
-        ("bump = \"bricks\"\nmain_direction = \"p_w\"", "main_direction"),
-        ("bump = \"bricks\"\nmain_direction = [0.0, 0.0, 0.0]", "main_direction"),
+        (
+            "bump = \"bricks\"\nmain_direction = \"p_w\"",
+            "main_direction",
+        ),
+        (
+            "bump = \"bricks\"\nmain_direction = [0.0, 0.0, 0.0]",
+            "main_direction",
+        ),
         ("bump = \"bricks\"\nbump_scale = nan", "bump_scale"),
         ("bump = \"bricks\"\nks = [-1.0, 0.0, 0.0]", "ks"),
     ] {

@@ -83,8 +83,12 @@ pub struct Material {
     /// bump mapped and shaded per pixel (Blinn-Phong); the height map becomes an offset map
     /// `(f_u, f_v)` when the maps are prepared.
     pub bump: Option<usize>,
-    /// Bump height scale (multiplies the height differences per level-0 texel).
+    /// Bump height scale (multiplies the height differences per level-0 texel, or the offsets
+    /// of a normal map).
     pub bump_scale: f32,
+    /// The `bump` texture is a tangent-space normal map, not a height map: OpenGL style, red
+    /// along `+s`, green towards the image's top row (`-t`, i.e. OBJ's `+v`), blue out.
+    pub bump_normal_map: bool,
     /// Local frame of the bump mapping; `None` uses the hardware's `frame_kind`.
     pub frame: Option<FrameKind>,
     /// Main direction `m` of the main-direction frame.
@@ -120,6 +124,7 @@ impl Default for Material {
             cull_back: false,
             bump: None,
             bump_scale: 1.0,
+            bump_normal_map: false,
             frame: None,
             main_direction: MainDirection::Pv,
             ks: [0.0; 3],

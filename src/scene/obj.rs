@@ -51,6 +51,8 @@ struct MtlEntry {
     /// `Ks` and `Ns` (used by per-pixel shading of bump-mapped materials).
     ks: Option<[f32; 3]>,
     ns: Option<f32>,
+    /// The bump map came from `norm` (a tangent-space normal map).
+    bump_is_normal_map: bool,
 }
 
 fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
@@ -79,6 +81,7 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     map_bump: None,
                     ks: None,
                     ns: None,
+                    bump_is_normal_map: false,
                 });
             }
             "Kd" => {
@@ -140,6 +143,17 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     .last_mut()
                     .ok_or_else(|| bad("bump map before any newmtl"))?;
                 cur.map_bump = Some(rest.to_string());
+                cur.bump_is_normal_map = false;
+            }
+            "norm" | "map_Norm" | "map_norm" => {
+                if rest.is_empty() {
+                    return Err(bad("normal map without a file name"));
+                }
+                let cur = out
+                    .last_mut()
+                    .ok_or_else(|| bad("normal map before any newmtl"))?;
+                cur.map_bump = Some(rest.to_string());
+                cur.bump_is_normal_map = true;
             }
             _ => {}
         }
@@ -430,6 +444,7 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                 }
             };
             m.bump = idx;
+            m.bump_normal_map = e.bump_is_normal_map;
             if let Some(bm) = bm {
                 m.bump_scale = bm;
             }

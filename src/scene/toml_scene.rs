@@ -89,6 +89,8 @@ struct MaterialCfg {
     /// Height map: a texture name of `[[textures]]` or an image file.
     bump: Option<String>,
     bump_scale: Option<f32>,
+    /// The bump texture is a tangent-space normal map.
+    bump_normal_map: Option<bool>,
     frame: Option<FrameKind>,
     main_direction: Option<MainDirCfg>,
     ks: Option<[f32; 3]>,
@@ -376,6 +378,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             cull_back: m.cull_back.unwrap_or(def.cull_back),
             bump,
             bump_scale: m.bump_scale.unwrap_or(def.bump_scale),
+            bump_normal_map: m.bump_normal_map.unwrap_or(def.bump_normal_map),
             frame: m.frame.or(def.frame),
             main_direction: main_dir,
             ks: m.ks.unwrap_or(def.ks),
