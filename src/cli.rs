@@ -315,7 +315,11 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         sc.triangle_count(),
         hw.name
     );
-    let maps = Maps::new(&sc, hw.trilinear.texel_bits);
+    let maps = Maps::with_offset_bits(
+        &sc,
+        hw.trilinear.texel_bits,
+        hw.shading.vector.offset_int_bits,
+    );
     let opts = RenderOptions {
         hw_impls: impls,
         reference: !a.no_reference,
@@ -460,6 +464,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
         eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
         maps.ensure_texel_bits(cfg.trilinear.texel_bits);
+        maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
         let r = render(&sc, &maps, cfg, &RenderOptions::default())?;
         rows.push(crate::summary::SweepRow::new(set.clone(), &r.stats));
     }

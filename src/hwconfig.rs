@@ -119,7 +119,9 @@ pub fn fields(c: &HwConfig) -> Vec<(String, String)> {
 
 /// Returns `c` with the field `name` (a unique leaf name like `weight_bits`, or a dotted path
 /// like `trilinear.weight_bits`) set to `value`, validated.
+/// `frame` is an alias of `frame_kind` (`--vary frame=natural,unit,main`).
 pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
+    let name = if name == "frame" { "frame_kind" } else { name };
     let all = fields(c);
     let matches: Vec<&String> = all
         .iter()

@@ -8,12 +8,23 @@
 //! fragments by default (shared coverage).
 
 use crate::fixedpoint::to_unorm;
+use crate::maps::quantize_unorm;
 use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
+use crate::pipeline::bump_stages::{BumpAttrs, BumpVertex};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
-use crate::pipeline::{plan, Frag, Impl, Plan, StageImpls, StageKind};
+use crate::pipeline::{
+    plan_with_bump, BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS,
+};
 use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
 use crate::report::{compare, ErrorMetrics, Image};
+use crate::scene::{FrameKind, MainDirection, Mesh, TextureImage};
 use crate::scene::{Light, Scene};
+use crate::shading::bump::{
+    height_to_offsets, heights_from_texture, normal_map_to_offsets, offsets_to_image, BumpParams,
+    OffsetEncoding,
+};
+use crate::shading::reference as fref;
+use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
 use glam::DVec3;
 use hw_model::fixed::SatCounter;
 use hw_model::{HwConfig, UnitCost};
@@ -22,22 +33,153 @@ use serde::Serialize;
 use std::time::Instant;
 
 /// The prepared texture maps of a scene: float MIP chains (host) and their quantization to the
-/// texel width of the machine.
+/// texel width of the machine. The scene's textures come first, then one offset map per
+/// distinct (height map, bump scale) of the bump materials ([`bump_sources`]).
+#[derive(Clone)]
 pub struct Maps {
     pub float: Vec<MipChain>,
     pub fixed: Vec<FixedMipChain>,
+    /// Per offset map: its level-0 offsets `(f_u, f_v)` before encoding (size, values).
+    #[allow(clippy::type_complexity)]
+    pub bump_offsets: Vec<(u32, u32, String, Vec<[f32; 2]>)>,
+    /// `offset_int_bits` of the offset encoding (range `2^bits`).
+    pub offset_int_bits: u32,
+    /// Offsets clamped by the encoding (all offset maps).
+    pub bump_clamped: u64,
+}
+
+/// One offset map to prepare: the source texture, the bump scale, and whether the source is
+/// a tangent-space normal map (else a height map, channel 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BumpSource {
+    pub texture: usize,
+    pub scale: f32,
+    pub normal_map: bool,
+}
+
+impl BumpSource {
+    fn of(m: &crate::scene::Material) -> Option<Self> {
+        m.bump.map(|texture| Self {
+            texture,
+            scale: m.bump_scale,
+            normal_map: m.bump_normal_map,
+        })
+    }
+
+    fn same(&self, o: &Self) -> bool {
+        self.texture == o.texture
+            && self.scale.to_bits() == o.scale.to_bits()
+            && self.normal_map == o.normal_map
+    }
+}
+
+/// The distinct offset maps of the scene's bump materials, in material order; offset map `k`
+/// is map `scene.textures.len() + k`.
+#[must_use]
+pub fn bump_sources(scene: &Scene) -> Vec<BumpSource> {
+    let mut out: Vec<BumpSource> = Vec::new();
+    for m in &scene.materials {
+        if let Some(b) = BumpSource::of(m) {
+            if !out.iter().any(|o| o.same(&b)) {
+                out.push(b);
+            }
+        }
+    }
+    out
+}
+
+/// Encodes offsets (range `2^offset_int_bits`) and builds the offset map's MIP chain with the
+/// ordinary texture path (16-bit unorm level 0, box-filtered levels). Returns the chain and
+/// the number of clamped offsets.
+fn offset_chain(w: u32, h: u32, name: &str, offs: &[[f32; 2]], bits: u32) -> (MipChain, u64) {
+    let enc = OffsetEncoding::for_offset_int_bits(bits);
+    let img = offsets_to_image(offs, w, h, &enc);
+    let tex = TextureImage {
+        name: format!("{name} (offsets)"),
+        width: w,
+        height: h,
+        texels: img
+            .texels
+            .iter()
+            .map(|t| t.map(|c| quantize_unorm(c, 16)))
+            .collect(),
+        prebuilt_levels: None,
+    };
+    (build_mip_chain(&tex), img.clamped)
 }
 
 impl Maps {
-    /// Builds every texture's MIP chain and quantizes it to `texel_bits`.
+    /// Builds every texture's MIP chain and quantizes it to `texel_bits`; bump height maps
+    /// become offset maps encoded for the default (texram16) `offset_int_bits`.
     #[must_use]
     pub fn new(scene: &Scene, texel_bits: u32) -> Self {
-        let float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
+        Self::with_offset_bits(
+            scene,
+            texel_bits,
+            hw_model::vector::VectorConfig::texram16().offset_int_bits,
+        )
+    }
+
+    /// As [`Maps::new`] with the offset encoding of `offset_int_bits`. A height map that
+    /// cannot be converted (bad size) gives a flat offset map.
+    #[must_use]
+    pub fn with_offset_bits(scene: &Scene, texel_bits: u32, offset_int_bits: u32) -> Self {
+        let mut float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
+        let mut bump_offsets = Vec::new();
+        for b in bump_sources(scene) {
+            let tex = &scene.textures[b.texture];
+            let p = BumpParams {
+                scale: b.scale,
+                v_up: false,
+            };
+            let offs = if b.normal_map {
+                normal_map_to_offsets(tex, true).map(|(o, _)| {
+                    o.into_iter()
+                        .map(|f| f.map(|x| x * b.scale))
+                        .collect::<Vec<_>>()
+                })
+            } else {
+                heights_from_texture(tex, 0)
+                    .and_then(|h| height_to_offsets(&h, tex.width, tex.height, &p))
+            }
+            .unwrap_or_else(|_| vec![[0.0; 2]; tex.texels.len()]);
+            bump_offsets.push((tex.width, tex.height, tex.name.clone(), offs));
+        }
+        let mut bump_clamped = 0;
+        for (w, h, name, offs) in &bump_offsets {
+            let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
+            float.push(c);
+            bump_clamped += cl;
+        }
         let fixed = float
             .par_iter()
             .map(|c| quantize_chain(c, texel_bits))
             .collect();
-        Self { float, fixed }
+        Self {
+            float,
+            fixed,
+            bump_offsets,
+            offset_int_bits,
+            bump_clamped,
+        }
+    }
+
+    /// Re-encodes the offset maps for another `offset_int_bits` if needed.
+    pub fn ensure_offset_bits(&mut self, offset_int_bits: u32) {
+        if self.offset_int_bits == offset_int_bits || self.bump_offsets.is_empty() {
+            self.offset_int_bits = offset_int_bits;
+            return;
+        }
+        let first = self.float.len() - self.bump_offsets.len();
+        let texel_bits = self.fixed.first().map_or(16, |f| f.texel_bits);
+        self.bump_clamped = 0;
+        for (k, (w, h, name, offs)) in self.bump_offsets.iter().enumerate() {
+            let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
+            self.fixed[first + k] = quantize_chain(&c, texel_bits);
+            self.float[first + k] = c;
+            self.bump_clamped += cl;
+        }
+        self.offset_int_bits = offset_int_bits;
     }
 
     /// Re-quantizes for another texel width if needed (sweeps reuse the float chains).
@@ -62,6 +204,12 @@ pub struct Geometry {
     pub clip: Vec<[f64; 4]>,
     pub color: Vec<[f64; 3]>,
     pub uv: Vec<[f64; 2]>,
+    /// Per-vertex bump data: empty unless some plan is bump mapped (then one per vertex;
+    /// default for vertices of other meshes).
+    pub bump: Vec<BumpVertex>,
+    /// World-space eye position and point-light positions (bump shading).
+    pub eye: [f64; 3],
+    pub point_lights: Vec<[f64; 3]>,
     pub draws: Vec<DrawTri>,
     /// Plan index of each draw.
     pub draw_plan: Vec<u32>,
@@ -83,7 +231,23 @@ impl Geometry {
             draws: Vec::with_capacity(scene.triangle_count()),
             draw_plan: Vec::with_capacity(scene.triangle_count()),
             plans: Vec::with_capacity(scene.meshes.len()),
+            bump: Vec::new(),
+            eye: scene
+                .camera
+                .view()
+                .inverse()
+                .transform_point3(DVec3::ZERO)
+                .to_array(),
+            point_lights: scene
+                .lights
+                .iter()
+                .filter_map(|l| match l {
+                    Light::Point { position, .. } => Some(position.map(f64::from)),
+                    Light::Directional { .. } => None,
+                })
+                .collect(),
         };
+        let sources = bump_sources(scene);
         for (mi, mesh) in scene.meshes.iter().enumerate() {
             let mat = &scene.materials[mesh.material];
             let base = g.clip.len() as u32;
@@ -103,7 +267,18 @@ impl Geometry {
                 g.color.push(c.clamp(DVec3::ZERO, DVec3::ONE).to_array());
                 g.uv.push(mesh.uvs.get(vi).map_or([0.0; 2], |t| t.map(f64::from)));
             }
-            g.plans.push(plan(mat, !mesh.uvs.is_empty()));
+            let bump_map = BumpSource::of(mat).and_then(|b| {
+                sources
+                    .iter()
+                    .position(|o| o.same(&b))
+                    .map(|k| scene.textures.len() + k)
+            });
+            let p = plan_with_bump(mat, !mesh.uvs.is_empty(), bump_map);
+            if let Some(bp) = &p.bump {
+                g.bump.resize(base as usize, BumpVertex::default());
+                g.bump.extend(bump_vertices(mesh, bp));
+            }
+            g.plans.push(p);
             for t in &mesh.indices {
                 g.draws.push(DrawTri {
                     v: t.map(|i| base + i),
@@ -114,6 +289,68 @@ impl Geometry {
         }
         g
     }
+}
+
+/// Per-vertex bump data of `mesh` (Schilling 1997 frame 1 via `reference::natural_vertex`,
+/// with per-object reference lengths: the mean `|p_u x p_v| / |p_v|` and `/ |p_u|`). Where the
+/// natural frame is undefined (UV-degenerate vertex), the directions come from the fallback
+/// tangent of `tangents::generate_tangents` (`d_u = -T`, `d_v = -B`) with length 1.
+fn bump_vertices(mesh: &Mesh, bp: &BumpPlan) -> Vec<BumpVertex> {
+    let (pos, nor, uvs, idx) = (&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
+    let der = generate_uv_derivatives(pos, nor, uvs, idx);
+    let tan = generate_tangents(pos, nor, uvs, idx);
+    let v3 = |a: [f32; 3]| DVec3::from(a.map(f64::from));
+    let (mut ru, mut rv, mut cnt) = (0.0, 0.0, 0.0);
+    for d in &der {
+        let (pu, pv) = (v3(d[0]), v3(d[1]));
+        let g = pu.cross(pv).length();
+        if g > 0.0 && g.is_finite() {
+            ru += g / pv.length();
+            rv += g / pu.length();
+            cnt += 1.0;
+        }
+    }
+    let (ref_u, ref_v) = if cnt > 0.0 {
+        (ru / cnt, rv / cnt)
+    } else {
+        (1.0, 1.0)
+    };
+    pos.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let n = nor.get(i).map_or(DVec3::Z, |&n| v3(n));
+            let n = fref::normalize_or(n, DVec3::Z).0;
+            let t = tan.get(i).copied().unwrap_or([1.0, 0.0, 0.0, 1.0]);
+            let tt = DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]));
+            let bb = f64::from(t[3]) * n.cross(tt);
+            let d = der.get(i).copied().unwrap_or([[0.0; 3]; 2]);
+            let (pu, pv) = (v3(d[0]), v3(d[1]));
+            let (du, dv, len) = match fref::natural_vertex(n, pu, pv, ref_u, ref_v) {
+                Some(nv) => (nv.dir_u, nv.dir_v, [nv.len_u, nv.len_v]),
+                None => (-tt, -bb, [1.0, 1.0]),
+            };
+            let m = match bp.main {
+                MainDirection::Pu => fref::normalize_or(pu, tt).0,
+                MainDirection::Pv => fref::normalize_or(pv, bb).0,
+                MainDirection::Constant(_) => DVec3::ZERO,
+            };
+            let fin = |v: DVec3| {
+                if v.is_finite() {
+                    v.to_array()
+                } else {
+                    [0.0; 3]
+                }
+            };
+            BumpVertex {
+                n: fin(n),
+                du: fin(du),
+                dv: fin(dv),
+                len: len.map(|l| if l.is_finite() { l } else { 1.0 }),
+                m: fin(m),
+                p: p.map(f64::from),
+            }
+        })
+        .collect()
 }
 
 /// Lambert irradiance at `p` with unit normal `n` (ambient + each light's n.l).
@@ -179,6 +416,37 @@ pub struct StageStats {
     pub texels: u64,
 }
 
+/// Bump-mapping events: frames from a fallback, zero interpolated normals, `l + v = 0`,
+/// non-finite float carriers (hardware and reference pass), offsets clamped by the map
+/// encoding. Format saturations are in the per-stage `saturated` counts.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct BumpStats {
+    pub frame_fallback: u64,
+    pub zero_normal: u64,
+    pub h_zero: u64,
+    pub nonfinite: u64,
+    pub ref_nonfinite: u64,
+    pub offset_clamped: u64,
+    /// The frames the bump materials used (`natural`, `unit`, `main`), empty without bumps.
+    pub frame: String,
+}
+
+fn bump_frames(geo: &Geometry, hw: &HwConfig) -> String {
+    let mut kinds: Vec<&str> = geo
+        .plans
+        .iter()
+        .filter_map(|p| p.bump.as_ref())
+        .map(|b| match b.frame.unwrap_or(hw.shading.frame.frame_kind) {
+            FrameKind::Natural => "natural",
+            FrameKind::Unit => "unit",
+            FrameKind::Main => "main",
+        })
+        .collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    kinds.join("+")
+}
+
 /// Wall times in milliseconds.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Timings {
@@ -228,6 +496,8 @@ pub struct RenderStats {
     pub covered_pixels: u64,
     /// Host-to-hardware conversions that saturated (vertex attributes out of format range).
     pub input_saturated: u64,
+    /// Bump-mapping events of the hardware pass (all zero without bump materials).
+    pub bump: BumpStats,
     pub stages: Vec<StageStats>,
     pub cycles: CycleEstimate,
     pub timings: Timings,
@@ -238,6 +508,58 @@ pub struct RenderStats {
 
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Bump data of every screen triangle of a bump plan (clipped vertices blended from their
+/// source vertices); sets `TriAttrs::bump`.
+fn bump_attrs(
+    setup: &Setup,
+    geo: &Geometry,
+    m: &Machine,
+    attrs: &mut [TriAttrs],
+) -> (Vec<BumpAttrs>, SatCounter) {
+    let mut out = Vec::new();
+    let mut sat = SatCounter::default();
+    if geo.bump.is_empty() {
+        return (out, sat);
+    }
+    for (t, a) in setup.tris.iter().zip(attrs.iter_mut()) {
+        let plan = &geo.plans[a.plan as usize];
+        if plan.bump.is_none() {
+            continue;
+        }
+        let d = &geo.draws[t.src as usize];
+        let blend = |k: usize| -> BumpVertex {
+            let w = t.src_bary[k];
+            let mut r = BumpVertex::default();
+            for (&wj, &vi) in w.iter().zip(&d.v) {
+                let Some(b) = geo.bump.get(vi as usize) else {
+                    continue;
+                };
+                for c in 0..3 {
+                    r.n[c] += wj * b.n[c];
+                    r.du[c] += wj * b.du[c];
+                    r.dv[c] += wj * b.dv[c];
+                    r.m[c] += wj * b.m[c];
+                    r.p[c] += wj * b.p[c];
+                }
+                for c in 0..2 {
+                    r.len[c] += wj * b.len[c];
+                }
+            }
+            r
+        };
+        let verts = [blend(0), blend(1), blend(2)];
+        a.bump = out.len() as u32;
+        out.push(BumpAttrs::new(
+            m,
+            &verts,
+            geo.eye,
+            &geo.point_lights,
+            &mut sat,
+        ));
+    }
+    (out, sat)
 }
 
 /// Per-triangle attributes of every screen triangle, in the machine's formats.
@@ -290,7 +612,7 @@ struct ShadeInput<'a> {
     geo: &'a Geometry,
     m: &'a Machine<'a>,
     /// Cost of each stage kind, per plan.
-    costs: &'a [[UnitCost; 6]],
+    costs: &'a [[UnitCost; StageKind::COUNT]],
 }
 
 /// Shades every covered pixel with `impls`; returns the image and the counters.
@@ -349,12 +671,36 @@ pub fn render(
     let t = Instant::now();
     let geo = Geometry::new(scene);
     tm.geometry_ms = ms(t);
+    let bumped = geo.plans.iter().any(|p| p.bump.is_some());
+    if bumped && geo.point_lights.len() > MAX_POINT_LIGHTS {
+        return Err(crate::Error::field(
+            "lights",
+            format!(
+                "{} point lights; bump-mapped materials shade at most {MAX_POINT_LIGHTS} per pixel",
+                geo.point_lights.len()
+            ),
+        ));
+    }
+    let offset_bits = hw.shading.vector.offset_int_bits;
+    let reencoded;
+    let maps = if maps.offset_int_bits == offset_bits || maps.bump_offsets.is_empty() {
+        maps
+    } else {
+        let mut mm = maps.clone();
+        mm.ensure_offset_bits(offset_bits);
+        reencoded = mm;
+        &reencoded
+    };
 
     let t = Instant::now();
     let setup = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &hw.raster);
-    let m = Machine::new(hw, &maps.float, &maps.fixed);
-    let (attrs, input_sat) = tri_attrs(&setup, &geo, &m);
-    let costs: Vec<[UnitCost; 6]> = geo.plans.iter().map(|p| m.plan_costs(p)).collect();
+    let m0 = Machine::new(hw, &maps.float, &maps.fixed).with_lights(&scene.lights, scene.ambient);
+    let (mut attrs, mut input_sat) = tri_attrs(&setup, &geo, &m0);
+    let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
+    input_sat.add(&bsat);
+    let m = m0.with_bump_attrs(&battrs);
+    let costs: Vec<[UnitCost; StageKind::COUNT]> =
+        geo.plans.iter().map(|p| m.plan_costs(p)).collect();
     tm.setup_ms = ms(t);
 
     let t = Instant::now();
@@ -377,6 +723,7 @@ pub fn render(
 
     let mut mask: Vec<bool> = vis.tri.iter().map(|&t| t != NO_TRI).collect();
     let mut ref_image = None;
+    let mut ref_nonfinite = 0;
     let (mut e8, mut e16) = (None, None);
     if opts.reference {
         let ref_vis;
@@ -396,7 +743,8 @@ pub fn render(
             }
         };
         let t = Instant::now();
-        let (img, _) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg);
+        let (img, rc) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg);
+        ref_nonfinite = rc.nonfinite;
         tm.shade_ref_ms = ms(t);
         tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
         e8 = Some(compare(&hw_image, &img, 8, Some(&mask)));
@@ -404,7 +752,7 @@ pub fn render(
         ref_image = Some(img);
     }
 
-    let mut stages = Vec::with_capacity(6);
+    let mut stages = Vec::with_capacity(StageKind::COUNT);
     let mut stage_cycles = 0u64;
     for kind in StageKind::ALL {
         let k = kind.index();
@@ -449,6 +797,15 @@ pub fn render(
             raster: raster_stats,
             covered_pixels: covered,
             input_saturated: input_sat.saturated,
+            bump: BumpStats {
+                frame_fallback: counters.frame_fallback,
+                zero_normal: counters.zero_normal,
+                h_zero: counters.h_zero,
+                nonfinite: counters.nonfinite,
+                ref_nonfinite,
+                offset_clamped: if bumped { maps.bump_clamped } else { 0 },
+                frame: bump_frames(&geo, hw),
+            },
             stages,
             cycles,
             timings: tm,

@@ -65,6 +65,14 @@ pub fn text(s: &RenderStats) -> String {
             s.input_saturated
         );
     }
+    let b = &s.bump;
+    if !b.frame.is_empty() {
+        let _ = writeln!(
+            o,
+            "bump mapping: frame {}; {} frame fallbacks, {} zero normals, {} l+v=0, {} offsets clamped by the map encoding, {}/{} non-finite float carriers (hw/ref)",
+            b.frame, b.frame_fallback, b.zero_normal, b.h_zero, b.offset_clamped, b.nonfinite, b.ref_nonfinite
+        );
+    }
     let c = &s.cycles;
     let _ = writeln!(
         o,

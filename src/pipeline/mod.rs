@@ -11,9 +11,10 @@
 //! of Fixed stages is bit-accurate, and a Fixed stage after a Float one sees the float value
 //! rounded into its input format (how a mixed run isolates one stage's error).
 
+pub mod bump_stages;
 pub mod stages;
 
-use crate::scene::{Material, WrapMode};
+use crate::scene::{FrameKind, MainDirection, Material, WrapMode};
 use serde::Serialize;
 use std::fmt;
 
@@ -33,17 +34,35 @@ pub enum StageKind {
     Trilinear,
     /// Colour x texel.
     Modulate,
+    /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
+    Normal,
+    /// Bump materials: LOD + trilinear fetch of the offset map `(f_u, f_v)`.
+    BumpFetch,
+    /// Bump materials: the local frame (natural, unit or main direction).
+    Frame,
+    /// Bump materials: `n' = normalize(n + f_u s_u + f_v s_v)`.
+    Perturb,
+    /// Bump materials: per-pixel Blinn-Phong over every scene light (+ ambient).
+    Phong,
 }
 
 impl StageKind {
-    /// Every stage kind, in pipeline order.
-    pub const ALL: [StageKind; 6] = [
+    /// Number of stage kinds.
+    pub const COUNT: usize = 11;
+
+    /// Every stage kind, in pipeline order (the bump stages follow the texture stages).
+    pub const ALL: [StageKind; StageKind::COUNT] = [
         StageKind::Bary,
         StageKind::Color,
         StageKind::Texcoord,
         StageKind::Lod,
         StageKind::Trilinear,
         StageKind::Modulate,
+        StageKind::Normal,
+        StageKind::BumpFetch,
+        StageKind::Frame,
+        StageKind::Perturb,
+        StageKind::Phong,
     ];
 
     /// The name used on the command line and in reports.
@@ -56,6 +75,11 @@ impl StageKind {
             StageKind::Lod => "lod",
             StageKind::Trilinear => "trilinear",
             StageKind::Modulate => "modulate",
+            StageKind::Normal => "normal",
+            StageKind::BumpFetch => "bump-fetch",
+            StageKind::Frame => "frame",
+            StageKind::Perturb => "perturb",
+            StageKind::Phong => "phong",
         }
     }
 
@@ -98,13 +122,13 @@ pub enum Impl {
 
 /// Which twin each stage kind uses in one run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StageImpls(pub [Impl; 6]);
+pub struct StageImpls(pub [Impl; StageKind::COUNT]);
 
 impl StageImpls {
     /// Every stage fixed: the hardware.
-    pub const FIXED: StageImpls = StageImpls([Impl::Fixed; 6]);
+    pub const FIXED: StageImpls = StageImpls([Impl::Fixed; StageKind::COUNT]);
     /// Every stage float: the reference.
-    pub const FLOAT: StageImpls = StageImpls([Impl::Float; 6]);
+    pub const FLOAT: StageImpls = StageImpls([Impl::Float; StageKind::COUNT]);
 
     /// The twin used for `kind`.
     #[must_use]
@@ -139,6 +163,23 @@ pub struct Plan {
     pub derivatives: bool,
     /// Texture addressing of s and t.
     pub wrap: [WrapMode; 2],
+    /// Bump mapping and per-pixel shading, for bump-mapped materials.
+    pub bump: Option<BumpPlan>,
+}
+
+/// What the bump stages of one material need.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BumpPlan {
+    /// Index of the offset map in the prepared maps (after the scene's textures).
+    pub map: usize,
+    /// The material's frame; `None` uses the hardware's `frame_kind`.
+    pub frame: Option<FrameKind>,
+    /// Main direction of the main frame.
+    pub main: MainDirection,
+    /// Diffuse and specular colours (0..1) and the specular exponent.
+    pub kd: [f64; 3],
+    pub ks: [f64; 3],
+    pub shininess: u32,
 }
 
 impl Plan {
@@ -150,10 +191,50 @@ impl Plan {
 }
 
 /// Builds the plan of one material. `has_uvs`: the mesh supplies texture coordinates.
+/// (Bump maps need the offset-map index: see [`plan_with_bump`]; here they are ignored.)
 #[must_use]
 pub fn plan(material: &Material, has_uvs: bool) -> Plan {
-    let mut stages = Vec::with_capacity(6);
+    plan_with_bump(material, has_uvs, None)
+}
+
+/// Builds the plan of one material whose bump height map (if any) was prepared as offset map
+/// `bump_map`. A bump material with texture coordinates runs `bary`, `texcoord` (with
+/// derivatives), the diffuse texture's `lod` and `trilinear` when textured, then `normal`,
+/// `bump-fetch`, `frame`, `perturb`, `phong`; it is lit per pixel whatever `lit` says.
+/// Without UVs or without `bump_map` the material is planned as if it had no bump map.
+#[must_use]
+pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize>) -> Plan {
     let textured = material.texture.is_some() && has_uvs;
+    if let (Some(map), true, Some(_)) = (bump_map, has_uvs, material.bump) {
+        let mut stages = vec![StageKind::Bary, StageKind::Texcoord];
+        if textured {
+            stages.extend([StageKind::Lod, StageKind::Trilinear]);
+        }
+        stages.extend([
+            StageKind::Normal,
+            StageKind::BumpFetch,
+            StageKind::Frame,
+            StageKind::Perturb,
+            StageKind::Phong,
+        ]);
+        let kd = material.kd.map(f64::from);
+        return Plan {
+            stages,
+            texture: if textured { material.texture } else { None },
+            const_color: [kd[0], kd[1], kd[2], 1.0],
+            derivatives: true,
+            wrap: [material.wrap_s, material.wrap_t],
+            bump: Some(BumpPlan {
+                map,
+                frame: material.frame,
+                main: material.main_direction,
+                kd,
+                ks: material.ks.map(f64::from),
+                shininess: material.shininess,
+            }),
+        };
+    }
+    let mut stages = Vec::with_capacity(6);
     let kd = material.kd.map(f64::from);
     let white = kd.iter().all(|&c| c == 1.0);
     if material.lit || textured {
@@ -174,6 +255,7 @@ pub fn plan(material: &Material, has_uvs: bool) -> Plan {
         const_color: [kd[0], kd[1], kd[2], 1.0],
         derivatives: textured,
         wrap: [material.wrap_s, material.wrap_t],
+        bump: None,
     }
 }
 
@@ -208,4 +290,46 @@ pub struct Frag {
     /// Raw output and its unorm width; `out_bits == 0` means the output is the float carrier.
     pub out_x: [u32; 4],
     pub out_bits: u32,
+    /// Bump stages (vectors in vector format `s1.F` when raw, lengths in len format).
+    pub bump: BumpFrag,
+}
+
+/// Most point lights shaded per pixel by a bump material (their vectors are interpolated).
+pub const MAX_POINT_LIGHTS: usize = 4;
+
+/// Per-fragment signals of the bump stages: carriers and raw values (`*_x`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BumpFrag {
+    /// Interpolated normal, directions of `s_u`, `s_v`, main direction.
+    pub n_i: [f64; 3],
+    pub n_i_x: [i64; 3],
+    pub d_u: [f64; 3],
+    pub d_u_x: [i64; 3],
+    pub d_v: [f64; 3],
+    pub d_v_x: [i64; 3],
+    pub m: [f64; 3],
+    pub m_x: [i64; 3],
+    /// Interpolated lengths of `s_u`, `s_v` (natural frame).
+    pub len: [f64; 2],
+    pub len_x: [i64; 2],
+    /// Interpolated (per-triangle scaled) vectors towards the eye and each point light.
+    pub to_eye: [f64; 3],
+    pub to_eye_x: [i64; 3],
+    pub to_light: [[f64; 3]; MAX_POINT_LIGHTS],
+    pub to_light_x: [[i64; 3]; MAX_POINT_LIGHTS],
+    /// Filtered offset-map channels (unorm) and their raw texels.
+    pub texel: [f64; 2],
+    pub texel_x: [u32; 2],
+    /// The frame: normal, the two tangents, the two lengths.
+    pub fr_n: [f64; 3],
+    pub fr_n_x: [i64; 3],
+    pub fr_t_u: [f64; 3],
+    pub fr_t_u_x: [i64; 3],
+    pub fr_t_v: [f64; 3],
+    pub fr_t_v_x: [i64; 3],
+    pub fr_len: [f64; 2],
+    pub fr_len_x: [i64; 2],
+    /// The perturbed unit normal.
+    pub normal: [f64; 3],
+    pub normal_x: [i64; 3],
 }

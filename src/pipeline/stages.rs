@@ -3,7 +3,8 @@
 //! [`run`]. Per-triangle vertex data is prepared once ([`TriAttrs`]), in float and in the
 //! hardware's input formats, so the per-pixel loop allocates nothing.
 
-use super::{Frag, Impl, Plan, StageImpls, StageKind};
+use super::bump_stages::{self, run_bump_stage, BumpAttrs};
+use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
@@ -11,8 +12,13 @@ use crate::reference::{
     interpolate_f64, lod_f64, perspective_bary_derivs_f64, perspective_bary_f64, trilinear_f64,
     LevelF,
 };
+use crate::scene::{FrameKind, Light};
+use crate::shading::reference as fref;
+use glam::DVec3;
+use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
+use hw_model::frame::{frame_cost, len_format, perturb_cost};
 use hw_model::interpolator::{
     interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
     perspective_bary_derivs, perspective_bary_derivs_cost,
@@ -20,24 +26,38 @@ use hw_model::interpolator::{
 use hw_model::lod::{lod, lod_cost};
 use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
 use hw_model::reciprocal::Reciprocal;
+use hw_model::rsqrt::rsqrt_cost;
 use hw_model::trilinear::{trilinear, trilinear_cost, Level};
+use hw_model::vector::{normalize_cost, vector_format};
 use hw_model::UnitCost;
 
 /// Per-stage counters of one run (summed over fragments; order-independent integer sums).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Counters {
     /// Invocations per stage kind (index = `StageKind::index`).
-    pub invocations: [u64; 6],
+    pub invocations: [u64; StageKind::COUNT],
     /// Overflow events per stage kind.
-    pub sat: [SatCounter; 6],
+    pub sat: [SatCounter; StageKind::COUNT],
     /// Cost per stage kind, summed over invocations (ops, cycles, texels).
-    pub cost: [[u64; 3]; 6],
+    pub cost: [[u64; 3]; StageKind::COUNT],
+    /// Bump frames built from a fallback (main-direction cone, zero tangent direction).
+    pub frame_fallback: u64,
+    /// Bump frames whose interpolated normal was zero.
+    pub zero_normal: u64,
+    /// Blinn-Phong evaluations with `l + v = 0`.
+    pub h_zero: u64,
+    /// Non-finite float carriers replaced by 0 before conversion (float twins).
+    pub nonfinite: u64,
 }
 
 impl Counters {
     /// Adds another set of counters.
     pub fn add(&mut self, o: &Counters) {
-        for i in 0..6 {
+        self.frame_fallback += o.frame_fallback;
+        self.zero_normal += o.zero_normal;
+        self.h_zero += o.h_zero;
+        self.nonfinite += o.nonfinite;
+        for i in 0..StageKind::COUNT {
             self.invocations[i] += o.invocations[i];
             self.sat[i].add(&o.sat[i]);
             for j in 0..3 {
@@ -62,6 +82,32 @@ pub struct Machine<'a> {
     /// Per texture: fixed levels and float levels.
     pub tex_fixed: Vec<Vec<Level<'a>>>,
     pub tex_float: Vec<Vec<LevelF<'a>>>,
+    /// Bump/shading units (rsqrt and pow tables built once).
+    pub units: ShadingUnits,
+    /// Vector components: signed 1.F (`vector_frac_bits`).
+    pub vec_fmt: Format,
+    /// Natural-frame lengths: unsigned `frame_len_int_bits.frame_len_frac_bits`.
+    pub len_fmt: Format,
+    /// The scene lights as the Phong stage sees them ([`Machine::with_lights`]).
+    pub lights: Vec<ShadeLight>,
+    /// Ambient light (0..1) and as `shade_color_bits` unorm.
+    pub ambient: [f64; 3],
+    pub ambient_x: [u64; 3],
+    /// Per-triangle bump data ([`TriAttrs::bump`] indexes it).
+    pub bump_attrs: &'a [BumpAttrs],
+}
+
+/// One scene light for per-pixel shading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadeLight {
+    /// Index of the point light's interpolated vector, `None` for a directional light.
+    pub point: Option<usize>,
+    /// Unit direction towards a directional light (float and vector format).
+    pub l_f: [f64; 3],
+    pub l_x: [i64; 3],
+    /// Colour (0..1 per channel, clamped) and as `shade_color_bits` unorm.
+    pub color_f: [f64; 3],
+    pub color_x: [u64; 3],
 }
 
 impl<'a> Machine<'a> {
@@ -102,13 +148,72 @@ impl<'a> Machine<'a> {
                         .collect()
                 })
                 .collect(),
+            units: ShadingUnits::new(&hw.shading),
+            vec_fmt: vector_format(&hw.shading.vector),
+            len_fmt: len_format(&hw.shading.frame, hw.shading.vector.vector_rounding),
+            lights: Vec::new(),
+            ambient: [0.0; 3],
+            ambient_x: [0; 3],
+            bump_attrs: &[],
         }
+    }
+
+    /// Sets the lights of per-pixel (bump) shading: directional lights as constant unit
+    /// directions, the first [`MAX_POINT_LIGHTS`] point lights through interpolated vectors
+    /// (further point lights are not shaded per pixel; `render` rejects such scenes).
+    #[must_use]
+    pub fn with_lights(mut self, lights: &[Light], ambient: [f32; 3]) -> Self {
+        let cb = self.hw.shading.shade.shade_color_bits;
+        let f = self.hw.shading.vector.vector_frac_bits;
+        let mut np = 0;
+        self.lights = lights
+            .iter()
+            .filter_map(|l| {
+                let (point, dir, col) = match l {
+                    Light::Directional { direction, color } => {
+                        let d = -DVec3::from(direction.map(f64::from));
+                        (None, fref::normalize_or(d, DVec3::Z).0, color)
+                    }
+                    Light::Point { color, .. } => {
+                        np += 1;
+                        if np > MAX_POINT_LIGHTS {
+                            return None;
+                        }
+                        (Some(np - 1), DVec3::Z, color)
+                    }
+                };
+                let color_f = col.map(|c| f64::from(c).clamp(0.0, 1.0));
+                Some(ShadeLight {
+                    point,
+                    l_f: dir.to_array(),
+                    l_x: fref::to_vec3x(dir, f),
+                    color_f,
+                    color_x: color_f.map(|c| u64::from(to_unorm(c, cb))),
+                })
+            })
+            .collect();
+        self.ambient = ambient.map(|c| f64::from(c).clamp(0.0, 1.0));
+        self.ambient_x = self.ambient.map(|c| u64::from(to_unorm(c, cb)));
+        self
+    }
+
+    /// Uses `attrs` as the per-triangle bump data.
+    #[must_use]
+    pub fn with_bump_attrs(mut self, attrs: &'a [BumpAttrs]) -> Self {
+        self.bump_attrs = attrs;
+        self
+    }
+
+    /// The frame a bump plan uses: its material's, else the hardware's `frame_kind`.
+    #[must_use]
+    pub fn frame_of(&self, bp: &BumpPlan) -> FrameKind {
+        bp.frame.unwrap_or(self.hw.shading.frame.frame_kind)
     }
 
     /// Cost of one invocation of each stage kind of `plan` (zero for absent stages).
     #[must_use]
-    pub fn plan_costs(&self, plan: &Plan) -> [UnitCost; 6] {
-        let mut c = [UnitCost::default(); 6];
+    pub fn plan_costs(&self, plan: &Plan) -> [UnitCost; StageKind::COUNT] {
+        let mut c = [UnitCost::default(); StageKind::COUNT];
         for &k in &plan.stages {
             c[k.index()] = self.stage_cost(k, plan);
         }
@@ -128,6 +233,44 @@ impl<'a> Machine<'a> {
             StageKind::Lod => lod_cost(&self.hw.lod),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
+            _ => self.bump_stage_cost(kind, plan),
+        }
+    }
+
+    /// Cost of one invocation of a bump stage of `plan` (zero without a bump plan).
+    fn bump_stage_cost(&self, kind: StageKind, plan: &Plan) -> UnitCost {
+        let Some(bp) = &plan.bump else {
+            return UnitCost::default();
+        };
+        let u = &self.units;
+        let fk = self.frame_of(bp);
+        let np = bump_stages::point_lights(self) as u32;
+        let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
+        let mac = UnitCost {
+            ops: 3,
+            cycles: u.cfg.shade.shade_cycles,
+            texels: 0,
+        };
+        match kind {
+            StageKind::Normal => interpolate_cost(&self.hw.interp)
+                .times(bump_stages::normal_attr_count(self, bp, fk)),
+            StageKind::BumpFetch => {
+                lod_cost(&self.hw.lod).plus(trilinear_cost(&self.hw.trilinear, 2))
+            }
+            StageKind::Frame => frame_cost(fk, u),
+            StageKind::Perturb => perturb_cost(u),
+            StageKind::Phong => {
+                let lights = self.lights.len() as u32;
+                let mut c = blinn_phong_cost(u)
+                    .times(lights)
+                    .plus(nz.times(1 + np))
+                    .plus(mac.times(1 + lights));
+                if plan.texture.is_some() {
+                    c = c.plus(mac);
+                }
+                c
+            }
+            _ => UnitCost::default(),
         }
     }
 }
@@ -144,6 +287,8 @@ pub struct TriAttrs {
     pub color_x: [[i64; 3]; 3],
     pub uv_f: [[f64; 2]; 3],
     pub uv_x: [[i64; 2]; 3],
+    /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
+    pub bump: u32,
 }
 
 impl TriAttrs {
@@ -171,17 +316,18 @@ impl TriAttrs {
             color_x: color.map(|c| c.map(|x| i64::from(to_unorm(x, cb)))),
             uv_f: uv,
             uv_x: uv.map(|t| t.map(|x| to_raw(x, &m.uv_fmt, sat))),
+            bump: u32::MAX,
         }
     }
 }
 
 #[inline]
-fn column<const N: usize>(v: &[[i64; N]; 3], c: usize) -> [i64; 3] {
+pub(crate) fn column<const N: usize>(v: &[[i64; N]; 3], c: usize) -> [i64; 3] {
     [v[0][c], v[1][c], v[2][c]]
 }
 
 #[inline]
-fn column_f<const N: usize>(v: &[[f64; N]; 3], c: usize) -> [f64; 3] {
+pub(crate) fn column_f<const N: usize>(v: &[[f64; N]; 3], c: usize) -> [f64; 3] {
     [v[0][c], v[1][c], v[2][c]]
 }
 
@@ -198,7 +344,7 @@ fn unorm(raw: u32, bits: u32) -> f64 {
 #[inline]
 pub fn run(
     plan: &Plan,
-    costs: &[UnitCost; 6],
+    costs: &[UnitCost; StageKind::COUNT],
     impls: &StageImpls,
     m: &Machine,
     tri: &ScreenTri,
@@ -398,6 +544,11 @@ pub fn run(
                     frag.out_bits = 0;
                 }
             }
+            StageKind::Normal
+            | StageKind::BumpFetch
+            | StageKind::Frame
+            | StageKind::Perturb
+            | StageKind::Phong => run_bump_stage(kind, plan, impls, m, a, frag, c),
         }
     }
 }

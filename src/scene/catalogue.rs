@@ -5,8 +5,10 @@
 use glam::{DMat4, DVec3};
 
 use super::geometry::{fit_camera, fit_light};
-use super::texture::{checker, mesa_texture, procedural, MESA_TEX_SIZE};
-use super::{shapes, Camera, Light, Material, Mesh, Scene, WrapMode};
+use super::texture::{
+    bricks_height, checker, mesa_texture, procedural, ripples_height, MESA_TEX_SIZE,
+};
+use super::{shapes, Camera, Light, MainDirection, Material, Mesh, Scene, WrapMode};
 use crate::{Error, Result};
 
 /// Built-in scene names with a one-line description (for `texsim scenes`).
@@ -15,6 +17,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("w1-plane", "Mesa anchor W1: 1024x1024, one textured quad receding to the horizon, unlit (GL_REPLACE)"),
     ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
     ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
+    ("bumps", "bump-mapped brick sphere, rippled torus and brick tile under a grazing directional light and a point light, 640x480"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -24,6 +27,7 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "w1-plane" => w1_plane(),
         "w2-mesh" => w2_mesh(),
         "sphere" => sphere()?,
+        "bumps" => bumps(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(
@@ -62,6 +66,7 @@ fn mesa_material() -> Material {
         wrap_t: WrapMode::Repeat,
         lit: false,
         cull_back: false,
+        ..Material::default()
     }
 }
 
@@ -232,4 +237,85 @@ fn sphere() -> Result<Scene> {
         hw: None,
         warnings: Vec::new(),
     })
+}
+
+/// `bumps`: three bump-mapped objects (frame from the hardware's `frame_kind`, so
+/// `--vary frame=...` switches all of them): a UV sphere with bricks (poles, seam), a torus
+/// with ripples and a brick tile lying flat, lit by a directional light 8 degrees above the
+/// tile (grazing) and a point light.
+fn bumps() -> Scene {
+    let mut ball = shapes::sphere(0.8, 48, 24);
+    ball.name = "brick-sphere".into();
+    ball.material = 0;
+    super::geometry::transform_mesh(
+        &mut ball,
+        &(DMat4::from_translation(DVec3::new(-0.95, 0.85, 0.0))
+            * DMat4::from_rotation_y(20f64.to_radians())),
+    );
+    let mut torus = shapes::torus(0.55, 0.22, 64, 32, 2.0);
+    torus.name = "ripple-torus".into();
+    torus.material = 1;
+    super::geometry::transform_mesh(
+        &mut torus,
+        &(DMat4::from_translation(DVec3::new(1.0, 0.75, 0.1))
+            * DMat4::from_rotation_y((-30f64).to_radians())
+            * DMat4::from_rotation_x((-60f64).to_radians())),
+    );
+    let mut tile = shapes::plane(4.4, 2.0);
+    tile.name = "brick-tile".into();
+    tile.material = 2;
+    let bump = |name: &str, kd: [f32; 3], tex: usize, scale: f32| Material {
+        name: name.into(),
+        kd,
+        bump: Some(tex),
+        bump_scale: scale,
+        ks: [0.35; 3],
+        shininess: 24,
+        cull_back: true,
+        ..Material::default()
+    };
+    let materials = vec![
+        bump("brick-sphere", [0.75, 0.38, 0.28], 0, 2.0),
+        Material {
+            main_direction: MainDirection::Pu,
+            ..bump("ripple-torus", [0.35, 0.55, 0.8], 1, 3.0)
+        },
+        Material {
+            main_direction: MainDirection::Constant([0.0, 0.0, -1.0]),
+            cull_back: false,
+            ..bump("brick-tile", [0.7, 0.66, 0.6], 0, 2.0)
+        },
+    ];
+    let graze = DVec3::new(-1.0, -(8f64.to_radians().tan()), -0.35).normalize();
+    Scene {
+        name: "bumps".into(),
+        width: 640,
+        height: 480,
+        camera: Camera {
+            eye: [0.0, 2.4, 3.6],
+            target: [0.0, 0.45, 0.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 45.0,
+            near: 0.1,
+            far: 50.0,
+            view_override: None,
+        },
+        lights: vec![
+            Light::Directional {
+                direction: [graze.x as f32, graze.y as f32, graze.z as f32],
+                color: [0.8, 0.75, 0.65],
+            },
+            Light::Point {
+                position: [0.3, 2.2, 1.6],
+                color: [0.45, 0.5, 0.6],
+            },
+        ],
+        ambient: [0.08, 0.08, 0.1],
+        background: [0.1, 0.11, 0.14, 1.0],
+        meshes: vec![ball, torus, tile],
+        materials,
+        textures: vec![bricks_height(256), ripples_height(256)],
+        hw: None,
+        warnings: Vec::new(),
+    }
 }

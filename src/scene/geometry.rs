@@ -267,6 +267,26 @@ pub fn validate(scene: &Scene) -> Result<()> {
                 "must be finite",
             ));
         }
+        let field = |f: &str| format!("materials[{mi}] '{}'.{f}", m.name);
+        if let Some(t) = m.bump {
+            if t >= scene.textures.len() {
+                return Err(Error::field(
+                    &field("bump"),
+                    format!("index {t} out of range ({} textures)", scene.textures.len()),
+                ));
+            }
+        }
+        if !m.bump_scale.is_finite() {
+            return Err(Error::field(&field("bump_scale"), "must be finite"));
+        }
+        if !finite3(&m.ks) || m.ks.iter().any(|&c| c < 0.0) {
+            return Err(Error::field(&field("ks"), "must be finite and >= 0"));
+        }
+        if let super::MainDirection::Constant(d) = m.main_direction {
+            if !finite3(&d) {
+                return Err(Error::field(&field("main_direction"), "must be finite"));
+            }
+        }
     }
     for (mi, mesh) in scene.meshes.iter().enumerate() {
         let what = |f: &str| format!("meshes[{mi}] '{}'.{f}", mesh.name);

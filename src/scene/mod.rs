@@ -79,7 +79,38 @@ pub struct Material {
     pub lit: bool,
     /// Cull back faces (counter-clockwise front faces, as OpenGL).
     pub cull_back: bool,
+    /// Index into [`Scene::textures`] of a height map (channel 0). When set, the material is
+    /// bump mapped and shaded per pixel (Blinn-Phong); the height map becomes an offset map
+    /// `(f_u, f_v)` when the maps are prepared.
+    pub bump: Option<usize>,
+    /// Bump height scale (multiplies the height differences per level-0 texel, or the offsets
+    /// of a normal map).
+    pub bump_scale: f32,
+    /// The `bump` texture is a tangent-space normal map, not a height map: OpenGL style, red
+    /// along `+s`, green towards the image's top row (`-t`, i.e. OBJ's `+v`), blue out.
+    pub bump_normal_map: bool,
+    /// Local frame of the bump mapping; `None` uses the hardware's `frame_kind`.
+    pub frame: Option<FrameKind>,
+    /// Main direction `m` of the main-direction frame.
+    pub main_direction: MainDirection,
+    /// Specular colour (per-pixel Blinn-Phong of bump-mapped materials).
+    pub ks: [f32; 3],
+    /// Specular exponent.
+    pub shininess: u32,
 }
+
+/// The main direction `m` of the main-direction frame (Schilling 1997, frame 3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MainDirection {
+    /// A constant world-space direction per object.
+    Constant([f32; 3]),
+    /// The surface derivative `p_u` (tangent), interpolated per pixel.
+    Pu,
+    /// The surface derivative `p_v` (bitangent), interpolated per pixel.
+    Pv,
+}
+
+pub use hw_model::frame::FrameKind;
 
 impl Default for Material {
     fn default() -> Self {
@@ -91,6 +122,13 @@ impl Default for Material {
             wrap_t: WrapMode::Repeat,
             lit: true,
             cull_back: false,
+            bump: None,
+            bump_scale: 1.0,
+            bump_normal_map: false,
+            frame: None,
+            main_direction: MainDirection::Pv,
+            ks: [0.0; 3],
+            shininess: 32,
         }
     }
 }

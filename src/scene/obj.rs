@@ -46,6 +46,13 @@ struct MtlEntry {
     name: String,
     kd: Option<[f32; 3]>,
     map_kd: Option<String>,
+    /// `bump` / `map_Bump`: a height map (with the `-bm` multiplier as bump scale).
+    map_bump: Option<String>,
+    /// `Ks` and `Ns` (used by per-pixel shading of bump-mapped materials).
+    ks: Option<[f32; 3]>,
+    ns: Option<f32>,
+    /// The bump map came from `norm` (a tangent-space normal map).
+    bump_is_normal_map: bool,
 }
 
 fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
@@ -71,6 +78,10 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     name: rest.to_string(),
                     kd: None,
                     map_kd: None,
+                    map_bump: None,
+                    ks: None,
+                    ns: None,
+                    bump_is_normal_map: false,
                 });
             }
             "Kd" => {
@@ -98,6 +109,51 @@ fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
                     .last_mut()
                     .ok_or_else(|| bad("map_Kd before any newmtl"))?;
                 cur.map_kd = Some(rest.to_string());
+            }
+            // Ks / Ns only matter to bump-mapped materials: malformed values are ignored
+            // (as they were before per-pixel shading existed).
+            "Ks" => {
+                let vals: Vec<f32> = rest
+                    .split_whitespace()
+                    .filter_map(|v| v.parse::<f32>().ok())
+                    .collect();
+                let ks = match vals.as_slice() {
+                    [r, g, b] => Some([*r, *g, *b]),
+                    [g] => Some([*g; 3]),
+                    _ => None,
+                };
+                if let (Some(ks), Some(cur)) = (ks, out.last_mut()) {
+                    if ks.iter().all(|c| c.is_finite() && *c >= 0.0) {
+                        cur.ks = Some(ks);
+                    }
+                }
+            }
+            "Ns" => {
+                if let (Ok(ns), Some(cur)) = (rest.parse::<f32>(), out.last_mut()) {
+                    if ns.is_finite() && ns >= 0.0 {
+                        cur.ns = Some(ns);
+                    }
+                }
+            }
+            "bump" | "map_Bump" | "map_bump" => {
+                if rest.is_empty() {
+                    return Err(bad("bump map without a file name"));
+                }
+                let cur = out
+                    .last_mut()
+                    .ok_or_else(|| bad("bump map before any newmtl"))?;
+                cur.map_bump = Some(rest.to_string());
+                cur.bump_is_normal_map = false;
+            }
+            "norm" | "map_Norm" | "map_norm" => {
+                if rest.is_empty() {
+                    return Err(bad("normal map without a file name"));
+                }
+                let cur = out
+                    .last_mut()
+                    .ok_or_else(|| bad("normal map before any newmtl"))?;
+                cur.map_bump = Some(rest.to_string());
+                cur.bump_is_normal_map = true;
             }
             _ => {}
         }
@@ -305,6 +361,12 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
         if let Some(kd) = e.kd {
             m.kd = kd;
         }
+        if let Some(ks) = e.ks {
+            m.ks = ks;
+        }
+        if let Some(ns) = e.ns {
+            m.shininess = ns.round().min(65535.0) as u32;
+        }
         if let Some(arg) = &e.map_kd {
             let (name, fallback, clamp) = parse_map_arg(arg);
             let mut file = mdir.join(&name);
@@ -349,6 +411,42 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                     m.wrap_s = WrapMode::ClampToEdge;
                     m.wrap_t = WrapMode::ClampToEdge;
                 }
+            }
+        }
+        if let Some(arg) = &e.map_bump {
+            let (name, _, _) = parse_map_arg(arg);
+            let toks: Vec<&str> = arg.split_whitespace().collect();
+            let bm = toks
+                .iter()
+                .position(|t| *t == "-bm")
+                .and_then(|i| toks.get(i + 1))
+                .and_then(|v| v.parse::<f32>().ok())
+                .filter(|v| v.is_finite());
+            let file = mdir.join(&name);
+            let idx = match tex_cache.get(&file) {
+                Some(i) => *i,
+                None => {
+                    let i = match decode_texture(&file) {
+                        Ok(t) => {
+                            textures.push(t);
+                            Some(textures.len() - 1)
+                        }
+                        Err(err) => {
+                            warnings.push(format!(
+                                "bump map '{name}' of material '{}' unusable ({err}); no bumps",
+                                e.name
+                            ));
+                            None
+                        }
+                    };
+                    tex_cache.insert(file.clone(), i);
+                    i
+                }
+            };
+            m.bump = idx;
+            m.bump_normal_map = e.bump_is_normal_map;
+            if let Some(bm) = bm {
+                m.bump_scale = bm;
             }
         }
         materials.push(m);

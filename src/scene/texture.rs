@@ -244,8 +244,63 @@ pub fn procedural(kind: &str, size: u32) -> Result<TextureImage> {
         }
         "mesa" => Ok(mesa_texture(size)),
         "tiles" => Ok(tiles(size)),
+        "bricks-height" => Ok(bricks_height(size)),
+        "ripples-height" => Ok(ripples_height(size)),
         other => Err(Error::msg(format!(
-            "unknown procedural texture '{other}' (known: checker, noise-checker, mesa, tiles)"
+            "unknown procedural texture '{other}' (known: checker, noise-checker, mesa, tiles, \
+             bricks-height, ripples-height)"
         ))),
     }
+}
+
+fn height_image(name: String, size: u32, h: impl Fn(f64, f64) -> f64) -> TextureImage {
+    let n = f64::from(size.max(1));
+    let mut texels = Vec::with_capacity(size as usize * size as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let v = h((f64::from(x) + 0.5) / n, (f64::from(y) + 0.5) / n).clamp(0.0, 1.0);
+            let c = (v * 65535.0).round() as u16;
+            texels.push([c, c, c, 65535]);
+        }
+    }
+    TextureImage {
+        name,
+        width: size,
+        height: size,
+        texels,
+        prebuilt_levels: None,
+    }
+}
+
+/// A brick height map (16-bit grey, tileable): 8 x 16 running-bond bricks at height 1 with
+/// bevelled edges down to mortar at 0.
+#[must_use]
+pub fn bricks_height(size: u32) -> TextureImage {
+    height_image(format!("bricks-height-{size}"), size, |s, t| {
+        let (rows, cols) = (16.0, 8.0);
+        let r = t * rows;
+        let shift = if (r.floor() as i64) % 2 == 0 {
+            0.0
+        } else {
+            0.5
+        };
+        let c = s * cols + shift;
+        // Distance to the nearest joint in brick-height units (a brick is 1 x 2 of them).
+        let dy = (r - r.floor()).min(r.ceil() - r);
+        let dx = (c - c.floor()).min(c.ceil() - c) * rows / cols;
+        let d = dy.min(dx);
+        let mortar = 0.06;
+        let bevel = 0.16;
+        let x = ((d - mortar) / bevel).clamp(0.0, 1.0);
+        x * x * (3.0 - 2.0 * x)
+    })
+}
+
+/// A ripple height map (16-bit grey, tileable): `0.5 + 0.5 sin` of two crossed waves.
+#[must_use]
+pub fn ripples_height(size: u32) -> TextureImage {
+    height_image(format!("ripples-height-{size}"), size, |s, t| {
+        let tau = std::f64::consts::TAU;
+        0.5 + 0.25 * (tau * 6.0 * s).sin() + 0.25 * (tau * 4.0 * (s + t)).sin()
+    })
 }

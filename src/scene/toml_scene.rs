@@ -10,7 +10,7 @@ use serde::Deserialize;
 use super::geometry::{bounding_sphere, fit_camera, fit_light, transform_mesh};
 use super::obj::{load_obj_parts, open_regular};
 use super::texture::{decode_texture, procedural, MAX_TEXTURE_SIDE};
-use super::{shapes, Camera, Light, Material, Mesh, Scene, WrapMode};
+use super::{shapes, Camera, FrameKind, Light, MainDirection, Material, Mesh, Scene, WrapMode};
 use crate::{Error, Result};
 
 #[derive(Deserialize)]
@@ -86,6 +86,42 @@ struct MaterialCfg {
     wrap_t: Option<WrapMode>,
     lit: Option<bool>,
     cull_back: Option<bool>,
+    /// Height map: a texture name of `[[textures]]` or an image file.
+    bump: Option<String>,
+    bump_scale: Option<f32>,
+    /// The bump texture is a tangent-space normal map.
+    bump_normal_map: Option<bool>,
+    frame: Option<FrameKind>,
+    main_direction: Option<MainDirCfg>,
+    ks: Option<[f32; 3]>,
+    shininess: Option<u32>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum MainDirCfg {
+    Vector([f32; 3]),
+    Name(String),
+}
+
+fn main_direction(field: &str, c: &MainDirCfg) -> Result<MainDirection> {
+    match c {
+        MainDirCfg::Vector(v) => {
+            if v.iter().all(|x| x.is_finite()) && v.iter().any(|&x| x != 0.0) {
+                Ok(MainDirection::Constant(*v))
+            } else {
+                Err(Error::field(field, "must be a finite non-zero vector"))
+            }
+        }
+        MainDirCfg::Name(n) => match n.as_str() {
+            "p_u" => Ok(MainDirection::Pu),
+            "p_v" => Ok(MainDirection::Pv),
+            other => Err(Error::field(
+                field,
+                format!("'{other}' is not [x, y, z], \"p_u\" or \"p_v\""),
+            )),
+        },
+    }
 }
 
 #[derive(Deserialize)]
@@ -312,7 +348,24 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             })?),
             None => None,
         };
+        let bump = match &m.bump {
+            Some(n) => Some(match tex_names.get(n) {
+                Some(&t) => t,
+                None => {
+                    let tex = decode_texture(&resolve(&base, n))
+                        .map_err(|e| e.context(format!("field '{}'", f("bump"))))?;
+                    tex_names.insert(n.clone(), textures.len());
+                    textures.push(tex);
+                    textures.len() - 1
+                }
+            }),
+            None => None,
+        };
         let def = Material::default();
+        let main_dir = match &m.main_direction {
+            Some(c) => main_direction(&f("main_direction"), c)?,
+            None => def.main_direction,
+        };
         materials.push(Material {
             name: m.name.clone(),
             kd: m
@@ -323,6 +376,13 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             wrap_t: m.wrap_t.unwrap_or(def.wrap_t),
             lit: m.lit.unwrap_or(def.lit),
             cull_back: m.cull_back.unwrap_or(def.cull_back),
+            bump,
+            bump_scale: m.bump_scale.unwrap_or(def.bump_scale),
+            bump_normal_map: m.bump_normal_map.unwrap_or(def.bump_normal_map),
+            frame: m.frame.or(def.frame),
+            main_direction: main_dir,
+            ks: m.ks.unwrap_or(def.ks),
+            shininess: m.shininess.unwrap_or(def.shininess),
         });
     }
     let mut default_mat: Option<usize> = None;
