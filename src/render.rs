@@ -472,7 +472,12 @@ pub fn render(
             }
         };
         let t = Instant::now();
-        let (img, _, _) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg, false);
+        let (img, _, _) = shade(
+            &ShadeInput { vis: rv, ..inp },
+            &StageImpls::FLOAT,
+            bg,
+            false,
+        );
         tm.shade_ref_ms = ms(t);
         tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
         e8 = Some(compare(&hw_image, &img, 8, Some(&mask)));

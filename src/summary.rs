@@ -136,7 +136,8 @@ const HEADER: [&str; 11] = [
 const TIMING_HEADER: &str = "timing_cycles";
 
 fn timing_cell(r: &SweepRow) -> String {
-    r.timing_cycles.map_or_else(|| "-".into(), |c| c.to_string())
+    r.timing_cycles
+        .map_or_else(|| "-".into(), |c| c.to_string())
 }
 
 fn cells(r: &SweepRow) -> Vec<String> {

@@ -54,6 +54,9 @@ pub struct TimingConfig {
     pub raster_fragments_per_cycle: u32,
     /// Pixels the shading pass issues per cycle.
     pub shade_pixels_per_cycle: u32,
+    /// Pixels in flight in the shading pass: pixel `i` issues only when pixel `i - n` is done
+    /// (the capacity of the pipeline registers and queues between the units).
+    pub shade_pixels_in_flight: u32,
     /// Arithmetic units are pipelined: one operation issues per cycle and its cycles from the
     /// unit configs are latency. When false, a unit is busy for all of its cycles (iterative).
     pub alu_pipelined: bool,
@@ -79,6 +82,7 @@ impl TimingConfig {
             texel_bytes: 8,
             raster_fragments_per_cycle: 1,
             shade_pixels_per_cycle: 1,
+            shade_pixels_in_flight: 16,
             alu_pipelined: false,
         }
     }
@@ -102,6 +106,7 @@ impl TimingConfig {
             texel_bytes: 8,
             raster_fragments_per_cycle: 1,
             shade_pixels_per_cycle: 1,
+            shade_pixels_in_flight: 64,
             alu_pipelined: true,
         }
     }
@@ -131,6 +136,12 @@ impl TimingConfig {
                 64,
             ),
             ("shade_pixels_per_cycle", self.shade_pixels_per_cycle, 1, 64),
+            (
+                "shade_pixels_in_flight",
+                self.shade_pixels_in_flight,
+                1,
+                4096,
+            ),
         ] {
             if v < lo || v > hi {
                 return Err(err(f, format!("{v} is out of range {lo}..={hi}")));

@@ -5,11 +5,11 @@
 
 use super::{Frag, Impl, Plan, StageImpls, StageKind};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
+use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
 use crate::reference::{interpolate_f64, lod_f64, perspective_bary_f64, trilinear_f64, LevelF};
 use hw_model::config::HwConfig;
-use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
 use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::footprint::{footprint, footprint_cost, footprint_filter};
 use hw_model::interpolator::{
@@ -123,9 +123,11 @@ impl<'a> Machine<'a> {
             StageKind::Color => interpolate_cost(i).times(3),
             StageKind::Texcoord => interpolate_cost(i).times(2 * samples),
             StageKind::Lod => lod_cost(&self.hw.lod),
-            StageKind::Trilinear if plan.derivatives => {
-                footprint_cost(&self.hw.trilinear, &self.hw.lod, self.hw.trilinear.aniso_probes)
-            }
+            StageKind::Trilinear if plan.derivatives => footprint_cost(
+                &self.hw.trilinear,
+                &self.hw.lod,
+                self.hw.trilinear.aniso_probes,
+            ),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
         }

@@ -18,7 +18,11 @@ use hw_model::HwConfig;
 
 /// Renders `scene` on `hw` with event collection (no float reference) and runs the timing
 /// model over the events.
-pub fn cycles(scene: &Scene, maps: &Maps, hw: &HwConfig) -> crate::Result<(Rendered, TimingReport)> {
+pub fn cycles(
+    scene: &Scene,
+    maps: &Maps,
+    hw: &HwConfig,
+) -> crate::Result<(Rendered, TimingReport)> {
     let opts = RenderOptions {
         reference: false,
         timing: true,

@@ -24,9 +24,14 @@
 //!   the footprint occupies the memory `max over banks of the summed busy cycles`; its latency
 //!   is that plus `cache_hit_cycles` when there is a cache. Bank conflicts: accesses beyond the
 //!   first in a bank within one footprint.
-//! - Stalls: cycles a pixel (or lookup) waited for a busy unit, by unit; plus the memory
-//!   cycles caused by bank conflicts (serialization beyond the slowest single access) and by
-//!   misses (a cache or page miss's cycles beyond a hit's).
+//! - In flight: pixel `i` issues at `max(i / shade_pixels_per_cycle, done(i - n))` with
+//!   `n = shade_pixels_in_flight`. Stalls: every cycle by which a pixel's issue is held back
+//!   by a full window is attributed to the unit where the pixel it waited for (`i - n`) lost
+//!   the most cycles waiting for a busy unit (memory, a filter unit or an arithmetic unit), or
+//!   to `latency` if that pixel never waited (the window is too small for the latency). The
+//!   stalls therefore sum to at most the shading pass. The memory's own time is split into
+//!   bank-conflict cycles (serialization beyond the slowest single access) and miss cycles (a
+//!   cache or page miss's cycles beyond a hit's), reported with the memory counters.
 
 use super::events::{FrameEvents, TexelFootprint};
 use crate::pipeline::StageKind;
@@ -84,6 +89,10 @@ pub struct TimingReport {
     pub units: Vec<UnitReport>,
     pub stalls: Vec<StallReport>,
     pub memory: MemoryReport,
+    /// Memory cycles caused by bank conflicts (serialization within footprints).
+    pub bank_conflict_cycles: u64,
+    /// Memory cycles caused by cache and page misses (beyond a hit's).
+    pub miss_cycles: u64,
     /// The unit with the most busy cycles.
     pub bottleneck: String,
     /// Events consumed (pixels + footprints + triangles + spans).
@@ -200,7 +209,9 @@ pub fn bank_of(x: u32, y: u32, w: u32, banks: u32, mode: BankInterleave) -> usiz
             let (bx, by) = tile(b);
             ((x % bx) + bx * (y % by)) as usize
         }
-        BankInterleave::Linear => ((u64::from(y) * u64::from(w) + u64::from(x)) % u64::from(b)) as usize,
+        BankInterleave::Linear => {
+            ((u64::from(y) * u64::from(w) + u64::from(x)) % u64::from(b)) as usize
+        }
     }
 }
 
@@ -360,12 +371,12 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
     // Visibility pass.
     let setup_busy = ev.triangles * u64::from(rc.setup_cycles);
     let traverse_busy = ev.spans * u64::from(rc.span_cycles)
-        + ev.fragments.div_ceil(u64::from(tc.raster_fragments_per_cycle.max(1)));
+        + ev.fragments
+            .div_ceil(u64::from(tc.raster_fragments_per_cycle.max(1)));
     let vis = if ev.triangles == 0 {
         0
     } else {
-        (setup_busy + traverse_busy / ev.triangles)
-            .max(u64::from(rc.setup_cycles) + traverse_busy)
+        (setup_busy + traverse_busy / ev.triangles).max(u64::from(rc.setup_cycles) + traverse_busy)
     };
 
     // Shading pass.
@@ -386,12 +397,35 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
     };
     let mut end = 0u64;
     let mut fp_start = 0usize;
+    // Causes: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2 latency.
+    let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
+    let mut stall_by = vec![0u64; nk + 3];
+    let win = tc.shade_pixels_in_flight.max(1) as usize;
+    let mut ring: Vec<(u64, usize)> = vec![(0, c_lat); win];
+    let mut last_issue = 0u64;
     for (i, px) in ev.pixels.iter().enumerate() {
         let fp_end = (px.fp_end as usize).min(ev.footprints.len());
         let fps = &ev.footprints[fp_start.min(fp_end)..fp_end];
         fp_start = fp_end;
-        let mut t = i as u64 / ppc;
+        let next_slot = u64::from(i as u64 % ppc == 0 && i > 0);
+        let ideal = (i as u64 / ppc).max(last_issue + next_slot);
+        let mut t = ideal;
+        if i >= win {
+            let (done, cause) = ring[i % win];
+            if done > t {
+                stall_by[cause] += done - t;
+                t = done;
+            }
+        }
+        last_issue = t;
+        let mut worst = (0u64, c_lat);
+        let mut note = |w: u64, cause: usize| {
+            if w > worst.0 {
+                worst = (w, cause);
+            }
+        };
         let Some(plan) = ev.plans.get(px.plan as usize) else {
+            ring[i % win] = (t, c_lat);
             continue;
         };
         for &(kind, cost) in &plan.stages {
@@ -412,6 +446,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
             if mine.is_empty() {
                 let c = u64::from(cost.cycles);
                 let s = alu[k].take(t, alu_occ(c));
+                note(s - t, k);
                 t = s + c;
                 continue;
             }
@@ -421,6 +456,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
                 .saturating_sub(lookups * u64::from(tri_cost.cycles))
                 .max(1);
             let s = alu[k].take(t, alu_occ(setup));
+            note(s - t, k);
             let ready = s + setup;
             let mut done = ready;
             let mut a = 0;
@@ -434,6 +470,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
                 for f in &mine[a..b] {
                     let (occ, lat) = mem.footprint(f);
                     let ms = mem_unit.take(ready, occ);
+                    note(ms - ready, c_mem);
                     data = data.max(ms + lat);
                 }
                 let nfp = (b - a) as u64;
@@ -448,11 +485,13 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
                     .min_by_key(|&j| (filters[j].free.max(data), j))
                     .unwrap_or(0);
                 let fs = filters[fu].take(data, occ);
+                note(fs - data, c_filt);
                 done = done.max(fs + lat.max(occ));
                 a = b;
             }
             t = done;
         }
+        ring[i % win] = (t, worst.1);
         end = end.max(t);
     }
     let shade = end;
@@ -504,33 +543,26 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
             _ => Some(u),
         })
         .map_or_else(String::new, |u| u.unit.clone());
-    let mut stalls = Vec::new();
-    stalls.push(StallReport {
+    let mut stalls = vec![StallReport {
         cause: "traverse waits for setup".into(),
         cycles: vis.saturating_sub(traverse_busy),
-    });
+    }];
     for kind in StageKind::ALL {
         stalls.push(StallReport {
             cause: format!("{} busy", kind.name()),
-            cycles: alu[kind.index()].stall,
+            cycles: stall_by[kind.index()],
         });
     }
-    stalls.push(StallReport {
-        cause: "memory busy".into(),
-        cycles: mem_unit.stall,
-    });
-    stalls.push(StallReport {
-        cause: "filter busy".into(),
-        cycles: filters.iter().map(|f| f.stall).sum(),
-    });
-    stalls.push(StallReport {
-        cause: "bank conflicts".into(),
-        cycles: mem.conflict_cycles,
-    });
-    stalls.push(StallReport {
-        cause: "cache/page misses".into(),
-        cycles: mem.miss_cycles,
-    });
+    for (cause, i) in [
+        ("memory busy", c_mem),
+        ("filter busy", c_filt),
+        ("latency", c_lat),
+    ] {
+        stalls.push(StallReport {
+            cause: cause.into(),
+            cycles: stall_by[i],
+        });
+    }
     let mut memory = mem.rep;
     if mem.cache.is_some() {
         memory.cache_hit_rate =
@@ -549,6 +581,8 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
         units,
         stalls,
         memory,
+        bank_conflict_cycles: mem.conflict_cycles,
+        miss_cycles: mem.miss_cycles,
         bottleneck,
         events: ev.len(),
     }

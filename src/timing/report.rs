@@ -22,7 +22,11 @@ pub fn text(r: &TimingReport) -> String {
         r.covered_pixels,
         r.cycles_per_pixel
     );
-    let _ = writeln!(o, "{:<12} {:>14} {:>12}", "unit", "busy cycles", "utilization");
+    let _ = writeln!(
+        o,
+        "{:<12} {:>14} {:>12}",
+        "unit", "busy cycles", "utilization"
+    );
     for u in &r.units {
         let _ = writeln!(
             o,
@@ -53,6 +57,11 @@ pub fn text(r: &TimingReport) -> String {
         m.dram_accesses,
         m.dram_page_hits,
         m.dram_page_misses
+    );
+    let _ = writeln!(
+        o,
+        "memory cycles from bank conflicts {}, from cache/page misses {}",
+        r.bank_conflict_cycles, r.miss_cycles
     );
     let _ = writeln!(o, "bottleneck: {}; {} events", r.bottleneck, r.events);
     o
