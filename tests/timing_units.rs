@@ -97,15 +97,30 @@ fn tiled_interleave_makes_2x2_conflict_free() {
 fn conflicts_are_counted_otherwise() {
     // Two tiled banks: bank = x mod 2, so the two texels of each column collide: 2 conflicts.
     assert_eq!(bank_of(3, 5, 16, 2, BankInterleave::Tiled), 1);
-    assert_eq!(footprint_conflicts(&fp(4, 7, 16, 16), 16, 2, BankInterleave::Tiled), 2);
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 16, 16), 16, 2, BankInterleave::Tiled),
+        2
+    );
     // One bank: everything collides (4 texels, 3 conflicts).
-    assert_eq!(footprint_conflicts(&fp(4, 7, 16, 16), 16, 1, BankInterleave::Tiled), 3);
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 16, 16), 16, 1, BankInterleave::Tiled),
+        3
+    );
     // Linear interleave with a width that is a multiple of the bank count: rows alias.
-    assert_eq!(footprint_conflicts(&fp(4, 7, 16, 16), 16, 4, BankInterleave::Linear), 2);
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 16, 16), 16, 4, BankInterleave::Linear),
+        2
+    );
     // Width = 1 mod 4: the next row's first texel aliases the right neighbour (1 conflict);
     // width = 2 mod 4: the four texels land in four banks.
-    assert_eq!(footprint_conflicts(&fp(4, 7, 17, 16), 17, 4, BankInterleave::Linear), 1);
-    assert_eq!(footprint_conflicts(&fp(4, 7, 18, 16), 18, 4, BankInterleave::Linear), 0);
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 17, 16), 17, 4, BankInterleave::Linear),
+        1
+    );
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 18, 16), 18, 4, BankInterleave::Linear),
+        0
+    );
     // A 1-texel-wide level reads the same texel twice: not a conflict.
     let thin = TexelFootprint {
         x: [0, 0],
@@ -150,13 +165,20 @@ fn dram_open_pages() {
     // Same footprint twice: 4 page misses (one per bank), then 4 page hits.
     let r = simulate(&frame(&[fp(2, 2, 64, 64), fp(2, 2, 64, 64)]), &hw, "t");
     let m = &r.memory;
-    assert_eq!((m.dram_accesses, m.dram_page_misses, m.dram_page_hits), (8, 4, 4));
+    assert_eq!(
+        (m.dram_accesses, m.dram_page_misses, m.dram_page_hits),
+        (8, 4, 4)
+    );
     // Memory busy: a miss footprint occupies max over banks = 6, a hit one 1.
     let mem = r.units.iter().find(|u| u.unit == "memory").expect("memory");
     assert_eq!(mem.busy_cycles, 7);
     assert_eq!(r.miss_cycles, 5);
     // A footprint in another 16x16 tile opens new pages in every bank again.
-    let r = simulate(&frame(&[fp(2, 2, 64, 64), fp(20, 2, 64, 64), fp(3, 3, 64, 64)]), &hw, "t");
+    let r = simulate(
+        &frame(&[fp(2, 2, 64, 64), fp(20, 2, 64, 64), fp(3, 3, 64, 64)]),
+        &hw,
+        "t",
+    );
     assert_eq!(r.memory.dram_page_misses, 12);
     // One bank: 4 accesses serialize (3 conflicts), 1 miss + 3 hits on the same page.
     hw.timing.banks = 1;
@@ -192,7 +214,11 @@ fn filter_throughput_and_units() {
     hw.timing.banks = 4;
     let fps: Vec<_> = (0..100).map(|_| fp(2, 2, 64, 64)).collect();
     let r = simulate(&frame(&fps), &hw, "t");
-    let f0 = r.units.iter().find(|u| u.unit == "filter0").expect("filter");
+    let f0 = r
+        .units
+        .iter()
+        .find(|u| u.unit == "filter0")
+        .expect("filter");
     assert_eq!(f0.busy_cycles, 100);
     hw.timing.trilinear_units = 2;
     let r = simulate(&frame(&fps), &hw, "t");
