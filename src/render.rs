@@ -300,15 +300,14 @@ struct ShadeInput<'a> {
     costs: &'a [[UnitCost; 6]],
 }
 
-/// Shades row `y` into `row`, adding to `c`; records timing events into `ev` when given.
-#[inline]
-fn shade_row(
+/// Shades row `y` into `row`, adding to `c`, and records its timing events into `ev`.
+fn shade_row_timed(
     inp: &ShadeInput,
     impls: &StageImpls,
     y: usize,
     row: &mut [[u16; 4]],
     c: &mut Counters,
-    mut ev: Option<&mut RowEvents>,
+    ev: &mut RowEvents,
 ) {
     let w = inp.vis.width as usize;
     let mut frag = Frag::default();
@@ -334,9 +333,7 @@ fn shade_row(
             c,
         );
         *out = output16(&frag);
-        if let Some(e) = ev.as_deref_mut() {
-            record_pixel(plan, a.plan, t, impls, inp.m, &frag, e);
-        }
+        record_pixel(plan, a.plan, t, impls, inp.m, &frag, ev);
     }
 }
 
@@ -357,8 +354,33 @@ fn shade(
             .par_chunks_mut(w.max(1))
             .enumerate()
             .map(|(y, row)| {
+                // The loop of `shade_row_timed` without event recording: exactly the code a render
+                // ran before the timing model existed.
                 let mut c = Counters::default();
-                shade_row(inp, impls, y, row, &mut c, None);
+                let mut frag = Frag::default();
+                let tris = &vis.tri[y * w..(y + 1) * w];
+                for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
+                    if t == NO_TRI {
+                        continue;
+                    }
+                    let a = &inp.attrs[t as usize];
+                    let pi = a.plan as usize;
+                    let tri = &inp.setup.tris[t as usize];
+                    let plan = &inp.geo.plans[pi];
+                    run(
+                        plan,
+                        &inp.costs[pi],
+                        impls,
+                        inp.m,
+                        tri,
+                        a,
+                        x as i64,
+                        y as i64,
+                        &mut frag,
+                        &mut c,
+                    );
+                    *out = output16(&frag);
+                }
                 c
             })
             .reduce(Counters::default, |mut a, b| {
@@ -378,7 +400,7 @@ fn shade(
         .map(|(y, row)| {
             let mut c = Counters::default();
             let mut ev = RowEvents::with_capacity(w, lookups);
-            shade_row(inp, impls, y, row, &mut c, Some(&mut ev));
+            shade_row_timed(inp, impls, y, row, &mut c, &mut ev);
             (c, ev)
         })
         .collect();

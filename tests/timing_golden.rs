@@ -11,21 +11,21 @@ use texsim::timing::{cycles, simulate};
 
 /// (scene, preset[+FIELD=VALUE], total cycles, cache hits, bank conflicts, DRAM page misses).
 const GOLDEN: &[(&str, &str, u64, u64, u64, u64)] = &[
-    ("demo", "texram16", 991912, 0, 0, 278957),
+    ("demo", "texram16", 535679, 0, 0, 278957),
     ("demo", "d3d11", 299077, 299530, 0, 3220),
-    ("w1-plane", "texram16", 940909, 0, 0, 174248),
+    ("w1-plane", "texram16", 347386, 0, 0, 174248),
     ("w1-plane", "d3d11", 143290, 253603, 0, 794),
-    ("w2-mesh", "texram16", 1869828, 0, 0, 340578),
+    ("w2-mesh", "texram16", 1481550, 0, 0, 340578),
     ("w2-mesh", "d3d11", 1694804, 315680, 0, 18988),
     (
         "w1-plane",
         "texram16+bank_interleave=linear",
-        941396,
+        380237,
         0,
         125988,
         60806,
     ),
-    ("w1-plane", "texram16+aniso_probes=4", 1231487, 0, 0, 363617),
+    ("w1-plane", "texram16+aniso_probes=4", 731723, 0, 0, 363617),
     ("w1-plane", "d3d11+aniso_probes=4", 471916, 841880, 0, 5425),
 ];
 

@@ -64,7 +64,7 @@ pub struct TimingConfig {
 
 impl TimingConfig {
     /// Texram-style: one trilinear unit, texels in embedded DRAM behind 4 banks (2D
-    /// interleave), no cache, cheap open-page hits, iterative arithmetic units.
+    /// interleave), no cache, cheap open-page hits, pipelined arithmetic units.
     #[must_use]
     pub fn texram16() -> Self {
         Self {
@@ -83,7 +83,7 @@ impl TimingConfig {
             raster_fragments_per_cycle: 1,
             shade_pixels_per_cycle: 1,
             shade_pixels_in_flight: 16,
-            alu_pipelined: false,
+            alu_pipelined: true,
         }
     }
 

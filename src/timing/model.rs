@@ -320,8 +320,8 @@ impl<'a> Memory<'a> {
             count[b] += 1;
             slowest = slowest.max(occ);
         }
-        let occ = busy.iter().copied().max().unwrap_or(0).max(1);
-        let conflicts: u32 = count.iter().map(|&c| c.saturating_sub(1)).sum();
+        let occ = busy[..banks].iter().copied().max().unwrap_or(0).max(1);
+        let conflicts: u32 = count[..banks].iter().map(|&c| c.saturating_sub(1)).sum();
         self.rep.bank_conflicts += u64::from(conflicts);
         if conflicts > 0 {
             self.rep.conflicting_footprints += 1;
