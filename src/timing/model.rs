@@ -148,30 +148,46 @@ fn tile(n: u32) -> (u32, u32) {
     (1 << lw, n >> lw)
 }
 
-/// Address map of the textures: level base indices for cache lines and DRAM pages.
+/// Address of one level: bases and tiles per row of its cache lines and DRAM pages.
+#[derive(Clone, Copy, Debug)]
+struct LevelAddr {
+    width: u32,
+    line_base: u64,
+    line_row: u64,
+    page_base: u64,
+    page_row: u64,
+}
+
+/// Address map of the textures: level base indices for cache lines and DRAM pages (tiles are
+/// powers of two, so indices are shifts).
 struct AddressMap {
-    /// Per texture, per level: (width, line base, page base).
-    levels: Vec<Vec<(u32, u64, u64)>>,
-    line_tile: (u32, u32),
-    page_tile: (u32, u32),
+    levels: Vec<Vec<LevelAddr>>,
+    /// log2 of the line tile's width and height, and of the page tile's.
+    line_shift: (u32, u32),
+    page_shift: (u32, u32),
 }
 
 impl AddressMap {
     fn new(textures: &[Vec<(u32, u32)>], tc: &TimingConfig) -> Self {
-        let line_tile = tile(tc.cache_line_bytes / tc.texel_bytes);
-        let page_tile = tile(tc.dram_page_bytes / tc.texel_bytes);
-        let tiles = |w: u32, h: u32, t: (u32, u32)| -> u64 {
-            u64::from(w.div_ceil(t.0)) * u64::from(h.div_ceil(t.1))
-        };
+        let lt = tile(tc.cache_line_bytes / tc.texel_bytes);
+        let pt = tile(tc.dram_page_bytes / tc.texel_bytes);
         let (mut lb, mut pb) = (0u64, 0u64);
         let levels = textures
             .iter()
             .map(|lv| {
                 lv.iter()
                     .map(|&(w, h)| {
-                        let e = (w, lb, pb);
-                        lb += tiles(w, h, line_tile);
-                        pb += tiles(w, h, page_tile);
+                        let line_row = u64::from(w.div_ceil(lt.0));
+                        let page_row = u64::from(w.div_ceil(pt.0));
+                        let e = LevelAddr {
+                            width: w,
+                            line_base: lb,
+                            line_row,
+                            page_base: pb,
+                            page_row,
+                        };
+                        lb += line_row * u64::from(h.div_ceil(lt.1));
+                        pb += page_row * u64::from(h.div_ceil(pt.1));
                         e
                     })
                     .collect()
@@ -179,24 +195,36 @@ impl AddressMap {
             .collect();
         Self {
             levels,
-            line_tile,
-            page_tile,
+            line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
+            page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
         }
     }
 
-    /// (line key, page key, level width) of texel (x, y).
-    fn keys(&self, tex: u16, level: u8, x: u32, y: u32) -> (u64, u64, u32) {
-        let Some(&(w, lb, pb)) = self
-            .levels
+    /// The address record of a level (a dummy 1-texel level if out of range).
+    #[inline]
+    fn level(&self, tex: u16, level: u8) -> LevelAddr {
+        self.levels
             .get(tex as usize)
             .and_then(|l| l.get(level as usize))
-        else {
-            return (0, 0, 1);
-        };
-        let key = |base: u64, t: (u32, u32)| {
-            base + u64::from(y / t.1) * u64::from(w.div_ceil(t.0)) + u64::from(x / t.0)
-        };
-        (key(lb, self.line_tile), key(pb, self.page_tile), w)
+            .copied()
+            .unwrap_or(LevelAddr {
+                width: 1,
+                line_base: 0,
+                line_row: 1,
+                page_base: 0,
+                page_row: 1,
+            })
+    }
+
+    /// (line key, page key) of texel (x, y) of level `l`.
+    #[inline]
+    fn keys(&self, l: &LevelAddr, x: u32, y: u32) -> (u64, u64) {
+        let (lx, ly) = self.line_shift;
+        let (px, py) = self.page_shift;
+        (
+            l.line_base + u64::from(y >> ly) * l.line_row + u64::from(x >> lx),
+            l.page_base + u64::from(y >> py) * l.page_row + u64::from(x >> px),
+        )
     }
 }
 
@@ -207,7 +235,7 @@ pub fn bank_of(x: u32, y: u32, w: u32, banks: u32, mode: BankInterleave) -> usiz
     match mode {
         BankInterleave::Tiled => {
             let (bx, by) = tile(b);
-            ((x % bx) + bx * (y % by)) as usize
+            ((x & (bx - 1)) + bx * (y & (by - 1))) as usize
         }
         BankInterleave::Linear => {
             ((u64::from(y) * u64::from(w) + u64::from(x)) % u64::from(b)) as usize
@@ -282,14 +310,15 @@ impl<'a> Memory<'a> {
         let mut n = 0;
         let mut slowest = 0u64;
         self.rep.footprints += 1;
+        let lv = self.map.level(fp.tex, fp.level);
         for (x, y) in texels(fp) {
             if seen[..n].contains(&(x, y)) {
                 continue;
             }
             seen[n] = (x, y);
             n += 1;
-            let (line, page, w) = self.map.keys(fp.tex, fp.level, x, y);
-            let b = bank_of(x, y, w, tc.banks, tc.bank_interleave).min(banks - 1);
+            let (line, page) = self.map.keys(&lv, x, y);
+            let b = bank_of(x, y, lv.width, tc.banks, tc.bank_interleave).min(banks - 1);
             self.rep.texel_accesses += 1;
             let hit = match &mut self.cache {
                 Some(c) => {
