@@ -171,7 +171,7 @@ impl TimingConfig {
         }
         if self.cache_bytes != 0 {
             let set = self.cache_line_bytes * self.cache_ways;
-            if self.cache_bytes < set || self.cache_bytes % set != 0 {
+            if self.cache_bytes < set || (self.cache_bytes / set) * set != self.cache_bytes {
                 return Err(err(
                     "cache_bytes",
                     format!(

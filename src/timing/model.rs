@@ -402,10 +402,9 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
     let traverse_busy = ev.spans * u64::from(rc.span_cycles)
         + ev.fragments
             .div_ceil(u64::from(tc.raster_fragments_per_cycle.max(1)));
-    let vis = if ev.triangles == 0 {
-        0
-    } else {
-        (setup_busy + traverse_busy / ev.triangles).max(u64::from(rc.setup_cycles) + traverse_busy)
+    let vis = match traverse_busy.checked_div(ev.triangles) {
+        None => 0,
+        Some(avg) => (setup_busy + avg).max(u64::from(rc.setup_cycles) + traverse_busy),
     };
 
     // Shading pass.
@@ -436,7 +435,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
         let fp_end = (px.fp_end as usize).min(ev.footprints.len());
         let fps = &ev.footprints[fp_start.min(fp_end)..fp_end];
         fp_start = fp_end;
-        let next_slot = u64::from(i as u64 % ppc == 0 && i > 0);
+        let next_slot = u64::from(i > 0 && (i as u64 / ppc) * ppc == i as u64);
         let ideal = (i as u64 / ppc).max(last_issue + next_slot);
         let mut t = ideal;
         if i >= win {
