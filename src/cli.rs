@@ -41,6 +41,9 @@ pub enum Command {
         #[command(subcommand)]
         cmd: BrdfCmd,
     },
+    /// Run the timing model on a scene: cycles, unit utilization, stalls, cache and banks;
+    /// prints the report and writes cycles.json.
+    Cycles(CyclesArgs),
 }
 
 /// Parameters of the Ashikhmin-Shirley BRDF.
@@ -181,6 +184,15 @@ pub struct SweepArgs {
     /// give it first, later axes edit it). Several --vary make a grid.
     #[arg(long, required = true)]
     pub vary: Vec<String>,
+    /// Also run the timing model per setting (adds its total cycles to each row).
+    #[arg(long)]
+    pub cycles: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct CyclesArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -251,6 +263,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Probe(a)) => crate::probe::probe_cmd(&a),
         Some(Command::Brdf { cmd }) => brdf_cmd(&cmd),
+        Some(Command::Cycles(a)) => cycles_cmd(&a),
     }
 }
 
@@ -323,6 +336,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let opts = RenderOptions {
         hw_impls: impls,
         reference: !a.no_reference,
+        timing: false,
         coverage: match a.coverage {
             CoverageArg::Shared => CoverageMode::Shared,
             CoverageArg::Independent => CoverageMode::Independent,
@@ -465,8 +479,16 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
         maps.ensure_texel_bits(cfg.trilinear.texel_bits);
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
-        let r = render(&sc, &maps, cfg, &RenderOptions::default())?;
-        rows.push(crate::summary::SweepRow::new(set.clone(), &r.stats));
+        let opts = RenderOptions {
+            timing: a.cycles,
+            ..RenderOptions::default()
+        };
+        let r = render(&sc, &maps, cfg, &opts)?;
+        let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        if let Some(ev) = &r.events {
+            row.timing_cycles = Some(crate::timing::simulate(ev, cfg, &sc.name).total_cycles);
+        }
+        rows.push(row);
     }
     let table = crate::summary::sweep_table(&rows);
     print!("{table}");
@@ -530,6 +552,39 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
     print!("{text}");
     if !text.ends_with('\n') {
         println!();
+    }
+    Ok(())
+}
+
+fn cycles_cmd(a: &CyclesArgs) -> Result<()> {
+    let (sc, hw) = a.scene.load()?;
+    for w in &sc.warnings {
+        eprintln!("warning: {w}");
+    }
+    eprintln!(
+        "texsim: timing '{}' ({}x{}, {} triangles) on '{}'...",
+        sc.name,
+        sc.width,
+        sc.height,
+        sc.triangle_count(),
+        hw.name
+    );
+    let maps = Maps::new(&sc, hw.trilinear.texel_bits);
+    let (_, rep) = crate::timing::cycles(&sc, &maps, &hw)?;
+    let mut out = OutputSet::new();
+    let json = serde_json::json!({
+        "scene": &sc.name,
+        "hw_config": &hw,
+        "timing": &rep,
+    });
+    out.add(
+        "cycles.json",
+        serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
+    );
+    let written = out.write_to(&a.scene.out)?;
+    print!("{}", crate::timing::report::text(&rep));
+    for p in written {
+        println!("wrote {}", p.display());
     }
     Ok(())
 }

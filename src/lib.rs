@@ -11,6 +11,7 @@ pub mod brdf;
 pub mod cli;
 pub mod error;
 pub mod fixedpoint;
+pub mod footprint_ref;
 pub mod hwconfig;
 pub mod maps;
 pub mod pipeline;
@@ -22,5 +23,6 @@ pub mod report;
 pub mod scene;
 pub mod shading;
 pub mod summary;
+pub mod timing;
 
 pub use error::{Error, Result};

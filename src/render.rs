@@ -25,6 +25,7 @@ use crate::shading::bump::{
 };
 use crate::shading::reference as fref;
 use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
+use crate::timing::events::{record_pixel, FrameEvents, PlanTiming, RowEvents};
 use glam::DVec3;
 use hw_model::fixed::SatCounter;
 use hw_model::{HwConfig, UnitCost};
@@ -390,6 +391,9 @@ pub struct RenderOptions {
     /// Also render the all-float reference and compare.
     pub reference: bool,
     pub coverage: CoverageMode,
+    /// Collect the timing model's event stream (`Rendered::events`). Off by default: a render
+    /// without it allocates no event buffer and does no extra work per pixel.
+    pub timing: bool,
 }
 
 impl Default for RenderOptions {
@@ -398,6 +402,7 @@ impl Default for RenderOptions {
             hw_impls: StageImpls::FIXED,
             reference: true,
             coverage: CoverageMode::Shared,
+            timing: false,
         }
     }
 }
@@ -480,6 +485,8 @@ pub struct Rendered {
     /// Pixels covered by the hardware or the reference pass (the compared set).
     pub mask: Vec<bool>,
     pub stats: RenderStats,
+    /// The timing model's events of the hardware pass, when `RenderOptions::timing` was set.
+    pub events: Option<FrameEvents>,
 }
 
 /// The numbers of one render (serialized into summary.json).
@@ -615,48 +622,121 @@ struct ShadeInput<'a> {
     costs: &'a [[UnitCost; StageKind::COUNT]],
 }
 
-/// Shades every covered pixel with `impls`; returns the image and the counters.
-fn shade(inp: &ShadeInput, impls: &StageImpls, background: [u16; 4]) -> (Image, Counters) {
+/// Shades row `y` into `row`, adding to `c`, and records its timing events into `ev`.
+fn shade_row_timed(
+    inp: &ShadeInput,
+    impls: &StageImpls,
+    y: usize,
+    row: &mut [[u16; 4]],
+    c: &mut Counters,
+    ev: &mut RowEvents,
+) {
+    let w = inp.vis.width as usize;
+    let mut frag = Frag::default();
+    let tris = &inp.vis.tri[y * w..(y + 1) * w];
+    for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
+        if t == NO_TRI {
+            continue;
+        }
+        let a = &inp.attrs[t as usize];
+        let pi = a.plan as usize;
+        let tri = &inp.setup.tris[t as usize];
+        let plan = &inp.geo.plans[pi];
+        run(
+            plan,
+            &inp.costs[pi],
+            impls,
+            inp.m,
+            tri,
+            a,
+            x as i64,
+            y as i64,
+            &mut frag,
+            c,
+        );
+        *out = output16(&frag);
+        record_pixel(plan, a.plan, t, impls, inp.m, &frag, ev);
+    }
+}
+
+/// Shades every covered pixel with `impls`; returns the image, the counters and, when
+/// `timing`, the event stream (rows concatenated in row order).
+fn shade(
+    inp: &ShadeInput,
+    impls: &StageImpls,
+    background: [u16; 4],
+    timing: bool,
+) -> (Image, Counters, Option<FrameEvents>) {
     let vis = inp.vis;
     let w = vis.width as usize;
     let mut img = Image::new(vis.width, vis.height, background);
-    let counters = img
+    if !timing {
+        let counters = img
+            .px
+            .par_chunks_mut(w.max(1))
+            .enumerate()
+            .map(|(y, row)| {
+                // The loop of `shade_row_timed` without event recording: exactly the code a render
+                // ran before the timing model existed.
+                let mut c = Counters::default();
+                let mut frag = Frag::default();
+                let tris = &vis.tri[y * w..(y + 1) * w];
+                for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
+                    if t == NO_TRI {
+                        continue;
+                    }
+                    let a = &inp.attrs[t as usize];
+                    let pi = a.plan as usize;
+                    let tri = &inp.setup.tris[t as usize];
+                    let plan = &inp.geo.plans[pi];
+                    run(
+                        plan,
+                        &inp.costs[pi],
+                        impls,
+                        inp.m,
+                        tri,
+                        a,
+                        x as i64,
+                        y as i64,
+                        &mut frag,
+                        &mut c,
+                    );
+                    *out = output16(&frag);
+                }
+                c
+            })
+            .reduce(Counters::default, |mut a, b| {
+                a.add(&b);
+                a
+            });
+        return (img, counters, None);
+    }
+    let lookups = StageKind::ALL
+        .iter()
+        .map(|&k| crate::timing::events::lookups(k, inp.m.hw) as usize)
+        .sum::<usize>();
+    let rows: Vec<(Counters, RowEvents)> = img
         .px
         .par_chunks_mut(w.max(1))
         .enumerate()
         .map(|(y, row)| {
             let mut c = Counters::default();
-            let mut frag = Frag::default();
-            let tris = &vis.tri[y * w..(y + 1) * w];
-            for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
-                if t == NO_TRI {
-                    continue;
-                }
-                let a = &inp.attrs[t as usize];
-                let pi = a.plan as usize;
-                let tri = &inp.setup.tris[t as usize];
-                let plan = &inp.geo.plans[pi];
-                run(
-                    plan,
-                    &inp.costs[pi],
-                    impls,
-                    inp.m,
-                    tri,
-                    a,
-                    x as i64,
-                    y as i64,
-                    &mut frag,
-                    &mut c,
-                );
-                *out = output16(&frag);
-            }
-            c
+            let mut ev = RowEvents::with_capacity(w, lookups);
+            shade_row_timed(inp, impls, y, row, &mut c, &mut ev);
+            (c, ev)
         })
-        .reduce(Counters::default, |mut a, b| {
-            a.add(&b);
-            a
-        });
-    (img, counters)
+        .collect();
+    let mut counters = Counters::default();
+    let mut fe = FrameEvents {
+        width: vis.width,
+        height: vis.height,
+        ..FrameEvents::default()
+    };
+    for (c, ev) in rows {
+        counters.add(&c);
+        fe.append_row(ev);
+    }
+    (img, counters, Some(fe))
 }
 
 /// Renders `scene` on the machine `hw` (and, if asked, the float reference) and measures both.
@@ -717,7 +797,25 @@ pub fn render(
         m: &m,
         costs: &costs,
     };
-    let (hw_image, counters) = shade(&inp, &opts.hw_impls, bg);
+    let (hw_image, counters, mut events) = shade(&inp, &opts.hw_impls, bg, opts.timing);
+    if let Some(fe) = events.as_mut() {
+        fe.triangles = setup.tris.len() as u64;
+        fe.spans = raster_stats.spans;
+        fe.fragments = raster_stats.fragments;
+        fe.plans = geo
+            .plans
+            .iter()
+            .zip(&costs)
+            .map(|(p, c)| PlanTiming {
+                stages: p.stages.iter().map(|&k| (k, c[k.index()])).collect(),
+            })
+            .collect();
+        fe.textures = maps
+            .fixed
+            .iter()
+            .map(|ch| ch.levels.iter().map(|l| (l.width, l.height)).collect())
+            .collect();
+    }
     tm.shade_hw_ms = ms(t);
     tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
 
@@ -743,7 +841,12 @@ pub fn render(
             }
         };
         let t = Instant::now();
-        let (img, rc) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg);
+        let (img, rc, _) = shade(
+            &ShadeInput { vis: rv, ..inp },
+            &StageImpls::FLOAT,
+            bg,
+            false,
+        );
         ref_nonfinite = rc.nonfinite;
         tm.shade_ref_ms = ms(t);
         tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
@@ -786,6 +889,7 @@ pub fn render(
         hw_image,
         ref_image,
         mask,
+        events,
         stats: RenderStats {
             scene: scene.name.clone(),
             hw: hw.name.clone(),

@@ -107,6 +107,8 @@ pub struct SweepRow {
     pub cycles_per_pixel: f64,
     pub hw_ms: f64,
     pub ref_ms: f64,
+    /// Total cycles of the timing model (`texsim sweep --cycles`), else `None`.
+    pub timing_cycles: Option<u64>,
 }
 
 impl SweepRow {
@@ -128,6 +130,7 @@ impl SweepRow {
             cycles_per_pixel: s.cycles.per_covered_pixel,
             hw_ms: s.timings.hw_total_ms,
             ref_ms: s.timings.ref_total_ms,
+            timing_cycles: None,
         }
     }
 }
@@ -136,6 +139,14 @@ const HEADER: [&str; 11] = [
     "max8", "mean8", "rmse8", "psnr8_db", "exact8_%", "max16", "rmse16", "sat", "cycles", "cyc/px",
     "hw_ms",
 ];
+
+/// Column of the timing model's total cycles (present when any row has them).
+const TIMING_HEADER: &str = "timing_cycles";
+
+fn timing_cell(r: &SweepRow) -> String {
+    r.timing_cycles
+        .map_or_else(|| "-".into(), |c| c.to_string())
+}
 
 fn cells(r: &SweepRow) -> Vec<String> {
     let e8 = r.error_8bit.as_ref();
@@ -166,12 +177,19 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     let set_names: Vec<String> = rows.first().map_or(vec![], |r| {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
+    let timed = rows.iter().any(|r| r.timing_cycles.is_some());
     let mut head = set_names.clone();
     head.extend(HEADER.iter().map(|s| s.to_string()));
+    if timed {
+        head.push(TIMING_HEADER.into());
+    }
     grid.push(head);
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         line.extend(cells(r));
+        if timed {
+            line.push(timing_cell(r));
+        }
         grid.push(line);
     }
     let ncol = grid[0].len();
@@ -199,16 +217,23 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 #[must_use]
 pub fn sweep_csv(rows: &[SweepRow]) -> String {
     let mut o = String::new();
+    let timed = rows.iter().any(|r| r.timing_cycles.is_some());
     if let Some(r) = rows.first() {
         let mut head: Vec<String> = r.settings.iter().map(|(f, _)| f.clone()).collect();
         head.extend(HEADER.iter().map(|s| s.to_string()));
         head.push("ref_ms".into());
+        if timed {
+            head.push(TIMING_HEADER.into());
+        }
         let _ = writeln!(o, "{}", head.join(","));
     }
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         line.extend(cells(r));
         line.push(format!("{:.1}", r.ref_ms));
+        if timed {
+            line.push(timing_cell(r));
+        }
         let _ = writeln!(o, "{}", line.join(","));
     }
     o

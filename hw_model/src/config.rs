@@ -219,6 +219,7 @@ impl HwConfig {
     pub fn d3d11() -> Self {
         let mut c = Self::texram16();
         c.name = "d3d11".into();
+        c.timing = TimingConfig::modern();
         c.raster.subpixel_bits = 8;
         c.trilinear.weight_bits = 8;
         c.lod.lod_frac_bits = 8;
@@ -231,6 +232,7 @@ impl HwConfig {
     pub fn vulkan_min() -> Self {
         let mut c = Self::texram16();
         c.name = "vulkan-min".into();
+        c.timing = TimingConfig::modern();
         c.raster.subpixel_bits = 4;
         c.trilinear.weight_bits = 4;
         c.lod.lod_frac_bits = 4;
@@ -242,6 +244,7 @@ impl HwConfig {
     pub fn cuda() -> Self {
         let mut c = Self::texram16();
         c.name = "cuda".into();
+        c.timing = TimingConfig::modern();
         c.trilinear.weight_bits = 8;
         c.trilinear.weight_rounding = Rounding::HalfEven;
         c.lod.lod_frac_bits = 8;

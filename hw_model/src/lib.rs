@@ -12,6 +12,7 @@ pub mod blinn_phong;
 pub mod config;
 pub mod cost;
 pub mod fixed;
+pub mod footprint;
 pub mod frame;
 pub mod interpolator;
 pub mod lod;

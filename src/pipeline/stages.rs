@@ -6,6 +6,7 @@
 use super::bump_stages::{self, run_bump_stage, BumpAttrs};
 use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
+use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
 use crate::reference::{
@@ -18,6 +19,7 @@ use glam::DVec3;
 use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
+use hw_model::footprint::{footprint, footprint_cost, footprint_filter};
 use hw_model::frame::{frame_cost, len_format, perturb_cost};
 use hw_model::interpolator::{
     interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
@@ -231,6 +233,11 @@ impl<'a> Machine<'a> {
             StageKind::Color => interpolate_cost(i).times(3),
             StageKind::Texcoord => interpolate_cost(i).times(2 * samples),
             StageKind::Lod => lod_cost(&self.hw.lod),
+            StageKind::Trilinear if plan.derivatives => footprint_cost(
+                &self.hw.trilinear,
+                &self.hw.lod,
+                self.hw.trilinear.aniso_probes,
+            ),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
             _ => self.bump_stage_cost(kind, plan),
@@ -487,9 +494,11 @@ pub fn run(
             }
             StageKind::Trilinear => {
                 let Some(t) = plan.texture else { continue };
+                let probes = hw.trilinear.aniso_probes;
+                let aniso = probes > 1 && plan.derivatives;
                 if fixed {
                     if !fixed_in(StageKind::Texcoord) && !fixed_in(StageKind::Lod) {
-                        quantize_uv(frag, m, 1, sat);
+                        quantize_uv(frag, m, if aniso { samples } else { 1 }, sat);
                     }
                     let l = if fixed_in(StageKind::Lod) {
                         frag.lod_x
@@ -497,24 +506,38 @@ pub fn run(
                         to_raw(frag.lod, &m.lod_fmt, sat)
                     };
                     let [u, v] = frag.uv_x[0];
-                    let r = trilinear(
-                        &m.tex_fixed[t],
-                        u,
-                        v,
-                        fb,
-                        l,
-                        lfb,
-                        plan.wrap,
-                        &hw.trilinear,
-                        None,
-                    );
+                    let r = if aniso {
+                        let levels = &m.tex_fixed[t];
+                        let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
+                        let fp = footprint(&frag.uv_x, size, fb, probes, &hw.lod, sat);
+                        footprint_filter(levels, u, v, fb, &fp, lfb, plan.wrap, &hw.trilinear, None)
+                    } else {
+                        trilinear(
+                            &m.tex_fixed[t],
+                            u,
+                            v,
+                            fb,
+                            l,
+                            lfb,
+                            plan.wrap,
+                            &hw.trilinear,
+                            None,
+                        )
+                    };
                     frag.texel_x = r.map(u32::from);
                     frag.texel = frag.texel_x.map(|x| unorm(x, tb));
                     frag.out_x = frag.texel_x;
                     frag.out_bits = tb;
                 } else {
                     let [u, v] = frag.uv[0];
-                    frag.texel = trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap);
+                    frag.texel = if aniso {
+                        let levels = &m.tex_float[t];
+                        let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
+                        let fp = footprint_f64(&frag.uv, size, probes);
+                        footprint_filter_f64(levels, u, v, &fp, plan.wrap)
+                    } else {
+                        trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap)
+                    };
                     frag.out_bits = 0;
                 }
                 frag.out = frag.texel;

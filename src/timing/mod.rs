@@ -1,0 +1,38 @@
+//! Timing model (GitHub issue 7): cycle counts of a frame on a Texram-style machine, separate
+//! from the functional model. It consumes the event stream of a render ([`events`]) and never
+//! changes a pixel; events are only built when `RenderOptions::timing` is set, so a render
+//! without it pays nothing. Parameters: `HwConfig::timing` (`hw_model::timing_config`) and the
+//! per-op cycle fields of the unit configs. The model is described in [`model`] and
+//! docs/TIMING.md.
+
+pub mod events;
+pub mod model;
+pub mod report;
+
+pub use events::{FrameEvents, PixelEvent, RowEvents, TexelFootprint};
+pub use model::{simulate, Cache, TimingReport};
+
+use crate::render::{render, Maps, RenderOptions, Rendered};
+use crate::scene::Scene;
+use hw_model::HwConfig;
+
+/// Renders `scene` on `hw` with event collection (no float reference) and runs the timing
+/// model over the events.
+pub fn cycles(
+    scene: &Scene,
+    maps: &Maps,
+    hw: &HwConfig,
+) -> crate::Result<(Rendered, TimingReport)> {
+    let opts = RenderOptions {
+        reference: false,
+        timing: true,
+        ..RenderOptions::default()
+    };
+    let r = render(scene, maps, hw, &opts)?;
+    let ev = r
+        .events
+        .as_ref()
+        .ok_or_else(|| crate::Error::msg("render produced no timing events"))?;
+    let rep = simulate(ev, hw, &scene.name);
+    Ok((r, rep))
+}

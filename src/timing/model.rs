@@ -1,0 +1,617 @@
+//! The timing model: replays a frame's events through units with throughputs and latencies,
+//! a banked texture memory, an optional set-associative LRU texel cache and open-page DRAM.
+//! Integer cycles, deterministic (one sequential pass in raster order).
+//!
+//! Frame = visibility pass + shading pass (the machine resolves visibility first, then shades
+//! each covered pixel once; the passes do not overlap):
+//! - Visibility pass: a two-stage pipeline, triangle setup (`setup_cycles` per triangle) then
+//!   traversal (`span_cycles` per span plus `fragments / raster_fragments_per_cycle`). Only the
+//!   totals are known, so its length is `max(setup_busy + traverse_busy / tris, setup_cycles +
+//!   traverse_busy)`: the bottleneck stage plus one average item of the other.
+//! - Shading pass: pixels issue at `shade_pixels_per_cycle`, in raster order, through their
+//!   plan's stages. Each arithmetic stage kind is one unit: with `alu_pipelined` it accepts one
+//!   pixel per cycle and its cycles (from the unit configs) are latency; otherwise it is busy
+//!   for all of them. A texture stage runs its address/footprint unit (the stage's cycles
+//!   beyond its trilinear samples, at least 1), then each lookup: its footprints go through
+//!   the memory (in order), then the lookup goes to the earliest free trilinear unit
+//!   (`ceil(footprints / bilinear_per_cycle)` busy cycles, latency = the filter's cycles). The
+//!   stage completes when its last lookup is filtered. Queues between units are unbounded; a
+//!   unit serves pixels in arrival order.
+//! - Memory: texel (x, y) of a level is in bank `interleave(x, y)`. Per footprint each distinct
+//!   texel is one bank access: a cache hit keeps its bank 1 cycle; a DRAM access (no cache, or
+//!   a cache miss filling its line) keeps it `dram_page_hit_cycles` if the bank's open page is
+//!   the texel's page, else `dram_page_miss_cycles` (and opens it). Banks work in parallel, so
+//!   the footprint occupies the memory `max over banks of the summed busy cycles`; its latency
+//!   is that plus `cache_hit_cycles` when there is a cache. Bank conflicts: accesses beyond the
+//!   first in a bank within one footprint.
+//! - In flight: pixel `i` issues at `max(i / shade_pixels_per_cycle, done(i - n))` with
+//!   `n = shade_pixels_in_flight`. Stalls: every cycle by which a pixel's issue is held back
+//!   by a full window is attributed to the unit where the pixel it waited for (`i - n`) lost
+//!   the most cycles waiting for a busy unit (memory, a filter unit or an arithmetic unit), or
+//!   to `latency` if that pixel never waited (the window is too small for the latency). The
+//!   stalls therefore sum to at most the shading pass. The memory's own time is split into
+//!   bank-conflict cycles (serialization beyond the slowest single access) and miss cycles (a
+//!   cache or page miss's cycles beyond a hit's), reported with the memory counters.
+
+use super::events::{FrameEvents, TexelFootprint};
+use crate::pipeline::StageKind;
+use hw_model::timing_config::{BankInterleave, TimingConfig};
+use hw_model::trilinear::trilinear_cost;
+use hw_model::HwConfig;
+use serde::Serialize;
+
+/// Busy cycles of one unit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct UnitReport {
+    pub unit: String,
+    pub busy_cycles: u64,
+    /// busy / total cycles.
+    pub utilization: f64,
+}
+
+/// Stall cycles by cause.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StallReport {
+    pub cause: String,
+    pub cycles: u64,
+}
+
+/// Memory-system counters.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MemoryReport {
+    pub footprints: u64,
+    /// Distinct texel accesses (a footprint on a 1-texel-wide level reads fewer than 4).
+    pub texel_accesses: u64,
+    pub cache_hits: u64,
+    pub cache_misses: u64,
+    /// hits / accesses; `None` without a cache.
+    pub cache_hit_rate: Option<f64>,
+    pub bank_conflicts: u64,
+    /// Footprints with at least one bank conflict.
+    pub conflicting_footprints: u64,
+    pub dram_accesses: u64,
+    pub dram_page_hits: u64,
+    pub dram_page_misses: u64,
+}
+
+/// The timing model's result for one frame.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TimingReport {
+    pub scene: String,
+    pub hw: String,
+    pub width: u32,
+    pub height: u32,
+    pub total_cycles: u64,
+    pub visibility_pass_cycles: u64,
+    pub shading_pass_cycles: u64,
+    pub covered_pixels: u64,
+    pub cycles_per_pixel: f64,
+    pub units: Vec<UnitReport>,
+    pub stalls: Vec<StallReport>,
+    pub memory: MemoryReport,
+    /// Memory cycles caused by bank conflicts (serialization within footprints).
+    pub bank_conflict_cycles: u64,
+    /// Memory cycles caused by cache and page misses (beyond a hit's).
+    pub miss_cycles: u64,
+    /// The unit with the most busy cycles.
+    pub bottleneck: String,
+    /// Events consumed (pixels + footprints + triangles + spans).
+    pub events: u64,
+}
+
+/// A set-associative texel cache with LRU replacement (each set ordered most recent first).
+#[derive(Clone, Debug)]
+pub struct Cache {
+    sets: u64,
+    ways: usize,
+    tags: Vec<u64>,
+}
+
+const EMPTY: u64 = u64::MAX;
+
+impl Cache {
+    /// A cache of `sets` x `ways` lines (both at least 1).
+    #[must_use]
+    pub fn new(sets: u64, ways: usize) -> Self {
+        let sets = sets.max(1);
+        let ways = ways.max(1);
+        Self {
+            sets,
+            ways,
+            tags: vec![EMPTY; sets as usize * ways],
+        }
+    }
+
+    /// Looks up line `key` (set = key mod sets); on a miss the line is filled, evicting the
+    /// least recently used way. Returns true on a hit.
+    pub fn access(&mut self, key: u64) -> bool {
+        let s = (key % self.sets) as usize * self.ways;
+        let set = &mut self.tags[s..s + self.ways];
+        match set.iter().position(|&t| t == key) {
+            Some(i) => {
+                set[..=i].rotate_right(1);
+                true
+            }
+            None => {
+                set.rotate_right(1);
+                set[0] = key;
+                false
+            }
+        }
+    }
+}
+
+/// Square-ish 2D tile of `n` texels (a power of two): width `2^ceil(log2 n / 2)`.
+fn tile(n: u32) -> (u32, u32) {
+    let n = n.max(1);
+    let lw = n.trailing_zeros().div_ceil(2);
+    (1 << lw, n >> lw)
+}
+
+/// Address of one level: bases and tiles per row of its cache lines and DRAM pages.
+#[derive(Clone, Copy, Debug)]
+struct LevelAddr {
+    width: u32,
+    line_base: u64,
+    line_row: u64,
+    page_base: u64,
+    page_row: u64,
+}
+
+/// Address map of the textures: level base indices for cache lines and DRAM pages (tiles are
+/// powers of two, so indices are shifts).
+struct AddressMap {
+    levels: Vec<Vec<LevelAddr>>,
+    /// log2 of the line tile's width and height, and of the page tile's.
+    line_shift: (u32, u32),
+    page_shift: (u32, u32),
+}
+
+impl AddressMap {
+    fn new(textures: &[Vec<(u32, u32)>], tc: &TimingConfig) -> Self {
+        let lt = tile(tc.cache_line_bytes / tc.texel_bytes);
+        let pt = tile(tc.dram_page_bytes / tc.texel_bytes);
+        let (mut lb, mut pb) = (0u64, 0u64);
+        let levels = textures
+            .iter()
+            .map(|lv| {
+                lv.iter()
+                    .map(|&(w, h)| {
+                        let line_row = u64::from(w.div_ceil(lt.0));
+                        let page_row = u64::from(w.div_ceil(pt.0));
+                        let e = LevelAddr {
+                            width: w,
+                            line_base: lb,
+                            line_row,
+                            page_base: pb,
+                            page_row,
+                        };
+                        lb += line_row * u64::from(h.div_ceil(lt.1));
+                        pb += page_row * u64::from(h.div_ceil(pt.1));
+                        e
+                    })
+                    .collect()
+            })
+            .collect();
+        Self {
+            levels,
+            line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
+            page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
+        }
+    }
+
+    /// The address record of a level (a dummy 1-texel level if out of range).
+    #[inline]
+    fn level(&self, tex: u16, level: u8) -> LevelAddr {
+        self.levels
+            .get(tex as usize)
+            .and_then(|l| l.get(level as usize))
+            .copied()
+            .unwrap_or(LevelAddr {
+                width: 1,
+                line_base: 0,
+                line_row: 1,
+                page_base: 0,
+                page_row: 1,
+            })
+    }
+
+    /// (line key, page key) of texel (x, y) of level `l`.
+    #[inline]
+    fn keys(&self, l: &LevelAddr, x: u32, y: u32) -> (u64, u64) {
+        let (lx, ly) = self.line_shift;
+        let (px, py) = self.page_shift;
+        (
+            l.line_base + u64::from(y >> ly) * l.line_row + u64::from(x >> lx),
+            l.page_base + u64::from(y >> py) * l.page_row + u64::from(x >> px),
+        )
+    }
+}
+
+/// The bank of texel (x, y) on a level of width `w`.
+#[must_use]
+pub fn bank_of(x: u32, y: u32, w: u32, banks: u32, mode: BankInterleave) -> usize {
+    let b = banks.max(1);
+    match mode {
+        BankInterleave::Tiled => {
+            let (bx, by) = tile(b);
+            ((x & (bx - 1)) + bx * (y & (by - 1))) as usize
+        }
+        BankInterleave::Linear => {
+            ((u64::from(y) * u64::from(w) + u64::from(x)) % u64::from(b)) as usize
+        }
+    }
+}
+
+/// Bank accesses of one footprint under an interleave: the distinct texels and their banks;
+/// returns the number of conflicts (accesses beyond the first per bank).
+#[must_use]
+pub fn footprint_conflicts(fp: &TexelFootprint, w: u32, banks: u32, mode: BankInterleave) -> u32 {
+    let mut count = [0u32; 64];
+    let mut seen: [(u32, u32); 4] = [(u32::MAX, u32::MAX); 4];
+    let mut n = 0;
+    for (x, y) in texels(fp) {
+        if seen[..n].contains(&(x, y)) {
+            continue;
+        }
+        seen[n] = (x, y);
+        n += 1;
+        count[bank_of(x, y, w, banks, mode).min(63)] += 1;
+    }
+    count.iter().map(|&c| c.saturating_sub(1)).sum()
+}
+
+#[inline]
+fn texels(fp: &TexelFootprint) -> [(u32, u32); 4] {
+    [
+        (fp.x[0], fp.y[0]),
+        (fp.x[1], fp.y[0]),
+        (fp.x[0], fp.y[1]),
+        (fp.x[1], fp.y[1]),
+    ]
+}
+
+/// Open-page state of the DRAM banks and the counters of the memory system.
+struct Memory<'a> {
+    tc: &'a TimingConfig,
+    map: AddressMap,
+    cache: Option<Cache>,
+    open_page: Vec<u64>,
+    rep: MemoryReport,
+    conflict_cycles: u64,
+    miss_cycles: u64,
+}
+
+impl<'a> Memory<'a> {
+    fn new(textures: &[Vec<(u32, u32)>], tc: &'a TimingConfig) -> Self {
+        let cache = (tc.cache_bytes > 0).then(|| {
+            let ways = tc.cache_ways.max(1);
+            let sets = tc.cache_bytes / (tc.cache_line_bytes * ways);
+            Cache::new(u64::from(sets), ways as usize)
+        });
+        Self {
+            tc,
+            map: AddressMap::new(textures, tc),
+            cache,
+            open_page: vec![EMPTY; tc.banks.max(1) as usize],
+            rep: MemoryReport::default(),
+            conflict_cycles: 0,
+            miss_cycles: 0,
+        }
+    }
+
+    /// Performs one footprint's accesses; returns (occupancy, latency) in cycles.
+    fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64) {
+        let tc = self.tc;
+        let banks = tc.banks.max(1) as usize;
+        let mut busy = [0u64; 64];
+        let mut count = [0u32; 64];
+        let mut seen: [(u32, u32); 4] = [(u32::MAX, u32::MAX); 4];
+        let mut n = 0;
+        let mut slowest = 0u64;
+        self.rep.footprints += 1;
+        let lv = self.map.level(fp.tex, fp.level);
+        for (x, y) in texels(fp) {
+            if seen[..n].contains(&(x, y)) {
+                continue;
+            }
+            seen[n] = (x, y);
+            n += 1;
+            let (line, page) = self.map.keys(&lv, x, y);
+            let b = bank_of(x, y, lv.width, tc.banks, tc.bank_interleave).min(banks - 1);
+            self.rep.texel_accesses += 1;
+            let hit = match &mut self.cache {
+                Some(c) => {
+                    let h = c.access(line);
+                    if h {
+                        self.rep.cache_hits += 1;
+                    } else {
+                        self.rep.cache_misses += 1;
+                    }
+                    h
+                }
+                None => false,
+            };
+            let occ = if hit {
+                1
+            } else {
+                self.rep.dram_accesses += 1;
+                if self.open_page[b] == page {
+                    self.rep.dram_page_hits += 1;
+                    u64::from(tc.dram_page_hit_cycles)
+                } else {
+                    self.rep.dram_page_misses += 1;
+                    self.open_page[b] = page;
+                    u64::from(tc.dram_page_miss_cycles)
+                }
+            };
+            busy[b] += occ;
+            count[b] += 1;
+            slowest = slowest.max(occ);
+        }
+        let occ = busy[..banks].iter().copied().max().unwrap_or(0).max(1);
+        let conflicts: u32 = count[..banks].iter().map(|&c| c.saturating_sub(1)).sum();
+        self.rep.bank_conflicts += u64::from(conflicts);
+        if conflicts > 0 {
+            self.rep.conflicting_footprints += 1;
+        }
+        let fastest = if self.cache.is_some() {
+            1
+        } else {
+            u64::from(tc.dram_page_hit_cycles)
+        };
+        self.conflict_cycles += occ - slowest.max(1);
+        self.miss_cycles += slowest.saturating_sub(fastest);
+        let lat = occ
+            + if self.cache.is_some() {
+                u64::from(tc.cache_hit_cycles)
+            } else {
+                0
+            };
+        (occ, lat)
+    }
+}
+
+/// A unit that serves requests in arrival order.
+#[derive(Clone, Copy, Debug, Default)]
+struct Unit {
+    free: u64,
+    busy: u64,
+    stall: u64,
+}
+
+impl Unit {
+    /// A request ready at `ready` occupying `occ` cycles: returns its start.
+    #[inline]
+    fn take(&mut self, ready: u64, occ: u64) -> u64 {
+        let start = ready.max(self.free);
+        self.stall += start - ready;
+        self.free = start + occ;
+        self.busy += occ;
+        start
+    }
+}
+
+/// Runs the timing model over `ev` on machine `hw`.
+#[must_use]
+pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
+    let tc = &hw.timing;
+    let rc = &hw.raster;
+    // Visibility pass.
+    let setup_busy = ev.triangles * u64::from(rc.setup_cycles);
+    let traverse_busy = ev.spans * u64::from(rc.span_cycles)
+        + ev.fragments
+            .div_ceil(u64::from(tc.raster_fragments_per_cycle.max(1)));
+    let vis = match traverse_busy.checked_div(ev.triangles) {
+        None => 0,
+        Some(avg) => (setup_busy + avg).max(u64::from(rc.setup_cycles) + traverse_busy),
+    };
+
+    // Shading pass.
+    let nk = StageKind::ALL.len();
+    let mut alu = vec![Unit::default(); nk];
+    let mut mem_unit = Unit::default();
+    let mut filters = vec![Unit::default(); tc.trilinear_units.max(1) as usize];
+    let mut mem = Memory::new(&ev.textures, tc);
+    let tri_cost = trilinear_cost(&hw.trilinear, 2);
+    let bpc = u64::from(tc.bilinear_per_cycle.max(1));
+    let ppc = u64::from(tc.shade_pixels_per_cycle.max(1));
+    let alu_occ = |cycles: u64| {
+        if tc.alu_pipelined {
+            cycles.min(1)
+        } else {
+            cycles
+        }
+    };
+    let mut end = 0u64;
+    let mut fp_start = 0usize;
+    // Causes: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2 latency.
+    let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
+    let mut stall_by = vec![0u64; nk + 3];
+    let win = tc.shade_pixels_in_flight.max(1) as usize;
+    let mut ring: Vec<(u64, usize)> = vec![(0, c_lat); win];
+    let mut last_issue = 0u64;
+    for (i, px) in ev.pixels.iter().enumerate() {
+        let fp_end = (px.fp_end as usize).min(ev.footprints.len());
+        let fps = &ev.footprints[fp_start.min(fp_end)..fp_end];
+        fp_start = fp_end;
+        let next_slot = u64::from(i > 0 && (i as u64 / ppc) * ppc == i as u64);
+        let ideal = (i as u64 / ppc).max(last_issue + next_slot);
+        let mut t = ideal;
+        if i >= win {
+            let (done, cause) = ring[i % win];
+            if done > t {
+                stall_by[cause] += done - t;
+                t = done;
+            }
+        }
+        last_issue = t;
+        let mut worst = (0u64, c_lat);
+        let mut note = |w: u64, cause: usize| {
+            if w > worst.0 {
+                worst = (w, cause);
+            }
+        };
+        let Some(plan) = ev.plans.get(px.plan as usize) else {
+            ring[i % win] = (t, c_lat);
+            continue;
+        };
+        for &(kind, cost) in &plan.stages {
+            let k = kind.index();
+            let mine: &[TexelFootprint] = {
+                let a = fps.iter().position(|f| usize::from(f.stage) == k);
+                match a {
+                    Some(a) => {
+                        let b = fps[a..]
+                            .iter()
+                            .position(|f| usize::from(f.stage) != k)
+                            .map_or(fps.len(), |e| a + e);
+                        &fps[a..b]
+                    }
+                    None => &[],
+                }
+            };
+            if mine.is_empty() {
+                let c = u64::from(cost.cycles);
+                let s = alu[k].take(t, alu_occ(c));
+                note(s - t, k);
+                t = s + c;
+                continue;
+            }
+            // Texture stage: address/footprint unit, then each lookup through memory + filter.
+            let lookups = u64::from(mine.last().map_or(0, |f| f.lookup) + 1);
+            let setup = u64::from(cost.cycles)
+                .saturating_sub(lookups * u64::from(tri_cost.cycles))
+                .max(1);
+            let s = alu[k].take(t, alu_occ(setup));
+            note(s - t, k);
+            let ready = s + setup;
+            let mut done = ready;
+            let mut a = 0;
+            while a < mine.len() {
+                let l = mine[a].lookup;
+                let b = mine[a..]
+                    .iter()
+                    .position(|f| f.lookup != l)
+                    .map_or(mine.len(), |e| a + e);
+                let mut data = ready;
+                for f in &mine[a..b] {
+                    let (occ, lat) = mem.footprint(f);
+                    let ms = mem_unit.take(ready, occ);
+                    note(ms - ready, c_mem);
+                    data = data.max(ms + lat);
+                }
+                let nfp = (b - a) as u64;
+                let occ = nfp.div_ceil(bpc);
+                let lat = nfp * u64::from(hw.trilinear.bilinear_cycles)
+                    + if nfp > 1 {
+                        u64::from(hw.trilinear.level_lerp_cycles)
+                    } else {
+                        0
+                    };
+                let fu = (0..filters.len())
+                    .min_by_key(|&j| (filters[j].free.max(data), j))
+                    .unwrap_or(0);
+                let fs = filters[fu].take(data, occ);
+                note(fs - data, c_filt);
+                done = done.max(fs + lat.max(occ));
+                a = b;
+            }
+            t = done;
+        }
+        ring[i % win] = (t, worst.1);
+        end = end.max(t);
+    }
+    let shade = end;
+    let total = vis + shade;
+    let covered = ev.pixels.len() as u64;
+    let util = |b: u64| {
+        if total == 0 {
+            0.0
+        } else {
+            b as f64 / total as f64
+        }
+    };
+    let mut units = vec![
+        UnitReport {
+            unit: "setup".into(),
+            busy_cycles: setup_busy,
+            utilization: util(setup_busy),
+        },
+        UnitReport {
+            unit: "traverse".into(),
+            busy_cycles: traverse_busy,
+            utilization: util(traverse_busy),
+        },
+    ];
+    for kind in StageKind::ALL {
+        let b = alu[kind.index()].busy;
+        units.push(UnitReport {
+            unit: kind.name().into(),
+            busy_cycles: b,
+            utilization: util(b),
+        });
+    }
+    units.push(UnitReport {
+        unit: "memory".into(),
+        busy_cycles: mem_unit.busy,
+        utilization: util(mem_unit.busy),
+    });
+    for (j, f) in filters.iter().enumerate() {
+        units.push(UnitReport {
+            unit: format!("filter{j}"),
+            busy_cycles: f.busy,
+            utilization: util(f.busy),
+        });
+    }
+    let bottleneck = units
+        .iter()
+        .fold(None::<&UnitReport>, |best, u| match best {
+            Some(b) if b.busy_cycles >= u.busy_cycles => Some(b),
+            _ => Some(u),
+        })
+        .map_or_else(String::new, |u| u.unit.clone());
+    let mut stalls = vec![StallReport {
+        cause: "traverse waits for setup".into(),
+        cycles: vis.saturating_sub(traverse_busy),
+    }];
+    for kind in StageKind::ALL {
+        stalls.push(StallReport {
+            cause: format!("{} busy", kind.name()),
+            cycles: stall_by[kind.index()],
+        });
+    }
+    for (cause, i) in [
+        ("memory busy", c_mem),
+        ("filter busy", c_filt),
+        ("latency", c_lat),
+    ] {
+        stalls.push(StallReport {
+            cause: cause.into(),
+            cycles: stall_by[i],
+        });
+    }
+    let mut memory = mem.rep;
+    if mem.cache.is_some() {
+        memory.cache_hit_rate =
+            Some(memory.cache_hits as f64 / memory.texel_accesses.max(1) as f64);
+    }
+    TimingReport {
+        scene: scene.to_string(),
+        hw: hw.name.clone(),
+        width: ev.width,
+        height: ev.height,
+        total_cycles: total,
+        visibility_pass_cycles: vis,
+        shading_pass_cycles: shade,
+        covered_pixels: covered,
+        cycles_per_pixel: total as f64 / covered.max(1) as f64,
+        units,
+        stalls,
+        memory,
+        bank_conflict_cycles: mem.conflict_cycles,
+        miss_cycles: mem.miss_cycles,
+        bottleneck,
+        events: ev.len(),
+    }
+}

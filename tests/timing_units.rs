@@ -1,0 +1,233 @@
+//! Unit tests of the timing model's parts: the LRU cache (hand cases), the bank interleave
+//! (2x2 footprints conflict-free under the tiled interleave, counted conflicts otherwise) and
+//! the DRAM open-page model, on hand-built event streams.
+
+use hw_model::timing_config::BankInterleave;
+use hw_model::{HwConfig, UnitCost};
+use texsim::pipeline::StageKind;
+use texsim::timing::events::{FrameEvents, PixelEvent, PlanTiming, TexelFootprint};
+use texsim::timing::model::{bank_of, footprint_conflicts};
+use texsim::timing::{simulate, Cache};
+
+fn splitmix(s: &mut u64) -> u64 {
+    *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *s;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+#[test]
+fn lru_cache_hand_cases() {
+    // One set, two ways.
+    let mut c = Cache::new(1, 2);
+    assert!(!c.access(1));
+    assert!(!c.access(2));
+    assert!(c.access(1)); // 1 is now most recent, 2 least
+    assert!(!c.access(3)); // evicts 2
+    assert!(c.access(1));
+    assert!(!c.access(2)); // 2 was evicted; evicts 3
+    assert!(!c.access(3));
+    // Two sets: even keys in set 0, odd keys in set 1; one way each.
+    let mut c = Cache::new(2, 1);
+    assert!(!c.access(0));
+    assert!(!c.access(1));
+    assert!(c.access(0));
+    assert!(c.access(1));
+    assert!(!c.access(2)); // evicts 0 from set 0 only
+    assert!(c.access(1));
+    assert!(!c.access(0));
+}
+
+#[test]
+fn lru_cache_matches_a_list_model() {
+    let mut seed = 7u64;
+    for ways in [1usize, 2, 4, 8] {
+        let sets = 4u64;
+        let mut c = Cache::new(sets, ways);
+        let mut model: Vec<Vec<u64>> = vec![vec![]; sets as usize];
+        for _ in 0..20000 {
+            let k = splitmix(&mut seed) % 64;
+            let set = &mut model[(k % sets) as usize];
+            let hit = if let Some(p) = set.iter().position(|&x| x == k) {
+                set.remove(p);
+                true
+            } else {
+                if set.len() == ways {
+                    set.pop();
+                }
+                false
+            };
+            set.insert(0, k);
+            assert_eq!(c.access(k), hit);
+        }
+    }
+}
+
+fn fp(x0: u32, y0: u32, w: u32, h: u32) -> TexelFootprint {
+    TexelFootprint {
+        stage: StageKind::Trilinear.index() as u8,
+        lookup: 0,
+        level: 0,
+        tex: 0,
+        x: [x0, (x0 + 1) % w],
+        y: [y0, (y0 + 1) % h],
+    }
+}
+
+#[test]
+fn tiled_interleave_makes_2x2_conflict_free() {
+    let mut seed = 1u64;
+    for banks in [4u32, 8, 16, 64] {
+        for _ in 0..20000 {
+            let w = 1u32 << (1 + splitmix(&mut seed) % 10);
+            let h = 1u32 << (1 + splitmix(&mut seed) % 10);
+            let x = (splitmix(&mut seed) % u64::from(w)) as u32;
+            let y = (splitmix(&mut seed) % u64::from(h)) as u32;
+            assert_eq!(
+                footprint_conflicts(&fp(x, y, w, h), w, banks, BankInterleave::Tiled),
+                0,
+                "banks {banks} at ({x},{y}) of {w}x{h}"
+            );
+        }
+    }
+}
+
+#[test]
+fn conflicts_are_counted_otherwise() {
+    // Two tiled banks: bank = x mod 2, so the two texels of each column collide: 2 conflicts.
+    assert_eq!(bank_of(3, 5, 16, 2, BankInterleave::Tiled), 1);
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 16, 16), 16, 2, BankInterleave::Tiled),
+        2
+    );
+    // One bank: everything collides (4 texels, 3 conflicts).
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 16, 16), 16, 1, BankInterleave::Tiled),
+        3
+    );
+    // Linear interleave with a width that is a multiple of the bank count: rows alias.
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 16, 16), 16, 4, BankInterleave::Linear),
+        2
+    );
+    // Width = 1 mod 4: the next row's first texel aliases the right neighbour (1 conflict);
+    // width = 2 mod 4: the four texels land in four banks.
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 17, 16), 17, 4, BankInterleave::Linear),
+        1
+    );
+    assert_eq!(
+        footprint_conflicts(&fp(4, 7, 18, 16), 18, 4, BankInterleave::Linear),
+        0
+    );
+    // A 1-texel-wide level reads the same texel twice: not a conflict.
+    let thin = TexelFootprint {
+        x: [0, 0],
+        y: [0, 0],
+        ..fp(0, 0, 1, 1)
+    };
+    assert_eq!(footprint_conflicts(&thin, 1, 1, BankInterleave::Tiled), 0);
+}
+
+/// A frame of `fps.len()` pixels, each doing one single-level lookup (one footprint) on a
+/// 64x64 texture, with free arithmetic stages.
+fn frame(fps: &[TexelFootprint]) -> FrameEvents {
+    let pixels = (0..fps.len())
+        .map(|i| PixelEvent {
+            plan: 0,
+            tri: 0,
+            fp_end: i as u32 + 1,
+        })
+        .collect();
+    FrameEvents {
+        width: 8,
+        height: 8,
+        triangles: 0,
+        spans: 0,
+        fragments: 0,
+        plans: vec![PlanTiming {
+            stages: vec![(StageKind::Trilinear, UnitCost::default())],
+        }],
+        textures: vec![vec![(64, 64)]],
+        pixels,
+        footprints: fps.to_vec(),
+    }
+}
+
+#[test]
+fn dram_open_pages() {
+    let mut hw = HwConfig::texram16();
+    hw.timing.dram_page_hit_cycles = 1;
+    hw.timing.dram_page_miss_cycles = 6;
+    hw.timing.dram_page_bytes = 2048; // 256 texels of 8 bytes: 16x16 tiles
+    hw.timing.shade_pixels_in_flight = 1;
+    // Same footprint twice: 4 page misses (one per bank), then 4 page hits.
+    let r = simulate(&frame(&[fp(2, 2, 64, 64), fp(2, 2, 64, 64)]), &hw, "t");
+    let m = &r.memory;
+    assert_eq!(
+        (m.dram_accesses, m.dram_page_misses, m.dram_page_hits),
+        (8, 4, 4)
+    );
+    // Memory busy: a miss footprint occupies max over banks = 6, a hit one 1.
+    let mem = r.units.iter().find(|u| u.unit == "memory").expect("memory");
+    assert_eq!(mem.busy_cycles, 7);
+    assert_eq!(r.miss_cycles, 5);
+    // A footprint in another 16x16 tile opens new pages in every bank again.
+    let r = simulate(
+        &frame(&[fp(2, 2, 64, 64), fp(20, 2, 64, 64), fp(3, 3, 64, 64)]),
+        &hw,
+        "t",
+    );
+    assert_eq!(r.memory.dram_page_misses, 12);
+    // One bank: 4 accesses serialize (3 conflicts), 1 miss + 3 hits on the same page.
+    hw.timing.banks = 1;
+    let r = simulate(&frame(&[fp(2, 2, 64, 64)]), &hw, "t");
+    assert_eq!(r.memory.bank_conflicts, 3);
+    assert_eq!((r.memory.dram_page_misses, r.memory.dram_page_hits), (1, 3));
+    let mem = r.units.iter().find(|u| u.unit == "memory").expect("memory");
+    assert_eq!(mem.busy_cycles, 6 + 3);
+    assert_eq!(r.bank_conflict_cycles, 3);
+}
+
+#[test]
+fn cache_in_front_of_dram() {
+    let mut hw = HwConfig::d3d11();
+    hw.timing.cache_bytes = 64 * 4;
+    hw.timing.cache_line_bytes = 32; // 4 texels: 2x2 tiles
+    hw.timing.cache_ways = 4;
+    // An aligned 2x2 footprint is one line: 1 miss then 3 hits; again: 4 hits.
+    let r = simulate(&frame(&[fp(2, 2, 64, 64), fp(2, 2, 64, 64)]), &hw, "t");
+    assert_eq!((r.memory.cache_hits, r.memory.cache_misses), (7, 1));
+    assert_eq!(r.memory.dram_accesses, 1);
+    assert_eq!(r.memory.cache_hit_rate, Some(7.0 / 8.0));
+    // An unaligned one touches 4 lines.
+    let r = simulate(&frame(&[fp(3, 3, 64, 64)]), &hw, "t");
+    assert_eq!(r.memory.cache_misses, 4);
+}
+
+#[test]
+fn filter_throughput_and_units() {
+    // 100 pixels, each one footprint that hits the open page: with 1 filter unit at 1
+    // bilinear/cycle the filter is busy 100 cycles.
+    let mut hw = HwConfig::texram16();
+    hw.timing.banks = 4;
+    let fps: Vec<_> = (0..100).map(|_| fp(2, 2, 64, 64)).collect();
+    let r = simulate(&frame(&fps), &hw, "t");
+    let f0 = r
+        .units
+        .iter()
+        .find(|u| u.unit == "filter0")
+        .expect("filter");
+    assert_eq!(f0.busy_cycles, 100);
+    hw.timing.trilinear_units = 2;
+    let r = simulate(&frame(&fps), &hw, "t");
+    let busy: u64 = r
+        .units
+        .iter()
+        .filter(|u| u.unit.starts_with("filter"))
+        .map(|u| u.busy_cycles)
+        .sum();
+    assert_eq!(busy, 100);
+    assert!(r.total_cycles >= 100);
+}
