@@ -343,9 +343,9 @@ fn shade(
         }
         None => {
             let float = p.albedo_quadrature(k_view, res);
-            let fixed_unit = |k1: DVec3, sat: &mut SatCounter, diffuse: bool| -> f64 {
-                // The unit's rho for k1 = integration direction, k2 = view (reciprocal).
-                match Dots::from_dirs(k1, k_view) {
+            let fixed_unit = |k: DVec3, sat: &mut SatCounter, diffuse: bool| -> f64 {
+                // The unit with the view as its k1 (reciprocity), as `fixed_twin::albedo_fixed`.
+                match Dots::from_dirs(k_view, k) {
                     Some(d) => {
                         let out = aniso_phong_prepared(&quantize(p, &d, cfg), roms, sat);
                         let part = if diffuse { out.diffuse } else { out.spec };
