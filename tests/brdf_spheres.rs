@@ -114,7 +114,7 @@ fn furnace_centre_is_normal_incidence_albedo() {
         // Rs = 1, no diffuse: energy is only lost below the horizon, so albedo <= 1 and it
         // grows with the exponent (paper Fig. 2).
         if m == Material::Metal {
-            let at = |k: usize| g.float_linear[((k * 9 + 4) * 27 + k * 9 + 4) as usize];
+            let at = |k: usize| g.float_linear[(k * 9 + 4) * 27 + k * 9 + 4];
             assert!(at(0) < at(1) && at(1) < at(2) && at(2) <= 1.0 + 1e-9);
             assert!(at(2) > 0.99);
         }

@@ -312,17 +312,24 @@ fn prepare(
     Ok((mats, m, light))
 }
 
-/// Float and fixed radiance of one pixel with normal `n` (view space) and saturation count.
-fn shade(
-    p: &AshikhminShirley,
-    n: DVec3,
+/// Per-grid constants of the pixel shader.
+struct Shading<'a> {
     m: DVec3,
     light: Option<DVec3>,
     res: usize,
-    cfg: &AnisoPhongConfig,
-    roms: &AnisoPhongRoms,
-    sat: &mut SatCounter,
-) -> (f64, f64) {
+    cfg: &'a AnisoPhongConfig,
+    roms: &'a AnisoPhongRoms,
+}
+
+/// Float and fixed radiance of one pixel with normal `n` (view space) and saturation count.
+fn shade(p: &AshikhminShirley, n: DVec3, sh: &Shading<'_>, sat: &mut SatCounter) -> (f64, f64) {
+    let Shading {
+        m,
+        light,
+        res,
+        cfg,
+        roms,
+    } = *sh;
     let (u, v) = main_direction_frame(m, n);
     let local = |w: DVec3| DVec3::new(w.dot(u), w.dot(v), w.dot(n));
     let k_view = local(DVec3::Z);
@@ -383,7 +390,13 @@ pub fn render_grid(spec: &GridSpec, cfg: &AnisoPhongConfig) -> Result<GridImages
     let side = spec.image_px();
     let w = side as usize;
     let n = spec.exponents.len();
-    let res = spec.furnace_res;
+    let sh = Shading {
+        m,
+        light,
+        res: spec.furnace_res,
+        cfg,
+        roms: &roms,
+    };
     let mut float_linear = vec![0.0; w * w];
     let mut fixed_linear = vec![0.0; w * w];
     let sats: Vec<SatCounter> = float_linear
@@ -395,7 +408,7 @@ pub fn render_grid(spec: &GridSpec, cfg: &AnisoPhongConfig) -> Result<GridImages
             for x in 0..w {
                 if let Some((row, col, nrm)) = pixel_normal(spec, x as u32, y as u32) {
                     let p = &mats[row * n + col];
-                    let (f, q) = shade(p, nrm, m, light, res, cfg, &roms, &mut sat);
+                    let (f, q) = shade(p, nrm, &sh, &mut sat);
                     frow[x] = f;
                     xrow[x] = q;
                 }
