@@ -384,7 +384,7 @@ fn interp(a: i64, b: i64, frac: i64, fb: u32, rnd: Rounding) -> i64 {
 /// `(n.h)^E = (1 - s)^(E/2)` as a pseudo-float; `s` has `2D` fraction bits, `e_raw` has
 /// `aniso_ratio_bits` fraction bits.
 #[must_use]
-fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
+fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig, rom: &impl RomSource) -> PseudoFloat {
     let f = cfg.aniso_pow_frac_bits;
     let rnd = cfg.aniso_rounding;
     let b = cfg.aniso_pow_lut_bits;
@@ -404,7 +404,7 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
         let fb = sb - b - 1;
         let idx = (s >> fb) as u32;
         let fr = (s & ((1u64 << fb) - 1)) as i64;
-        let g = interp(rom_g(idx, cfg), rom_g(idx + 1, cfg), fr, fb, rnd);
+        let g = interp(rom.g(idx), rom.g(idx + 1), fr, fb, rnd);
         u128::from(s) * g.max(0) as u128
     } else {
         let y = (1u64 << sb) - s;
@@ -421,7 +421,7 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
         } else {
             ((mfrac << (b - mf)) as u32, 0, 0)
         };
-        let lg = interp(rom_log2(idx, cfg), rom_log2(idx + 1, cfg), fr, fb, rnd);
+        let lg = interp(rom.log2(idx), rom.log2(idx + 1), fr, fb, rnd);
         let k = i64::from(sb + 1 - bl);
         (((k << f) - lg).max(0) as u128) << sb
     };
@@ -439,7 +439,7 @@ fn power(s: u64, e_raw: u64, cfg: &AnisoPhongConfig) -> PseudoFloat {
     let fb = f - b;
     let idx = (xf >> fb) as u32;
     let fr = xf & ((1i64 << fb) - 1);
-    let pm = interp(rom_exp2(idx, cfg), rom_exp2(idx + 1, cfg), fr, fb, rnd);
+    let pm = interp(rom.exp2(idx), rom.exp2(idx + 1), fr, fb, rnd);
     pf_norm(pm.max(0) as u128, -(xi as i32) - f as i32, f, rnd)
 }
 
@@ -522,11 +522,99 @@ fn clamp_dot(x: i32, d: u32, sat: &mut SatCounter) -> i64 {
     v
 }
 
+/// Where the datapath reads its ROM entries: computed on demand ([`aniso_phong`]) or from
+/// tables built once ([`AnisoPhongRoms`]); both give the same entries.
+trait RomSource {
+    fn g(&self, i: u32) -> i64;
+    fn log2(&self, i: u32) -> i64;
+    fn exp2(&self, i: u32) -> i64;
+}
+
+/// ROM entries computed per lookup from their defining functions.
+struct DirectRoms<'a>(&'a AnisoPhongConfig);
+
+impl RomSource for DirectRoms<'_> {
+    fn g(&self, i: u32) -> i64 {
+        rom_g(i, self.0)
+    }
+    fn log2(&self, i: u32) -> i64 {
+        rom_log2(i, self.0)
+    }
+    fn exp2(&self, i: u32) -> i64 {
+        rom_exp2(i, self.0)
+    }
+}
+
+/// The three ROMs of one configuration, built once (`3 (2^aniso_pow_lut_bits + 1)` entries):
+/// [`aniso_phong_prepared`] with these tables is bit-identical to [`aniso_phong`], which
+/// recomputes each entry it reads.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AnisoPhongRoms {
+    cfg: AnisoPhongConfig,
+    g: Vec<i64>,
+    log2: Vec<i64>,
+    exp2: Vec<i64>,
+}
+
+impl AnisoPhongRoms {
+    /// Tables of [`rom_g`], [`rom_log2`] and [`rom_exp2`] for `cfg` (which should be valid).
+    #[must_use]
+    pub fn new(cfg: &AnisoPhongConfig) -> Self {
+        let n = (1u32 << cfg.aniso_pow_lut_bits.min(16)) + 1;
+        Self {
+            cfg: cfg.clone(),
+            g: (0..n).map(|i| rom_g(i, cfg)).collect(),
+            log2: (0..n).map(|i| rom_log2(i, cfg)).collect(),
+            exp2: (0..n).map(|i| rom_exp2(i, cfg)).collect(),
+        }
+    }
+
+    /// The configuration the tables were built for.
+    #[must_use]
+    pub fn config(&self) -> &AnisoPhongConfig {
+        &self.cfg
+    }
+}
+
+impl RomSource for AnisoPhongRoms {
+    fn g(&self, i: u32) -> i64 {
+        self.g.get(i as usize).copied().unwrap_or(0)
+    }
+    fn log2(&self, i: u32) -> i64 {
+        self.log2.get(i as usize).copied().unwrap_or(0)
+    }
+    fn exp2(&self, i: u32) -> i64 {
+        self.exp2.get(i as usize).copied().unwrap_or(0)
+    }
+}
+
 /// Evaluates the BRDF (times pi) from dot products. See the module doc for formats and guards.
+/// Recomputes every ROM entry it reads; for many evaluations use [`aniso_phong_prepared`].
 #[must_use]
 pub fn aniso_phong(
     inp: &AnisoPhongInputs,
     cfg: &AnisoPhongConfig,
+    sat: &mut SatCounter,
+) -> AnisoPhongOut {
+    aniso_phong_core(inp, cfg, &DirectRoms(cfg), sat)
+}
+
+/// [`aniso_phong`] reading its ROMs from tables built once by [`AnisoPhongRoms::new`] (for the
+/// configuration `roms.config()`); bit-identical to [`aniso_phong`] with that configuration.
+#[must_use]
+pub fn aniso_phong_prepared(
+    inp: &AnisoPhongInputs,
+    roms: &AnisoPhongRoms,
+    sat: &mut SatCounter,
+) -> AnisoPhongOut {
+    aniso_phong_core(inp, &roms.cfg, roms, sat)
+}
+
+#[must_use]
+fn aniso_phong_core(
+    inp: &AnisoPhongInputs,
+    cfg: &AnisoPhongConfig,
+    rom: &impl RomSource,
     sat: &mut SatCounter,
 ) -> AnisoPhongOut {
     let d = cfg.aniso_dot_frac_bits;
@@ -578,7 +666,7 @@ pub fn aniso_phong(
         let q = restoring_div(num, u128::from(s), cfg.exponent_max_bits + r + 2) as i64;
         round_shift_right(q, 1, Rounding::HalfUp) as u64
     };
-    let p = power(s, e_raw, cfg);
+    let p = power(s, e_raw, cfg, rom);
 
     // Fresnel, eq. 11.
     let fpf = fresnel(kh, d, rs, fb, rnd);
@@ -729,6 +817,64 @@ mod tests {
         ] {
             let r = isqrt(v);
             assert!(r * r <= v && (r + 1) * (r + 1) > v, "{v}");
+        }
+    }
+
+    #[test]
+    fn prepared_is_bit_identical_to_direct() {
+        let mut cfgs = vec![AnisoPhongConfig::texram16()];
+        let mut small = AnisoPhongConfig::texram16();
+        small.aniso_dot_frac_bits = 10;
+        small.aniso_pow_lut_bits = 5;
+        small.aniso_pow_frac_bits = 12;
+        small.aniso_rounding = Rounding::HalfUp;
+        cfgs.push(small);
+        fn next(x: &mut u64) -> u64 {
+            *x ^= *x << 13;
+            *x ^= *x >> 7;
+            *x ^= *x << 17;
+            *x
+        }
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for cfg in &cfgs {
+            assert!(cfg.validate().is_ok());
+            let roms = AnisoPhongRoms::new(cfg);
+            let one = 1i64 << cfg.aniso_dot_frac_bits;
+            // Dot products over [-1.1, 1.1] (some saturate), biased to h near n half the time.
+            let dot = |x: &mut u64, near_one: bool| -> i32 {
+                let r = (next(x) % (2 * one as u64 + one as u64 / 5)) as i64 - one - one / 10;
+                if near_one {
+                    (one - (r.abs() >> 6)) as i32
+                } else {
+                    r as i32
+                }
+            };
+            for k in 0..20_000 {
+                let near = k % 2 == 0;
+                let hn = dot(&mut x, near);
+                let (hu, hv) = if near {
+                    (dot(&mut x, false) >> 5, dot(&mut x, false) >> 5)
+                } else {
+                    (dot(&mut x, false), dot(&mut x, false))
+                };
+                let inp = AnisoPhongInputs {
+                    hn,
+                    hu,
+                    hv,
+                    kh: dot(&mut x, near),
+                    nk1: dot(&mut x, false),
+                    nk2: dot(&mut x, false),
+                    nu: (next(&mut x) % 200_000) as u32,
+                    nv: (next(&mut x) % 2_000) as u32,
+                    rs: (next(&mut x) % (1 << cfg.fresnel_bits)) as u32,
+                    rd: (next(&mut x) % (1 << cfg.fresnel_bits)) as u32,
+                };
+                let (mut s1, mut s2) = (SatCounter::default(), SatCounter::default());
+                let a = aniso_phong(&inp, cfg, &mut s1);
+                let b = aniso_phong_prepared(&inp, &roms, &mut s2);
+                assert_eq!(a, b, "{inp:?}");
+                assert_eq!(s1, s2);
+            }
         }
     }
 

@@ -6,6 +6,7 @@
 pub mod ashikhmin_shirley;
 pub mod fixed_twin;
 pub mod report;
+pub mod spheres;
 pub mod stats;
 
 pub use ashikhmin_shirley::{dir_from_angles, AshikhminShirley, Dots, McAlbedo, SplitMix64};
