@@ -121,7 +121,11 @@ pub fn fields(c: &HwConfig) -> Vec<(String, String)> {
 /// like `trilinear.weight_bits`) set to `value`, validated.
 /// `frame` is an alias of `frame_kind` (`--vary frame=natural,unit,main`).
 pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
-    let name = if name == "frame" { "frame_kind" } else { name };
+    let name = match name {
+        "frame" => "frame_kind",
+        "roughness" => "rough_variant",
+        other => other,
+    };
     let all = fields(c);
     let matches: Vec<&String> = all
         .iter()

@@ -8,6 +8,7 @@
 use crate::aniso_phong::AnisoPhongConfig;
 use crate::blinn_phong::ShadingConfig;
 use crate::fixed::Rounding;
+use crate::roughness::RoughnessConfig;
 use crate::timing_config::TimingConfig;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -153,6 +154,9 @@ pub struct HwConfig {
     pub shading: ShadingConfig,
     /// The Ashikhmin-Shirley anisotropic Phong unit.
     pub aniso_phong: AnisoPhongConfig,
+    /// The roughness-map unit (modified Blinn-Phong, Schilling 1997); absent in old files.
+    #[serde(default)]
+    pub roughness: RoughnessConfig,
     /// Timing-model parameters (never read by the functional units).
     pub timing: TimingConfig,
 }
@@ -210,6 +214,7 @@ impl HwConfig {
             },
             shading: ShadingConfig::texram16(),
             aniso_phong: AnisoPhongConfig::texram16(),
+            roughness: RoughnessConfig::texram16(),
             timing: TimingConfig::texram16(),
         }
     }
@@ -295,6 +300,7 @@ impl HwConfig {
         check("color.color_bits", self.color.color_bits, 1, 16)?;
         self.shading.validate()?;
         self.aniso_phong.validate()?;
+        self.roughness.validate()?;
         self.timing.validate()?;
         Ok(())
     }

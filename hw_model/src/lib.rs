@@ -19,6 +19,7 @@ pub mod lod;
 pub mod modulate;
 pub mod pow;
 pub mod reciprocal;
+pub mod roughness;
 pub mod rsqrt;
 pub mod timing_config;
 pub mod trilinear;

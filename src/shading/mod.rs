@@ -5,4 +5,5 @@
 
 pub mod bump;
 pub mod reference;
+pub mod roughness;
 pub mod tangents;

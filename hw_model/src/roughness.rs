@@ -1,0 +1,467 @@
+//! Modified Blinn-Phong with a roughness map in fixed point (Schilling 1997, "Antialiasing of
+//! Bump-Maps", Appendix A): `cos^2 a' = cos^2 a / (|d|^4 / |D d|^2 + cos^2 a)`, where `d` is
+//! the projection of `n - h` into the tangent plane (`|d|^2 = 1 - cos^2 a`) and `D` the
+//! filtered roughness factor `[[d1, d2], [0, d3]]` with `D D^T = K` (offset covariance).
+//!
+//! Written as `Q = |d|^2 * N / M`, `cos a' = cos a / sqrt(Q + cos^2 a)` (so
+//! `tan a' = tan a / sigma(d)`, sigma the standard deviation of the offsets in direction `d`):
+//! - `published`: `N = |d|^2`, `M = |D d|^2` (the paper's formula as printed);
+//! - `directional`: `N = |d|^2`, `M = |D^T d|^2 = d^T K d` (the standard deviation of the
+//!   offsets along `d`, consistent with `K = D D^T`; `|D d|` is that of `D^T D` instead);
+//! - `mahalanobis`: `Q = d^T K^-1 d = N / M` (no `|d|^2` factor: `d^T K^-1 d` already is
+//!   `|d|^2 / sigma^2`), `N = (d3 x - d2 y)^2 + (d1 y)^2`, `M = (d1 d3)^2` (the paper's
+//!   ellipse `x^T K^-1 x = 1`: the distance to it along `d` is the standard deviation there);
+//! - `isotropic`: `N = 1`, `M = lambda1^2` (channel 0 holds lambda1; the paper's simplified
+//!   formula `cos^2 a' = l^2 cos^2 a / (1 - cos^2 a + l^2 cos^2 a)`);
+//! - `none`: `cos a' = cos a` (the plain filtered bump map, the baseline).
+//!
+//! Guards, in this order: `cos a = 0` gives 0; `d = 0` (h = n) gives 1 (`Q = 0` by the limit
+//! `|d|^4/|Dd|^2 <= |d|^2 / sigma_min^2 -> 0`); `M = 0` (D singular along d, d != 0) gives 0
+//! and counts a saturation; `Q >= 2^`[`Q_CAP_BITS`] gives 0 and counts a saturation.
+//!
+//! Datapath: `d`, `cos a` in vector format (s1.F); the D channels are filtered unorm texels
+//! `t` (`texel_bits`) decoded exactly as `d1 = t 2^(e - bits)`, `d2 = (t - 2^(bits-1))
+//! 2^(e + 1 - bits)`, `d3` like `d1` (`e = rough_range_exp`, channel range `[0, 2^e)`,
+//! `d2` in `[-2^e, 2^e)`). `N` and `M` are exact integers; the divider returns `N / M` with
+//! `rough_div_bits` significant bits (round half even, exact remainder); `Q` is formed with
+//! `W = 4F + 8` fraction bits; the square root of `Q + cos^2 a` has `rough_sqrt_bits`
+//! significant bits (correctly rounded); the divider then forms `cos a / sqrt(...)`, rounded
+//! once more to the output's `P` fraction bits.
+//!
+//! ERROR BOUND (absolute, against the float twin `texsim::shading::roughness::rough_cos_twin`
+//! on the same quantized inputs): `1.5 * 2^-div_bits + 2^-sqrt_bits + 2^-(P+1) + 2^-20`
+//! (divider `2^-B` relative twice, half of it through the square root; square root `2^-B`;
+//! output rounding; the `Q` cap). Measured in `tests/roughness_unit.rs` (docs/ROUGHNESS.md).
+
+use crate::config::ConfigError;
+use crate::cost::UnitCost;
+use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
+use crate::pow::{pow_cost, Pow, PowConfig};
+use crate::rsqrt::{isqrt_u128, range};
+use serde::{Deserialize, Serialize};
+
+/// `Q` (the squared modified tangent) saturates at `2^Q_CAP_BITS`: the result is then below
+/// `2^-(Q_CAP_BITS/2)` and is returned as 0.
+pub const Q_CAP_BITS: u32 = 40;
+
+/// Which form of the modified Blinn-Phong is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RoughVariant {
+    /// No roughness: plain Blinn-Phong on the filtered bump normal.
+    None,
+    /// The paper's printed formula, `|D d|`.
+    Published,
+    /// The directional standard deviation `|D^T d|` (`K = D D^T`).
+    Directional,
+    /// The exact Mahalanobis form `d^T K^-1 d`.
+    Mahalanobis,
+    /// The isotropic form with lambda1 (largest standard deviation).
+    Isotropic,
+}
+
+impl RoughVariant {
+    /// All variants, in the order reports list them.
+    pub const ALL: [RoughVariant; 5] = [
+        RoughVariant::None,
+        RoughVariant::Published,
+        RoughVariant::Directional,
+        RoughVariant::Mahalanobis,
+        RoughVariant::Isotropic,
+    ];
+
+    /// The configuration name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            RoughVariant::None => "none",
+            RoughVariant::Published => "published",
+            RoughVariant::Directional => "directional",
+            RoughVariant::Mahalanobis => "mahalanobis",
+            RoughVariant::Isotropic => "isotropic",
+        }
+    }
+
+    /// Parses a configuration name.
+    #[must_use]
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|v| v.name() == s)
+    }
+}
+
+/// Where the specular exponent comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RoughExponentMode {
+    /// `rough_const_exponent` for every material: the highlight size comes from D alone
+    /// (the material enters through the base roughness added to K).
+    Constant,
+    /// The material's own shininess.
+    Material,
+}
+
+/// Roughness unit configuration.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoughnessConfig {
+    /// Stored bits per D channel (expanded to the texel width by bit replication). 2..=16.
+    pub rough_d_bits: u32,
+    /// Range exponent `e`: d1, d3 in `[0, 2^e)`, d2 in `[-2^e, 2^e)`. -4..=4.
+    pub rough_range_exp: i32,
+    /// Significant bits of the divider's quotient. 8..=30.
+    pub rough_div_bits: u32,
+    /// Significant bits of the square root. 8..=30.
+    pub rough_sqrt_bits: u32,
+    /// The formula.
+    pub rough_variant: RoughVariant,
+    /// Constant or material exponent.
+    pub rough_exponent_mode: RoughExponentMode,
+    /// The exponent in constant mode. 1..=1024.
+    pub rough_const_exponent: u32,
+    /// Cycles per multiplier stage.
+    pub rough_mul_cycles: u32,
+    /// Quotient bits the divider produces per cycle (SRT radix). 1..=8.
+    pub rough_div_bits_per_cycle: u32,
+    /// Root bits the square root produces per cycle. 1..=8.
+    pub rough_sqrt_bits_per_cycle: u32,
+}
+
+impl RoughnessConfig {
+    /// Texram-style default: 16-bit D channels in `[0, 2)`, 16-bit divide and root,
+    /// directional variant, constant exponent 1, radix-4 divider and root.
+    #[must_use]
+    pub fn texram16() -> Self {
+        Self {
+            rough_d_bits: 16,
+            rough_range_exp: 1,
+            rough_div_bits: 16,
+            rough_sqrt_bits: 16,
+            rough_variant: RoughVariant::Directional,
+            rough_exponent_mode: RoughExponentMode::Constant,
+            rough_const_exponent: 1,
+            rough_mul_cycles: 1,
+            rough_div_bits_per_cycle: 2,
+            rough_sqrt_bits_per_cycle: 2,
+        }
+    }
+
+    /// Checks the widths; the error names the field.
+    ///
+    /// # Errors
+    /// A [`ConfigError`] naming the first out-of-range field.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        range("roughness.rough_d_bits", self.rough_d_bits, 2, 16)?;
+        if !(-4..=4).contains(&self.rough_range_exp) {
+            return Err(ConfigError {
+                field: "roughness.rough_range_exp".into(),
+                what: format!("{} is out of range -4..=4", self.rough_range_exp),
+            });
+        }
+        range("roughness.rough_div_bits", self.rough_div_bits, 8, 30)?;
+        range("roughness.rough_sqrt_bits", self.rough_sqrt_bits, 8, 30)?;
+        range(
+            "roughness.rough_const_exponent",
+            self.rough_const_exponent,
+            1,
+            1024,
+        )?;
+        range(
+            "roughness.rough_div_bits_per_cycle",
+            self.rough_div_bits_per_cycle,
+            1,
+            8,
+        )?;
+        range(
+            "roughness.rough_sqrt_bits_per_cycle",
+            self.rough_sqrt_bits_per_cycle,
+            1,
+            8,
+        )?;
+        Ok(())
+    }
+
+    /// The specular exponent for a material of shininess `material`.
+    #[must_use]
+    pub fn exponent(&self, material: u32) -> u32 {
+        match self.rough_exponent_mode {
+            RoughExponentMode::Constant => self.rough_const_exponent,
+            RoughExponentMode::Material => material,
+        }
+    }
+}
+
+impl Default for RoughnessConfig {
+    fn default() -> Self {
+        Self::texram16()
+    }
+}
+
+/// Expands a `d_bits`-bit stored channel `q` to `texel_bits` by bit replication (the usual
+/// unorm widening, `q (2^T - 1) / (2^d - 1)` within one LSB; exact for `d_bits == texel_bits`).
+#[must_use]
+pub fn expand_channel(q: u64, d_bits: u32, texel_bits: u32) -> u64 {
+    let d = d_bits.clamp(1, 32);
+    let t = texel_bits.clamp(1, 32);
+    let q = q.min((1u64 << d) - 1);
+    if d >= t {
+        return q >> (d - t);
+    }
+    let mut out = 0u64;
+    let mut filled = 0u32;
+    while filled < t {
+        let take = d.min(t - filled);
+        out = (out << take) | (q >> (d - take));
+        filled += take;
+    }
+    out
+}
+
+/// Raw D values `[d1, d2, d3]` with `T = texel_bits - rough_range_exp` fraction bits, decoded
+/// exactly from filtered texels (module doc). Returns the values and `T`.
+#[must_use]
+pub fn decode_d(t: [u64; 3], texel_bits: u32, cfg: &RoughnessConfig) -> ([i64; 3], u32) {
+    let bits = texel_bits.clamp(1, 16);
+    let lim = 1u64 << bits;
+    let t = t.map(|x| x.min(lim) as i64);
+    let frac = (bits as i32 - cfg.rough_range_exp.clamp(-4, 4)) as u32;
+    ([t[0], 2 * (t[1] - (1i64 << (bits - 1))), t[2]], frac)
+}
+
+/// Inputs of one evaluation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RoughInput {
+    /// `cos a = n . h`, vector format (negative values clamp to 0).
+    pub cos_a: i64,
+    /// `d`, the tangent-plane projection of `n - h` in offset coordinates, vector format.
+    pub d: [i64; 2],
+    /// Filtered D texels `[d1, d2, d3]` (isotropic: `[lambda1, -, -]`).
+    pub dch: [u64; 3],
+    /// Bits of those texels.
+    pub texel_bits: u32,
+}
+
+/// Result of one evaluation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RoughOut {
+    /// `cos a'`, unsigned with `P` fraction bits, in `[0, 2^P]`.
+    pub cos_mod: u64,
+    /// `d` was zero (h = n): `cos a' = 1`.
+    pub d_zero: bool,
+    /// `M = 0` with `d != 0` (singular D along d) or `Q` saturated: `cos a' = 0`.
+    pub degenerate: bool,
+}
+
+fn bitlen(x: u128) -> u32 {
+    128 - x.leading_zeros()
+}
+
+/// Drops `drop >= 1` low bits of `q` rounding half even, with `sticky` = nonzero bits below.
+fn round_drop(q: u128, drop: u32, sticky: bool) -> u128 {
+    let floor = q >> drop;
+    let rem = q & ((1u128 << drop) - 1);
+    let half = 1u128 << (drop - 1);
+    let up = rem > half || (rem == half && (sticky || floor & 1 == 1));
+    floor + u128::from(up)
+}
+
+/// The divider: `n / m ~= mant * 2^exp`, `mant` in `[2^(b-1), 2^b)`, correctly rounded (half
+/// even) to `b` significant bits. `n, m > 0` and below 2^95; `b` in 2..=30.
+#[must_use]
+pub fn div_round(n: u128, m: u128, b: u32) -> (u64, i32) {
+    let b = b.clamp(2, 30);
+    let (ln, lm) = (bitlen(n) as i32, bitlen(m) as i32);
+    // n 2^k / m lies in (2^(b+1), 2^(b+3)) for k = b + 2 + lm - ln.
+    let k = b as i32 + 2 + lm - ln;
+    let (nn, mm) = if k >= 0 {
+        (n << k as u32, m)
+    } else {
+        (n, m << (-k) as u32)
+    };
+    let q0 = nn / mm;
+    let sticky = nn % mm != 0;
+    let drop = bitlen(q0) - b;
+    let mut mant = round_drop(q0, drop, sticky);
+    let mut e = drop as i32 - k;
+    if mant >> b != 0 {
+        mant >>= 1;
+        e += 1;
+    }
+    (mant as u64, e)
+}
+
+/// The square root: `sqrt(s) ~= mant * 2^exp`, `mant` in `[2^(b-1), 2^b)`, correctly rounded
+/// to `b` significant bits. `s > 0`, below 2^120; `b` in 2..=30.
+#[must_use]
+pub fn sqrt_round(s: u128, b: u32) -> (u64, i32) {
+    let b = b.clamp(2, 30);
+    let ls = bitlen(s) as i32;
+    // s 4^j has 2b + 1 or 2b + 2 bits, so its root has b + 1 bits.
+    let j = (2 * b as i32 + 2 - ls).div_euclid(2);
+    let (sp, lost) = if j >= 0 {
+        (s << (2 * j) as u32, false)
+    } else {
+        let sh = (-2 * j) as u32;
+        (s >> sh, s & ((1u128 << sh) - 1) != 0)
+    };
+    let r = isqrt_u128(sp);
+    let sticky = lost || r * r != sp;
+    let mut mant = round_drop(r, 1, sticky);
+    let mut e = 1 - j;
+    if mant >> b != 0 {
+        mant >>= 1;
+        e += 1;
+    }
+    (mant as u64, e)
+}
+
+/// `mant * 2^sh` rounded half even to an integer, capped at `cap`.
+fn scale_round(mant: u128, sh: i32, cap: u128) -> u128 {
+    if sh >= 0 {
+        if bitlen(mant) as i32 + sh > bitlen(cap) as i32 {
+            return cap;
+        }
+        (mant << sh as u32).min(cap)
+    } else {
+        let s = (-sh) as u32;
+        if s >= 127 {
+            return 0;
+        }
+        round_drop(mant, s, false).min(cap)
+    }
+}
+
+/// `cos a'` of the configured variant (module doc), `F = vector_frac_bits` of the inputs,
+/// `P = out_frac_bits` (2..=30) of the result.
+#[must_use]
+pub fn rough_cos(
+    inp: &RoughInput,
+    cfg: &RoughnessConfig,
+    vector_frac_bits: u32,
+    out_frac_bits: u32,
+    sat: &mut SatCounter,
+) -> RoughOut {
+    let f = vector_frac_bits.clamp(1, 15);
+    let p = out_frac_bits.clamp(2, 30);
+    let one_f = 1i64 << f;
+    let c = inp.cos_a.clamp(0, one_f);
+    let mut out = RoughOut {
+        cos_mod: 0,
+        d_zero: false,
+        degenerate: false,
+    };
+    if cfg.rough_variant == RoughVariant::None {
+        let shifted = if p >= f {
+            c << (p - f)
+        } else {
+            round_shift_right_wide(i128::from(c), f - p, Rounding::HalfEven)
+        };
+        out.cos_mod = shifted as u64;
+        return out;
+    }
+    if c == 0 {
+        return out;
+    }
+    let x = inp.d[0].clamp(-one_f, one_f);
+    let y = inp.d[1].clamp(-one_f, one_f);
+    let dd = (x * x + y * y) as u128;
+    if dd == 0 {
+        out.d_zero = true;
+        out.cos_mod = 1u64 << p;
+        return out;
+    }
+    let ([d1, d2, d3], t) = decode_d(inp.dch, inp.texel_bits, cfg);
+    let (x, y, d1, d2, d3) = (
+        i128::from(x),
+        i128::from(y),
+        i128::from(d1),
+        i128::from(d2),
+        i128::from(d3),
+    );
+    let sq = |v: i128| (v * v) as u128;
+    // N / M has value (N / M) 2^sh.
+    let (n, m, sh) = match cfg.rough_variant {
+        RoughVariant::Published => (dd, sq(d1 * x + d2 * y) + sq(d3 * y), 2 * t as i32),
+        RoughVariant::Directional => (dd, sq(d1 * x) + sq(d2 * x + d3 * y), 2 * t as i32),
+        RoughVariant::Mahalanobis => (
+            sq(d3 * x - d2 * y) + sq(d1 * y),
+            sq(d1 * d3),
+            2 * t as i32 - 2 * f as i32,
+        ),
+        RoughVariant::Isotropic | RoughVariant::None => (1, sq(d1), 2 * t as i32),
+    };
+    if m == 0 {
+        sat.saturated += 1;
+        out.degenerate = true;
+        return out;
+    }
+    let (rm, re) = div_round(n, m, cfg.rough_div_bits);
+    // Q with W = 4F + 8 fraction bits: lead (2F) * rm * 2^(re + sh) * 2^(2F + 8), `lead` = dd
+    // (1.0 for Mahalanobis).
+    let w = 4 * f + 8;
+    let cap = 1u128 << (w + Q_CAP_BITS);
+    let lead = if cfg.rough_variant == RoughVariant::Mahalanobis {
+        1u128 << (2 * f)
+    } else {
+        dd
+    };
+    let q = scale_round(lead * u128::from(rm), re + sh + 2 * f as i32 + 8, cap);
+    if q >= cap {
+        sat.saturated += 1;
+        out.degenerate = true;
+        return out;
+    }
+    let s = q + ((c * c) as u128) * (1u128 << (2 * f + 8));
+    let (sm, se) = sqrt_round(s, cfg.rough_sqrt_bits);
+    // cos a' = (c 2^-F) / (sm 2^(se - W/2)).
+    let (qm, qe) = div_round(c as u128, u128::from(sm), cfg.rough_div_bits);
+    let shift = qe - f as i32 - se + (w / 2) as i32 + p as i32;
+    out.cos_mod = scale_round(u128::from(qm), shift, 1u128 << p) as u64;
+    out
+}
+
+/// `cos a'` raised to the mode's exponent by the power unit (`P = pow_frac_bits`).
+#[must_use]
+pub fn rough_specular(
+    inp: &RoughInput,
+    cfg: &RoughnessConfig,
+    vector_frac_bits: u32,
+    material_exponent: u32,
+    pow: &Pow,
+    sat: &mut SatCounter,
+) -> (u64, RoughOut) {
+    let p = pow.config().pow_frac_bits;
+    let o = rough_cos(inp, cfg, vector_frac_bits, p, sat);
+    (pow.pow(o.cos_mod, cfg.exponent(material_exponent), sat), o)
+}
+
+/// Cycles of one divide or square root of `bits` result bits at `per_cycle` bits per cycle.
+fn iter_cycles(bits: u32, per_cycle: u32) -> u32 {
+    bits.div_ceil(per_cycle.max(1))
+}
+
+/// Cost of one `cos a'` for the configured variant (excluding the power unit):
+/// `none` is free; the others need `|d|^2` (2 mul, 1 add), `N`/`M` (published, directional,
+/// Mahalanobis: 5 mul + 2 add; isotropic: 1 mul), two divides, `dd * N/M` and `cos^2 a`
+/// (2 mul, 1 add) and one square root. Cycles: three multiplier stages (isotropic: two), the
+/// two divides and the root at their radix.
+#[must_use]
+pub fn rough_cost(cfg: &RoughnessConfig) -> UnitCost {
+    let div = iter_cycles(cfg.rough_div_bits, cfg.rough_div_bits_per_cycle);
+    let root = iter_cycles(cfg.rough_sqrt_bits, cfg.rough_sqrt_bits_per_cycle);
+    let (nm_ops, mul_stages) = match cfg.rough_variant {
+        RoughVariant::None => return UnitCost::default(),
+        RoughVariant::Isotropic => (1, 2),
+        RoughVariant::Published | RoughVariant::Directional | RoughVariant::Mahalanobis => (7, 3),
+    };
+    UnitCost {
+        ops: 3 + nm_ops + 3 + 3,
+        cycles: mul_stages * cfg.rough_mul_cycles + 2 * div + root,
+        texels: 0,
+    }
+}
+
+/// Cost of [`rough_specular`]: [`rough_cost`] plus the power unit.
+#[must_use]
+pub fn rough_specular_cost(cfg: &RoughnessConfig, pow: &PowConfig) -> UnitCost {
+    rough_cost(cfg).plus(pow_cost(pow))
+}

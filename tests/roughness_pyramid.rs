@@ -1,0 +1,310 @@
+//! Roughness pyramid (Schilling 1997): the recursive covariance rule against the direct
+//! covariance of all finest offsets under each texel, the D factorization, lambda1, the
+//! encoding and the quantized chain.
+
+#![allow(clippy::needless_range_loop)]
+
+use hw_model::roughness::{decode_d, RoughnessConfig};
+use texsim::shading::roughness::{
+    build_rough_pyramid, d_factor, d_product, decode_d_texels, lambda1, quantize_rough_chain,
+    rough_mip_chain, RoughParams, RoughnessEncoding, UNIFORM_CORRECTION,
+};
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Direct mean and covariance (population, 1/n) of the finest offsets in the block of texel
+/// `(x, y)` at level `l` of a power-of-two map.
+fn direct(offs: &[[f32; 2]], w: u32, l: u32, x: u32, y: u32) -> ([f64; 2], [f64; 3]) {
+    let s = 1u32 << l;
+    let n = f64::from(s * s);
+    let mut m = [0.0; 2];
+    for py in y * s..(y + 1) * s {
+        for px in x * s..(x + 1) * s {
+            let o = offs[(py * w + px) as usize];
+            m[0] += f64::from(o[0]);
+            m[1] += f64::from(o[1]);
+        }
+    }
+    let m = m.map(|v| v / n);
+    let mut k = [0.0; 3];
+    for py in y * s..(y + 1) * s {
+        for px in x * s..(x + 1) * s {
+            let o = offs[(py * w + px) as usize];
+            let (du, dv) = (f64::from(o[0]) - m[0], f64::from(o[1]) - m[1]);
+            k[0] += du * du;
+            k[1] += du * dv;
+            k[2] += dv * dv;
+        }
+    }
+    (m, k.map(|v| v / n))
+}
+
+fn check_against_direct(offs: &[[f32; 2]], w: u32, h: u32, tol: f64) -> f64 {
+    let pyr = build_rough_pyramid(offs, w, h).expect("valid map");
+    let mut worst = 0.0f64;
+    for (l, lev) in pyr.levels.iter().enumerate() {
+        assert_eq!(lev.width, (w >> l).max(1));
+        for y in 0..lev.height {
+            for x in 0..lev.width {
+                let i = (y * lev.width + x) as usize;
+                // Blocks are square only while both sides halve; these maps are square.
+                let (m, k) = direct(offs, w, l as u32, x, y);
+                for c in 0..2 {
+                    let e = (lev.mean[i][c] - m[c]).abs();
+                    worst = worst.max(e);
+                    assert!(e <= tol, "mean level {l} ({x},{y}) {e}");
+                }
+                for c in 0..3 {
+                    let e = (lev.cov[i][c] - k[c]).abs();
+                    worst = worst.max(e);
+                    assert!(
+                        e <= tol,
+                        "cov level {l} ({x},{y}) {} vs {}",
+                        lev.cov[i][c],
+                        k[c]
+                    );
+                }
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn recursive_rule_is_exact_for_dyadic_offsets() {
+    let mut r = Rng(1);
+    let (w, h) = (32u32, 32u32);
+    let offs: Vec<[f32; 2]> = (0..w * h)
+        .map(|_| {
+            let a = (r.next() % 512) as f32 / 256.0 - 1.0;
+            let b = (r.next() % 512) as f32 / 256.0 - 1.0;
+            [a, b]
+        })
+        .collect();
+    let worst = check_against_direct(&offs, w, h, 0.0);
+    assert_eq!(worst, 0.0);
+}
+
+#[test]
+fn recursive_rule_matches_direct_for_random_offsets() {
+    let mut r = Rng(2);
+    let (w, h) = (64u32, 64u32);
+    let offs: Vec<[f32; 2]> = (0..w * h)
+        .map(|_| [(r.unit() * 4.0 - 2.0) as f32, (r.unit() * 0.5 - 0.1) as f32])
+        .collect();
+    let worst = check_against_direct(&offs, w, h, 1e-12);
+    println!("random 64x64: worst |recursive - direct| = {worst:e}");
+}
+
+#[test]
+fn garbled_forms_fail_the_direct_check() {
+    // Negative control: dropping either term of the rule breaks the equality the test checks.
+    let mut r = Rng(3);
+    let offs: Vec<[f32; 2]> = (0..16 * 16)
+        .map(|_| [(r.unit() * 2.0 - 1.0) as f32, (r.unit() * 2.0 - 1.0) as f32])
+        .collect();
+    let pyr = build_rough_pyramid(&offs, 16, 16).expect("valid");
+    let top = pyr.levels.last().expect("levels");
+    let (_, k) = direct(&offs, 16, 4, 0, 0);
+    // Scatter of the level-3 means alone (the second term without the first):
+    let l3 = &pyr.levels[3];
+    let m = top.mean[0];
+    let scatter: f64 = l3.mean.iter().map(|c| (c[0] - m[0]).powi(2)).sum::<f64>() / 4.0;
+    let down: f64 = l3.cov.iter().map(|c| c[0]).sum::<f64>() / 4.0;
+    assert!((top.cov[0][0] - k[0]).abs() < 1e-12);
+    assert!((scatter - k[0]).abs() > 1e-3 && (down - k[0]).abs() > 1e-3);
+    assert!((scatter + down - k[0]).abs() < 1e-12);
+}
+
+#[test]
+fn npot_maps_keep_the_bump_mip_mean_and_a_psd_covariance() {
+    let mut r = Rng(4);
+    for &(w, h) in &[(5u32, 3u32), (7, 1), (1, 9), (12, 6), (33, 17)] {
+        let offs: Vec<[f32; 2]> = (0..w * h)
+            .map(|_| [(r.unit() * 2.0 - 1.0) as f32, (r.unit() * 2.0 - 1.0) as f32])
+            .collect();
+        let pyr = build_rough_pyramid(&offs, w, h).expect("valid");
+        let last = pyr.levels.last().expect("levels");
+        assert_eq!((last.width, last.height), (1, 1));
+        assert_eq!(
+            pyr.levels.len(),
+            texsim::maps::chain_sizes(w, h).len(),
+            "{w}x{h}"
+        );
+        for lev in &pyr.levels {
+            for k in &lev.cov {
+                assert!(k[0] >= -1e-15 && k[2] >= -1e-15);
+                assert!(k[1] * k[1] <= k[0] * k[2] + 1e-12, "{k:?}");
+            }
+        }
+        // Past the last level: clamped.
+        assert_eq!(pyr.level(99), last);
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    assert!(build_rough_pyramid(&[[0.0, 0.0]; 3], 2, 2).is_err());
+    assert!(build_rough_pyramid(&[], 0, 0).is_err());
+    assert!(build_rough_pyramid(&[[f32::NAN, 0.0]], 1, 1).is_err());
+}
+
+fn random_psd(r: &mut Rng) -> [f64; 3] {
+    // K = A A^T with random A, some rank-deficient, some with tiny c.
+    let s = |r: &mut Rng| (r.unit() * 2.0 - 1.0) * 10f64.powf(r.unit() * 6.0 - 4.0);
+    let (p, q, t, u) = (s(r), s(r), s(r), s(r));
+    match r.next() % 4 {
+        0 => [p * p, p * q, q * q],                        // rank 1
+        1 => [p * p + q * q, q * 1e-9 * t, 1e-18 * t * t], // c -> 0
+        _ => [p * p + q * q, p * t + q * u, t * t + u * u],
+    }
+}
+
+#[test]
+fn d_factor_reproduces_k_including_singular_and_c_to_zero() {
+    let mut r = Rng(5);
+    let mut worst = 0.0f64;
+    for _ in 0..200_000 {
+        let k = random_psd(&mut r);
+        let d = d_factor(k);
+        assert!(d.iter().all(|v| v.is_finite()));
+        assert!(d[0] >= 0.0 && d[2] >= 0.0);
+        let kk = d_product(d);
+        let scale = k[0].max(k[2]).max(1e-300);
+        for i in 0..3 {
+            let e = (kk[i] - k[i]).abs() / scale;
+            worst = worst.max(e);
+        }
+    }
+    println!("D D^T vs K: worst relative error {worst:e}");
+    assert!(worst < 1e-9, "{worst}");
+    // Exact zero c, zero matrix, slightly non-PSD input (rounding): finite, non-negative.
+    for k in [
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [1.0, 1.0 + 1e-12, 1.0],
+        [-1e-20, 0.0, 2.0],
+    ] {
+        let d = d_factor(k);
+        assert!(d.iter().all(|v| v.is_finite()), "{k:?}");
+        assert!(d[0] >= 0.0 && d[2] >= 0.0);
+    }
+    assert_eq!(d_factor([4.0, 0.0, 0.0]), [2.0, 0.0, 0.0]);
+}
+
+#[test]
+fn lambda1_is_the_largest_standard_deviation() {
+    let mut r = Rng(6);
+    for _ in 0..100_000 {
+        let k = random_psd(&mut r);
+        let l = lambda1(k);
+        // Largest directional variance over a fine angle sweep, from below.
+        let mut best = 0.0f64;
+        for i in 0..720 {
+            let t = f64::from(i) * std::f64::consts::PI / 720.0;
+            let (c, s) = (t.cos(), t.sin());
+            best = best.max(k[0] * c * c + 2.0 * k[1] * c * s + k[2] * s * s);
+        }
+        let scale = k[0] + k[2];
+        assert!(l * l >= best - 1e-12 * scale, "{k:?}");
+        assert!(l * l <= best * (1.0 + 2e-5) + 1e-12 * scale, "{k:?}");
+    }
+}
+
+#[test]
+fn stored_covariance_adds_base_roughness_and_correction() {
+    let p = RoughParams {
+        base_sigma: 0.25,
+        exponent: 2.0,
+        correction: UNIFORM_CORRECTION,
+    };
+    let k = p.stored_cov([0.0, 0.0, 0.0]);
+    assert_eq!(k, [0.125, 0.0, 0.125]);
+    let k = p.stored_cov([1.0, 0.5, 1.0]);
+    assert_eq!(k, [2.0 * (3.0 + 0.0625), 3.0, 2.0 * (3.0 + 0.0625)]);
+    // Uniform offsets in [-w, w]: sigma = w / sqrt(3); corrected, the ellipse reaches w.
+    let n = 4096;
+    let offs: Vec<[f32; 2]> = (0..n)
+        .map(|i| {
+            [
+                ((f64::from(i) + 0.5) / f64::from(n) * 2.0 - 1.0) as f32,
+                0.0,
+            ]
+        })
+        .collect();
+    let pyr = build_rough_pyramid(&offs, n, 1).expect("valid");
+    let a = pyr.levels.last().expect("levels").cov[0][0];
+    assert!((a * UNIFORM_CORRECTION - 1.0).abs() < 1e-5, "{a}");
+    let fm = RoughParams::for_material(64, 1, false);
+    assert!((fm.base_sigma - 0.125).abs() < 1e-15);
+}
+
+#[test]
+fn encoding_round_trips_through_the_hw_decoder() {
+    let cfg = RoughnessConfig::texram16();
+    let enc = RoughnessEncoding::for_range_exp(cfg.rough_range_exp);
+    let mut r = Rng(7);
+    for _ in 0..10_000 {
+        let d = [r.unit() * 1.9, r.unit() * 3.8 - 1.9, r.unit() * 1.9];
+        let (ch, clamped) = enc.encode(d);
+        assert_eq!(clamped, 0);
+        let back = enc.decode(ch.map(f64::from));
+        for i in 0..3 {
+            assert!((back[i] - d[i]).abs() < 1e-6);
+        }
+        // Texels as texture memory holds them, then the hw decoder vs the float decoder.
+        let t = ch.map(|c| u64::from(texsim::maps::quantize_unorm(c, 16)));
+        let (raw, frac) = decode_d(t, 16, &cfg);
+        let f = decode_d_texels(t, 16, cfg.rough_range_exp);
+        for i in 0..3 {
+            assert_eq!(raw[i] as f64 * (-f64::from(frac)).exp2(), f[i]);
+            assert!(
+                (f[i] - d[i]).abs() < 4.0 * 2f64.powi(-15),
+                "{} {}",
+                f[i],
+                d[i]
+            );
+        }
+    }
+    let (_, clamped) = enc.encode([5.0, -9.0, f64::NAN]);
+    assert_eq!(clamped, 3);
+}
+
+#[test]
+fn quantized_chain_has_d_bits_resolution() {
+    let mut r = Rng(8);
+    let offs: Vec<[f32; 2]> = (0..16 * 16)
+        .map(|_| [(r.unit() * 2.0 - 1.0) as f32, (r.unit() - 0.5) as f32])
+        .collect();
+    let pyr = build_rough_pyramid(&offs, 16, 16).expect("valid");
+    let params = RoughParams::for_material(32, 1, false);
+    let enc = RoughnessEncoding::for_range_exp(1);
+    for iso in [false, true] {
+        let (chain, clamped) = rough_mip_chain(&pyr, &params, &enc, iso);
+        assert_eq!(clamped, 0);
+        for bits in [4u32, 8, 12, 16] {
+            let q = quantize_rough_chain(&chain, bits, 16);
+            for (fl, ql) in chain.levels.iter().zip(&q.levels) {
+                for (ft, qt) in fl.texels.iter().zip(&ql.texels) {
+                    for c in 0..3 {
+                        let v = f64::from(qt[c]) / 65535.0;
+                        let e = (v - f64::from(ft[c])).abs();
+                        assert!(e <= 0.5 / ((1u32 << bits) - 1) as f64 + 2e-5, "{bits} {e}");
+                    }
+                }
+            }
+        }
+    }
+}
