@@ -173,6 +173,13 @@ pub struct RenderArgs {
     /// Skip the float reference (no error metrics).
     #[arg(long)]
     pub no_reference: bool,
+    /// Also render the supersampled ground truth of roughness materials (truth.png) and add
+    /// model_error, quantization_error and baseline_error to summary.json.
+    #[arg(long)]
+    pub truth: bool,
+    /// Ground-truth sub-samples per pixel axis (N x N per pixel).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub truth_samples: u32,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -239,6 +246,8 @@ pub fn run(cli: Cli) -> Result<()> {
             float: vec![],
             isolate: None,
             no_reference: false,
+            truth: false,
+            truth_samples: 16,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -341,10 +350,14 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
             CoverageArg::Shared => CoverageMode::Shared,
             CoverageArg::Independent => CoverageMode::Independent,
         },
+        truth: if a.truth { a.truth_samples } else { 0 },
     };
-    let r = render(&sc, &maps, &hw, &opts)?;
+    let mut r = render(&sc, &maps, &hw, &opts)?;
     let mut out = OutputSet::new();
     stage_images(&r, a.png16, &mut out)?;
+    if a.truth {
+        truth_outputs(&sc, &maps, &hw, &mut r, &mut out)?;
+    }
     let json = serde_json::json!({
         "scene": &r.stats.scene,
         "hw_config": &hw,
@@ -360,6 +373,60 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     println!("wrote:");
     for p in written {
         println!("  {}", p.display());
+    }
+    Ok(())
+}
+
+/// Writes truth.png and fills the baseline error: the same scene with every roughness material
+/// switched to `none` (plain filtered bump map), all stages float, against the truth.
+fn truth_outputs(
+    sc: &Scene,
+    maps: &Maps,
+    hw: &HwConfig,
+    r: &mut Rendered,
+    out: &mut OutputSet,
+) -> Result<()> {
+    let Some(truth) = &r.truth_image else {
+        eprintln!("warning: --truth: the scene has no roughness material, no truth rendered");
+        return Ok(());
+    };
+    out.add("truth.png", report::encode_png8(truth)?);
+    let mut base = sc.clone();
+    for m in &mut base.materials {
+        if m.roughness.is_some() {
+            m.roughness = Some(scene::RoughChoice::Variant(
+                hw_model::roughness::RoughVariant::None,
+            ));
+        }
+    }
+    let b = render(
+        &base,
+        maps,
+        hw,
+        &RenderOptions {
+            hw_impls: StageImpls::FLOAT,
+            reference: false,
+            ..RenderOptions::default()
+        },
+    )?;
+    out.add("baseline.png", report::encode_png8(&b.hw_image)?);
+    if let Some(rs) = r.stats.roughness.as_mut() {
+        rs.baseline_error = Some(report::compare(&b.hw_image, truth, 8, Some(&r.mask)));
+        let show = |n: &str, e: &Option<report::ErrorMetrics>| {
+            if let Some(e) = e {
+                eprintln!(
+                    "  {n:<20} mean {:.3} rmse {:.3} max {} (8-bit LSB)",
+                    e.mean_abs_lsb, e.rmse_lsb, e.max_abs_lsb
+                );
+            }
+        };
+        eprintln!(
+            "roughness vs ground truth ({0}x{0} samples/pixel):",
+            rs.truth_samples
+        );
+        show("model_error", &rs.model_error);
+        show("quantization_error", &rs.quantization_error);
+        show("baseline_error", &rs.baseline_error);
     }
     Ok(())
 }

@@ -274,7 +274,8 @@ impl Geometry {
                     .position(|o| o.same(&b))
                     .map(|k| scene.textures.len() + k)
             });
-            let p = plan_with_bump(mat, !mesh.uvs.is_empty(), bump_map);
+            let mut p = plan_with_bump(mat, !mesh.uvs.is_empty(), bump_map);
+            crate::pipeline::rough_stages::mark_plan(&mut p, mat);
             if let Some(bp) = &p.bump {
                 g.bump.resize(base as usize, BumpVertex::default());
                 g.bump.extend(bump_vertices(mesh, bp));
@@ -394,6 +395,9 @@ pub struct RenderOptions {
     /// Collect the timing model's event stream (`Rendered::events`). Off by default: a render
     /// without it allocates no event buffer and does no extra work per pixel.
     pub timing: bool,
+    /// Ground truth of roughness materials (`rough_stages`): sub-samples per pixel axis,
+    /// 0 = off.
+    pub truth: u32,
 }
 
 impl Default for RenderOptions {
@@ -403,6 +407,7 @@ impl Default for RenderOptions {
             reference: true,
             coverage: CoverageMode::Shared,
             timing: false,
+            truth: 0,
         }
     }
 }
@@ -487,6 +492,9 @@ pub struct Rendered {
     pub stats: RenderStats,
     /// The timing model's events of the hardware pass, when `RenderOptions::timing` was set.
     pub events: Option<FrameEvents>,
+    /// The supersampled ground truth, when `RenderOptions::truth` was set and the scene has
+    /// roughness materials.
+    pub truth_image: Option<Image>,
 }
 
 /// The numbers of one render (serialized into summary.json).
@@ -511,6 +519,24 @@ pub struct RenderStats {
     /// Error of the hardware image against the reference, in 8-bit and 16-bit LSBs.
     pub error_8bit: Option<ErrorMetrics>,
     pub error_16bit: Option<ErrorMetrics>,
+    /// Roughness materials (issue 4): D maps, ground truth and the two errors.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<RoughStats>,
+}
+
+/// Roughness statistics of one render (8-bit LSB metrics over the covered pixels).
+#[derive(Clone, Debug, Serialize)]
+pub struct RoughStats {
+    /// D channel values clamped by the encoding.
+    pub d_clamped: u64,
+    /// Ground-truth sub-samples per pixel axis (0: no truth rendered).
+    pub truth_samples: u32,
+    /// Float model vs ground truth.
+    pub model_error: Option<ErrorMetrics>,
+    /// Fixed vs float of the same model (= `error_8bit`).
+    pub quantization_error: Option<ErrorMetrics>,
+    /// Plain filtered bump map (variant `none`, float) vs ground truth; filled by the CLI.
+    pub baseline_error: Option<ErrorMetrics>,
 }
 
 fn ms(t: Instant) -> f64 {
@@ -749,7 +775,7 @@ pub fn render(
     hw.validate()?;
     let mut tm = Timings::default();
     let t = Instant::now();
-    let geo = Geometry::new(scene);
+    let mut geo = Geometry::new(scene);
     tm.geometry_ms = ms(t);
     let bumped = geo.plans.iter().any(|p| p.bump.is_some());
     if bumped && geo.point_lights.len() > MAX_POINT_LIGHTS {
@@ -770,6 +796,19 @@ pub fn render(
         mm.ensure_offset_bits(offset_bits);
         reencoded = mm;
         &reencoded
+    };
+    let rough_sources =
+        crate::pipeline::rough_stages::resolve_plans(&mut geo.plans, hw, maps.float.len());
+    let has_rough = geo.plans.iter().any(|p| p.rough.is_some());
+    let mut d_clamped = 0;
+    let rough_owned;
+    let maps = if rough_sources.is_empty() {
+        maps
+    } else {
+        let (mm, cl) = crate::pipeline::rough_stages::rough_maps(maps, &rough_sources, hw)?;
+        d_clamped = cl;
+        rough_owned = mm;
+        &rough_owned
     };
 
     let t = Instant::now();
@@ -854,6 +893,34 @@ pub fn render(
         e16 = Some(compare(&hw_image, &img, 16, Some(&mask)));
         ref_image = Some(img);
     }
+    let mut truth_image = None;
+    if opts.truth > 0 && has_rough {
+        let tp = crate::pipeline::rough_stages::truth_plans(&geo.plans, opts.truth);
+        let saved = std::mem::replace(&mut geo.plans, tp);
+        let tcosts: Vec<[UnitCost; StageKind::COUNT]> =
+            geo.plans.iter().map(|p| m.plan_costs(p)).collect();
+        let tin = ShadeInput {
+            vis: &vis,
+            setup: &setup,
+            attrs: &attrs,
+            geo: &geo,
+            m: &m,
+            costs: &tcosts,
+        };
+        let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, false);
+        geo.plans = saved;
+        truth_image = Some(img);
+    }
+    let roughness = has_rough.then(|| RoughStats {
+        d_clamped,
+        truth_samples: if truth_image.is_some() { opts.truth } else { 0 },
+        model_error: match (&ref_image, &truth_image) {
+            (Some(r), Some(t)) => Some(compare(r, t, 8, Some(&mask))),
+            _ => None,
+        },
+        quantization_error: e8.clone(),
+        baseline_error: None,
+    });
 
     let mut stages = Vec::with_capacity(StageKind::COUNT);
     let mut stage_cycles = 0u64;
@@ -890,6 +957,7 @@ pub fn render(
         ref_image,
         mask,
         events,
+        truth_image,
         stats: RenderStats {
             scene: scene.name.clone(),
             hw: hw.name.clone(),
@@ -915,6 +983,7 @@ pub fn render(
             timings: tm,
             error_8bit: e8,
             error_16bit: e16,
+            roughness,
         },
     })
 }

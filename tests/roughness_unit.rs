@@ -363,6 +363,7 @@ fn specular_applies_the_exponent_mode() {
     };
     let constant = RoughnessConfig {
         rough_const_exponent: 4,
+        rough_exponent_mode: RoughExponentMode::Constant,
         ..RoughnessConfig::texram16()
     };
     let material = RoughnessConfig {
@@ -441,8 +442,8 @@ fn sweep_knobs_set_the_roughness_fields() {
     }
     let n = texsim::hwconfig::set_field(&c, "rough_d_bits", "8").expect("bits");
     assert_eq!(n.roughness.rough_d_bits, 8);
-    let n = texsim::hwconfig::set_field(&c, "rough_exponent_mode", "material").expect("mode");
-    assert_eq!(n.roughness.rough_exponent_mode, RoughExponentMode::Material);
+    let n = texsim::hwconfig::set_field(&c, "rough_exponent_mode", "constant").expect("mode");
+    assert_eq!(n.roughness.rough_exponent_mode, RoughExponentMode::Constant);
     let e = texsim::hwconfig::set_field(&c, "roughness", "shiny").expect_err("bad");
     assert!(e.to_string().contains("rough_variant"), "{e}");
     let e = texsim::hwconfig::set_field(&c, "rough_div_bits", "99").expect_err("bad");

@@ -33,11 +33,13 @@
 //! (divider `2^-B` relative twice, half of it through the square root; square root `2^-B`;
 //! output rounding; the `Q` cap). Measured in `tests/roughness_unit.rs` (docs/ROUGHNESS.md).
 
+use crate::blinn_phong::{blinn_phong_cost, BlinnPhongInput, BlinnPhongOut, ShadingUnits};
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
-use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
+use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
 use crate::pow::{pow_cost, Pow, PowConfig};
 use crate::rsqrt::{isqrt_u128, range};
+use crate::vector::{dot3, dot_cost, normalize3, Vec3x};
 use serde::{Deserialize, Serialize};
 
 /// `Q` (the squared modified tangent) saturates at `2^Q_CAP_BITS`: the result is then below
@@ -124,24 +126,30 @@ pub struct RoughnessConfig {
     pub rough_div_bits_per_cycle: u32,
     /// Root bits the square root produces per cycle. 1..=8.
     pub rough_sqrt_bits_per_cycle: u32,
+    /// Scale K by 3 when the pyramid is built (offsets uniformly distributed rather than
+    /// normal: the ellipse then reaches the edge of the distribution). Host side only.
+    #[serde(default)]
+    pub rough_uniform: bool,
 }
 
 impl RoughnessConfig {
-    /// Texram-style default: 16-bit D channels in `[0, 2)`, 16-bit divide and root,
-    /// directional variant, constant exponent 1, radix-4 divider and root.
+    /// Texram-style default: 16-bit D channels in `[0, 4)`, 16-bit divide and root,
+    /// directional variant, material exponent (constant exponent 1 when switched), radix-4
+    /// divider and root, no uniform correction.
     #[must_use]
     pub fn texram16() -> Self {
         Self {
             rough_d_bits: 16,
-            rough_range_exp: 1,
+            rough_range_exp: 2,
             rough_div_bits: 16,
             rough_sqrt_bits: 16,
             rough_variant: RoughVariant::Directional,
-            rough_exponent_mode: RoughExponentMode::Constant,
+            rough_exponent_mode: RoughExponentMode::Material,
             rough_const_exponent: 1,
             rough_mul_cycles: 1,
             rough_div_bits_per_cycle: 2,
             rough_sqrt_bits_per_cycle: 2,
+            rough_uniform: false,
         }
     }
 
@@ -340,10 +348,80 @@ pub fn rough_cos(
     out_frac_bits: u32,
     sat: &mut SatCounter,
 ) -> RoughOut {
+    let (dv, t) = decode_d(inp.dch, inp.texel_bits, cfg);
+    rough_cos_d(
+        inp.cos_a,
+        inp.d,
+        dv,
+        t,
+        cfg,
+        vector_frac_bits,
+        out_frac_bits,
+        sat,
+    )
+}
+
+/// Largest magnitude of a raw D value entering [`rough_cos_d`] (larger values saturate,
+/// counted): keeps every product of the datapath below 2^100.
+pub const D_RAW_LIMIT: i64 = 1 << 20;
+
+/// Scales decoded D (`t` fraction bits) by the frame lengths (`len_frac_bits`): `L D` with
+/// `L = diag(len_u, len_v)` is again upper triangular and `(L D)(L D)^T = L K L`, the offset
+/// covariance in tangent-plane units (the perturbation is `f_u len_u t_u + f_v len_v t_v`).
+/// Rounded half even back to `t` fraction bits; magnitudes above [`D_RAW_LIMIT`] saturate
+/// (counted). The isotropic lambda1 (channel 0) is scaled by `max(len_u, len_v)`.
+#[must_use]
+pub fn scale_d(
+    dv: [i64; 3],
+    len: [i64; 2],
+    len_frac_bits: u32,
+    isotropic: bool,
+    sat: &mut SatCounter,
+) -> [i64; 3] {
+    let lf = len_frac_bits.min(30);
+    let (lu, lv) = (len[0].max(0), len[1].max(0));
+    let ls = if isotropic {
+        [lu.max(lv), lu, lv]
+    } else {
+        [lu, lu, lv]
+    };
+    let mut out = [0i64; 3];
+    for i in 0..3 {
+        let prod = i128::from(dv[i]) * i128::from(ls[i]);
+        let r = if lf == 0 {
+            prod
+        } else {
+            i128::from(round_shift_right_wide(prod, lf, Rounding::HalfEven))
+        };
+        let lim = i128::from(D_RAW_LIMIT);
+        out[i] = if r > lim || r < -lim {
+            sat.saturated += 1;
+            r.clamp(-lim, lim) as i64
+        } else {
+            r as i64
+        };
+    }
+    out
+}
+
+/// [`rough_cos`] on decoded D values `dv = [d1, d2, d3]` with `t` fraction bits (e.g. from
+/// [`decode_d`] and [`scale_d`]); `c = cos a` and `d` in vector format (`F` fraction bits).
+#[must_use]
+#[allow(clippy::too_many_arguments)]
+pub fn rough_cos_d(
+    cos_a: i64,
+    d: [i64; 2],
+    dv: [i64; 3],
+    t: u32,
+    cfg: &RoughnessConfig,
+    vector_frac_bits: u32,
+    out_frac_bits: u32,
+    sat: &mut SatCounter,
+) -> RoughOut {
     let f = vector_frac_bits.clamp(1, 15);
     let p = out_frac_bits.clamp(2, 30);
     let one_f = 1i64 << f;
-    let c = inp.cos_a.clamp(0, one_f);
+    let c = cos_a.clamp(0, one_f);
     let mut out = RoughOut {
         cos_mod: 0,
         d_zero: false,
@@ -361,15 +439,19 @@ pub fn rough_cos(
     if c == 0 {
         return out;
     }
-    let x = inp.d[0].clamp(-one_f, one_f);
-    let y = inp.d[1].clamp(-one_f, one_f);
+    let x = d[0].clamp(-one_f, one_f);
+    let y = d[1].clamp(-one_f, one_f);
     let dd = (x * x + y * y) as u128;
     if dd == 0 {
         out.d_zero = true;
         out.cos_mod = 1u64 << p;
         return out;
     }
-    let ([d1, d2, d3], t) = decode_d(inp.dch, inp.texel_bits, cfg);
+    let lim = D_RAW_LIMIT;
+    if dv.iter().any(|v| v.abs() > lim) {
+        sat.saturated += 1;
+    }
+    let [d1, d2, d3] = dv.map(|v| v.clamp(-lim, lim));
     let (x, y, d1, d2, d3) = (
         i128::from(x),
         i128::from(y),
@@ -464,4 +546,86 @@ pub fn rough_cost(cfg: &RoughnessConfig) -> UnitCost {
 #[must_use]
 pub fn rough_specular_cost(cfg: &RoughnessConfig, pow: &PowConfig) -> UnitCost {
     rough_cost(cfg).plus(pow_cost(pow))
+}
+
+/// Inputs of [`rough_blinn_phong`] beyond the Blinn-Phong ones.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RoughShadeInput {
+    /// The frame's unit tangents (vector format).
+    pub t_u: Vec3x,
+    pub t_v: Vec3x,
+    /// D in tangent-plane units ([`scale_d`]), `t` fraction bits.
+    pub dv: [i64; 3],
+    pub t: u32,
+}
+
+/// Blinn-Phong with the modified specular term (Appendix A): as
+/// [`crate::blinn_phong::blinn_phong`], with `n.h` replaced by `cos a'` of [`rough_cos_d`]
+/// (`d = (h_t . t_u, h_t . t_v)`, `h_t = h - (n.h) n` the tangent-plane projection of `h`)
+/// and the exponent of the configured mode (`inp.shininess` is the material's).
+///
+/// ERROR BOUND: that of `blinn_phong` with the power unit's input error increased by the
+/// [`rough_cos`] bound (module doc).
+#[must_use]
+pub fn rough_blinn_phong(
+    inp: &BlinnPhongInput,
+    ri: &RoughShadeInput,
+    cfg: &RoughnessConfig,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> (BlinnPhongOut, RoughOut) {
+    let vc = &units.cfg.vector;
+    let f = vc.vector_frac_bits;
+    let p = units.cfg.pow.pow_frac_bits.clamp(8, 24);
+    let c = units.cfg.shade.shade_color_bits;
+    let one_f = 1i64 << f;
+    let ndl = dot3(&inp.n, &inp.l, vc, sat).clamp(0, one_f);
+    let sum = [
+        inp.l[0] + inp.v[0],
+        inp.l[1] + inp.v[1],
+        inp.l[2] + inp.v[2],
+    ];
+    let h_zero = sum == [0; 3];
+    let mut ro = RoughOut {
+        cos_mod: 0,
+        d_zero: false,
+        degenerate: false,
+    };
+    let spec: i64 = if h_zero || ndl == 0 {
+        0
+    } else {
+        let h = normalize3(&sum, [0; 3], &units.rsqrt, vc, sat).v;
+        let ndh = dot3(&inp.n, &h, vc, sat);
+        let proj = |t: &Vec3x, sat: &mut SatCounter| {
+            let ht = dot3(&h, t, vc, sat);
+            let nt = dot3(&inp.n, t, vc, sat);
+            ht - round_shift_right_wide(i128::from(ndh) * i128::from(nt), f, vc.vector_rounding)
+        };
+        let d = [proj(&ri.t_u, sat), proj(&ri.t_v, sat)];
+        ro = rough_cos_d(ndh, d, ri.dv, ri.t, cfg, f, p, sat);
+        units.pow.pow(ro.cos_mod, cfg.exponent(inp.shininess), sat) as i64
+    };
+    let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
+    let color = [0usize, 1, 2].map(|i| {
+        let acc = i128::from(inp.kd[i]) * i128::from(ndl) * (1i128 << p)
+            + i128::from(inp.ks[i]) * i128::from(spec) * (1i128 << f);
+        let lit = acc * i128::from(inp.light[i]);
+        let r = round_shift_right_wide(lit, c + f + p, units.cfg.shade.shade_rounding);
+        out_fmt.fit(r, sat) as u64
+    });
+    (BlinnPhongOut { color, h_zero }, ro)
+}
+
+/// Cost of [`rough_blinn_phong`]: Blinn-Phong plus four dots and two multiply-subtracts for
+/// `d`, the D scaling (3 multiplies) and [`rough_cost`].
+#[must_use]
+pub fn rough_blinn_phong_cost(cfg: &RoughnessConfig, units: &ShadingUnits) -> UnitCost {
+    blinn_phong_cost(units)
+        .plus(dot_cost(&units.cfg.vector).times(4))
+        .plus(UnitCost {
+            ops: 5,
+            cycles: cfg.rough_mul_cycles,
+            texels: 0,
+        })
+        .plus(rough_cost(cfg))
 }

@@ -240,6 +240,9 @@ impl<'a> Machine<'a> {
             ),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
+            StageKind::RoughFetch | StageKind::RoughShade => {
+                super::rough_stages::rough_stage_cost(self, kind, plan)
+            }
             _ => self.bump_stage_cost(kind, plan),
         }
     }
@@ -572,6 +575,9 @@ pub fn run(
             | StageKind::Frame
             | StageKind::Perturb
             | StageKind::Phong => run_bump_stage(kind, plan, impls, m, a, frag, c),
+            StageKind::RoughFetch | StageKind::RoughShade => {
+                super::rough_stages::run_rough_stage(kind, plan, impls, m, frag, c);
+            }
         }
     }
 }

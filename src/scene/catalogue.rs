@@ -18,6 +18,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
     ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
     ("bumps", "bump-mapped brick sphere, rippled torus and brick tile under a grazing directional light and a point light, 640x480"),
+    ("lake", "roughness: waves on a lake under a low sun, near to far (highlight widens with distance), 480x320"),
+    ("corrugated", "roughness: corrugated sheet iron receding (one-dimensional bumps, singular K), 480x320"),
+    ("brushed", "roughness: brushed metal plate (anisotropic streaks), 480x320"),
+    ("scratches", "roughness: small scratches on a glossy surface, 480x320"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -28,6 +32,10 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "w2-mesh" => w2_mesh(),
         "sphere" => sphere()?,
         "bumps" => bumps(),
+        "lake" => super::rough_scenes::lake(),
+        "corrugated" => super::rough_scenes::corrugated(),
+        "brushed" => super::rough_scenes::brushed(),
+        "scratches" => super::rough_scenes::scratches(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(

@@ -16,6 +16,7 @@ use glam::{DMat4, DVec3};
 mod catalogue;
 mod geometry;
 mod obj;
+pub mod rough_scenes;
 pub mod shapes;
 pub mod texture;
 mod toml_scene;
@@ -97,6 +98,32 @@ pub struct Material {
     pub ks: [f32; 3],
     /// Specular exponent.
     pub shininess: u32,
+    /// Roughness map of a bump material (Schilling 1997 roughness pyramid + modified
+    /// Blinn-Phong, `pipeline::rough_stages`); `None`: plain Blinn-Phong.
+    pub roughness: Option<RoughChoice>,
+}
+
+/// Which modified Blinn-Phong a roughness material uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RoughChoice {
+    /// The hardware's `rough_variant` (so `--vary roughness=...` switches it).
+    Hw,
+    /// This variant whatever the hardware says.
+    Variant(hw_model::roughness::RoughVariant),
+}
+
+impl RoughChoice {
+    /// Parses `hw` or a variant name; the error lists the names.
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        if s == "hw" {
+            return Ok(Self::Hw);
+        }
+        hw_model::roughness::RoughVariant::from_name(s)
+            .map(Self::Variant)
+            .ok_or_else(|| {
+                format!("'{s}' is not hw, none, published, directional, mahalanobis or isotropic")
+            })
+    }
 }
 
 /// The main direction `m` of the main-direction frame (Schilling 1997, frame 3).
@@ -129,6 +156,7 @@ impl Default for Material {
             main_direction: MainDirection::Pv,
             ks: [0.0; 3],
             shininess: 32,
+            roughness: None,
         }
     }
 }

@@ -253,7 +253,7 @@ pub fn procedural(kind: &str, size: u32) -> Result<TextureImage> {
     }
 }
 
-fn height_image(name: String, size: u32, h: impl Fn(f64, f64) -> f64) -> TextureImage {
+pub(crate) fn height_image(name: String, size: u32, h: impl Fn(f64, f64) -> f64) -> TextureImage {
     let n = f64::from(size.max(1));
     let mut texels = Vec::with_capacity(size as usize * size as usize);
     for y in 0..size {

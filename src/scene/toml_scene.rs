@@ -95,6 +95,8 @@ struct MaterialCfg {
     main_direction: Option<MainDirCfg>,
     ks: Option<[f32; 3]>,
     shininess: Option<u32>,
+    /// Roughness map: `hw` (the hardware's variant) or a variant name.
+    roughness: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -366,7 +368,15 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             Some(c) => main_direction(&f("main_direction"), c)?,
             None => def.main_direction,
         };
+        let roughness = match &m.roughness {
+            Some(r) => Some(
+                crate::scene::RoughChoice::parse(r)
+                    .map_err(|e| Error::field(&f("roughness"), e))?,
+            ),
+            None => None,
+        };
         materials.push(Material {
+            roughness,
             name: m.name.clone(),
             kd: m
                 .kd

@@ -1,8 +1,8 @@
 //! Bump and roughness pyramids (Schilling 1997, "Antialiasing of Bump-Maps": "The roughness
 //! pyramid", "Isotropic roughness representation", Appendix A), host side in float: the
 //! pyramid of mean offsets and offset covariances, its D factorization and unorm encoding, the
-//! float twin of `hw_model::roughness`, the float model shading, and the supersampled ground
-//! truth.
+//! float twin of `hw_model::roughness` and of its shading (the supersampled ground truth is
+//! in `crate::pipeline::rough_stages`).
 //!
 //! Recursive rule. The converted paper text garbles it (a sum over `n = 0..3` of `K_{l-1,n}`
 //! runs into the scatter matrix with no operator between them). The form implemented, the law
@@ -37,7 +37,6 @@
 
 use crate::error::{Error, Result};
 use crate::maps::{next_level_size, quantize_unorm, FixedLevel, FixedMipChain, MipChain, MipLevel};
-use crate::shading::reference::{blinn_phong, perturb_normal, FrameF};
 use glam::DVec3;
 use hw_model::roughness::{expand_channel, RoughVariant, Q_CAP_BITS};
 
@@ -385,162 +384,54 @@ pub fn rough_cos_twin(variant: RoughVariant, cos_a: f64, d: [f64; 2], dv: [f64; 
     c / (q + c * c).sqrt()
 }
 
-/// Lighting of one pixel: directions towards light and eye, exponent, colours.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ShadeParams {
-    /// Unit vector towards the light.
-    pub l: DVec3,
-    /// Unit vector towards the eye.
-    pub v: DVec3,
-    /// Blinn-Phong shininess (used by the truth and the `none` baseline).
-    pub shininess: u32,
-    /// Exponent applied to `cos a'` by the roughness variants.
-    pub rough_exponent: u32,
-    /// `[kd, ks, light]`.
-    pub colors: [[f64; 3]; 3],
+/// Float twin of `hw_model::roughness::scale_d`: `L D`, `L = diag(len_u, len_v)` (isotropic:
+/// lambda1 times `max(len_u, len_v)`).
+#[must_use]
+pub fn scale_d_f(dv: [f64; 3], len: [f64; 2], isotropic: bool) -> [f64; 3] {
+    let (lu, lv) = (len[0].max(0.0), len[1].max(0.0));
+    if isotropic {
+        [dv[0] * lu.max(lv), dv[1] * lu, dv[2] * lv]
+    } else {
+        [dv[0] * lu, dv[1] * lu, dv[2] * lv]
+    }
 }
 
-/// `d` of the paper (tangent-plane projection of `n - h`, sign irrelevant) in offset
-/// coordinates of the frame (`h_t . t_u / len_u`, `h_t . t_v / len_v`), and `cos a = n . h`.
+/// `d = (h_t . t_u, h_t . t_v)` with `h_t = h - (n.h) n`, and `cos a = n.h` (the inputs of the
+/// modified Blinn-Phong; twin of the projection in `hw_model::roughness::rough_blinn_phong`).
 #[must_use]
-pub fn d_and_cos(fr: &FrameF, n: DVec3, h: DVec3) -> ([f64; 2], f64) {
+pub fn d_and_cos(n: DVec3, h: DVec3, t_u: DVec3, t_v: DVec3) -> ([f64; 2], f64) {
     let c = n.dot(h);
     let ht = h - c * n;
-    let lu = if fr.len_u != 0.0 { fr.len_u } else { 1.0 };
-    let lv = if fr.len_v != 0.0 { fr.len_v } else { 1.0 };
-    ([ht.dot(fr.t_u) / lu, ht.dot(fr.t_v) / lv], c)
+    ([ht.dot(t_u), ht.dot(t_v)], c)
 }
 
-/// The float roughness model of one pixel: perturb by the filtered mean offset, then the
-/// modified Blinn-Phong of `variant` with the filtered D (`none`: plain Blinn-Phong with
-/// `shininess`, the filtered bump map baseline).
+/// Float twin of `hw_model::roughness::rough_blinn_phong` for one light: colour and `l + v = 0`.
+/// `dv` is D in tangent-plane units ([`scale_d_f`]); `exponent` the mode's exponent.
+#[allow(clippy::too_many_arguments)]
 #[must_use]
-pub fn rough_shade(
-    fr: &FrameF,
-    mean: [f64; 2],
+pub fn rough_blinn_phong_f(
+    n: DVec3,
+    l: DVec3,
+    v: DVec3,
+    t: [DVec3; 2],
     dv: [f64; 3],
     variant: RoughVariant,
-    sp: &ShadeParams,
-) -> [f64; 3] {
-    let n = perturb_normal(fr, mean[0], mean[1]);
-    if variant == RoughVariant::None {
-        return blinn_phong(
-            n,
-            sp.l,
-            sp.v,
-            sp.shininess,
-            sp.colors[0],
-            sp.colors[1],
-            sp.colors[2],
-        )
-        .0;
-    }
-    let ndl = n.dot(sp.l).clamp(0.0, 1.0);
-    let sum = sp.l + sp.v;
-    let spec = if ndl == 0.0 || sum == DVec3::ZERO {
+    exponent: u32,
+    colors: [[f64; 3]; 3],
+) -> ([f64; 3], bool) {
+    let ndl = n.dot(l).clamp(0.0, 1.0);
+    let sum = l + v;
+    let h_zero = sum == DVec3::ZERO;
+    let spec = if h_zero || ndl == 0.0 {
         0.0
     } else {
         let h = sum.normalize();
-        let (d, c) = d_and_cos(fr, n, h);
-        let x = rough_cos_twin(variant, c, d, dv);
-        crate::shading::reference::pow(x, sp.rough_exponent)
+        let (d, c) = d_and_cos(n, h, t[0], t[1]);
+        crate::shading::reference::pow(rough_cos_twin(variant, c, d, dv), exponent)
     };
-    let [kd, ks, light] = sp.colors;
-    [0, 1, 2].map(|i| (light[i] * (kd[i] * ndl + ks[i] * spec)).clamp(0.0, 1.0))
-}
-
-/// The finest offsets as a continuous function: bilinear, wrapping, texel `i` centred at
-/// `(i + 1/2) / w`.
-#[derive(Clone, Copy, Debug)]
-pub struct OffsetMap<'a> {
-    width: u32,
-    height: u32,
-    offsets: &'a [[f32; 2]],
-}
-
-impl<'a> OffsetMap<'a> {
-    /// Wraps `w * h` offsets; an error names a size mismatch.
-    pub fn new(offsets: &'a [[f32; 2]], w: u32, h: u32) -> Result<Self> {
-        if w == 0 || h == 0 || (w as usize).checked_mul(h as usize) != Some(offsets.len()) {
-            return Err(Error::field(
-                "bump offsets",
-                format!("{} offsets for a {w}x{h} map", offsets.len()),
-            ));
-        }
-        Ok(Self {
-            width: w,
-            height: h,
-            offsets,
-        })
-    }
-
-    /// Bilinear sample at normalized `(u, v)` (v down the rows); non-finite coordinates give
-    /// texel 0.
-    #[must_use]
-    pub fn sample(&self, u: f64, v: f64) -> [f64; 2] {
-        let (w, h) = (f64::from(self.width), f64::from(self.height));
-        let fix = |x: f64| if x.is_finite() { x } else { 0.0 };
-        let (x, y) = (fix(u) * w - 0.5, fix(v) * h - 0.5);
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f64, n: u32| (i.rem_euclid(f64::from(n)) as u32).min(n - 1) as usize;
-        let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
-        let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
-        let at = |xi: usize, yi: usize| self.offsets[yi * self.width as usize + xi];
-        let mut out = [0.0; 2];
-        for (k, o) in out.iter_mut().enumerate() {
-            let top = f64::from(at(xa, ya)[k]) * (1.0 - fx) + f64::from(at(xb, ya)[k]) * fx;
-            let bot = f64::from(at(xa, yb)[k]) * (1.0 - fx) + f64::from(at(xb, yb)[k]) * fx;
-            *o = top * (1.0 - fy) + bot * fy;
-        }
-        out
-    }
-}
-
-/// A pixel's footprint in normalized texture space: centre and the derivatives along screen x
-/// and y (the parallelogram `uv + s dx + t dy`, `s, t` in `[-1/2, 1/2]`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Footprint {
-    pub uv: [f64; 2],
-    pub dx: [f64; 2],
-    pub dy: [f64; 2],
-}
-
-/// Ground truth of one pixel: the mean over `k x k` sub-samples on a regular grid of the
-/// footprint parallelogram (a box filter) of Blinn-Phong with each sub-sample's own perturbed
-/// normal from the full-resolution offsets (`sp.shininess`). `k = 0` counts as 1.
-#[must_use]
-pub fn supersample_truth(
-    fp: &Footprint,
-    map: &OffsetMap<'_>,
-    fr: &FrameF,
-    sp: &ShadeParams,
-    k: u32,
-) -> [f64; 3] {
-    let k = k.max(1);
-    let inv = 1.0 / f64::from(k);
-    let mut acc = [0.0; 3];
-    for j in 0..k {
-        let t = (f64::from(j) + 0.5) * inv - 0.5;
-        for i in 0..k {
-            let s = (f64::from(i) + 0.5) * inv - 0.5;
-            let u = fp.uv[0] + s * fp.dx[0] + t * fp.dy[0];
-            let v = fp.uv[1] + s * fp.dx[1] + t * fp.dy[1];
-            let f = map.sample(u, v);
-            let n = perturb_normal(fr, f[0], f[1]);
-            let (c, _) = blinn_phong(
-                n,
-                sp.l,
-                sp.v,
-                sp.shininess,
-                sp.colors[0],
-                sp.colors[1],
-                sp.colors[2],
-            );
-            for (a, x) in acc.iter_mut().zip(c) {
-                *a += x;
-            }
-        }
-    }
-    acc.map(|a| a * inv * inv)
+    let [kd, ks, light] = colors;
+    (
+        [0, 1, 2].map(|i| (light[i] * (kd[i] * ndl + ks[i] * spec)).clamp(0.0, 1.0)),
+        h_zero,
+    )
 }

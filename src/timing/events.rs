@@ -122,7 +122,7 @@ impl FrameEvents {
 pub fn lookups(kind: StageKind, hw: &HwConfig) -> u32 {
     match kind {
         StageKind::Trilinear => hw.trilinear.aniso_probes.max(1),
-        StageKind::BumpFetch => 1,
+        StageKind::BumpFetch | StageKind::RoughFetch => 1,
         _ => 0,
     }
 }
@@ -176,6 +176,7 @@ pub fn record_pixel(
         let t = match kind {
             StageKind::Trilinear => plan.texture,
             StageKind::BumpFetch => plan.bump.as_ref().map(|b| b.map),
+            StageKind::RoughFetch => plan.rough.as_ref().map(|r| r.map),
             _ => None,
         };
         let Some(t) = t else { continue };

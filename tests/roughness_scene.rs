@@ -1,0 +1,260 @@
+//! Roughness scenes end to end (issue 4): the lake's highlight widens with distance in the
+//! ground truth, and the roughness model follows it better than the plain filtered bump map.
+
+use hw_model::roughness::RoughVariant;
+use hw_model::HwConfig;
+use texsim::render::{render, Maps, RenderOptions};
+use texsim::report::Image;
+use texsim::scene::{builtin, RoughChoice, Scene};
+
+fn lum(img: &Image, x: u32, y: u32) -> f64 {
+    let p = img.px[(y * img.width + x) as usize];
+    (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / (3.0 * 65535.0)
+}
+
+/// Full width at half maximum of the highlight in row `y` (pixels above half the row's peak
+/// over its floor, contiguous around the peak).
+fn fwhm(img: &Image, y: u32) -> f64 {
+    let w = img.width;
+    let row: Vec<f64> = (0..w).map(|x| lum(img, x, y)).collect();
+    let floor = row.iter().copied().fold(f64::MAX, f64::min);
+    let (px, peak) = row
+        .iter()
+        .enumerate()
+        .fold((0, 0.0), |b, (i, &v)| if v > b.1 { (i, v) } else { b });
+    let half = floor + 0.5 * (peak - floor);
+    let mut l = px;
+    while l > 0 && row[l - 1] >= half {
+        l -= 1;
+    }
+    let mut r = px;
+    while r + 1 < row.len() && row[r + 1] >= half {
+        r += 1;
+    }
+    (r - l + 1) as f64
+}
+
+/// Mean absolute difference between vertically adjacent pixels of the highlight path in rows
+/// `y0..y1` (columns `x0..x1`): sparkle, i.e. aliasing of the highlight.
+fn sparkle(img: &Image, y0: u32, y1: u32, x0: u32, x1: u32) -> f64 {
+    let mut s = 0.0;
+    let mut n = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            s += (lum(img, x, y) - lum(img, x, y + 1)).abs();
+            n += 1.0;
+        }
+    }
+    s / n
+}
+
+fn with_variant(s: &Scene, v: RoughVariant) -> Scene {
+    let mut s = s.clone();
+    for m in &mut s.materials {
+        m.roughness = Some(RoughChoice::Variant(v));
+    }
+    s
+}
+
+#[test]
+fn lake_highlight_widens_with_distance_and_the_model_follows_the_truth() {
+    let mut sc = builtin("lake").expect("lake");
+    sc.width = 240;
+    sc.height = 160;
+    let hw = HwConfig::texram16();
+    let maps = Maps::new(&sc, hw.trilinear.texel_bits);
+    let r = render(
+        &sc,
+        &maps,
+        &hw,
+        &RenderOptions {
+            truth: 16,
+            ..RenderOptions::default()
+        },
+    )
+    .expect("render");
+    let truth = r.truth_image.as_ref().expect("truth");
+    let model = r.ref_image.as_ref().expect("float model");
+    let base = render(
+        &with_variant(&sc, RoughVariant::None),
+        &maps,
+        &hw,
+        &RenderOptions::default(),
+    )
+    .expect("baseline");
+    let base = base.ref_image.as_ref().expect("baseline float");
+    // Rows 78..100 are the far water (the horizon is near row 77), 130..160 the near water.
+    let band = |img: &Image, ys: std::ops::Range<u32>| {
+        let n = f64::from(ys.end - ys.start);
+        ys.map(|y| fwhm(img, y)).sum::<f64>() / n
+    };
+    let (far, near) = (79..100, 130..159);
+    let (tf, mf, bf) = (
+        band(truth, far.clone()),
+        band(model, far.clone()),
+        band(base, far.clone()),
+    );
+    let (tn, mn, bn) = (
+        band(truth, near.clone()),
+        band(model, near.clone()),
+        band(base, near.clone()),
+    );
+    let (ts, ms, bs) = (
+        sparkle(truth, 79, 100, 100, 140),
+        sparkle(model, 79, 100, 100, 140),
+        sparkle(base, 79, 100, 100, 140),
+    );
+    println!("FWHM far rows:  truth {tf:.2} model {mf:.2} baseline {bf:.2}");
+    println!("FWHM near rows: truth {tn:.2} model {mn:.2} baseline {bn:.2}");
+    println!("sparkle far rows: truth {ts:.4} model {ms:.4} baseline {bs:.4}");
+    let err = |img: &Image, ys: std::ops::Range<u32>| {
+        let (mut s, mut n) = (0.0, 0.0);
+        for y in ys {
+            for x in 0..img.width {
+                s += (lum(img, x, y) - lum(truth, x, y)).abs() * 255.0;
+                n += 1.0;
+            }
+        }
+        s / n
+    };
+    let (me, be) = (err(model, far.clone()), err(base, far.clone()));
+    let (men, ben) = (err(model, near.clone()), err(base, near.clone()));
+    println!("mean |x - truth| (8-bit) far: model {me:.3} baseline {be:.3}; near: model {men:.3} baseline {ben:.3}");
+    // The truth's highlight is wider in the far rows than the filtered bump map's (whose
+    // bumps have been averaged away); the roughness model widens it and lands closer.
+    assert!(tf > bf, "truth {tf} vs baseline {bf}");
+    assert!(mf > bf, "model {mf} vs baseline {bf}");
+    assert!(
+        (mf - tf).abs() < (bf - tf).abs(),
+        "model {mf} baseline {bf} truth {tf}"
+    );
+    let rs = r.stats.roughness.as_ref().expect("rough stats");
+    assert_eq!(rs.truth_samples, 16);
+    assert!(rs.model_error.is_some());
+    let q = rs.quantization_error.as_ref().expect("quantization error");
+    assert!(q.max_abs_lsb <= 2, "{q:?}");
+}
+
+fn small(name: &str) -> Scene {
+    let mut sc = builtin(name).expect("scene");
+    sc.width = 96;
+    sc.height = 64;
+    sc
+}
+
+#[test]
+fn plans_costs_and_lookups_follow_the_variant() {
+    use texsim::pipeline::StageKind;
+    let sc = small("lake");
+    let maps = Maps::new(&sc, 16);
+    let mut cycles = Vec::new();
+    for v in RoughVariant::ALL {
+        let mut hw = HwConfig::texram16();
+        hw.roughness.rough_variant = v;
+        let r = render(
+            &sc,
+            &maps,
+            &hw,
+            &RenderOptions {
+                timing: true,
+                ..RenderOptions::default()
+            },
+        )
+        .expect("render");
+        let st = |k: StageKind| {
+            r.stats
+                .stages
+                .iter()
+                .find(|s| s.stage == k)
+                .expect("stage")
+                .clone()
+        };
+        let (fetch, shade, phong) = (
+            st(StageKind::RoughFetch),
+            st(StageKind::RoughShade),
+            st(StageKind::Phong),
+        );
+        let ev = r.events.as_ref().expect("events");
+        let rough_lookups = ev
+            .footprints
+            .iter()
+            .filter(|f| usize::from(f.stage) == StageKind::RoughFetch.index())
+            .count();
+        if v == RoughVariant::None {
+            assert_eq!(fetch.invocations + shade.invocations, 0);
+            assert!(phong.invocations > 0);
+            assert_eq!(rough_lookups, 0);
+        } else {
+            assert_eq!(phong.invocations, 0);
+            assert_eq!(fetch.invocations, shade.invocations);
+            assert!(fetch.texels > 0 && shade.cycles > 0);
+            assert!(rough_lookups > 0, "{v:?}");
+        }
+        let rs = r.stats.roughness.as_ref().expect("stats");
+        assert_eq!(rs.d_clamped, 0);
+        let q = rs.quantization_error.as_ref().expect("error");
+        assert!(q.max_abs_lsb <= 2, "{v:?} {q:?}");
+        cycles.push((v, r.stats.cycles.per_covered_pixel));
+    }
+    println!("{cycles:?}");
+    let c = |v: RoughVariant| cycles.iter().find(|x| x.0 == v).expect("v").1;
+    assert!(c(RoughVariant::None) < c(RoughVariant::Isotropic));
+    assert!(c(RoughVariant::Isotropic) < c(RoughVariant::Directional));
+}
+
+#[test]
+fn every_roughness_scene_renders_every_variant_finite_with_truth() {
+    for name in ["lake", "corrugated", "brushed", "scratches"] {
+        let sc = small(name);
+        let maps = Maps::new(&sc, 16);
+        for v in RoughVariant::ALL {
+            let mut hw = HwConfig::texram16();
+            hw.roughness.rough_variant = v;
+            let r = render(
+                &sc,
+                &maps,
+                &hw,
+                &RenderOptions {
+                    truth: 4,
+                    ..RenderOptions::default()
+                },
+            )
+            .expect("render");
+            assert_eq!(
+                r.stats.bump.nonfinite + r.stats.bump.ref_nonfinite,
+                0,
+                "{name}"
+            );
+            assert!(r.truth_image.is_some(), "{name}");
+            let rs = r.stats.roughness.as_ref().expect("stats");
+            assert!(rs.model_error.is_some());
+        }
+    }
+}
+
+#[test]
+fn none_variant_is_the_plain_bump_material_and_renders_are_deterministic() {
+    let sc = small("brushed");
+    let maps = Maps::new(&sc, 16);
+    let mut plain = sc.clone();
+    plain.materials[0].roughness = None;
+    let hw = {
+        let mut h = HwConfig::texram16();
+        h.roughness.rough_variant = RoughVariant::None;
+        h
+    };
+    let a = render(
+        &with_variant(&sc, RoughVariant::None),
+        &maps,
+        &hw,
+        &RenderOptions::default(),
+    )
+    .expect("none");
+    let b = render(&plain, &maps, &hw, &RenderOptions::default()).expect("plain");
+    assert_eq!(a.hw_image, b.hw_image);
+    let hw = HwConfig::texram16();
+    let c = render(&sc, &maps, &hw, &RenderOptions::default()).expect("rough");
+    let d = render(&sc, &maps, &hw, &RenderOptions::default()).expect("rough again");
+    assert_eq!(c.hw_image, d.hw_image);
+    assert_ne!(c.hw_image, b.hw_image);
+}
