@@ -194,6 +194,10 @@ pub struct SweepArgs {
     /// Also run the timing model per setting (adds its total cycles to each row).
     #[arg(long)]
     pub cycles: bool,
+    /// Ground truth of roughness materials with N x N sub-samples per pixel: adds each row's
+    /// model error (float model vs truth) to sweep.json and prints it (0 = off).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub truth: u32,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -548,10 +552,22 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
         let opts = RenderOptions {
             timing: a.cycles,
+            truth: a.truth,
             ..RenderOptions::default()
         };
         let r = render(&sc, &maps, cfg, &opts)?;
         let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        row.model_error = r
+            .stats
+            .roughness
+            .as_ref()
+            .and_then(|x| x.model_error.clone());
+        if let (Some(m), Some(q)) = (&row.model_error, &row.error_8bit) {
+            eprintln!(
+                "  model_error (vs truth) mean {:.3} rmse {:.3}; quantization_error mean {:.4} rmse {:.4}; {:.2} cycles/px",
+                m.mean_abs_lsb, m.rmse_lsb, q.mean_abs_lsb, q.rmse_lsb, row.cycles_per_pixel
+            );
+        }
         if let Some(ev) = &r.events {
             row.timing_cycles = Some(crate::timing::simulate(ev, cfg, &sc.name).total_cycles);
         }

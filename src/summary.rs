@@ -38,13 +38,13 @@ pub fn text(s: &RenderStats) -> String {
     }
     let _ = writeln!(
         o,
-        "{:<10} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
+        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
         "stage", "impl", "invocations", "saturated", "wrapped", "cycles", "texels"
     );
     for st in &s.stages {
         let _ = writeln!(
             o,
-            "{:<10} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
+            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
             st.stage.name(),
             if st.invocations == 0 {
                 "-"
@@ -109,6 +109,9 @@ pub struct SweepRow {
     pub ref_ms: f64,
     /// Total cycles of the timing model (`texsim sweep --cycles`), else `None`.
     pub timing_cycles: Option<u64>,
+    /// Roughness float model vs supersampled truth (`texsim sweep --truth N`), 8-bit LSBs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_error: Option<ErrorMetrics>,
 }
 
 impl SweepRow {
@@ -131,6 +134,7 @@ impl SweepRow {
             hw_ms: s.timings.hw_total_ms,
             ref_ms: s.timings.ref_total_ms,
             timing_cycles: None,
+            model_error: None,
         }
     }
 }

@@ -258,3 +258,43 @@ fn none_variant_is_the_plain_bump_material_and_renders_are_deterministic() {
     assert_eq!(c.hw_image, d.hw_image);
     assert_ne!(c.hw_image, b.hw_image);
 }
+
+fn toml_scene(name: &str, roughness: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("texsim-rough-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("tmp");
+    let p = d.join("s.toml");
+    let body = format!(
+        "[[textures]]\nname = \"b\"\nprocedural = \"bricks-height\"\nsize = 32\n\n[[materials]]\nname = \"m\"\nbump = \"b\"\nks = [0.5, 0.5, 0.5]\n{roughness}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n"
+    );
+    std::fs::write(&p, body).expect("write");
+    p
+}
+
+#[test]
+fn toml_roughness_field_parses_and_bad_values_name_the_field() {
+    for (v, want) in [
+        ("hw", RoughChoice::Hw),
+        ("none", RoughChoice::Variant(RoughVariant::None)),
+        ("published", RoughChoice::Variant(RoughVariant::Published)),
+        (
+            "mahalanobis",
+            RoughChoice::Variant(RoughVariant::Mahalanobis),
+        ),
+        ("isotropic", RoughChoice::Variant(RoughVariant::Isotropic)),
+    ] {
+        let p = toml_scene(v, &format!("roughness = \"{v}\""));
+        let s = texsim::scene::load(&p).expect("load");
+        assert_eq!(s.materials[0].roughness, Some(want));
+    }
+    let p = toml_scene("absent", "");
+    assert_eq!(
+        texsim::scene::load(&p).expect("load").materials[0].roughness,
+        None
+    );
+    for bad in ["roughness = \"shiny\"", "roughness = 3"] {
+        let p = toml_scene("bad", bad);
+        let e = texsim::scene::load(&p).expect_err(bad).to_string();
+        assert!(e.contains("roughness"), "{bad}: {e}");
+    }
+}

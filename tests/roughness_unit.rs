@@ -101,7 +101,7 @@ fn random_cases_meet_the_bound_for_every_variant_and_width() {
             };
             let b = bound(&cfg, p);
             let mut worst = 0.0f64;
-            for _ in 0..200_000 {
+            for _ in 0..125_000 {
                 let inp = random_input(&mut r, 14, 16);
                 let e = err(&inp, &cfg, 14, p, &mut sat);
                 worst = worst.max(e);
@@ -448,4 +448,43 @@ fn sweep_knobs_set_the_roughness_fields() {
     assert!(e.to_string().contains("rough_variant"), "{e}");
     let e = texsim::hwconfig::set_field(&c, "rough_div_bits", "99").expect_err("bad");
     assert!(e.to_string().contains("rough_div_bits"), "{e}");
+}
+
+#[test]
+fn normalization_matches_its_float_twin() {
+    use hw_model::roughness::{normalize_spec, RoughShadeInput};
+    use texsim::shading::roughness::normalize_factor;
+    let mut r = Rng(14);
+    for v in VARIANTS {
+        let cfg = RoughnessConfig {
+            rough_variant: v,
+            rough_normalize: true,
+            ..RoughnessConfig::texram16()
+        };
+        for _ in 0..200_000 {
+            let t = 14u32;
+            let dv = [
+                (r.next() % (1 << 17)) as i64,
+                (r.next() % (1 << 17)) as i64 - (1 << 16),
+                (r.next() % (1 << 17)) as i64,
+            ];
+            let ri = RoughShadeInput {
+                t_u: [0; 3],
+                t_v: [0; 3],
+                dv,
+                t,
+            };
+            let spec = r.next() % (1 << 16 | 1);
+            let (e, s) = (1 + (r.next() % 256) as u32, 1 + (r.next() % 256) as u32);
+            let got = normalize_spec(spec, e, s, &ri, &cfg) as f64;
+            let scale = (-f64::from(t)).exp2();
+            let want = spec as f64 * normalize_factor(dv.map(|x| x as f64 * scale), v, e, s);
+            let tol = want * (-f64::from(cfg.rough_div_bits)).exp2() + 0.5 + 1e-9;
+            assert!(
+                (got - want).abs() <= tol,
+                "{v:?} {dv:?} {spec} {e} {s}: {got} {want}"
+            );
+            assert!(got <= spec as f64);
+        }
+    }
 }

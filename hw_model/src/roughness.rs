@@ -130,6 +130,12 @@ pub struct RoughnessConfig {
     /// normal: the ellipse then reaches the edge of the distribution). Host side only.
     #[serde(default)]
     pub rough_uniform: bool,
+    /// Scale the specular term by `min(1, (m / s) / (d1 d3))` (`d1 d3 = sqrt(det K')`;
+    /// isotropic: `lambda1^2`): the peak of a lobe convolved with Gaussian slopes,
+    /// `det(I + s K)^(-1/2)`, so widening conserves energy. Not in the paper (an extension;
+    /// off = as published).
+    #[serde(default)]
+    pub rough_normalize: bool,
 }
 
 impl RoughnessConfig {
@@ -150,6 +156,7 @@ impl RoughnessConfig {
             rough_div_bits_per_cycle: 2,
             rough_sqrt_bits_per_cycle: 2,
             rough_uniform: false,
+            rough_normalize: false,
         }
     }
 
@@ -603,7 +610,13 @@ pub fn rough_blinn_phong(
         };
         let d = [proj(&ri.t_u, sat), proj(&ri.t_v, sat)];
         ro = rough_cos_d(ndh, d, ri.dv, ri.t, cfg, f, p, sat);
-        units.pow.pow(ro.cos_mod, cfg.exponent(inp.shininess), sat) as i64
+        let e = cfg.exponent(inp.shininess);
+        let sp = units.pow.pow(ro.cos_mod, e, sat);
+        if cfg.rough_normalize {
+            normalize_spec(sp, e, inp.shininess, ri, cfg) as i64
+        } else {
+            sp as i64
+        }
     };
     let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
     let color = [0usize, 1, 2].map(|i| {
@@ -614,6 +627,38 @@ pub fn rough_blinn_phong(
         out_fmt.fit(r, sat) as u64
     });
     (BlinnPhongOut { color, h_zero }, ro)
+}
+
+/// The energy normalization of [`RoughnessConfig::rough_normalize`]: `spec * min(1, (e / s) /
+/// (d1 d3))` with `d1 d3` from the scaled D (`t` fraction bits; isotropic `d1^2`), one divide
+/// of `rough_div_bits` and one rounding (half even). `d1 d3 = 0` leaves `spec` unchanged.
+#[must_use]
+pub fn normalize_spec(
+    spec: u64,
+    exponent: u32,
+    shininess: u32,
+    ri: &RoughShadeInput,
+    cfg: &RoughnessConfig,
+) -> u64 {
+    let lim = D_RAW_LIMIT;
+    let d1 = ri.dv[0].clamp(0, lim) as u128;
+    let d3 = if cfg.rough_variant == RoughVariant::Isotropic {
+        d1
+    } else {
+        ri.dv[2].clamp(0, lim) as u128
+    };
+    let det = d1 * d3;
+    if det == 0 || spec == 0 {
+        return spec;
+    }
+    // (e / s) / (det 2^-2t) = e 2^2t / (s det).
+    let t = ri.t.min(40);
+    let (m, ex) = div_round(
+        u128::from(exponent.max(1)) << (2 * t),
+        u128::from(shininess.max(1)) * det,
+        cfg.rough_div_bits,
+    );
+    scale_round(u128::from(spec) * u128::from(m), ex, u128::from(spec)) as u64
 }
 
 /// Cost of [`rough_blinn_phong`]: Blinn-Phong plus four dots and two multiply-subtracts for
@@ -628,4 +673,16 @@ pub fn rough_blinn_phong_cost(cfg: &RoughnessConfig, units: &ShadingUnits) -> Un
             texels: 0,
         })
         .plus(rough_cost(cfg))
+        .plus(
+            if cfg.rough_normalize && cfg.rough_variant != RoughVariant::None {
+                UnitCost {
+                    ops: 3,
+                    cycles: 2 * cfg.rough_mul_cycles
+                        + iter_cycles(cfg.rough_div_bits, cfg.rough_div_bits_per_cycle),
+                    texels: 0,
+                }
+            } else {
+                UnitCost::default()
+            },
+        )
 }

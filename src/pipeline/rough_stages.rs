@@ -26,8 +26,8 @@ use crate::render::Maps;
 use crate::scene::{Material, RoughChoice};
 use crate::shading::reference as fref;
 use crate::shading::roughness::{
-    build_rough_pyramid, quantize_rough_chain, rough_blinn_phong_f, rough_mip_chain, scale_d_f,
-    RoughParams, RoughnessEncoding,
+    build_rough_pyramid, normalize_factor, quantize_rough_chain, rough_blinn_phong_f,
+    rough_mip_chain, scale_d_f, RoughParams, RoughnessEncoding,
 };
 use glam::DVec3;
 use hw_model::blinn_phong::BlinnPhongInput;
@@ -458,6 +458,11 @@ pub fn run_rough_stage(
                 let rexp = rcfg.exponent(bp.shininess);
                 let enc = RoughnessEncoding::for_range_exp(rcfg.rough_range_exp);
                 let dv = scale_d_f(enc.decode(frag.rough), bf.fr_len, iso);
+                let norm = if rcfg.rough_normalize {
+                    normalize_factor(dv, rp.variant, rexp, bp.shininess)
+                } else {
+                    1.0
+                };
                 let n = DVec3::from(bf.normal);
                 let kk = rp.truth_samples;
                 let range = f64::from(vc.offset_int_bits.min(30)).exp2();
@@ -476,6 +481,7 @@ pub fn run_rough_stage(
                             dv,
                             rp.variant,
                             rexp,
+                            norm,
                             [kd, bp.ks, light.color_f],
                         ),
                         (kk, Some(l0)) => {

@@ -405,8 +405,26 @@ pub fn d_and_cos(n: DVec3, h: DVec3, t_u: DVec3, t_v: DVec3) -> ([f64; 2], f64) 
     ([ht.dot(t_u), ht.dot(t_v)], c)
 }
 
+/// Float twin of `hw_model::roughness::normalize_spec`: `min(1, (e / s) / (d1 d3))`
+/// (isotropic `d1^2`); 1 when `d1 d3 = 0`.
+#[must_use]
+pub fn normalize_factor(dv: [f64; 3], variant: RoughVariant, exponent: u32, shininess: u32) -> f64 {
+    let d1 = dv[0].max(0.0);
+    let d3 = if variant == RoughVariant::Isotropic {
+        d1
+    } else {
+        dv[2].max(0.0)
+    };
+    let det = d1 * d3;
+    if det <= 0.0 || !det.is_finite() {
+        return 1.0;
+    }
+    (f64::from(exponent.max(1)) / f64::from(shininess.max(1)) / det).min(1.0)
+}
+
 /// Float twin of `hw_model::roughness::rough_blinn_phong` for one light: colour and `l + v = 0`.
-/// `dv` is D in tangent-plane units ([`scale_d_f`]); `exponent` the mode's exponent.
+/// `dv` is D in tangent-plane units ([`scale_d_f`]); `exponent` the mode's exponent; `norm`
+/// the specular scale ([`normalize_factor`], or 1).
 #[allow(clippy::too_many_arguments)]
 #[must_use]
 pub fn rough_blinn_phong_f(
@@ -417,6 +435,7 @@ pub fn rough_blinn_phong_f(
     dv: [f64; 3],
     variant: RoughVariant,
     exponent: u32,
+    norm: f64,
     colors: [[f64; 3]; 3],
 ) -> ([f64; 3], bool) {
     let ndl = n.dot(l).clamp(0.0, 1.0);
@@ -427,7 +446,7 @@ pub fn rough_blinn_phong_f(
     } else {
         let h = sum.normalize();
         let (d, c) = d_and_cos(n, h, t[0], t[1]);
-        crate::shading::reference::pow(rough_cos_twin(variant, c, d, dv), exponent)
+        crate::shading::reference::pow(rough_cos_twin(variant, c, d, dv), exponent) * norm
     };
     let [kd, ks, light] = colors;
     (
