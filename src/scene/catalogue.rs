@@ -13,7 +13,7 @@ use crate::{Error, Result};
 
 /// Built-in scene names with a one-line description (for `texsim scenes`).
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("demo", "textured ground plane to the horizon (minification) + lit textured torus and sphere up close"),
+    ("demo", "textured ground plane to the horizon (minification), lit textured torus and sphere, bump-mapped brick sphere"),
     ("w1-plane", "Mesa anchor W1: 1024x1024, one textured quad receding to the horizon, unlit (GL_REPLACE)"),
     ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
     ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
@@ -155,6 +155,14 @@ fn demo() -> Result<Scene> {
         &mut ball,
         &DMat4::from_translation(DVec3::new(-1.6, 0.7, -4.5)),
     );
+    let mut bumped = shapes::sphere(0.45, 48, 24);
+    bumped.name = "brick-sphere".into();
+    bumped.material = 3;
+    super::geometry::transform_mesh(
+        &mut bumped,
+        &(DMat4::from_translation(DVec3::new(-0.55, 0.5, -2.1))
+            * DMat4::from_rotation_y(-30f64.to_radians())),
+    );
     let materials = vec![
         Material {
             name: "ground".into(),
@@ -173,6 +181,16 @@ fn demo() -> Result<Scene> {
             name: "sphere".into(),
             kd: [1.0; 3],
             texture: Some(2),
+            cull_back: true,
+            ..Material::default()
+        },
+        Material {
+            name: "brick-sphere".into(),
+            kd: [0.75, 0.38, 0.28],
+            bump: Some(3),
+            bump_scale: 2.0,
+            ks: [0.35; 3],
+            shininess: 24,
             cull_back: true,
             ..Material::default()
         },
@@ -201,9 +219,9 @@ fn demo() -> Result<Scene> {
         }],
         ambient: [0.15, 0.16, 0.2],
         background: [0.55, 0.68, 0.86, 1.0],
-        meshes: vec![ground, torus, ball],
+        meshes: vec![ground, torus, ball, bumped],
         materials,
-        textures: vec![ground_tex, torus_tex, sphere_tex],
+        textures: vec![ground_tex, torus_tex, sphere_tex, bricks_height(256)],
         hw: None,
         warnings: Vec::new(),
     })
