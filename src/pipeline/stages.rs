@@ -386,16 +386,13 @@ pub fn run(
             StageKind::Bary => {
                 let sub = hw.raster.subpixel_bits;
                 if fixed {
-                    let e = tri.edges_fixed(px, py, sub);
                     if plan.derivatives {
-                        let ex = tri.edges_fixed(px + 1, py, sub);
-                        let ey = tri.edges_fixed(px, py + 1, sub);
-                        let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
-                        let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
+                        let (e, dx, dy) = tri.edges_fixed_with_steps(px, py, sub);
                         frag.bary_x = perspective_bary_derivs(
                             e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat,
                         );
                     } else {
+                        let e = tri.edges_fixed(px, py, sub);
                         frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
                     }
                     for s in 0..samples {
