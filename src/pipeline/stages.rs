@@ -469,24 +469,11 @@ pub fn run(
                     if !fixed_in(StageKind::Texcoord) {
                         quantize_uv(frag, m, samples, sat);
                     }
-                    let uv = &frag.uv_x;
-                    let d = [
-                        (uv[1][0] - uv[0][0]) * i64::from(w),
-                        (uv[1][1] - uv[0][1]) * i64::from(h),
-                        (uv[2][0] - uv[0][0]) * i64::from(w),
-                        (uv[2][1] - uv[0][1]) * i64::from(h),
-                    ];
+                    let d = texel_derivs(&frag.uv_x, w, h);
                     frag.lod_x = lod(d, fb, &hw.lod, sat);
                     frag.lod = from_raw(frag.lod_x, lfb);
                 } else {
-                    let uv = &frag.uv;
-                    let (wf, hf) = (f64::from(w), f64::from(h));
-                    frag.lod = lod_f64([
-                        (uv[1][0] - uv[0][0]) * wf,
-                        (uv[1][1] - uv[0][1]) * hf,
-                        (uv[2][0] - uv[0][0]) * wf,
-                        (uv[2][1] - uv[0][1]) * hf,
-                    ]);
+                    frag.lod = lod_f64(texel_derivs_f64(&frag.uv, w, h));
                 }
             }
             StageKind::Trilinear => {
@@ -581,6 +568,33 @@ fn quantize_uv(frag: &mut Frag, m: &Machine, samples: usize, sat: &mut SatCounte
             frag.uv_x[s][ax] = to_raw(frag.uv[s][ax], &m.uv_fmt, sat);
         }
     }
+}
+
+/// Texel-space derivatives `[du/dx, dv/dx, du/dy, dv/dy]` (raw, texcoord fraction bits) of a
+/// `w` x `h` texture from the pixel's texture coordinates and its two helper samples.
+#[inline]
+#[must_use]
+pub fn texel_derivs(uv: &[[i64; 2]; 3], w: u32, h: u32) -> [i64; 4] {
+    let (w, h) = (i64::from(w), i64::from(h));
+    [
+        (uv[1][0] - uv[0][0]) * w,
+        (uv[1][1] - uv[0][1]) * h,
+        (uv[2][0] - uv[0][0]) * w,
+        (uv[2][1] - uv[0][1]) * h,
+    ]
+}
+
+/// The float twin of [`texel_derivs`].
+#[inline]
+#[must_use]
+pub fn texel_derivs_f64(uv: &[[f64; 2]; 3], w: u32, h: u32) -> [f64; 4] {
+    let (w, h) = (f64::from(w), f64::from(h));
+    [
+        (uv[1][0] - uv[0][0]) * w,
+        (uv[1][1] - uv[0][1]) * h,
+        (uv[2][0] - uv[0][0]) * w,
+        (uv[2][1] - uv[0][1]) * h,
+    ]
 }
 
 #[inline]
