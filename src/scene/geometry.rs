@@ -223,6 +223,11 @@ pub fn validate(scene: &Scene) -> Result<()> {
     }
     check_finite("ambient", &scene.ambient)?;
     check_finite("background", &scene.background)?;
+    for (mi, m) in scene.materials.iter().enumerate() {
+        if let Some(b) = &m.brdf {
+            b.validate(&format!("materials[{mi}]"))?;
+        }
+    }
     for (ti, t) in scene.textures.iter().enumerate() {
         let what = format!("textures[{ti}] '{}'", t.name);
         if t.width == 0 || t.height == 0 || t.width > 65536 || t.height > 65536 {
