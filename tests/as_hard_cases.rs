@@ -85,7 +85,13 @@ fn hard_cases_are_finite_and_bounded() {
     for &nu in &EXPONENTS {
         for &nv in &EXPONENTS {
             for (rs, rd) in [(1.0, 0.0), (0.05, 1.0), (0.0, 0.0), (0.5, 0.5)] {
-                let brdf = AsBrdf { nu, nv, rs, rd };
+                let brdf = AsBrdf {
+                    nu,
+                    nv,
+                    rs,
+                    rd,
+                    exponent_map: None,
+                };
                 let cases = [
                     // h -> n: light and eye along the normal (eq. 18's 0/0), and 1e-4 off.
                     (n, n),
@@ -137,6 +143,7 @@ fn k1_equal_minus_k2_is_counted_and_gives_ambient_only() {
         nv: 10.0,
         rs: 0.5,
         rd: 1.0,
+        exponent_map: None,
     };
     let c = Case {
         n,
@@ -165,6 +172,7 @@ fn n_u_equal_n_v_is_isotropic_around_the_normal() {
         nv: 50.0,
         rs: 0.3,
         rd: 0.0,
+        exponent_map: None,
     };
     let mut at = |phi: f64| {
         let c = Case {
@@ -233,6 +241,7 @@ fn random_fragments_fixed_within_bound_of_float() {
             nv: pick(rng.next()),
             rs: rng.next(),
             rd: rng.next(),
+            exponent_map: None,
         };
         let c = Case {
             n,

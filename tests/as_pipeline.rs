@@ -200,9 +200,53 @@ fn toml_material_fields_and_errors() {
         ("brdf = \"ashikhmin-shirley\"\nnv = 1e7", "materials[0].nv"),
         ("brdf = \"ashikhmin-shirley\"\nrs = 2", "materials[0].rs"),
         ("brdf = \"ashikhmin-shirley\"\nrd = nan", "materials[0].rd"),
+        (
+            "brdf = \"ashikhmin-shirley\"\nexponent_map = \"nope\"",
+            "materials[0].exponent_map",
+        ),
+        ("exponent_map = \"nope\"", "materials[0].exponent_map"),
     ] {
         let p = write_toml("bad", &with_material(fields));
         let e = scene::load(&p).expect_err(fields).to_string();
         assert!(e.contains(needle), "{fields}: {e}");
     }
+}
+
+#[test]
+fn exponent_map_scene_fetches_per_pixel_exponents() {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/as_brushed.toml");
+    let mut s = scene::load(&p).expect("load");
+    s.width = 240;
+    s.height = 180;
+    let m = &s.materials[1];
+    assert_eq!(m.brdf.and_then(|b| b.exponent_map), Some(0));
+    let hw = HwConfig::texram16();
+    let r = go(&s, &hw, StageImpls::FIXED);
+    let fetch = stage(&r, StageKind::BumpFetch);
+    assert!(fetch.invocations > 0 && fetch.texels > 0);
+    assert_eq!(
+        fetch.invocations,
+        stage(&r, StageKind::Texcoord).invocations
+    );
+    assert!(
+        fetch.invocations < r.stats.covered_pixels,
+        "only the mapped sphere"
+    );
+    let e8 = r.stats.error_8bit.as_ref().expect("reference");
+    eprintln!("as_brushed.toml 240x180: max {} LSB8", e8.max_abs_lsb);
+    assert!(e8.max_abs_lsb <= 8, "{}", e8.max_abs_lsb);
+    assert_eq!(r.stats.bump.nonfinite + r.stats.bump.ref_nonfinite, 0);
+    // A constant exponent map of 1 (white) gives the material's own exponents.
+    let mut flat = s.clone();
+    flat.textures[0]
+        .texels
+        .iter_mut()
+        .for_each(|t| *t = [u16::MAX; 4]);
+    let mut plain = flat.clone();
+    if let Some(b) = plain.materials[1].brdf.as_mut() {
+        b.exponent_map = None;
+    }
+    let a = go(&flat, &hw, StageImpls::FIXED);
+    let b = go(&plain, &hw, StageImpls::FIXED);
+    assert_eq!(a.hw_image.px, b.hw_image.px);
 }

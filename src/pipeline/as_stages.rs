@@ -3,7 +3,8 @@
 //! eq. 16), fixed (`hw_model::aniso_phong`) and float ([`AshikhminShirley::eval_from_dots`]).
 //!
 //! An AS material runs `bary` (+ `texcoord`, `lod`, `trilinear` when textured), `normal`,
-//! `frame` and `as-shade`: the bump stages' interpolation and Schilling's main-direction frame
+//! (`bump-fetch` of its exponent map, when it has one), `frame` and `as-shade`: the bump
+//! stages' interpolation and Schilling's main-direction frame
 //! (frame 3: `n`, `u = e1 = m x n / |m x n|`, `v = e2 = n x e1`) supply the anisotropy axes, so
 //! one main direction gives brushed metal on any mesh. Per light `k1 = l`, with `k2` the
 //! direction to the eye:
@@ -11,6 +12,11 @@
 //! `L = pi (rho_s + kd rho_d) (n.l) E_light` per channel (`E = pi` times the light colour, so a
 //! white Lambertian surface facing a unit light shows its colour), plus `ambient kd R_d`.
 //! `kd` (times the texture when textured) tints the diffuse term only.
+//!
+//! Exponent map: `bump-fetch` filters it (LOD + trilinear, like an offset map) and
+//! `n_u = t_0 nu`, `n_v = t_1 nv` per pixel; the fixed twin rounds them to integers
+//! (`round(t_raw nu / (2^texel_bits - 1))`, the unit takes integer exponents), the float twin
+//! keeps them continuous.
 //!
 //! Fixed twin (integers only): `h = normalize(l + v)` by the vector unit; the six dot products
 //! `h.n, h.u, h.v, k.h, n.k1, n.k2` exact from the vector-format operands, rounded once to
@@ -48,28 +54,42 @@ pub struct AsPlan {
     pub brdf: AshikhminShirley,
     /// Diffuse tint (0..1 per channel).
     pub kd: [f64; 3],
+    /// The exponents are scaled per pixel by the exponent map (`BumpPlan::map`, fetched by
+    /// `bump-fetch`).
+    pub exponent_map: bool,
 }
 
 /// The plan of an Ashikhmin-Shirley material (`None` for other materials): `bary`, the
-/// texture stages when `textured`, `normal`, `frame` (always the main-direction frame, with
-/// the material's main direction) and `as-shade`. A bump map of the material is not used.
+/// texture stages when textured, `normal`, `bump-fetch` of the exponent map, `frame` (always
+/// the main-direction frame, with the material's main direction) and `as-shade`. Without
+/// texture coordinates (`has_uvs` false) the texture and the exponent map are not used; a bump
+/// map of the material is never used.
 #[must_use]
-pub fn plan_as(material: &Material, textured: bool) -> Option<Plan> {
+pub fn plan_as(material: &Material, has_uvs: bool) -> Option<Plan> {
     let b = material.brdf?;
+    let textured = material.texture.is_some() && has_uvs;
+    let emap = b.exponent_map.filter(|_| has_uvs);
     let mut stages = vec![StageKind::Bary];
-    if textured {
-        stages.extend([StageKind::Texcoord, StageKind::Lod, StageKind::Trilinear]);
+    if textured || emap.is_some() {
+        stages.push(StageKind::Texcoord);
     }
-    stages.extend([StageKind::Normal, StageKind::Frame, StageKind::AsShade]);
+    if textured {
+        stages.extend([StageKind::Lod, StageKind::Trilinear]);
+    }
+    stages.push(StageKind::Normal);
+    if emap.is_some() {
+        stages.push(StageKind::BumpFetch);
+    }
+    stages.extend([StageKind::Frame, StageKind::AsShade]);
     let kd = material.kd.map(f64::from);
     Some(Plan {
         stages,
         texture: if textured { material.texture } else { None },
         const_color: [kd[0], kd[1], kd[2], 1.0],
-        derivatives: textured,
+        derivatives: textured || emap.is_some(),
         wrap: [material.wrap_s, material.wrap_t],
         bump: Some(BumpPlan {
-            map: usize::MAX,
+            map: emap.unwrap_or(usize::MAX),
             frame: Some(FrameKind::Main),
             main: material.main_direction,
             kd,
@@ -84,6 +104,7 @@ pub fn plan_as(material: &Material, textured: bool) -> Option<Plan> {
                 rd: b.rd,
             },
             kd,
+            exponent_map: emap.is_some(),
         }),
     })
 }
@@ -227,9 +248,23 @@ pub fn run_as_shade(
                 .clamp(0.0, (1u64 << fb) as f64)
         };
         let p = &ap.brdf;
+        let mut nu = p.nu.clamp(0.0, f64::from(u32::MAX)) as u64;
+        let mut nv = p.nv.clamp(0.0, f64::from(u32::MAX)) as u64;
+        if ap.exponent_map {
+            let tb = m.hw.trilinear.texel_bits;
+            let tex = if fixed_in(StageKind::BumpFetch) {
+                bf.texel_x
+            } else {
+                bf.texel.map(|x| to_unorm(x, tb))
+            };
+            let tmax = (1u64 << tb) - 1;
+            let scale = |n: u64, t: u32| (2 * u64::from(t) * n + tmax) / (2 * tmax);
+            nu = scale(nu, tex[0]);
+            nv = scale(nv, tex[1]);
+        }
         let mut inp = AnisoPhongInputs {
-            nu: p.nu.clamp(0.0, f64::from(u32::MAX)) as u32,
-            nv: p.nv.clamp(0.0, f64::from(u32::MAX)) as u32,
+            nu: nu.min(u64::from(u32::MAX)) as u32,
+            nv: nv.min(u64::from(u32::MAX)) as u32,
             rs: unorm_f(p.rs) as u32,
             rd: unorm_f(p.rd) as u32,
             ..AnisoPhongInputs::default()
@@ -299,7 +334,11 @@ pub fn run_as_shade(
                 kd[ch] *= frag.texel[ch];
             }
         }
-        let p = &ap.brdf;
+        let mut p = ap.brdf;
+        if ap.exponent_map {
+            p.nu *= bf.texel[0];
+            p.nv *= bf.texel[1];
+        }
         let mut acc = [0.0f64; 3];
         for ch in 0..3 {
             acc[ch] = m.ambient[ch] * kd[ch] * p.rd;

@@ -212,7 +212,7 @@ pub fn plan(material: &Material, has_uvs: bool) -> Plan {
 #[must_use]
 pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize>) -> Plan {
     let textured = material.texture.is_some() && has_uvs;
-    if let Some(p) = as_stages::plan_as(material, textured) {
+    if let Some(p) = as_stages::plan_as(material, has_uvs) {
         return p;
     }
     if let (Some(map), true, Some(_)) = (bump_map, has_uvs, material.bump) {

@@ -33,7 +33,13 @@ fn grid(name: &str, kd: [f32; 3], rs: f64, rd: f64) -> Scene {
                 kd,
                 cull_back: true,
                 main_direction: MainDirection::Constant([0.0, 1.0, 0.0]),
-                brdf: Some(AsBrdf { nu, nv, rs, rd }),
+                brdf: Some(AsBrdf {
+                    nu,
+                    nv,
+                    rs,
+                    rd,
+                    exponent_map: None,
+                }),
                 ..Material::default()
             });
         }
@@ -110,6 +116,7 @@ pub fn as_brushed() -> Scene {
                 nv: 2000.0,
                 rs: 0.9,
                 rd: 0.05,
+                exponent_map: None,
             }),
             ..Material::default()
         },
@@ -123,6 +130,7 @@ pub fn as_brushed() -> Scene {
                 nv: 10.0,
                 rs: 0.7,
                 rd: 0.2,
+                exponent_map: None,
             }),
             ..Material::default()
         },

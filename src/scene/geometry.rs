@@ -226,6 +226,12 @@ pub fn validate(scene: &Scene) -> Result<()> {
     for (mi, m) in scene.materials.iter().enumerate() {
         if let Some(b) = &m.brdf {
             b.validate(&format!("materials[{mi}]"))?;
+            if let Some(t) = b.exponent_map.filter(|&t| t >= scene.textures.len()) {
+                return Err(Error::field(
+                    &format!("materials[{mi}].exponent_map"),
+                    format!("index {t} out of range ({} textures)", scene.textures.len()),
+                ));
+            }
         }
     }
     for (ti, t) in scene.textures.iter().enumerate() {

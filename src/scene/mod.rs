@@ -116,6 +116,9 @@ pub struct AsBrdf {
     pub rs: f64,
     /// Diffuse reflectance, `[0, 1]`.
     pub rd: f64,
+    /// Index into [`Scene::textures`] of an exponent map: per pixel `n_u = t_0 nu` and
+    /// `n_v = t_1 nv` from its channels 0 and 1 (unorm `t`; the fixed stage rounds to integers).
+    pub exponent_map: Option<usize>,
 }
 
 /// Largest exponent a scene may give (`2^20 - 1`, the widest `exponent_max_bits`; a narrower

@@ -103,13 +103,34 @@ struct MaterialCfg {
     nv: Option<f64>,
     rs: Option<f64>,
     rd: Option<f64>,
+    /// Exponent map: a texture name of `[[textures]]` (channel 0 scales `nu`, 1 scales `nv`).
+    exponent_map: Option<String>,
 }
 
 /// The Ashikhmin-Shirley parameters of material `i` (defaults `nu = nv = 100`, `rs = 0.05`,
-/// `rd = 0.5`); parameters without `brdf = "ashikhmin-shirley"` are an error.
-fn as_brdf(i: usize, m: &MaterialCfg) -> Result<Option<AsBrdf>> {
+/// `rd = 0.5`, no exponent map); parameters without `brdf = "ashikhmin-shirley"` are an error.
+fn as_brdf(
+    i: usize,
+    m: &MaterialCfg,
+    tex_names: &BTreeMap<String, usize>,
+) -> Result<Option<AsBrdf>> {
     let f = |n: &str| format!("materials[{i}].{n}");
-    let given = [("nu", m.nu), ("nv", m.nv), ("rs", m.rs), ("rd", m.rd)];
+    let given = [
+        ("nu", m.nu),
+        ("nv", m.nv),
+        ("rs", m.rs),
+        ("rd", m.rd),
+        ("exponent_map", m.exponent_map.as_ref().map(|_| 0.0)),
+    ];
+    let exponent_map = match &m.exponent_map {
+        Some(n) => Some(*tex_names.get(n).ok_or_else(|| {
+            Error::field(
+                &f("exponent_map"),
+                format!("no texture named '{n}' in [[textures]]"),
+            )
+        })?),
+        None => None,
+    };
     match m.brdf.as_deref() {
         Some("ashikhmin-shirley") => {
             let b = AsBrdf {
@@ -117,6 +138,7 @@ fn as_brdf(i: usize, m: &MaterialCfg) -> Result<Option<AsBrdf>> {
                 nv: m.nv.unwrap_or(100.0),
                 rs: m.rs.unwrap_or(0.05),
                 rd: m.rd.unwrap_or(0.5),
+                exponent_map,
             };
             b.validate(&format!("materials[{i}]"))?;
             Ok(Some(b))
@@ -421,7 +443,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             main_direction: main_dir,
             ks: m.ks.unwrap_or(def.ks),
             shininess: m.shininess.unwrap_or(def.shininess),
-            brdf: as_brdf(i, m)?,
+            brdf: as_brdf(i, m, &tex_names)?,
         });
     }
     let mut default_mat: Option<usize> = None;
