@@ -97,6 +97,8 @@ pub struct Machine<'a> {
     pub ambient_x: [u64; 3],
     /// Per-triangle bump data ([`TriAttrs::bump`] indexes it).
     pub bump_attrs: &'a [BumpAttrs],
+    /// ROMs of the anisotropic Phong unit, built on first use ([`Machine::aniso_roms`]).
+    pub aniso_roms: std::sync::OnceLock<hw_model::aniso_phong::AnisoPhongRoms>,
 }
 
 /// One scene light for per-pixel shading.
@@ -157,6 +159,7 @@ impl<'a> Machine<'a> {
             ambient: [0.0; 3],
             ambient_x: [0; 3],
             bump_attrs: &[],
+            aniso_roms: std::sync::OnceLock::new(),
         }
     }
 
@@ -240,6 +243,7 @@ impl<'a> Machine<'a> {
             ),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
+            StageKind::AsShade => super::as_stages::as_shade_cost(self, plan),
             _ => self.bump_stage_cost(kind, plan),
         }
     }
@@ -556,6 +560,7 @@ pub fn run(
             | StageKind::Frame
             | StageKind::Perturb
             | StageKind::Phong => run_bump_stage(kind, plan, impls, m, a, frag, c),
+            StageKind::AsShade => super::as_stages::run_as_shade(plan, impls, m, frag, c),
         }
     }
 }

@@ -18,6 +18,9 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
     ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
     ("bumps", "bump-mapped brick sphere, rippled torus and brick tile under a grazing directional light and a point light, 640x480"),
+    ("as-metal", "Ashikhmin-Shirley metal spheres over n_u x n_v = 1..10000 under a light (paper Fig. 3), 400x400"),
+    ("as-plastic", "Ashikhmin-Shirley red plastic spheres over n_u x n_v = 1..10000 under a light (paper Fig. 5), 400x400"),
+    ("as-brushed", "brushed-metal torus (one main direction) and sphere (m = p_u), Ashikhmin-Shirley, 640x480"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -28,6 +31,9 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "w2-mesh" => w2_mesh(),
         "sphere" => sphere()?,
         "bumps" => bumps(),
+        "as-metal" => super::as_scenes::as_metal(),
+        "as-plastic" => super::as_scenes::as_plastic(),
+        "as-brushed" => super::as_scenes::as_brushed(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(
