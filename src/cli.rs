@@ -188,7 +188,8 @@ pub struct RenderArgs {
     /// How the reference chooses fragments.
     #[arg(long, value_enum, default_value = "shared")]
     pub coverage: CoverageArg,
-    /// Stages the "hardware" image runs in float (comma list: bary,color,texcoord,lod,trilinear,modulate).
+    /// Stages the "hardware" image runs in float (comma list of stage names as the stage table
+    /// prints them, e.g. bary,lod,trilinear,frame,phong; an unknown name lists them all).
     #[arg(long, value_delimiter = ',')]
     pub float: Vec<String>,
     /// Run only this stage in fixed point (all others float): the error of one stage in isolation.
