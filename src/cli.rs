@@ -110,6 +110,30 @@ pub enum BrdfCmd {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Render the paper's sphere grids (metal and plastic, furnace and light; Figs. 2-5) with
+    /// the fixed unit and the float reference; writes the images and their difference, prints
+    /// error and cost per grid.
+    Spheres(SpheresArgs),
+}
+
+/// Arguments of `texsim brdf spheres`.
+#[derive(Args, Debug, Clone)]
+pub struct SpheresArgs {
+    /// Output directory.
+    #[arg(long, default_value = "out/spheres")]
+    pub out: PathBuf,
+    /// Hardware preset or hw TOML file (its `aniso_phong` unit).
+    #[arg(long, default_value = "texram16")]
+    pub hw: String,
+    /// Pixels per sphere.
+    #[arg(long, default_value_t = crate::brdf::spheres::PAPER_SPHERE_PX)]
+    pub size: u32,
+    /// Exponents of both axes (comma list; n_u per column, n_v per row).
+    #[arg(long, value_delimiter = ',', default_values_t = crate::brdf::spheres::PAPER_EXPONENTS)]
+    pub exponents: Vec<f64>,
+    /// Furnace quadrature resolution (64 res^2 evaluations per pixel).
+    #[arg(long, default_value_t = crate::brdf::spheres::FURNACE_RES)]
+    pub furnace_res: usize,
 }
 
 #[derive(Subcommand, Debug)]
@@ -164,7 +188,8 @@ pub struct RenderArgs {
     /// How the reference chooses fragments.
     #[arg(long, value_enum, default_value = "shared")]
     pub coverage: CoverageArg,
-    /// Stages the "hardware" image runs in float (comma list: bary,color,texcoord,lod,trilinear,modulate).
+    /// Stages the "hardware" image runs in float (comma list of stage names as the stage table
+    /// prints them, e.g. bary,lod,trilinear,frame,phong; an unknown name lists them all).
     #[arg(long, value_delimiter = ',')]
     pub float: Vec<String>,
     /// Run only this stage in fixed point (all others float): the error of one stage in isolation.
@@ -631,6 +656,16 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
             *samples,
             *seed,
         )?,
+        BrdfCmd::Spheres(a) => {
+            let cfg = hwconfig::resolve(&a.hw)?.aniso_phong;
+            let (out, text) =
+                crate::brdf::spheres::spheres_report(&cfg, &a.exponents, a.size, a.furnace_res)?;
+            let mut text = text;
+            for p in out.write_to(&a.out)? {
+                text.push_str(&format!("wrote {}\n", p.display()));
+            }
+            text
+        }
     };
     print!("{text}");
     if !text.ends_with('\n') {

@@ -648,14 +648,16 @@ struct ShadeInput<'a> {
     costs: &'a [[UnitCost; StageKind::COUNT]],
 }
 
-/// Shades row `y` into `row`, adding to `c`, and records its timing events into `ev`.
-fn shade_row_timed(
+/// Shades row `y` into `row`, adding to `c`; `on_pixel(plan, plan index, triangle, frag)`
+/// sees every shaded fragment (a no-op closure compiles to the plain loop; the timing model
+/// records its events through it).
+fn shade_row(
     inp: &ShadeInput,
     impls: &StageImpls,
     y: usize,
     row: &mut [[u16; 4]],
     c: &mut Counters,
-    ev: &mut RowEvents,
+    mut on_pixel: impl FnMut(&Plan, u32, u32, &Frag),
 ) {
     let w = inp.vis.width as usize;
     let mut frag = Frag::default();
@@ -681,7 +683,7 @@ fn shade_row_timed(
             c,
         );
         *out = output16(&frag);
-        record_pixel(plan, a.plan, t, impls, inp.m, &frag, ev);
+        on_pixel(plan, a.plan, t, &frag);
     }
 }
 
@@ -702,33 +704,8 @@ fn shade(
             .par_chunks_mut(w.max(1))
             .enumerate()
             .map(|(y, row)| {
-                // The loop of `shade_row_timed` without event recording: exactly the code a render
-                // ran before the timing model existed.
                 let mut c = Counters::default();
-                let mut frag = Frag::default();
-                let tris = &vis.tri[y * w..(y + 1) * w];
-                for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
-                    if t == NO_TRI {
-                        continue;
-                    }
-                    let a = &inp.attrs[t as usize];
-                    let pi = a.plan as usize;
-                    let tri = &inp.setup.tris[t as usize];
-                    let plan = &inp.geo.plans[pi];
-                    run(
-                        plan,
-                        &inp.costs[pi],
-                        impls,
-                        inp.m,
-                        tri,
-                        a,
-                        x as i64,
-                        y as i64,
-                        &mut frag,
-                        &mut c,
-                    );
-                    *out = output16(&frag);
-                }
+                shade_row(inp, impls, y, row, &mut c, |_, _, _, _| {});
                 c
             })
             .reduce(Counters::default, |mut a, b| {
@@ -748,7 +725,9 @@ fn shade(
         .map(|(y, row)| {
             let mut c = Counters::default();
             let mut ev = RowEvents::with_capacity(w, lookups);
-            shade_row_timed(inp, impls, y, row, &mut c, &mut ev);
+            shade_row(inp, impls, y, row, &mut c, |plan, pi, t, frag| {
+                record_pixel(plan, pi, t, impls, inp.m, frag, &mut ev);
+            });
             (c, ev)
         })
         .collect();

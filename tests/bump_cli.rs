@@ -1,31 +1,10 @@
 //! The bump-mapping command line: `texsim render --scene bumps`, the frame sweep with its
 //! `frame` alias, the knobs of the shading units, and the real mesh's TOML scene.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod cli_common;
 
-fn texsim(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texsim"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run texsim")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-bump-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp dir");
-    d
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use cli_common::{texsim, text, tmp};
+use std::path::Path;
 
 #[test]
 fn scenes_lists_bumps_and_render_reports_bump_stages() {

@@ -155,7 +155,7 @@ fn per_frame_costs_follow_the_units() {
 
 #[test]
 fn scenes_without_bumps_run_no_bump_stage() {
-    for name in ["demo", "sphere"] {
+    for name in ["w1-plane", "sphere"] {
         let s = small(name, 96, 72);
         let r = go(&s, &HwConfig::texram16());
         for k in BUMP_STAGES {

@@ -415,3 +415,47 @@ fn depth_ordering_near_hides_far() {
         assert_eq!(st.depth_fails * 2, st.fragments);
     }
 }
+
+/// `edges_fixed_with_steps` (one i64 evaluation plus constant steps) is bit-identical to three
+/// `edges_fixed` calls, for ordinary and for huge coordinates (where it must fall back).
+#[test]
+fn edge_steps_match_three_evaluations() {
+    let mut rng = Rng(77);
+    let mut t = ScreenTri {
+        xy: [[0; 2]; 3],
+        xy_f: [[0.0; 2]; 3],
+        z: [0; 3],
+        z_f: [0.0; 3],
+        inv_w: [1.0; 3],
+        src: 0,
+        src_bary: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        area2: 1,
+        area2_f: 1.0,
+        bbox: [0; 4],
+    };
+    for case in 0..1_000_000u32 {
+        let (span, pspan) = match case % 4 {
+            0 => (1i64 << 20, 4096i64),
+            1 => (1 << 31, 1 << 20),
+            2 => (1 << 40, 1 << 40),
+            _ => (i64::MAX / 2, i64::MAX / 4),
+        };
+        for v in &mut t.xy {
+            *v = [0, 1].map(|_| rng.below(2 * span as u64) as i64 - span);
+        }
+        let px = rng.below(2 * pspan as u64) as i64 - pspan;
+        let py = rng.below(2 * pspan as u64) as i64 - pspan;
+        let sub = 1 + (rng.below(12) as u32);
+        let e = t.edges_fixed(px, py, sub);
+        let ex = t.edges_fixed(px + 1, py, sub);
+        let ey = t.edges_fixed(px, py + 1, sub);
+        let dx = [0, 1, 2].map(|i| ex[i].wrapping_sub(e[i]));
+        let dy = [0, 1, 2].map(|i| ey[i].wrapping_sub(e[i]));
+        assert_eq!(
+            t.edges_fixed_with_steps(px, py, sub),
+            (e, dx, dy),
+            "case {case}: {:?} at ({px}, {py}) sub {sub}",
+            t.xy
+        );
+    }
+}

@@ -106,6 +106,7 @@ fn absent_stages_are_never_invoked() {
     let mut s = small("demo", 160, 120);
     for m in &mut s.materials {
         m.texture = None;
+        m.bump = None;
         m.lit = false;
     }
     let r = go(&s, &RenderOptions::default());

@@ -11,8 +11,8 @@ use texsim::timing::{cycles, simulate};
 
 /// (scene, preset[+FIELD=VALUE], total cycles, cache hits, bank conflicts, DRAM page misses).
 const GOLDEN: &[(&str, &str, u64, u64, u64, u64)] = &[
-    ("demo", "texram16", 532625, 0, 0, 278796),
-    ("demo", "d3d11", 298317, 299055, 0, 3208),
+    ("demo", "texram16", 547268, 0, 0, 278271),
+    ("demo", "d3d11", 352827, 297423, 0, 4520),
     ("w1-plane", "texram16", 339825, 0, 0, 173232),
     ("w1-plane", "d3d11", 142679, 252254, 0, 781),
     ("w2-mesh", "texram16", 1481565, 0, 0, 340591),

@@ -586,3 +586,81 @@ pub fn paper_outputs(cfg: &AnisoPhongConfig) -> Result<(OutputSet, String)> {
     }
     Ok((all, text))
 }
+
+/// Fixed-point cost of a grid: unit evaluations per covered pixel (1 under a light; the
+/// furnace quadrature's `64 res^2` specular and `4 res` diffuse evaluations), their ops and
+/// cycles from `hw_model::aniso_phong::aniso_phong_cost`, and the per-sphere setup
+/// (`aniso_phong_material_cost`, once per sphere).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridCost {
+    /// Unit evaluations per covered pixel.
+    pub evals_per_px: u64,
+    /// Cycles per covered pixel.
+    pub cycles_per_px: u64,
+    /// Ops per covered pixel.
+    pub ops_per_px: u64,
+    /// Covered pixels (inside a sphere).
+    pub covered_px: u64,
+    /// Total cycles: pixels plus the per-sphere setups.
+    pub total_cycles: u64,
+}
+
+/// The cost of rendering `spec` on the unit `cfg` (see [`GridCost`]).
+#[must_use]
+pub fn grid_cost(spec: &GridSpec, cfg: &AnisoPhongConfig) -> GridCost {
+    let unit = hw_model::aniso_phong::aniso_phong_cost(cfg);
+    let setup = hw_model::aniso_phong::aniso_phong_material_cost(cfg);
+    let evals = match spec.lighting {
+        Lighting::Light { .. } => 1,
+        Lighting::Furnace => {
+            let r = spec.furnace_res as u64;
+            64 * r * r + 4 * r
+        }
+    };
+    let side = spec.image_px();
+    let mut covered = 0u64;
+    for y in 0..side {
+        for x in 0..side {
+            covered += u64::from(pixel_normal(spec, x, y).is_some());
+        }
+    }
+    let cycles_per_px = evals * u64::from(unit.cycles);
+    let spheres = (spec.exponents.len() * spec.exponents.len()) as u64;
+    GridCost {
+        evals_per_px: evals,
+        cycles_per_px,
+        ops_per_px: evals * u64::from(unit.ops),
+        covered_px: covered,
+        total_cycles: covered * cycles_per_px + spheres * u64::from(setup.cycles),
+    }
+}
+
+/// One line describing [`grid_cost`].
+#[must_use]
+pub fn cost_line(name: &str, c: &GridCost) -> String {
+    format!(
+        "{name} cost: {} unit evaluation(s)/px, {} ops/px, {} cycles/px over {} covered px; {} cycles total (with per-sphere setup)\n",
+        c.evals_per_px, c.ops_per_px, c.cycles_per_px, c.covered_px, c.total_cycles
+    )
+}
+
+/// The four paper grids (metal/plastic x furnace/light) at `sphere_px` per sphere over
+/// `exponents`, furnace resolution `furnace_res`: images ([`add_grid_outputs`]) plus a text
+/// report with error and cost per grid (`texsim brdf spheres`).
+pub fn spheres_report(
+    cfg: &AnisoPhongConfig,
+    exponents: &[f64],
+    sphere_px: u32,
+    furnace_res: usize,
+) -> Result<(OutputSet, String)> {
+    let mut all = OutputSet::new();
+    let mut text = String::new();
+    for (name, mut spec) in paper_grids() {
+        spec.exponents = exponents.to_vec();
+        spec.sphere_px = sphere_px;
+        spec.furnace_res = furnace_res;
+        text.push_str(&add_grid_outputs(&mut all, &name, &spec, cfg)?);
+        text.push_str(&cost_line(&name, &grid_cost(&spec, cfg)));
+    }
+    Ok((all, text))
+}

@@ -278,13 +278,7 @@ pub fn run_bump_stage(
                         }
                     }
                 }
-                let uv = &frag.uv_x;
-                let d = [
-                    (uv[1][0] - uv[0][0]) * i64::from(w),
-                    (uv[1][1] - uv[0][1]) * i64::from(h),
-                    (uv[2][0] - uv[0][0]) * i64::from(w),
-                    (uv[2][1] - uv[0][1]) * i64::from(h),
-                ];
+                let d = super::stages::texel_derivs(&frag.uv_x, w, h);
                 let l = lod(d, fb, &hw.lod, &mut sat);
                 let [u, v] = frag.uv_x[0];
                 let r = trilinear(
@@ -302,14 +296,8 @@ pub fn run_bump_stage(
                 bf.texel_x = [u32::from(r[0]), u32::from(r[1])];
                 bf.texel = bf.texel_x.map(|x| crate::fixedpoint::from_unorm(x, tb));
             } else {
+                let l = lod_f64(super::stages::texel_derivs_f64(&frag.uv, w, h));
                 let uv = &frag.uv;
-                let (wf, hf) = (f64::from(w), f64::from(h));
-                let l = lod_f64([
-                    (uv[1][0] - uv[0][0]) * wf,
-                    (uv[1][1] - uv[0][1]) * hf,
-                    (uv[2][0] - uv[0][0]) * wf,
-                    (uv[2][1] - uv[0][1]) * hf,
-                ]);
                 let [u, v] = uv[0];
                 let r = trilinear_f64(&m.tex_float[t], u, v, l, plan.wrap);
                 bf.texel = [r[0], r[1]];

@@ -11,6 +11,7 @@
 //! of Fixed stages is bit-accurate, and a Fixed stage after a Float one sees the float value
 //! rounded into its input format (how a mixed run isolates one stage's error).
 
+pub mod as_stages;
 pub mod bump_stages;
 pub mod rough_stages;
 pub mod stages;
@@ -45,6 +46,8 @@ pub enum StageKind {
     Perturb,
     /// Bump materials: per-pixel Blinn-Phong over every scene light (+ ambient).
     Phong,
+    /// Ashikhmin-Shirley materials: the anisotropic Phong BRDF per pixel over every light.
+    AsShade,
     /// Roughness materials: trilinear fetch of the D map at the bump fetch's LOD.
     RoughFetch,
     /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
@@ -53,7 +56,7 @@ pub enum StageKind {
 
 impl StageKind {
     /// Number of stage kinds.
-    pub const COUNT: usize = 13;
+    pub const COUNT: usize = 14;
 
     /// Every stage kind, in pipeline order (the bump stages follow the texture stages).
     pub const ALL: [StageKind; StageKind::COUNT] = [
@@ -68,6 +71,7 @@ impl StageKind {
         StageKind::Frame,
         StageKind::Perturb,
         StageKind::Phong,
+        StageKind::AsShade,
         StageKind::RoughFetch,
         StageKind::RoughShade,
     ];
@@ -87,6 +91,7 @@ impl StageKind {
             StageKind::Frame => "frame",
             StageKind::Perturb => "perturb",
             StageKind::Phong => "phong",
+            StageKind::AsShade => "as-shade",
             StageKind::RoughFetch => "rough-fetch",
             StageKind::RoughShade => "rough-shade",
         }
@@ -174,6 +179,8 @@ pub struct Plan {
     pub wrap: [WrapMode; 2],
     /// Bump mapping and per-pixel shading, for bump-mapped materials.
     pub bump: Option<BumpPlan>,
+    /// Ashikhmin-Shirley shading (with `bump` holding its normal/frame inputs).
+    pub aniso: Option<as_stages::AsPlan>,
     /// Roughness map and modified Blinn-Phong (`rough_stages`), for roughness materials.
     pub rough: Option<rough_stages::RoughPlan>,
 }
@@ -216,6 +223,9 @@ pub fn plan(material: &Material, has_uvs: bool) -> Plan {
 #[must_use]
 pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize>) -> Plan {
     let textured = material.texture.is_some() && has_uvs;
+    if let Some(p) = as_stages::plan_as(material, has_uvs) {
+        return p;
+    }
     if let (Some(map), true, Some(_)) = (bump_map, has_uvs, material.bump) {
         let mut stages = vec![StageKind::Bary, StageKind::Texcoord];
         if textured {
@@ -243,6 +253,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
                 ks: material.ks.map(f64::from),
                 shininess: material.shininess,
             }),
+            aniso: None,
             rough: None,
         };
     }
@@ -268,6 +279,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         derivatives: textured,
         wrap: [material.wrap_s, material.wrap_t],
         bump: None,
+        aniso: None,
         rough: None,
     }
 }

@@ -57,8 +57,12 @@ pub struct RoughPlan {
 }
 
 /// Marks a bump plan of a roughness material (called by the planner of `render`; the stages
-/// are set by [`resolve_plans`] once the hardware is known).
+/// are set by [`resolve_plans`] once the hardware is known). Ashikhmin-Shirley plans (which
+/// also carry a bump plan) are left alone: they have no Blinn-Phong to modify.
 pub fn mark_plan(plan: &mut Plan, material: &Material) {
+    if plan.aniso.is_some() || !plan.stages.contains(&StageKind::Phong) {
+        return;
+    }
     if let (Some(choice), Some(_)) = (material.roughness, &plan.bump) {
         plan.rough = Some(RoughPlan {
             choice,

@@ -97,6 +97,8 @@ pub struct Machine<'a> {
     pub ambient_x: [u64; 3],
     /// Per-triangle bump data ([`TriAttrs::bump`] indexes it).
     pub bump_attrs: &'a [BumpAttrs],
+    /// ROMs of the anisotropic Phong unit, built on first use ([`Machine::aniso_roms`]).
+    pub aniso_roms: std::sync::OnceLock<hw_model::aniso_phong::AnisoPhongRoms>,
 }
 
 /// One scene light for per-pixel shading.
@@ -157,6 +159,7 @@ impl<'a> Machine<'a> {
             ambient: [0.0; 3],
             ambient_x: [0; 3],
             bump_attrs: &[],
+            aniso_roms: std::sync::OnceLock::new(),
         }
     }
 
@@ -240,6 +243,7 @@ impl<'a> Machine<'a> {
             ),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
+            StageKind::AsShade => super::as_stages::as_shade_cost(self, plan),
             StageKind::RoughFetch | StageKind::RoughShade => {
                 super::rough_stages::rough_stage_cost(self, kind, plan)
             }
@@ -389,16 +393,13 @@ pub fn run(
             StageKind::Bary => {
                 let sub = hw.raster.subpixel_bits;
                 if fixed {
-                    let e = tri.edges_fixed(px, py, sub);
                     if plan.derivatives {
-                        let ex = tri.edges_fixed(px + 1, py, sub);
-                        let ey = tri.edges_fixed(px, py + 1, sub);
-                        let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
-                        let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
+                        let (e, dx, dy) = tri.edges_fixed_with_steps(px, py, sub);
                         frag.bary_x = perspective_bary_derivs(
                             e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat,
                         );
                     } else {
+                        let e = tri.edges_fixed(px, py, sub);
                         frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
                     }
                     for s in 0..samples {
@@ -475,24 +476,11 @@ pub fn run(
                     if !fixed_in(StageKind::Texcoord) {
                         quantize_uv(frag, m, samples, sat);
                     }
-                    let uv = &frag.uv_x;
-                    let d = [
-                        (uv[1][0] - uv[0][0]) * i64::from(w),
-                        (uv[1][1] - uv[0][1]) * i64::from(h),
-                        (uv[2][0] - uv[0][0]) * i64::from(w),
-                        (uv[2][1] - uv[0][1]) * i64::from(h),
-                    ];
+                    let d = texel_derivs(&frag.uv_x, w, h);
                     frag.lod_x = lod(d, fb, &hw.lod, sat);
                     frag.lod = from_raw(frag.lod_x, lfb);
                 } else {
-                    let uv = &frag.uv;
-                    let (wf, hf) = (f64::from(w), f64::from(h));
-                    frag.lod = lod_f64([
-                        (uv[1][0] - uv[0][0]) * wf,
-                        (uv[1][1] - uv[0][1]) * hf,
-                        (uv[2][0] - uv[0][0]) * wf,
-                        (uv[2][1] - uv[0][1]) * hf,
-                    ]);
+                    frag.lod = lod_f64(texel_derivs_f64(&frag.uv, w, h));
                 }
             }
             StageKind::Trilinear => {
@@ -575,6 +563,7 @@ pub fn run(
             | StageKind::Frame
             | StageKind::Perturb
             | StageKind::Phong => run_bump_stage(kind, plan, impls, m, a, frag, c),
+            StageKind::AsShade => super::as_stages::run_as_shade(plan, impls, m, frag, c),
             StageKind::RoughFetch | StageKind::RoughShade => {
                 super::rough_stages::run_rough_stage(kind, plan, impls, m, frag, c);
             }
@@ -590,6 +579,33 @@ fn quantize_uv(frag: &mut Frag, m: &Machine, samples: usize, sat: &mut SatCounte
             frag.uv_x[s][ax] = to_raw(frag.uv[s][ax], &m.uv_fmt, sat);
         }
     }
+}
+
+/// Texel-space derivatives `[du/dx, dv/dx, du/dy, dv/dy]` (raw, texcoord fraction bits) of a
+/// `w` x `h` texture from the pixel's texture coordinates and its two helper samples.
+#[inline]
+#[must_use]
+pub fn texel_derivs(uv: &[[i64; 2]; 3], w: u32, h: u32) -> [i64; 4] {
+    let (w, h) = (i64::from(w), i64::from(h));
+    [
+        (uv[1][0] - uv[0][0]) * w,
+        (uv[1][1] - uv[0][1]) * h,
+        (uv[2][0] - uv[0][0]) * w,
+        (uv[2][1] - uv[0][1]) * h,
+    ]
+}
+
+/// The float twin of [`texel_derivs`].
+#[inline]
+#[must_use]
+pub fn texel_derivs_f64(uv: &[[f64; 2]; 3], w: u32, h: u32) -> [f64; 4] {
+    let (w, h) = (f64::from(w), f64::from(h));
+    [
+        (uv[1][0] - uv[0][0]) * w,
+        (uv[1][1] - uv[0][1]) * h,
+        (uv[2][0] - uv[0][0]) * w,
+        (uv[2][1] - uv[0][1]) * h,
+    ]
 }
 
 #[inline]

@@ -98,6 +98,58 @@ impl ScreenTri {
         e
     }
 
+    /// The edge values at the centres of pixels (px, py), (px + 1, py) and (px, py + 1), as
+    /// `(e, e(px + 1) - e, e(py + 1) - e)`: bit-identical to three calls of
+    /// [`Self::edges_fixed`], computed once in `i64` plus the edges' constant steps
+    /// (`-(y_k - y_j) 2^s`, `(x_k - x_j) 2^s`); any overflow falls back to the exact calls.
+    #[must_use]
+    pub fn edges_fixed_with_steps(
+        &self,
+        px: i64,
+        py: i64,
+        subpixel_bits: u32,
+    ) -> ([i64; 3], [i64; 3], [i64; 3]) {
+        self.edges_steps_i64(px, py, subpixel_bits)
+            .unwrap_or_else(|| {
+                let e = self.edges_fixed(px, py, subpixel_bits);
+                let ex = self.edges_fixed(px + 1, py, subpixel_bits);
+                let ey = self.edges_fixed(px, py + 1, subpixel_bits);
+                let dx = [0, 1, 2].map(|i| ex[i].wrapping_sub(e[i]));
+                let dy = [0, 1, 2].map(|i| ey[i].wrapping_sub(e[i]));
+                (e, dx, dy)
+            })
+    }
+
+    /// [`Self::edges_fixed_with_steps`] in `i64`, `None` when any intermediate (including
+    /// the neighbours' edge values) would leave `i64`.
+    fn edges_steps_i64(
+        &self,
+        px: i64,
+        py: i64,
+        subpixel_bits: u32,
+    ) -> Option<([i64; 3], [i64; 3], [i64; 3])> {
+        let s = subpixel_bits.clamp(1, 12);
+        let h = 1i64 << (s - 1);
+        let x = px.checked_mul(1 << s)?.checked_add(h)?;
+        let y = py.checked_mul(1 << s)?.checked_add(h)?;
+        let (mut e, mut dx, mut dy) = ([0i64; 3], [0i64; 3], [0i64; 3]);
+        for i in 0..3 {
+            let [xj, yj] = self.xy[(i + 1) % 3];
+            let [xk, yk] = self.xy[(i + 2) % 3];
+            let ax = xk.checked_sub(xj)?;
+            let ay = yk.checked_sub(yj)?;
+            let v = ax
+                .checked_mul(y.checked_sub(yj)?)?
+                .checked_sub(ay.checked_mul(x.checked_sub(xj)?)?)?;
+            let sx = ay.checked_mul(1 << s)?.checked_neg()?;
+            let sy = ax.checked_mul(1 << s)?;
+            v.checked_add(sx)?;
+            v.checked_add(sy)?;
+            (e[i], dx[i], dy[i]) = (v, sx, sy);
+        }
+        Some((e, dx, dy))
+    }
+
     /// Float edge values at the point (px + 0.5, py + 0.5) from `xy_f`, evaluated with each
     /// edge's endpoints in canonical order (bit-exact negation across shared edges).
     #[must_use]

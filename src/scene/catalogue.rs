@@ -13,11 +13,14 @@ use crate::{Error, Result};
 
 /// Built-in scene names with a one-line description (for `texsim scenes`).
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("demo", "textured ground plane to the horizon (minification) + lit textured torus and sphere up close"),
+    ("demo", "textured ground plane to the horizon (minification), lit textured torus and sphere, bump-mapped brick sphere"),
     ("w1-plane", "Mesa anchor W1: 1024x1024, one textured quad receding to the horizon, unlit (GL_REPLACE)"),
     ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
     ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
     ("bumps", "bump-mapped brick sphere, rippled torus and brick tile under a grazing directional light and a point light, 640x480"),
+    ("as-metal", "Ashikhmin-Shirley metal spheres over n_u x n_v = 1..10000 under a light (paper Fig. 3), 400x400"),
+    ("as-plastic", "Ashikhmin-Shirley red plastic spheres over n_u x n_v = 1..10000 under a light (paper Fig. 5), 400x400"),
+    ("as-brushed", "brushed-metal torus (one main direction) and sphere (m = p_u), Ashikhmin-Shirley, 640x480"),
     ("lake", "roughness: waves on a lake under a low sun, near to far (highlight widens with distance), 480x320"),
     ("corrugated", "roughness: corrugated sheet iron receding (one-dimensional bumps, singular K), 480x320"),
     ("brushed", "roughness: brushed metal plate (anisotropic streaks), 480x320"),
@@ -32,6 +35,9 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "w2-mesh" => w2_mesh(),
         "sphere" => sphere()?,
         "bumps" => bumps(),
+        "as-metal" => super::as_scenes::as_metal(),
+        "as-plastic" => super::as_scenes::as_plastic(),
+        "as-brushed" => super::as_scenes::as_brushed(),
         "lake" => super::rough_scenes::lake(),
         "corrugated" => super::rough_scenes::corrugated(),
         "brushed" => super::rough_scenes::brushed(),
@@ -163,6 +169,14 @@ fn demo() -> Result<Scene> {
         &mut ball,
         &DMat4::from_translation(DVec3::new(-1.6, 0.7, -4.5)),
     );
+    let mut bumped = shapes::sphere(0.45, 48, 24);
+    bumped.name = "brick-sphere".into();
+    bumped.material = 3;
+    super::geometry::transform_mesh(
+        &mut bumped,
+        &(DMat4::from_translation(DVec3::new(-0.55, 0.5, -2.1))
+            * DMat4::from_rotation_y(-30f64.to_radians())),
+    );
     let materials = vec![
         Material {
             name: "ground".into(),
@@ -181,6 +195,16 @@ fn demo() -> Result<Scene> {
             name: "sphere".into(),
             kd: [1.0; 3],
             texture: Some(2),
+            cull_back: true,
+            ..Material::default()
+        },
+        Material {
+            name: "brick-sphere".into(),
+            kd: [0.75, 0.38, 0.28],
+            bump: Some(3),
+            bump_scale: 2.0,
+            ks: [0.35; 3],
+            shininess: 24,
             cull_back: true,
             ..Material::default()
         },
@@ -209,9 +233,9 @@ fn demo() -> Result<Scene> {
         }],
         ambient: [0.15, 0.16, 0.2],
         background: [0.55, 0.68, 0.86, 1.0],
-        meshes: vec![ground, torus, ball],
+        meshes: vec![ground, torus, ball, bumped],
         materials,
-        textures: vec![ground_tex, torus_tex, sphere_tex],
+        textures: vec![ground_tex, torus_tex, sphere_tex, bricks_height(256)],
         hw: None,
         warnings: Vec::new(),
     })

@@ -223,6 +223,17 @@ pub fn validate(scene: &Scene) -> Result<()> {
     }
     check_finite("ambient", &scene.ambient)?;
     check_finite("background", &scene.background)?;
+    for (mi, m) in scene.materials.iter().enumerate() {
+        if let Some(b) = &m.brdf {
+            b.validate(&format!("materials[{mi}]"))?;
+            if let Some(t) = b.exponent_map.filter(|&t| t >= scene.textures.len()) {
+                return Err(Error::field(
+                    &format!("materials[{mi}].exponent_map"),
+                    format!("index {t} out of range ({} textures)", scene.textures.len()),
+                ));
+            }
+        }
+    }
     for (ti, t) in scene.textures.iter().enumerate() {
         let what = format!("textures[{ti}] '{}'", t.name);
         if t.width == 0 || t.height == 0 || t.width > 65536 || t.height > 65536 {

@@ -13,6 +13,7 @@ use std::path::Path;
 
 use glam::{DMat4, DVec3};
 
+pub mod as_scenes;
 mod catalogue;
 mod geometry;
 mod obj;
@@ -101,6 +102,9 @@ pub struct Material {
     /// Roughness map of a bump material (Schilling 1997 roughness pyramid + modified
     /// Blinn-Phong, `pipeline::rough_stages`); `None`: plain Blinn-Phong.
     pub roughness: Option<RoughChoice>,
+    /// Ashikhmin-Shirley anisotropic Phong BRDF: shaded per pixel in the main-direction frame
+    /// instead of Gouraud or Blinn-Phong (`pipeline::as_stages`).
+    pub brdf: Option<AsBrdf>,
 }
 
 /// Which modified Blinn-Phong a roughness material uses.
@@ -123,6 +127,51 @@ impl RoughChoice {
             .ok_or_else(|| {
                 format!("'{s}' is not hw, none, published, directional, mahalanobis or isotropic")
             })
+    }
+}
+
+/// Parameters of the Ashikhmin-Shirley BRDF (Ashikhmin & Shirley 2000, eqs. 11, 16, 18) of a
+/// material: exponents along `u` (main-direction tangent `e1`) and `v`, Schlick's `R_s` and the
+/// diffuse `R_d` (which the material's `kd` tints).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AsBrdf {
+    /// Exponent along `u`: an integer in `0..=MAX_AS_EXPONENT`.
+    pub nu: f64,
+    /// Exponent along `v`.
+    pub nv: f64,
+    /// Specular reflectance at normal incidence, `[0, 1]`.
+    pub rs: f64,
+    /// Diffuse reflectance, `[0, 1]`.
+    pub rd: f64,
+    /// Index into [`Scene::textures`] of an exponent map: per pixel `n_u = t_0 nu` and
+    /// `n_v = t_1 nv` from its channels 0 and 1 (unorm `t`; the fixed stage rounds to integers).
+    pub exponent_map: Option<usize>,
+}
+
+/// Largest exponent a scene may give (`2^20 - 1`, the widest `exponent_max_bits`; a narrower
+/// unit clamps and counts a saturation).
+pub const MAX_AS_EXPONENT: f64 = 1_048_575.0;
+
+impl AsBrdf {
+    /// Checks the parameters; the error names `field.nu` etc.
+    pub fn validate(&self, field: &str) -> crate::Result<()> {
+        for (n, v) in [("nu", self.nu), ("nv", self.nv)] {
+            if !((0.0..=MAX_AS_EXPONENT).contains(&v) && v.fract() == 0.0) {
+                return Err(crate::Error::field(
+                    &format!("{field}.{n}"),
+                    format!("{v} is not an integer in 0..={MAX_AS_EXPONENT}"),
+                ));
+            }
+        }
+        for (n, v) in [("rs", self.rs), ("rd", self.rd)] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(crate::Error::field(
+                    &format!("{field}.{n}"),
+                    format!("{v} is not in [0, 1]"),
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -157,6 +206,7 @@ impl Default for Material {
             ks: [0.0; 3],
             shininess: 32,
             roughness: None,
+            brdf: None,
         }
     }
 }

@@ -10,7 +10,9 @@ use serde::Deserialize;
 use super::geometry::{bounding_sphere, fit_camera, fit_light, transform_mesh};
 use super::obj::{load_obj_parts, open_regular};
 use super::texture::{decode_texture, procedural, MAX_TEXTURE_SIDE};
-use super::{shapes, Camera, FrameKind, Light, MainDirection, Material, Mesh, Scene, WrapMode};
+use super::{
+    shapes, AsBrdf, Camera, FrameKind, Light, MainDirection, Material, Mesh, Scene, WrapMode,
+};
 use crate::{Error, Result};
 
 #[derive(Deserialize)]
@@ -97,6 +99,64 @@ struct MaterialCfg {
     shininess: Option<u32>,
     /// Roughness map: `hw` (the hardware's variant) or a variant name.
     roughness: Option<String>,
+    /// `"ashikhmin-shirley"` (with `nu`, `nv`, `rs`, `rd`) or `"phong"` (the default).
+    brdf: Option<String>,
+    nu: Option<f64>,
+    nv: Option<f64>,
+    rs: Option<f64>,
+    rd: Option<f64>,
+    /// Exponent map: a texture name of `[[textures]]` (channel 0 scales `nu`, 1 scales `nv`).
+    exponent_map: Option<String>,
+}
+
+/// The Ashikhmin-Shirley parameters of material `i` (defaults `nu = nv = 100`, `rs = 0.05`,
+/// `rd = 0.5`, no exponent map); parameters without `brdf = "ashikhmin-shirley"` are an error.
+fn as_brdf(
+    i: usize,
+    m: &MaterialCfg,
+    tex_names: &BTreeMap<String, usize>,
+) -> Result<Option<AsBrdf>> {
+    let f = |n: &str| format!("materials[{i}].{n}");
+    let given = [
+        ("nu", m.nu),
+        ("nv", m.nv),
+        ("rs", m.rs),
+        ("rd", m.rd),
+        ("exponent_map", m.exponent_map.as_ref().map(|_| 0.0)),
+    ];
+    let exponent_map = match &m.exponent_map {
+        Some(n) => Some(*tex_names.get(n).ok_or_else(|| {
+            Error::field(
+                &f("exponent_map"),
+                format!("no texture named '{n}' in [[textures]]"),
+            )
+        })?),
+        None => None,
+    };
+    match m.brdf.as_deref() {
+        Some("ashikhmin-shirley") => {
+            let b = AsBrdf {
+                nu: m.nu.unwrap_or(100.0),
+                nv: m.nv.unwrap_or(100.0),
+                rs: m.rs.unwrap_or(0.05),
+                rd: m.rd.unwrap_or(0.5),
+                exponent_map,
+            };
+            b.validate(&format!("materials[{i}]"))?;
+            Ok(Some(b))
+        }
+        None | Some("phong") => match given.iter().find(|(_, v)| v.is_some()) {
+            Some((n, _)) => Err(Error::field(
+                &f(n),
+                "only used with brdf = \"ashikhmin-shirley\"",
+            )),
+            None => Ok(None),
+        },
+        Some(other) => Err(Error::field(
+            &f("brdf"),
+            format!("'{other}' is not \"ashikhmin-shirley\" or \"phong\""),
+        )),
+    }
 }
 
 #[derive(Deserialize)]
@@ -393,6 +453,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             main_direction: main_dir,
             ks: m.ks.unwrap_or(def.ks),
             shininess: m.shininess.unwrap_or(def.shininess),
+            brdf: as_brdf(i, m, &tex_names)?,
         });
     }
     let mut default_mat: Option<usize> = None;

@@ -212,13 +212,7 @@ pub fn record_pixel(
             }
         } else {
             // The bump fetch computes its LOD inline against the offset map's size.
-            let (w, h) = (i64::from(size.0), i64::from(size.1));
-            let d = [
-                (uv[1][0] - uv[0][0]) * w,
-                (uv[1][1] - uv[0][1]) * h,
-                (uv[2][0] - uv[0][0]) * w,
-                (uv[2][1] - uv[0][1]) * h,
-            ];
+            let d = crate::pipeline::stages::texel_derivs(&uv, size.0, size.1);
             lod(d, fb, &hw.lod, &mut sat)
         };
         let mut tr = TrilinearTrace::default();

@@ -1,0 +1,252 @@
+//! Ashikhmin-Shirley materials through the pipeline: the built-in scenes `as-metal`,
+//! `as-plastic` and `as-brushed` render fixed and float within measured error bounds, without
+//! NaN, deterministically for any thread count; the `as-shade` cost is the unit costs; the
+//! TOML material fields and their errors; the sweep knobs of the unit.
+
+use hw_model::HwConfig;
+use texsim::pipeline::{Impl, StageImpls, StageKind};
+use texsim::render::{render, Maps, RenderOptions, Rendered};
+use texsim::scene::{self, Scene};
+
+fn small(name: &str, w: u32, h: u32) -> Scene {
+    let mut s = scene::builtin(name).expect("builtin scene");
+    s.width = w;
+    s.height = h;
+    s
+}
+
+fn go(s: &Scene, hw: &HwConfig, impls: StageImpls) -> Rendered {
+    let maps = Maps::new(s, hw.trilinear.texel_bits);
+    let opts = RenderOptions {
+        hw_impls: impls,
+        ..RenderOptions::default()
+    };
+    render(s, &maps, hw, &opts).expect("render")
+}
+
+fn stage(r: &Rendered, k: StageKind) -> &texsim::render::StageStats {
+    r.stats.stages.iter().find(|s| s.stage == k).expect("stage")
+}
+
+/// (scene, width, height, max 8-bit LSB all fixed, max 8-bit LSB with only `as-shade` fixed).
+/// Measured at these sizes: as-metal 38 / 3, as-plastic 6 / 3, as-brushed 4 / 2. The all-fixed
+/// maximum of as-metal is one pixel on the highlight of an `n = 10^4` sphere, a pixel-sized
+/// spike where the 2^-14 quantization of the interpolated normal (upstream of `as-shade`)
+/// moves the lobe `(h.n)^E` by a large fraction of its height; `as-shade` alone stays within 3.
+const SCENES: [(&str, u32, u32, u32, u32); 3] = [
+    ("as-metal", 200, 200, 64, 4),
+    ("as-plastic", 200, 200, 10, 4),
+    ("as-brushed", 240, 180, 6, 4),
+];
+
+#[test]
+fn scenes_render_within_bounds_without_nan() {
+    let hw = HwConfig::texram16();
+    for (name, w, h, max_all, max_iso) in SCENES {
+        let s = small(name, w, h);
+        let r = go(&s, &hw, StageImpls::FIXED);
+        let st = &r.stats;
+        let e8 = st.error_8bit.as_ref().expect("reference");
+        eprintln!(
+            "{name} {w}x{h}: max {} mean {:.4} LSB8, {:.2} cycles/px",
+            e8.max_abs_lsb, e8.mean_abs_lsb, st.cycles.per_covered_pixel
+        );
+        assert!(st.covered_pixels > 1000, "{name}");
+        assert!(e8.max_abs_lsb <= max_all, "{name}: {}", e8.max_abs_lsb);
+        assert!(e8.pct_within_1lsb >= 99.8, "{name}: {}", e8.pct_within_1lsb);
+        assert_eq!(st.bump.nonfinite + st.bump.ref_nonfinite, 0, "{name}");
+        let a = stage(&r, StageKind::AsShade);
+        assert_eq!(a.invocations, st.covered_pixels, "{name}");
+        assert_eq!(a.imp, Impl::Fixed);
+        // Only the stages an AS material needs ran.
+        for k in [StageKind::Phong, StageKind::Perturb, StageKind::BumpFetch] {
+            assert_eq!(stage(&r, k).invocations, 0, "{name} {k}");
+        }
+        // The AS stage alone (everything else float).
+        let iso = go(
+            &s,
+            &hw,
+            StageImpls::FLOAT.with(StageKind::AsShade, Impl::Fixed),
+        );
+        let e = iso.stats.error_8bit.as_ref().expect("reference");
+        eprintln!("{name} as-shade isolated: max {} LSB8", e.max_abs_lsb);
+        assert!(e.max_abs_lsb <= max_iso, "{name}: {}", e.max_abs_lsb);
+        // All float: the hardware image is the reference.
+        let fl = go(&s, &hw, StageImpls::FLOAT);
+        assert_eq!(fl.stats.error_16bit.as_ref().expect("ref").max_abs_lsb, 0);
+    }
+}
+
+#[test]
+fn as_shade_cost_is_the_unit_costs() {
+    use hw_model::aniso_phong::aniso_phong_cost;
+    use hw_model::rsqrt::rsqrt_cost;
+    use hw_model::vector::{dot_cost, normalize_cost};
+    let hw = HwConfig::texram16();
+    let s = small("as-brushed", 160, 120);
+    let r = go(&s, &hw, StageImpls::FIXED);
+    let sh = &hw.shading;
+    let nz = normalize_cost(&sh.vector, rsqrt_cost(&sh.rsqrt));
+    // One directional and one point light: eye + point normalizations, then per light the
+    // half vector (add + normalize), six dots, the unit and two colour multiply-adds; ambient.
+    let per_light = 1
+        + nz.cycles
+        + 6 * dot_cost(&sh.vector).cycles
+        + aniso_phong_cost(&hw.aniso_phong).cycles
+        + 2 * sh.shade.shade_cycles;
+    let per_px = 2 * nz.cycles + 2 * per_light + sh.shade.shade_cycles;
+    let a = stage(&r, StageKind::AsShade);
+    assert_eq!(a.cycles, a.invocations * u64::from(per_px));
+    // A costlier unit shows up in the stage's cycles and the summary's cycles/px.
+    let mut slow = hw.clone();
+    slow.aniso_phong.aniso_mul_cycles = 3;
+    let r2 = go(&s, &slow, StageImpls::FIXED);
+    assert!(stage(&r2, StageKind::AsShade).cycles > a.cycles);
+    assert!(r2.stats.cycles.per_covered_pixel > r.stats.cycles.per_covered_pixel);
+}
+
+#[test]
+fn deterministic_for_any_thread_count() {
+    let hw = HwConfig::texram16();
+    let s = small("as-brushed", 160, 120);
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool")
+        .install(|| go(&s, &hw, StageImpls::FIXED));
+    let many = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .expect("pool")
+        .install(|| go(&s, &hw, StageImpls::FIXED));
+    assert_eq!(one.hw_image.px, many.hw_image.px);
+    assert_eq!(
+        one.ref_image.as_ref().map(|i| &i.px),
+        many.ref_image.as_ref().map(|i| &i.px)
+    );
+    let (a, b) = (
+        stage(&one, StageKind::AsShade),
+        stage(&many, StageKind::AsShade),
+    );
+    assert_eq!((a.saturated, a.cycles), (b.saturated, b.cycles));
+}
+
+#[test]
+fn pow_precision_changes_the_error_and_is_sweepable() {
+    let hw = HwConfig::texram16();
+    let s = small("as-metal", 120, 120);
+    let mut prev = None;
+    for (field, value) in [
+        ("aniso_pow_lut_bits", "4"),
+        ("aniso_pow_frac_bits", "12"),
+        ("exponent_max_bits", "10"),
+        ("fresnel_bits", "6"),
+    ] {
+        let c = texsim::hwconfig::set_field(&hw, field, value).expect(field);
+        let r = go(
+            &s,
+            &c,
+            StageImpls::FLOAT.with(StageKind::AsShade, Impl::Fixed),
+        );
+        let e = r.stats.error_16bit.as_ref().expect("ref").mean_abs_lsb;
+        assert!(e.is_finite(), "{field}");
+        prev = Some(prev.map_or(e, |p: f64| p.max(e)));
+    }
+    let base = go(
+        &s,
+        &hw,
+        StageImpls::FLOAT.with(StageKind::AsShade, Impl::Fixed),
+    );
+    let e0 = base.stats.error_16bit.as_ref().expect("ref").mean_abs_lsb;
+    assert!(
+        prev.expect("ran") > e0,
+        "coarser units must be worse than texram16"
+    );
+}
+
+fn write_toml(name: &str, body: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("texsim-as-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("tmp");
+    let p = d.join("s.toml");
+    std::fs::write(&p, body).expect("write");
+    p
+}
+
+fn with_material(fields: &str) -> String {
+    format!(
+        "[output]\nwidth = 64\nheight = 48\n\n[[materials]]\nname = \"m\"\n{fields}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n"
+    )
+}
+
+#[test]
+fn toml_material_fields_and_errors() {
+    let p = write_toml(
+        "ok",
+        &with_material(
+            "brdf = \"ashikhmin-shirley\"\nnu = 10\nnv = 1000.0\nrs = 0.9\nrd = 0.1\nmain_direction = [0.0, 1.0, 0.0]",
+        ),
+    );
+    let s = scene::load(&p).expect("load");
+    let b = s.materials[0].brdf.expect("AS material");
+    assert_eq!((b.nu, b.nv, b.rs, b.rd), (10.0, 1000.0, 0.9, 0.1));
+    let r = go(&s, &HwConfig::texram16(), StageImpls::FIXED);
+    assert!(stage(&r, StageKind::AsShade).invocations > 0);
+    for (fields, needle) in [
+        ("nu = 10", "materials[0].nu"),
+        ("brdf = \"cook-torrance\"", "materials[0].brdf"),
+        ("brdf = \"ashikhmin-shirley\"\nnu = 1.5", "materials[0].nu"),
+        ("brdf = \"ashikhmin-shirley\"\nnv = -1", "materials[0].nv"),
+        ("brdf = \"ashikhmin-shirley\"\nnv = 1e7", "materials[0].nv"),
+        ("brdf = \"ashikhmin-shirley\"\nrs = 2", "materials[0].rs"),
+        ("brdf = \"ashikhmin-shirley\"\nrd = nan", "materials[0].rd"),
+        (
+            "brdf = \"ashikhmin-shirley\"\nexponent_map = \"nope\"",
+            "materials[0].exponent_map",
+        ),
+        ("exponent_map = \"nope\"", "materials[0].exponent_map"),
+    ] {
+        let p = write_toml("bad", &with_material(fields));
+        let e = scene::load(&p).expect_err(fields).to_string();
+        assert!(e.contains(needle), "{fields}: {e}");
+    }
+}
+
+#[test]
+fn exponent_map_scene_fetches_per_pixel_exponents() {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/as_brushed.toml");
+    let mut s = scene::load(&p).expect("load");
+    s.width = 240;
+    s.height = 180;
+    let m = &s.materials[1];
+    assert_eq!(m.brdf.and_then(|b| b.exponent_map), Some(0));
+    let hw = HwConfig::texram16();
+    let r = go(&s, &hw, StageImpls::FIXED);
+    let fetch = stage(&r, StageKind::BumpFetch);
+    assert!(fetch.invocations > 0 && fetch.texels > 0);
+    assert_eq!(
+        fetch.invocations,
+        stage(&r, StageKind::Texcoord).invocations
+    );
+    assert!(
+        fetch.invocations < r.stats.covered_pixels,
+        "only the mapped sphere"
+    );
+    let e8 = r.stats.error_8bit.as_ref().expect("reference");
+    eprintln!("as_brushed.toml 240x180: max {} LSB8", e8.max_abs_lsb);
+    assert!(e8.max_abs_lsb <= 8, "{}", e8.max_abs_lsb);
+    assert_eq!(r.stats.bump.nonfinite + r.stats.bump.ref_nonfinite, 0);
+    // A constant exponent map of 1 (white) gives the material's own exponents.
+    let mut flat = s.clone();
+    flat.textures[0]
+        .texels
+        .iter_mut()
+        .for_each(|t| *t = [u16::MAX; 4]);
+    let mut plain = flat.clone();
+    if let Some(b) = plain.materials[1].brdf.as_mut() {
+        b.exponent_map = None;
+    }
+    let a = go(&flat, &hw, StageImpls::FIXED);
+    let b = go(&plain, &hw, StageImpls::FIXED);
+    assert_eq!(a.hw_image.px, b.hw_image.px);
+}
