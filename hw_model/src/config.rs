@@ -155,6 +155,9 @@ pub struct HwConfig {
     pub aniso_phong: AnisoPhongConfig,
     /// Timing-model parameters (never read by the functional units).
     pub timing: TimingConfig,
+    /// The NDF mapping unit (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub ndf: crate::ndf::NdfConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -211,6 +214,7 @@ impl HwConfig {
             shading: ShadingConfig::texram16(),
             aniso_phong: AnisoPhongConfig::texram16(),
             timing: TimingConfig::texram16(),
+            ndf: crate::ndf::NdfConfig::texram16(),
         }
     }
 
@@ -296,6 +300,7 @@ impl HwConfig {
         self.shading.validate()?;
         self.aniso_phong.validate()?;
         self.timing.validate()?;
+        self.ndf.validate()?;
         Ok(())
     }
 }

@@ -4,5 +4,6 @@
 //! generation.
 
 pub mod bump;
+pub mod ndf;
 pub mod reference;
 pub mod tangents;
