@@ -12,6 +12,7 @@
 //! rounded into its input format (how a mixed run isolates one stage's error).
 
 pub mod bump_stages;
+pub mod ndf_stages;
 pub mod stages;
 
 use crate::scene::{FrameKind, MainDirection, Material, WrapMode};
@@ -44,11 +45,15 @@ pub enum StageKind {
     Perturb,
     /// Bump materials: per-pixel Blinn-Phong over every scene light (+ ambient).
     Phong,
+    /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).
+    NdfFetch,
+    /// NDF materials: Sigma, its inverse, Mahalanobis distance, density, normalization, lights.
+    NdfShade,
 }
 
 impl StageKind {
     /// Number of stage kinds.
-    pub const COUNT: usize = 11;
+    pub const COUNT: usize = 13;
 
     /// Every stage kind, in pipeline order (the bump stages follow the texture stages).
     pub const ALL: [StageKind; StageKind::COUNT] = [
@@ -63,6 +68,8 @@ impl StageKind {
         StageKind::Frame,
         StageKind::Perturb,
         StageKind::Phong,
+        StageKind::NdfFetch,
+        StageKind::NdfShade,
     ];
 
     /// The name used on the command line and in reports.
@@ -80,6 +87,8 @@ impl StageKind {
             StageKind::Frame => "frame",
             StageKind::Perturb => "perturb",
             StageKind::Phong => "phong",
+            StageKind::NdfFetch => "ndf-fetch",
+            StageKind::NdfShade => "ndf-shade",
         }
     }
 
@@ -165,6 +174,8 @@ pub struct Plan {
     pub wrap: [WrapMode; 2],
     /// Bump mapping and per-pixel shading, for bump-mapped materials.
     pub bump: Option<BumpPlan>,
+    /// NDF mapping (with `bump` for the frame), for NDF materials.
+    pub ndf: Option<ndf_stages::NdfPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -232,6 +243,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
                 ks: material.ks.map(f64::from),
                 shininess: material.shininess,
             }),
+            ndf: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -256,6 +268,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         derivatives: textured,
         wrap: [material.wrap_s, material.wrap_t],
         bump: None,
+        ndf: None,
     }
 }
 
@@ -292,6 +305,8 @@ pub struct Frag {
     pub out_bits: u32,
     /// Bump stages (vectors in vector format `s1.F` when raw, lengths in len format).
     pub bump: BumpFrag,
+    /// NDF stages.
+    pub ndf: ndf_stages::NdfFrag,
 }
 
 /// Most point lights shaded per pixel by a bump material (their vectors are interpolated).

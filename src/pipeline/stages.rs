@@ -97,6 +97,8 @@ pub struct Machine<'a> {
     pub ambient_x: [u64; 3],
     /// Per-triangle bump data ([`TriAttrs::bump`] indexes it).
     pub bump_attrs: &'a [BumpAttrs],
+    /// The fixed NDF unit of `hw.ndf` (`None` for the float-only `exact` normalization).
+    pub ndf: Option<hw_model::ndf::NdfUnit>,
 }
 
 /// One scene light for per-pixel shading.
@@ -157,6 +159,7 @@ impl<'a> Machine<'a> {
             ambient: [0.0; 3],
             ambient_x: [0; 3],
             bump_attrs: &[],
+            ndf: super::ndf_stages::ndf_unit(hw),
         }
     }
 
@@ -240,6 +243,9 @@ impl<'a> Machine<'a> {
             ),
             StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
             StageKind::Modulate => modulate_cost(&self.hw.color),
+            StageKind::NdfFetch | StageKind::NdfShade => {
+                super::ndf_stages::ndf_stage_cost(self, kind, plan)
+            }
             _ => self.bump_stage_cost(kind, plan),
         }
     }
@@ -572,6 +578,9 @@ pub fn run(
             | StageKind::Frame
             | StageKind::Perturb
             | StageKind::Phong => run_bump_stage(kind, plan, impls, m, a, frag, c),
+            StageKind::NdfFetch | StageKind::NdfShade => {
+                super::ndf_stages::run_ndf_stage(kind, plan, impls, m, frag, c);
+            }
         }
     }
 }

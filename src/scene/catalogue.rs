@@ -18,6 +18,9 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("w2-mesh", "Mesa anchor W2: 1024x1024, 256x128 textured torus (65536 triangles), unlit, culling off"),
     ("sphere", "a lit, checker-textured UV sphere, fitted camera, 1024x768"),
     ("bumps", "bump-mapped brick sphere, rippled torus and brick tile under a grazing directional light and a point light, 640x480"),
+    ("ripple-sphere", "NDF mapping (Olano-North Fig. 1): a rippled sphere at three distances, highlight blurs and stretches with the MIP level, 480x320"),
+    ("lod-pair", "NDF mapping (Olano-North Fig. 2): a smooth sphere at two polygon counts, consistent highlights, 480x320"),
+    ("foil", "NDF mapping: crumpled foil tile, shininess 256, 480x320"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -28,6 +31,9 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "w2-mesh" => w2_mesh(),
         "sphere" => sphere()?,
         "bumps" => bumps(),
+        "ripple-sphere" => super::ndf_scenes::ripple_sphere(),
+        "lod-pair" => super::ndf_scenes::lod_pair(),
+        "foil" => super::ndf_scenes::foil(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(

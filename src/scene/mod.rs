@@ -15,6 +15,7 @@ use glam::{DMat4, DVec3};
 
 mod catalogue;
 mod geometry;
+mod ndf_scenes;
 mod obj;
 pub mod shapes;
 pub mod texture;
@@ -95,8 +96,11 @@ pub struct Material {
     pub main_direction: MainDirection,
     /// Specular colour (per-pixel Blinn-Phong of bump-mapped materials).
     pub ks: [f32; 3],
-    /// Specular exponent.
+    /// Specular exponent (for NDF materials, the base shininess of the moment maps).
     pub shininess: u32,
+    /// NDF mapping (Olano and North 1997): the `bump` map's normals become moment maps,
+    /// shaded by `ndf-fetch` and `ndf-shade` instead of the bump path's Blinn-Phong.
+    pub ndf: bool,
 }
 
 /// The main direction `m` of the main-direction frame (Schilling 1997, frame 3).
@@ -129,6 +133,7 @@ impl Default for Material {
             main_direction: MainDirection::Pv,
             ks: [0.0; 3],
             shininess: 32,
+            ndf: false,
         }
     }
 }

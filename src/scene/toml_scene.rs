@@ -95,6 +95,8 @@ struct MaterialCfg {
     main_direction: Option<MainDirCfg>,
     ks: Option<[f32; 3]>,
     shininess: Option<u32>,
+    /// NDF mapping of the `bump` map (Olano and North 1997).
+    ndf: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -383,6 +385,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             main_direction: main_dir,
             ks: m.ks.unwrap_or(def.ks),
             shininess: m.shininess.unwrap_or(def.shininess),
+            ndf: m.ndf.unwrap_or(def.ndf),
         });
     }
     let mut default_mat: Option<usize> = None;

@@ -375,6 +375,12 @@ pub fn sphere_integral(mu: DVec3, s: &[f64; 6], cfg: &NdfConfig) -> f64 {
     let t2 = axis.cross(t1);
     let spread = (s[0] + s[1] + s[2]).max(0.0).sqrt() / mu.length().max(0.05);
     let mut width = (0.25 * spread).clamp(1e-4, 0.25);
+    let det = sym(s).determinant();
+    if det <= 0.0 || !det.is_finite() {
+        return f64::MIN_POSITIVE;
+    }
+    let inv = sym(s).inverse();
+    let dmax = f64::from(1u32 << hw_model::ndf::DMAX_INT_BITS);
     let mut a = 0.0;
     let mut z = 0.0;
     let dphi = 2.0 * PI / NPHI as f64;
@@ -396,7 +402,8 @@ pub fn sphere_integral(mu: DVec3, s: &[f64; 6], cfg: &NdfConfig) -> f64 {
             let mut ring = 0.0;
             for k in 0..NPHI {
                 let dir = axis * ct + (t1 * cphi[k] + t2 * sphi[k]) * st;
-                ring += density(mahalanobis(s, dir - mu), cfg);
+                let v = dir - mu;
+                ring += density(v.dot(inv * v).clamp(0.0, dmax), cfg);
             }
             z += wgt * half * st * ring * dphi;
         }

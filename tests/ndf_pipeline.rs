@@ -1,0 +1,105 @@
+//! NDF materials in the pipeline: the built-in scenes render in fixed point and float, the
+//! fixed image tracks the float one, `ndf-fetch` makes 3 lookups (4 with the normalization
+//! map) in the costs and in the timing model's events, and `exact` runs `ndf-shade` in float.
+
+use hw_model::ndf::NdfNorm;
+use hw_model::HwConfig;
+use texsim::pipeline::{Impl, StageKind};
+use texsim::render::{render, Maps, RenderOptions, Rendered};
+use texsim::scene::builtin;
+
+fn run(name: &str, hw: &HwConfig, timing: bool) -> Rendered {
+    let s = builtin(name).expect("scene");
+    let maps = Maps::new(&s, hw.trilinear.texel_bits);
+    let opts = RenderOptions {
+        timing,
+        ..RenderOptions::default()
+    };
+    render(&s, &maps, hw, &opts).expect("render")
+}
+
+fn stage(r: &Rendered, k: StageKind) -> &texsim::render::StageStats {
+    r.stats
+        .stages
+        .iter()
+        .find(|s| s.stage == k)
+        .expect("stage present")
+}
+
+#[test]
+fn scenes_render_and_fixed_tracks_float() {
+    let hw = HwConfig::texram16();
+    for name in ["ripple-sphere", "lod-pair", "foil"] {
+        let r = run(name, &hw, false);
+        let fetch = stage(&r, StageKind::NdfFetch);
+        let shade = stage(&r, StageKind::NdfShade);
+        assert!(fetch.invocations > 1000, "{name}");
+        assert_eq!(fetch.invocations, shade.invocations);
+        assert_eq!(
+            fetch.texels,
+            8 * 3 * fetch.invocations,
+            "{name}: 3 trilinear lookups"
+        );
+        let e = r.stats.error_8bit.as_ref().expect("reference");
+        println!(
+            "{name}: max {} mean {:.4} (8-bit LSB)",
+            e.max_abs_lsb, e.mean_abs_lsb
+        );
+        assert!(e.max_abs_lsb <= 2, "{name}: {e:?}");
+        assert!(r
+            .stats
+            .stages
+            .iter()
+            .all(|s| s.stage != StageKind::Phong || s.invocations == 0));
+    }
+}
+
+#[test]
+fn map_normalization_adds_a_lookup_in_costs_and_timing() {
+    let mut hw = HwConfig::texram16();
+    hw.ndf.ndf_norm = NdfNorm::Map;
+    let r = run("lod-pair", &hw, true);
+    let fetch = stage(&r, StageKind::NdfFetch);
+    assert_eq!(fetch.texels, 8 * 4 * fetch.invocations);
+    let ev = r.events.as_ref().expect("events");
+    let k = StageKind::NdfFetch.index() as u8;
+    let lookups: std::collections::BTreeSet<u8> = ev
+        .footprints
+        .iter()
+        .filter(|f| f.stage == k)
+        .map(|f| f.lookup)
+        .collect();
+    assert_eq!(lookups.into_iter().collect::<Vec<_>>(), vec![0, 1, 2, 3]);
+    let e = r.stats.error_8bit.as_ref().expect("reference");
+    assert!(e.max_abs_lsb <= 2, "{e:?}");
+    let partial = run("lod-pair", &HwConfig::texram16(), true);
+    let t4 = texsim::timing::simulate(ev, &hw, "lod-pair").total_cycles;
+    let t3 = texsim::timing::simulate(partial.events.as_ref().expect("events"), &hw, "lod-pair")
+        .total_cycles;
+    assert!(t4 > t3, "{t4} <= {t3}");
+}
+
+#[test]
+fn exact_runs_ndf_shade_in_float() {
+    let mut hw = HwConfig::texram16();
+    hw.ndf.ndf_norm = NdfNorm::Exact;
+    let mut s = builtin("lod-pair").expect("scene");
+    s.width = 96;
+    s.height = 64;
+    let maps = Maps::new(&s, 16);
+    let r = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
+    assert_eq!(stage(&r, StageKind::NdfShade).imp, Impl::Float);
+    assert_eq!(stage(&r, StageKind::NdfFetch).imp, Impl::Fixed);
+}
+
+#[test]
+fn moment_bits_sweep_rebuilds_maps() {
+    let mut hw = HwConfig::texram16();
+    hw.ndf.moment_bits = 8;
+    let r8 = run("foil", &hw, false);
+    let r16 = run("foil", &HwConfig::texram16(), false);
+    let e8 = r8.stats.error_8bit.as_ref().expect("ref").mean_abs_lsb;
+    let e16 = r16.stats.error_8bit.as_ref().expect("ref").mean_abs_lsb;
+    println!("foil mean error: 8-bit moments {e8:.4}, 16-bit {e16:.4}");
+    assert!(e8 > e16);
+}
