@@ -173,6 +173,10 @@ pub struct RenderArgs {
     /// Skip the float reference (no error metrics).
     #[arg(long)]
     pub no_reference: bool,
+    /// Also render the ground truth (NDF materials: supersampled finest normal map) and report
+    /// model_error (float vs truth) and quantization_error (hardware vs float); writes truth.png.
+    #[arg(long)]
+    pub truth: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -187,6 +191,9 @@ pub struct SweepArgs {
     /// Also run the timing model per setting (adds its total cycles to each row).
     #[arg(long)]
     pub cycles: bool,
+    /// Also render the ground truth per setting (adds the model error, float vs truth).
+    #[arg(long)]
+    pub truth: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -239,6 +246,7 @@ pub fn run(cli: Cli) -> Result<()> {
             float: vec![],
             isolate: None,
             no_reference: false,
+            truth: false,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -335,8 +343,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     );
     let opts = RenderOptions {
         hw_impls: impls,
-        reference: !a.no_reference,
+        reference: !a.no_reference || a.truth,
         timing: false,
+        truth: a.truth,
         coverage: match a.coverage {
             CoverageArg::Shared => CoverageMode::Shared,
             CoverageArg::Independent => CoverageMode::Independent,
@@ -345,6 +354,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let r = render(&sc, &maps, &hw, &opts)?;
     let mut out = OutputSet::new();
     stage_images(&r, a.png16, &mut out)?;
+    if let Some(t) = &r.truth_image {
+        out.add("truth.png", report::encode_png8(t)?);
+    }
     let json = serde_json::json!({
         "scene": &r.stats.scene,
         "hw_config": &hw,
@@ -481,6 +493,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
         let opts = RenderOptions {
             timing: a.cycles,
+            truth: a.truth,
             ..RenderOptions::default()
         };
         let r = render(&sc, &maps, cfg, &opts)?;

@@ -499,6 +499,10 @@ pub struct RenderOptions {
     /// Collect the timing model's event stream (`Rendered::events`). Off by default: a render
     /// without it allocates no event buffer and does no extra work per pixel.
     pub timing: bool,
+    /// Also render the ground truth (supersampled finest normal maps of NDF materials, see
+    /// `pipeline::ndf_stages::NdfTruth`) and report `model_error` (float vs truth) beside
+    /// `quantization_error` (hardware vs float).
+    pub truth: bool,
 }
 
 impl Default for RenderOptions {
@@ -508,6 +512,7 @@ impl Default for RenderOptions {
             reference: true,
             coverage: CoverageMode::Shared,
             timing: false,
+            truth: false,
         }
     }
 }
@@ -587,6 +592,8 @@ pub struct CycleEstimate {
 pub struct Rendered {
     pub hw_image: Image,
     pub ref_image: Option<Image>,
+    /// The ground truth image (`RenderOptions::truth`).
+    pub truth_image: Option<Image>,
     /// Pixels covered by the hardware or the reference pass (the compared set).
     pub mask: Vec<bool>,
     pub stats: RenderStats,
@@ -616,6 +623,10 @@ pub struct RenderStats {
     /// Error of the hardware image against the reference, in 8-bit and 16-bit LSBs.
     pub error_8bit: Option<ErrorMetrics>,
     pub error_16bit: Option<ErrorMetrics>,
+    /// With `--truth`: the float reference against the ground truth (the model's error) and
+    /// the hardware against the float reference (quantization), 8-bit LSBs.
+    pub model_error: Option<ErrorMetrics>,
+    pub quantization_error: Option<ErrorMetrics>,
 }
 
 fn ms(t: Instant) -> f64 {
@@ -978,6 +989,20 @@ pub fn render(
         e16 = Some(compare(&hw_image, &img, 16, Some(&mask)));
         ref_image = Some(img);
     }
+    let mut truth_image = None;
+    let mut model_error = None;
+    if opts.truth {
+        let truth = crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans);
+        let mt = Machine::new(hw, &maps.float, &maps.fixed)
+            .with_lights(&scene.lights, scene.ambient)
+            .with_bump_attrs(&battrs)
+            .with_ndf_truth(&truth);
+        let (img, _, _) = shade(&ShadeInput { m: &mt, ..inp }, &StageImpls::FLOAT, bg, false);
+        if let Some(r) = &ref_image {
+            model_error = Some(compare(r, &img, 8, Some(&mask)));
+        }
+        truth_image = Some(img);
+    }
 
     let mut stages = Vec::with_capacity(StageKind::COUNT);
     let mut stage_cycles = 0u64;
@@ -1012,6 +1037,7 @@ pub fn render(
     Ok(Rendered {
         hw_image,
         ref_image,
+        truth_image,
         mask,
         events,
         stats: RenderStats {
@@ -1037,6 +1063,8 @@ pub fn render(
             stages,
             cycles,
             timings: tm,
+            quantization_error: if opts.truth { e8.clone() } else { None },
+            model_error,
             error_8bit: e8,
             error_16bit: e16,
         },

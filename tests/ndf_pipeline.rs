@@ -103,3 +103,31 @@ fn moment_bits_sweep_rebuilds_maps() {
     println!("foil mean error: 8-bit moments {e8:.4}, 16-bit {e16:.4}");
     assert!(e8 > e16);
 }
+
+/// `truth` renders the supersampled ground truth and separates the model error (float vs
+/// truth) from the quantization error (fixed vs float); the model error dominates.
+#[test]
+fn truth_separates_model_and_quantization_error() {
+    let s = builtin("ripple-sphere").expect("scene");
+    let hw = HwConfig::texram16();
+    let maps = Maps::new(&s, 16);
+    let opts = RenderOptions {
+        truth: true,
+        ..RenderOptions::default()
+    };
+    let r = render(&s, &maps, &hw, &opts).expect("render");
+    assert!(r.truth_image.is_some());
+    let me = r.stats.model_error.as_ref().expect("model error");
+    let qe = r
+        .stats
+        .quantization_error
+        .as_ref()
+        .expect("quantization error");
+    println!(
+        "model {:.4} quantization {:.4}",
+        me.mean_abs_lsb, qe.mean_abs_lsb
+    );
+    assert!(me.mean_abs_lsb > qe.mean_abs_lsb);
+    let plain = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
+    assert!(plain.stats.model_error.is_none() && plain.truth_image.is_none());
+}

@@ -22,7 +22,7 @@ use super::stages::{Counters, Machine};
 use super::{Frag, Impl, Plan, StageImpls, StageKind};
 use crate::fixedpoint::{from_unorm, to_raw, to_unorm};
 use crate::reference::{lod_f64, trilinear_f64};
-use crate::shading::ndf::{eval_float, Moments};
+use crate::shading::ndf::{eval_float, ground_truth, Moments};
 use crate::shading::reference as fref;
 use glam::DVec3;
 use hw_model::config::HwConfig;
@@ -81,6 +81,54 @@ pub fn with_ndf(mut plan: Plan, maps: usize, shininess: u32, norm_exp: u32) -> P
         norm_exp,
     });
     plan
+}
+
+/// The ground truth of one set of moment maps: the finest normals (tangent space), their size
+/// and the base shininess. The truth of a pixel is [`crate::shading::ndf::ground_truth`]: the
+/// exactly normalized base lobes of the finest normals averaged over a square footprint of
+/// side `2^lod` texels (the pixel's footprint on the map) with `k x k` samples,
+/// `k = clamp(ceil(2 side), 2, 32)`.
+#[derive(Clone, Debug)]
+pub struct NdfTruth {
+    /// Index of moment map A of the set (as in [`NdfPlan::maps`]).
+    pub maps: usize,
+    pub width: u32,
+    pub height: u32,
+    pub normals: Vec<DVec3>,
+    pub shininess: f64,
+}
+
+/// The truth data of every NDF plan in `plans` from the maps' finest offsets.
+#[must_use]
+pub fn truth_maps(
+    maps: &crate::render::Maps,
+    scene: &crate::scene::Scene,
+    plans: &[Plan],
+) -> Vec<NdfTruth> {
+    let first = scene.textures.len() + maps.bump_offsets.len();
+    let mut out: Vec<NdfTruth> = Vec::new();
+    for np in plans.iter().filter_map(|p| p.ndf.as_ref()) {
+        if out.iter().any(|t| t.maps == np.maps) || np.maps < first {
+            continue;
+        }
+        let Some(&(k, s)) = maps.ndf.get((np.maps - first) / 4) else {
+            continue;
+        };
+        let Some((w, h, _, offs)) = maps.bump_offsets.get(k) else {
+            continue;
+        };
+        out.push(NdfTruth {
+            maps: np.maps,
+            width: *w,
+            height: *h,
+            normals: offs
+                .iter()
+                .map(|o| DVec3::new(f64::from(o[0]), f64::from(o[1]), 1.0).normalize())
+                .collect(),
+            shininess: f64::from(s),
+        });
+    }
+    out
 }
 
 /// Lookups of one `ndf-fetch` (3, 4 with the normalization map).
@@ -342,6 +390,7 @@ pub fn run_ndf_stage(
                     frag.ndf.texel
                 };
                 let (mom, inv_z) = moments_of(&texel, hw, np.norm_exp);
+                let truth = m.ndf_truth.iter().find(|t| t.maps == np.maps);
                 let n = DVec3::from(bf.fr_n);
                 let tu = DVec3::from(bf.fr_t_u);
                 let tv = DVec3::from(bf.fr_t_v);
@@ -363,7 +412,28 @@ pub fn run_ndf_stage(
                     let ht =
                         fref::normalize_or(DVec3::new(hv.dot(tu), hv.dot(tv), hv.dot(n)), DVec3::Z)
                             .0;
-                    let d = eval_float(&mom, ht, inv_z, &hw.ndf).d_value;
+                    let d = match truth {
+                        Some(tr) => {
+                            let side = frag
+                                .lod
+                                .exp2()
+                                .clamp(1.0, f64::from(tr.width.max(tr.height)));
+                            let ks = (2.0 * side).ceil().clamp(2.0, 32.0) as u32;
+                            let [u, vv] = frag.uv[0];
+                            ground_truth(
+                                &tr.normals,
+                                tr.width,
+                                tr.height,
+                                tr.shininess,
+                                u * f64::from(tr.width),
+                                vv * f64::from(tr.height),
+                                side,
+                                ks,
+                                ht,
+                            )
+                        }
+                        None => eval_float(&mom, ht, inv_z, &hw.ndf).d_value,
+                    };
                     let spec = d * spec_scale;
                     for ch in 0..3 {
                         acc[ch] += light.color_f[ch] * (bp.kd[ch] * ndl + bp.ks[ch] * spec);

@@ -99,6 +99,8 @@ pub struct Machine<'a> {
     pub bump_attrs: &'a [BumpAttrs],
     /// The fixed NDF unit of `hw.ndf` (`None` for the float-only `exact` normalization).
     pub ndf: Option<hw_model::ndf::NdfUnit>,
+    /// Ground-truth normal maps: when not empty, the float `ndf-shade` supersamples them.
+    pub ndf_truth: &'a [super::ndf_stages::NdfTruth],
 }
 
 /// One scene light for per-pixel shading.
@@ -160,6 +162,7 @@ impl<'a> Machine<'a> {
             ambient_x: [0; 3],
             bump_attrs: &[],
             ndf: super::ndf_stages::ndf_unit(hw),
+            ndf_truth: &[],
         }
     }
 
@@ -199,6 +202,13 @@ impl<'a> Machine<'a> {
             .collect();
         self.ambient = ambient.map(|c| f64::from(c).clamp(0.0, 1.0));
         self.ambient_x = self.ambient.map(|c| u64::from(to_unorm(c, cb)));
+        self
+    }
+
+    /// Shades NDF materials (float twin) from the supersampled finest normals `truth`.
+    #[must_use]
+    pub fn with_ndf_truth(mut self, truth: &'a [super::ndf_stages::NdfTruth]) -> Self {
+        self.ndf_truth = truth;
         self
     }
 
