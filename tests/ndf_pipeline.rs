@@ -131,3 +131,33 @@ fn truth_separates_model_and_quantization_error() {
     let plain = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
     assert!(plain.stats.model_error.is_none() && plain.truth_image.is_none());
 }
+
+/// A TOML material with `ndf = true` on a height map (the bump path's offsets give the
+/// normals) renders through the NDF stages; `ndf = "yes"` is an error naming the field.
+#[test]
+fn toml_ndf_material_from_a_height_map() {
+    let d = std::env::temp_dir().join(format!("texsim-ndf-toml-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("tmp");
+    let body = |ndf: &str| {
+        format!(
+            "[output]\nwidth = 96\nheight = 64\n\n[[textures]]\nname = \"bricks\"\nprocedural = \"bricks-height\"\nsize = 64\n\n[[materials]]\nname = \"m\"\nbump = \"bricks\"\nks = [0.5, 0.5, 0.5]\nshininess = 48\nndf = {ndf}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n\n[[lights]]\nkind = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\ncolor = [1.0, 1.0, 1.0]\n"
+        )
+    };
+    let p = d.join("ok.toml");
+    std::fs::write(&p, body("true")).expect("write");
+    let s = texsim::scene::load(&p).expect("load");
+    assert!(s.materials[0].ndf);
+    let hw = HwConfig::texram16();
+    let maps = Maps::new(&s, 16);
+    let r = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
+    assert!(stage(&r, StageKind::NdfShade).invocations > 100);
+    let e = r.stats.error_8bit.as_ref().expect("reference");
+    assert!(e.max_abs_lsb <= 2, "{e:?}");
+    let bad = d.join("bad.toml");
+    std::fs::write(&bad, body("\"yes\"")).expect("write");
+    let err = texsim::scene::load(&bad)
+        .expect_err("string for bool")
+        .to_string();
+    assert!(err.contains("ndf"), "{err}");
+}

@@ -86,8 +86,8 @@ pub fn ripple_sphere() -> Scene {
         "ripple-sphere",
         vec![
             placed(s.clone(), "near", DVec3::new(-1.45, 0.0, 0.0), 1.0),
-            placed(s.clone(), "mid", DVec3::new(0.9, 0.0, -3.0), 1.0),
-            placed(s, "far", DVec3::new(2.4, 0.6, -8.0), 1.0),
+            placed(s.clone(), "mid", DVec3::new(1.0, -0.2, -3.0), 1.0),
+            placed(s, "far", DVec3::new(5.0, 1.0, -8.0), 1.0),
         ],
         vec![ndf_material("ripple", [0.25, 0.35, 0.6], 64)],
         normal_texture("ripple", 128, 0.5),
