@@ -161,3 +161,35 @@ fn toml_ndf_material_from_a_height_map() {
         .to_string();
     assert!(err.contains("ndf"), "{err}");
 }
+
+/// The NDF scenes (hardware, reference and truth) are bit-identical on 1 and 2 threads.
+#[test]
+fn deterministic_across_thread_counts() {
+    let mut s = builtin("ripple-sphere").expect("scene");
+    s.width = 160;
+    s.height = 100;
+    let mut hw = HwConfig::texram16();
+    hw.ndf.ndf_norm = NdfNorm::Map;
+    let maps = Maps::new(&s, 16);
+    let opts = RenderOptions {
+        truth: true,
+        ..RenderOptions::default()
+    };
+    let go = |n: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .expect("pool");
+        pool.install(|| render(&s, &maps, &hw, &opts).expect("render"))
+    };
+    let (a, b) = (go(1), go(2));
+    assert_eq!(a.hw_image.px, b.hw_image.px);
+    assert_eq!(
+        a.ref_image.as_ref().map(|i| &i.px),
+        b.ref_image.as_ref().map(|i| &i.px)
+    );
+    assert_eq!(
+        a.truth_image.as_ref().map(|i| &i.px),
+        b.truth_image.as_ref().map(|i| &i.px)
+    );
+}

@@ -384,10 +384,11 @@ pub fn sphere_integral(mu: DVec3, s: &[f64; 6], cfg: &NdfConfig) -> f64 {
     let mut a = 0.0;
     let mut z = 0.0;
     let dphi = 2.0 * PI / NPHI as f64;
-    let (cphi, sphi): (Vec<f64>, Vec<f64>) = (0..NPHI)
-        .map(|k| ((k as f64 + 0.5) * dphi).sin_cos())
-        .map(|(s, c)| (c, s))
-        .unzip();
+    let mut cphi = [0.0f64; NPHI];
+    let mut sphi = [0.0f64; NPHI];
+    for (k, (s, c)) in sphi.iter_mut().zip(cphi.iter_mut()).enumerate() {
+        (*s, *c) = ((k as f64 + 0.5) * dphi).sin_cos();
+    }
     while a < PI {
         let b = (a + width).min(PI);
         let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
