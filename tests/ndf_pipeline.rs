@@ -193,3 +193,26 @@ fn deterministic_across_thread_counts() {
         b.truth_image.as_ref().map(|i| &i.px)
     );
 }
+
+/// Hardware files without an `[ndf]` section still load (the defaults); bad widths are errors
+/// naming the field; the knobs are sweep fields.
+#[test]
+fn hw_config_ndf_section() {
+    let full = texsim::hwconfig::to_toml(&HwConfig::texram16());
+    let start = full.find("[ndf]").expect("ndf section");
+    let end = full[start + 5..]
+        .find("\n[")
+        .map_or(full.len(), |i| start + 5 + i);
+    let old = format!("{}{}", &full[..start], &full[end..]);
+    assert!(!old.contains("moment_bits"));
+    let c: HwConfig = toml::from_str(&old).expect("old file parses");
+    assert_eq!(c.ndf, hw_model::ndf::NdfConfig::texram16());
+    let e = texsim::hwconfig::parse("[ndf]\nmoment_bits = 3\n").expect_err("too narrow");
+    assert!(e.to_string().contains("ndf.moment_bits"), "{e}");
+    let base = HwConfig::texram16();
+    let c = texsim::hwconfig::set_field(&base, "ndf_norm", "projected").expect("knob");
+    assert_eq!(c.ndf.ndf_norm, NdfNorm::Projected);
+    let c = texsim::hwconfig::set_field(&base, "pearson_m", "16").expect("knob");
+    assert_eq!(c.ndf.pearson_m, 16);
+    assert!(texsim::hwconfig::set_field(&base, "ndf_density", "cauchy").is_err());
+}
