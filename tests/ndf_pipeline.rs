@@ -29,7 +29,10 @@ fn stage(r: &Rendered, k: StageKind) -> &texsim::render::StageStats {
 #[test]
 fn scenes_render_and_fixed_tracks_float() {
     let hw = HwConfig::texram16();
-    for name in ["ripple-sphere", "lod-pair", "foil"] {
+    // Foil: the sparkles of 2x2-texel facets at shininess 256 have edges one texture-coordinate
+    // LSB wide, so the fixed barycentrics alone move a few pixels by up to 3 LSB
+    // (`texsim render --scene foil --isolate bary`).
+    for (name, bound) in [("ripple-sphere", 2), ("lod-pair", 2), ("foil", 4)] {
         let r = run(name, &hw, false);
         let fetch = stage(&r, StageKind::NdfFetch);
         let shade = stage(&r, StageKind::NdfShade);
@@ -45,7 +48,7 @@ fn scenes_render_and_fixed_tracks_float() {
             "{name}: max {} mean {:.4} (8-bit LSB)",
             e.max_abs_lsb, e.mean_abs_lsb
         );
-        assert!(e.max_abs_lsb <= 2, "{name}: {e:?}");
+        assert!(e.max_abs_lsb <= bound, "{name}: {e:?}");
         assert!(r
             .stats
             .stages

@@ -118,21 +118,30 @@ pub fn lod_pair() -> Scene {
     )
 }
 
-/// `foil`: a crumpled-foil tile (random facets, 2x2 texels each) tilted towards the light,
-/// shininess 256.
+/// `foil`: crumpled foil (random facets, 2x2 texels each), shininess 256, as a near tile (the
+/// facets sparkle) and a far one (coarse levels: one broad, duller highlight), both facing the
+/// halfway vector of the light and the eye.
 pub fn foil() -> Scene {
-    let mut tile = shapes::plane(3.0, 3.0);
-    tile.name = "foil".into();
-    super::geometry::transform_mesh(
-        &mut tile,
-        &(DMat4::from_translation(DVec3::new(0.0, -0.6, 0.0))
-            * DMat4::from_rotation_x(35f64.to_radians())),
-    );
+    let tile = |name: &str, at: DVec3, scale: f64| {
+        let mut t = shapes::plane(3.0, 3.0);
+        t.name = name.into();
+        super::geometry::transform_mesh(
+            &mut t,
+            &(DMat4::from_translation(at)
+                * DMat4::from_scale(DVec3::splat(scale))
+                * DMat4::from_rotation_y((-12f64).to_radians())
+                * DMat4::from_rotation_x(70f64.to_radians())),
+        );
+        t
+    };
     let mut m = ndf_material("foil", [0.5, 0.5, 0.52], 256);
     m.cull_back = false;
     scene(
         "foil",
-        vec![tile],
+        vec![
+            tile("near", DVec3::new(-0.9, 0.0, 0.0), 0.6),
+            tile("far", DVec3::new(4.0, 0.8, -12.0), 0.6),
+        ],
         vec![m],
         normal_texture("foil", 128, 0.45),
     )
