@@ -542,6 +542,8 @@ pub struct BumpStats {
     pub nonfinite: u64,
     pub ref_nonfinite: u64,
     pub offset_clamped: u64,
+    /// NDF moment-map channels clamped by their encoding (all moment maps of the scene).
+    pub ndf_clamped: u64,
     /// The frames the bump materials used (`natural`, `unit`, `main`), empty without bumps.
     pub frame: String,
 }
@@ -1058,6 +1060,7 @@ pub fn render(
                 nonfinite: counters.nonfinite,
                 ref_nonfinite,
                 offset_clamped: if bumped { maps.bump_clamped } else { 0 },
+                ndf_clamped: maps.ndf_clamped,
                 frame: bump_frames(&geo, hw),
             },
             stages,

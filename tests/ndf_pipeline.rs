@@ -219,3 +219,22 @@ fn hw_config_ndf_section() {
     assert_eq!(c.ndf.pearson_m, 16);
     assert!(texsim::hwconfig::set_field(&base, "ndf_density", "cauchy").is_err());
 }
+
+/// Figure 2: the coarse (12x6) and fine (64x32) spheres of `lod-pair` get highlights of the
+/// same size, since the NDF is evaluated per pixel in the interpolated frame.
+#[test]
+fn lod_pair_highlights_agree() {
+    let r = run("lod-pair", &HwConfig::texram16(), false);
+    let img = &r.hw_image;
+    let w = img.width as usize;
+    let mut bright = [0u32; 2];
+    for (i, p) in img.px.iter().enumerate() {
+        if p[0] > 60_000 && p[2] > 60_000 {
+            bright[usize::from(i % w >= w / 2)] += 1;
+        }
+    }
+    println!("highlight pixels: coarse {} fine {}", bright[0], bright[1]);
+    assert!(bright[0] > 100 && bright[1] > 100);
+    let ratio = f64::from(bright[0]) / f64::from(bright[1]);
+    assert!((0.8..1.25).contains(&ratio), "{bright:?}");
+}
