@@ -198,8 +198,10 @@ pub struct RenderArgs {
     /// Skip the float reference (no error metrics).
     #[arg(long)]
     pub no_reference: bool,
-    /// Also render the supersampled ground truth of roughness materials (truth.png) and add
-    /// model_error, quantization_error and baseline_error to summary.json.
+    /// Also render the supersampled ground truth (roughness materials: the full-resolution
+    /// bump map; NDF materials: the finest normal map; others: their float reference) into
+    /// truth.png and add model_error (float vs truth) and quantization_error (hardware vs
+    /// float) to summary.json; roughness scenes also get baseline.png and baseline_error.
     #[arg(long)]
     pub truth: bool,
     /// Ground-truth sub-samples per pixel axis (N x N per pixel).
@@ -219,9 +221,10 @@ pub struct SweepArgs {
     /// Also run the timing model per setting (adds its total cycles to each row).
     #[arg(long)]
     pub cycles: bool,
-    /// Ground truth of roughness materials with N x N sub-samples per pixel: adds each row's
-    /// model error (float model vs truth) to sweep.json and prints it (0 = off).
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=64))]
+    /// Also render the ground truth per setting, with N x N sub-samples per pixel (`--truth`
+    /// alone: 16), and add each row's model error (float vs truth); 0 = off.
+    #[arg(long, default_value_t = 0, num_args = 0..=1, default_missing_value = "16",
+          value_parser = clap::value_parser!(u32).range(0..=64))]
     pub truth: u32,
 }
 
@@ -373,7 +376,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     );
     let opts = RenderOptions {
         hw_impls: impls,
-        reference: !a.no_reference,
+        reference: !a.no_reference || a.truth,
         timing: false,
         coverage: match a.coverage {
             CoverageArg::Shared => CoverageMode::Shared,
@@ -416,10 +419,21 @@ fn truth_outputs(
     out: &mut OutputSet,
 ) -> Result<()> {
     let Some(truth) = &r.truth_image else {
-        eprintln!("warning: --truth: the scene has no roughness material, no truth rendered");
+        eprintln!(
+            "warning: --truth: the scene has no roughness or NDF material, no truth rendered"
+        );
         return Ok(());
     };
     out.add("truth.png", report::encode_png8(truth)?);
+    if r.stats.roughness.is_none() {
+        if let (Some(m), Some(q)) = (&r.stats.model_error, &r.stats.quantization_error) {
+            eprintln!(
+                "vs ground truth: model_error mean {:.3} rmse {:.3}; quantization_error mean {:.4} rmse {:.4} (8-bit LSB)",
+                m.mean_abs_lsb, m.rmse_lsb, q.mean_abs_lsb, q.rmse_lsb
+            );
+        }
+        return Ok(());
+    }
     let mut base = sc.clone();
     for m in &mut base.materials {
         if m.roughness.is_some() {
@@ -582,11 +596,6 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         };
         let r = render(&sc, &maps, cfg, &opts)?;
         let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
-        row.model_error = r
-            .stats
-            .roughness
-            .as_ref()
-            .and_then(|x| x.model_error.clone());
         if let (Some(m), Some(q)) = (&row.model_error, &row.error_8bit) {
             eprintln!(
                 "  model_error (vs truth) mean {:.3} rmse {:.3}; quantization_error mean {:.4} rmse {:.4}; {:.2} cycles/px",

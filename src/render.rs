@@ -47,6 +47,12 @@ pub struct Maps {
     pub offset_int_bits: u32,
     /// Offsets clamped by the encoding (all offset maps).
     pub bump_clamped: u64,
+    /// NDF moment maps ([`ndf_sources`]): four chains each (A, B, C, normalization) after the
+    /// offset maps, quantized to `moment_bits`, and the config they were built for.
+    pub ndf: Vec<(usize, u32)>,
+    pub ndf_cfg: hw_model::ndf::NdfConfig,
+    /// Moment channels clamped by the encoding (all moment maps).
+    pub ndf_clamped: u64,
 }
 
 /// One offset map to prepare: the source texture, the bump scale, and whether the source is
@@ -84,6 +90,24 @@ pub fn bump_sources(scene: &Scene) -> Vec<BumpSource> {
             if !out.iter().any(|o| o.same(&b)) {
                 out.push(b);
             }
+        }
+    }
+    out
+}
+
+/// The distinct (offset map, base shininess) pairs of the scene's NDF materials, in material
+/// order; pair `j` is prepared as maps `scene.textures.len() + bump_sources.len() + 4 j ..+4`.
+#[must_use]
+pub fn ndf_sources(scene: &Scene) -> Vec<(usize, u32)> {
+    let sources = bump_sources(scene);
+    let mut out: Vec<(usize, u32)> = Vec::new();
+    for m in scene.materials.iter().filter(|m| m.ndf) {
+        let Some(b) = BumpSource::of(m) else { continue };
+        let Some(k) = sources.iter().position(|o| o.same(&b)) else {
+            continue;
+        };
+        if !out.contains(&(k, m.shininess)) {
+            out.push((k, m.shininess));
         }
     }
     out
@@ -156,12 +180,79 @@ impl Maps {
             .par_iter()
             .map(|c| quantize_chain(c, texel_bits))
             .collect();
-        Self {
+        let mut maps = Self {
             float,
             fixed,
             bump_offsets,
             offset_int_bits,
             bump_clamped,
+            ndf: ndf_sources(scene),
+            ndf_cfg: hw_model::ndf::NdfConfig::texram16(),
+            ndf_clamped: 0,
+        };
+        let cfg = maps.ndf_cfg.clone();
+        maps.build_ndf(&cfg, false);
+        maps
+    }
+
+    /// Number of chains of the NDF moment maps (at the end of the lists).
+    #[must_use]
+    pub fn ndf_chains(&self) -> usize {
+        4 * self.ndf.len()
+    }
+
+    /// True when the moment maps must be rebuilt for `cfg` (encoding, or the normalization
+    /// map's density and regularization when `cfg` uses it).
+    #[must_use]
+    pub fn ndf_stale(&self, cfg: &hw_model::ndf::NdfConfig) -> bool {
+        use hw_model::ndf::NdfNorm;
+        let o = &self.ndf_cfg;
+        let map = cfg.ndf_norm == NdfNorm::Map;
+        !self.ndf.is_empty()
+            && (o.moment_bits != cfg.moment_bits
+                || o.moment_scale_bits != cfg.moment_scale_bits
+                || (map
+                    && (o.ndf_norm != NdfNorm::Map
+                        || o.ndf_density != cfg.ndf_density
+                        || o.pearson_m != cfg.pearson_m
+                        || o.ndf_min_variance_bits != cfg.ndf_min_variance_bits)))
+    }
+
+    /// Rebuilds the moment maps for `cfg` if [`Maps::ndf_stale`].
+    pub fn ensure_ndf(&mut self, cfg: &hw_model::ndf::NdfConfig) {
+        if self.ndf_stale(cfg) {
+            self.build_ndf(cfg, true);
+        }
+    }
+
+    fn build_ndf(&mut self, cfg: &hw_model::ndf::NdfConfig, replace: bool) {
+        if replace {
+            let keep = self.float.len() - self.ndf_chains();
+            self.float.truncate(keep);
+            self.fixed.truncate(keep);
+        }
+        self.ndf_cfg = cfg.clone();
+        self.ndf_clamped = 0;
+        for &(k, s) in &self.ndf {
+            let (w, h, _, offs) = &self.bump_offsets[k];
+            let normals: Vec<DVec3> = offs
+                .iter()
+                .map(|o| DVec3::new(f64::from(o[0]), f64::from(o[1]), 1.0).normalize())
+                .collect();
+            match crate::shading::ndf::build_ndf_maps(&normals, *w, *h, f64::from(s), cfg) {
+                Ok(nm) => {
+                    self.ndf_clamped += nm.clamped;
+                    self.float.extend(nm.float);
+                    self.fixed.extend([nm.mean, nm.diag, nm.off, nm.norm]);
+                }
+                Err(_) => {
+                    let flat = vec![DVec3::Z; normals.len()];
+                    let nm = crate::shading::ndf::build_ndf_maps(&flat, *w, *h, 1.0, cfg)
+                        .expect("flat maps of a valid size");
+                    self.float.extend(nm.float);
+                    self.fixed.extend([nm.mean, nm.diag, nm.off, nm.norm]);
+                }
+            }
         }
     }
 
@@ -171,7 +262,7 @@ impl Maps {
             self.offset_int_bits = offset_int_bits;
             return;
         }
-        let first = self.float.len() - self.bump_offsets.len();
+        let first = self.float.len() - self.bump_offsets.len() - self.ndf_chains();
         let texel_bits = self.fixed.first().map_or(16, |f| f.texel_bits);
         self.bump_clamped = 0;
         for (k, (w, h, name, offs)) in self.bump_offsets.iter().enumerate() {
@@ -190,11 +281,13 @@ impl Maps {
             .first()
             .is_some_and(|f| f.texel_bits != texel_bits)
         {
-            self.fixed = self
-                .float
+            let keep = self.float.len() - self.ndf_chains();
+            let ndf = self.fixed.split_off(keep);
+            self.fixed = self.float[..keep]
                 .par_iter()
                 .map(|c| quantize_chain(c, texel_bits))
                 .collect();
+            self.fixed.extend(ndf);
         }
     }
 }
@@ -249,6 +342,7 @@ impl Geometry {
                 .collect(),
         };
         let sources = bump_sources(scene);
+        let ndf_srcs = ndf_sources(scene);
         for (mi, mesh) in scene.meshes.iter().enumerate() {
             let mat = &scene.materials[mesh.material];
             let base = g.clip.len() as u32;
@@ -276,6 +370,17 @@ impl Geometry {
             });
             let mut p = plan_with_bump(mat, !mesh.uvs.is_empty(), bump_map);
             crate::pipeline::rough_stages::mark_plan(&mut p, mat);
+            if mat.ndf {
+                let first = scene.textures.len() + sources.len();
+                if let Some(j) = bump_map.and_then(|b| {
+                    ndf_srcs
+                        .iter()
+                        .position(|&s| s == (b - scene.textures.len(), mat.shininess))
+                }) {
+                    let ne = crate::shading::ndf::norm_exp_for(f64::from(mat.shininess));
+                    p = crate::pipeline::ndf_stages::with_ndf(p, first + 4 * j, mat.shininess, ne);
+                }
+            }
             if let Some(bp) = &p.bump {
                 g.bump.resize(base as usize, BumpVertex::default());
                 g.bump.extend(bump_vertices(mesh, bp));
@@ -395,8 +500,11 @@ pub struct RenderOptions {
     /// Collect the timing model's event stream (`Rendered::events`). Off by default: a render
     /// without it allocates no event buffer and does no extra work per pixel.
     pub timing: bool,
-    /// Ground truth of roughness materials (`rough_stages`): sub-samples per pixel axis,
-    /// 0 = off.
+    /// Also render the ground truth, with this many sub-samples per pixel axis (0 = off):
+    /// roughness materials supersample their full-resolution bump map
+    /// (`pipeline::rough_stages`), NDF materials their finest normal map
+    /// (`pipeline::ndf_stages::NdfTruth`); the stats gain `model_error` (float vs truth) and
+    /// `quantization_error` (hardware vs float).
     pub truth: u32,
 }
 
@@ -437,6 +545,8 @@ pub struct BumpStats {
     pub nonfinite: u64,
     pub ref_nonfinite: u64,
     pub offset_clamped: u64,
+    /// NDF moment-map channels clamped by their encoding (all moment maps of the scene).
+    pub ndf_clamped: u64,
     /// The frames the bump materials used (`natural`, `unit`, `main`), empty without bumps.
     pub frame: String,
 }
@@ -487,14 +597,13 @@ pub struct CycleEstimate {
 pub struct Rendered {
     pub hw_image: Image,
     pub ref_image: Option<Image>,
+    /// The ground truth image (`RenderOptions::truth`).
+    pub truth_image: Option<Image>,
     /// Pixels covered by the hardware or the reference pass (the compared set).
     pub mask: Vec<bool>,
     pub stats: RenderStats,
     /// The timing model's events of the hardware pass, when `RenderOptions::timing` was set.
     pub events: Option<FrameEvents>,
-    /// The supersampled ground truth, when `RenderOptions::truth` was set and the scene has
-    /// roughness materials.
-    pub truth_image: Option<Image>,
 }
 
 /// The numbers of one render (serialized into summary.json).
@@ -522,6 +631,10 @@ pub struct RenderStats {
     /// Roughness materials (issue 4): D maps, ground truth and the two errors.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub roughness: Option<RoughStats>,
+    /// With `--truth`: the float reference against the ground truth (the model's error) and
+    /// the hardware against the float reference (quantization), 8-bit LSBs.
+    pub model_error: Option<ErrorMetrics>,
+    pub quantization_error: Option<ErrorMetrics>,
 }
 
 /// Roughness statistics of one render (8-bit LSB metrics over the covered pixels).
@@ -776,6 +889,17 @@ pub fn render(
         reencoded = mm;
         &reencoded
     };
+    // NDF chains first: `ensure_ndf` replaces the chains at the end of the list, and the
+    // roughness maps of this render are appended after them.
+    let ndf_rebuilt;
+    let maps = if maps.ndf_stale(&hw.ndf) {
+        let mut mm = maps.clone();
+        mm.ensure_ndf(&hw.ndf);
+        ndf_rebuilt = mm;
+        &ndf_rebuilt
+    } else {
+        maps
+    };
     let rough_sources =
         crate::pipeline::rough_stages::resolve_plans(&mut geo.plans, hw, maps.float.len());
     let has_rough = geo.plans.iter().any(|p| p.rough.is_some());
@@ -789,6 +913,16 @@ pub fn render(
         rough_owned = mm;
         &rough_owned
     };
+
+    let mut opts = opts.clone();
+    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+        && geo.plans.iter().any(|p| p.ndf.is_some())
+        && opts.hw_impls.of(StageKind::NdfShade) == Impl::Fixed
+    {
+        eprintln!("texsim: ndf_norm = exact is float only: ndf-shade runs in float");
+        opts.hw_impls = opts.hw_impls.with(StageKind::NdfShade, Impl::Float);
+    }
+    let opts = &opts;
 
     let t = Instant::now();
     let setup = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &hw.raster);
@@ -873,30 +1007,40 @@ pub fn render(
         ref_image = Some(img);
     }
     let mut truth_image = None;
-    if opts.truth > 0 && has_rough {
+    let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
+    if opts.truth > 0 && (has_rough || has_ndf) {
+        // One float pass over every material: roughness materials shade their supersampled
+        // bump map (`rough_stages::truth_plans`), NDF materials their supersampled finest normal
+        // map (`ndf_stages::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough_stages::truth_plans(&geo.plans, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
+        let ndf_truth = crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans);
+        let mt = Machine::new(hw, &maps.float, &maps.fixed)
+            .with_lights(&scene.lights, scene.ambient)
+            .with_bump_attrs(&battrs)
+            .with_ndf_truth(&ndf_truth);
         let tcosts: Vec<[UnitCost; StageKind::COUNT]> =
-            geo.plans.iter().map(|p| m.plan_costs(p)).collect();
+            geo.plans.iter().map(|p| mt.plan_costs(p)).collect();
         let tin = ShadeInput {
             vis: &vis,
             setup: &setup,
             attrs: &attrs,
             geo: &geo,
-            m: &m,
+            m: &mt,
             costs: &tcosts,
         };
         let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, false);
         geo.plans = saved;
         truth_image = Some(img);
     }
+    let model_error = match (&ref_image, &truth_image) {
+        (Some(r), Some(t)) => Some(compare(r, t, 8, Some(&mask))),
+        _ => None,
+    };
     let roughness = has_rough.then(|| RoughStats {
         d_clamped,
         truth_samples: if truth_image.is_some() { opts.truth } else { 0 },
-        model_error: match (&ref_image, &truth_image) {
-            (Some(r), Some(t)) => Some(compare(r, t, 8, Some(&mask))),
-            _ => None,
-        },
+        model_error: model_error.clone(),
         quantization_error: e8.clone(),
         baseline_error: None,
     });
@@ -934,9 +1078,9 @@ pub fn render(
     Ok(Rendered {
         hw_image,
         ref_image,
+        truth_image,
         mask,
         events,
-        truth_image,
         stats: RenderStats {
             scene: scene.name.clone(),
             hw: hw.name.clone(),
@@ -955,11 +1099,18 @@ pub fn render(
                 nonfinite: counters.nonfinite,
                 ref_nonfinite,
                 offset_clamped: if bumped { maps.bump_clamped } else { 0 },
+                ndf_clamped: maps.ndf_clamped,
                 frame: bump_frames(&geo, hw),
             },
             stages,
             cycles,
             timings: tm,
+            quantization_error: if model_error.is_some() {
+                e8.clone()
+            } else {
+                None
+            },
+            model_error,
             error_8bit: e8,
             error_16bit: e16,
             roughness,

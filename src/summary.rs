@@ -109,8 +109,9 @@ pub struct SweepRow {
     pub ref_ms: f64,
     /// Total cycles of the timing model (`texsim sweep --cycles`), else `None`.
     pub timing_cycles: Option<u64>,
-    /// Roughness float model vs supersampled truth (`texsim sweep --truth N`), 8-bit LSBs.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Trilinear texture lookups (8 texels each) per covered pixel.
+    pub lookups_per_pixel: f64,
+    /// `texsim sweep --truth`: float reference vs ground truth, 8-bit LSBs.
     pub model_error: Option<ErrorMetrics>,
 }
 
@@ -134,13 +135,27 @@ impl SweepRow {
             hw_ms: s.timings.hw_total_ms,
             ref_ms: s.timings.ref_total_ms,
             timing_cycles: None,
-            model_error: None,
+            lookups_per_pixel: s.stages.iter().map(|x| x.texels).sum::<u64>() as f64
+                / 8.0
+                / s.covered_pixels.max(1) as f64,
+            model_error: s.model_error.clone(),
         }
     }
 }
 
-const HEADER: [&str; 11] = [
-    "max8", "mean8", "rmse8", "psnr8_db", "exact8_%", "max16", "rmse16", "sat", "cycles", "cyc/px",
+const HEADER: [&str; 13] = [
+    "max8",
+    "mean8",
+    "rmse8",
+    "psnr8_db",
+    "exact8_%",
+    "max16",
+    "rmse16",
+    "sat",
+    "cycles",
+    "cyc/px",
+    "lookups/px",
+    "model_mean8",
     "hw_ms",
 ];
 
@@ -170,6 +185,10 @@ fn cells(r: &SweepRow) -> Vec<String> {
         r.saturated.to_string(),
         r.cycles.to_string(),
         format!("{:.2}", r.cycles_per_pixel),
+        format!("{:.2}", r.lookups_per_pixel),
+        r.model_error
+            .as_ref()
+            .map_or("-".into(), |e| format!("{:.4}", e.mean_abs_lsb)),
         format!("{:.1}", r.hw_ms),
     ]
 }

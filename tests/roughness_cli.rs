@@ -73,7 +73,7 @@ fn render_truth_writes_the_truth_and_the_three_errors() {
         &d,
     );
     assert!(o.status.success());
-    assert!(text(&o).contains("no roughness material"));
+    assert!(text(&o).contains("no roughness or NDF material"));
     assert!(!d.join("b/truth.png").exists());
 }
 

@@ -159,6 +159,9 @@ pub struct HwConfig {
     pub roughness: RoughnessConfig,
     /// Timing-model parameters (never read by the functional units).
     pub timing: TimingConfig,
+    /// The NDF mapping unit (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub ndf: crate::ndf::NdfConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -216,6 +219,7 @@ impl HwConfig {
             aniso_phong: AnisoPhongConfig::texram16(),
             roughness: RoughnessConfig::texram16(),
             timing: TimingConfig::texram16(),
+            ndf: crate::ndf::NdfConfig::texram16(),
         }
     }
 
@@ -302,6 +306,7 @@ impl HwConfig {
         self.aniso_phong.validate()?;
         self.roughness.validate()?;
         self.timing.validate()?;
+        self.ndf.validate()?;
         Ok(())
     }
 }

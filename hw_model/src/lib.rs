@@ -17,6 +17,7 @@ pub mod frame;
 pub mod interpolator;
 pub mod lod;
 pub mod modulate;
+pub mod ndf;
 pub mod pow;
 pub mod reciprocal;
 pub mod roughness;

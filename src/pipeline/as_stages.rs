@@ -107,6 +107,7 @@ pub fn plan_as(material: &Material, has_uvs: bool) -> Option<Plan> {
             exponent_map: emap.is_some(),
         }),
         rough: None,
+        ndf: None,
     })
 }
 

@@ -13,6 +13,7 @@
 
 pub mod as_stages;
 pub mod bump_stages;
+pub mod ndf_stages;
 pub mod rough_stages;
 pub mod stages;
 
@@ -52,11 +53,15 @@ pub enum StageKind {
     RoughFetch,
     /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
     RoughShade,
+    /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).
+    NdfFetch,
+    /// NDF materials: Sigma, its inverse, Mahalanobis distance, density, normalization, lights.
+    NdfShade,
 }
 
 impl StageKind {
     /// Number of stage kinds.
-    pub const COUNT: usize = 14;
+    pub const COUNT: usize = 16;
 
     /// Every stage kind, in pipeline order (the bump stages follow the texture stages).
     pub const ALL: [StageKind; StageKind::COUNT] = [
@@ -74,6 +79,8 @@ impl StageKind {
         StageKind::AsShade,
         StageKind::RoughFetch,
         StageKind::RoughShade,
+        StageKind::NdfFetch,
+        StageKind::NdfShade,
     ];
 
     /// The name used on the command line and in reports.
@@ -94,6 +101,8 @@ impl StageKind {
             StageKind::AsShade => "as-shade",
             StageKind::RoughFetch => "rough-fetch",
             StageKind::RoughShade => "rough-shade",
+            StageKind::NdfFetch => "ndf-fetch",
+            StageKind::NdfShade => "ndf-shade",
         }
     }
 
@@ -183,6 +192,8 @@ pub struct Plan {
     pub aniso: Option<as_stages::AsPlan>,
     /// Roughness map and modified Blinn-Phong (`rough_stages`), for roughness materials.
     pub rough: Option<rough_stages::RoughPlan>,
+    /// NDF mapping (with `bump` for the frame), for NDF materials.
+    pub ndf: Option<ndf_stages::NdfPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -255,6 +266,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             }),
             aniso: None,
             rough: None,
+            ndf: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -281,6 +293,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         bump: None,
         aniso: None,
         rough: None,
+        ndf: None,
     }
 }
 
@@ -320,6 +333,8 @@ pub struct Frag {
     /// Roughness fetch: filtered D channels (unorm) and their raw texels.
     pub rough: [f64; 3],
     pub rough_x: [u32; 3],
+    /// NDF stages.
+    pub ndf: ndf_stages::NdfFrag,
 }
 
 /// Most point lights shaded per pixel by a bump material (their vectors are interpolated).

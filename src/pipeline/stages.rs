@@ -99,6 +99,10 @@ pub struct Machine<'a> {
     pub bump_attrs: &'a [BumpAttrs],
     /// ROMs of the anisotropic Phong unit, built on first use ([`Machine::aniso_roms`]).
     pub aniso_roms: std::sync::OnceLock<hw_model::aniso_phong::AnisoPhongRoms>,
+    /// The fixed NDF unit of `hw.ndf` (`None` for the float-only `exact` normalization).
+    pub ndf: Option<hw_model::ndf::NdfUnit>,
+    /// Ground-truth normal maps: when not empty, the float `ndf-shade` supersamples them.
+    pub ndf_truth: &'a [super::ndf_stages::NdfTruth],
 }
 
 /// One scene light for per-pixel shading.
@@ -160,6 +164,8 @@ impl<'a> Machine<'a> {
             ambient_x: [0; 3],
             bump_attrs: &[],
             aniso_roms: std::sync::OnceLock::new(),
+            ndf: super::ndf_stages::ndf_unit(hw),
+            ndf_truth: &[],
         }
     }
 
@@ -199,6 +205,13 @@ impl<'a> Machine<'a> {
             .collect();
         self.ambient = ambient.map(|c| f64::from(c).clamp(0.0, 1.0));
         self.ambient_x = self.ambient.map(|c| u64::from(to_unorm(c, cb)));
+        self
+    }
+
+    /// Shades NDF materials (float twin) from the supersampled finest normals `truth`.
+    #[must_use]
+    pub fn with_ndf_truth(mut self, truth: &'a [super::ndf_stages::NdfTruth]) -> Self {
+        self.ndf_truth = truth;
         self
     }
 
@@ -246,6 +259,9 @@ impl<'a> Machine<'a> {
             StageKind::AsShade => super::as_stages::as_shade_cost(self, plan),
             StageKind::RoughFetch | StageKind::RoughShade => {
                 super::rough_stages::rough_stage_cost(self, kind, plan)
+            }
+            StageKind::NdfFetch | StageKind::NdfShade => {
+                super::ndf_stages::ndf_stage_cost(self, kind, plan)
             }
             _ => self.bump_stage_cost(kind, plan),
         }
@@ -566,6 +582,9 @@ pub fn run(
             StageKind::AsShade => super::as_stages::run_as_shade(plan, impls, m, frag, c),
             StageKind::RoughFetch | StageKind::RoughShade => {
                 super::rough_stages::run_rough_stage(kind, plan, impls, m, frag, c);
+            }
+            StageKind::NdfFetch | StageKind::NdfShade => {
+                super::ndf_stages::run_ndf_stage(kind, plan, impls, m, frag, c);
             }
         }
     }

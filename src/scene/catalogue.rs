@@ -25,6 +25,9 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("corrugated", "roughness: corrugated sheet iron receding (one-dimensional bumps, singular K), 480x320"),
     ("brushed", "roughness: brushed metal plate (anisotropic streaks), 480x320"),
     ("scratches", "roughness: small scratches on a glossy surface, 480x320"),
+    ("ripple-sphere", "NDF mapping (Olano-North Fig. 1): a rippled sphere at three distances, highlight blurs and stretches with the MIP level, 480x320"),
+    ("lod-pair", "NDF mapping (Olano-North Fig. 2): a smooth sphere at two polygon counts, consistent highlights, 480x320"),
+    ("foil", "NDF mapping: crumpled foil tile, shininess 256, 480x320"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -42,6 +45,9 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "corrugated" => super::rough_scenes::corrugated(),
         "brushed" => super::rough_scenes::brushed(),
         "scratches" => super::rough_scenes::scratches(),
+        "ripple-sphere" => super::ndf_scenes::ripple_sphere(),
+        "lod-pair" => super::ndf_scenes::lod_pair(),
+        "foil" => super::ndf_scenes::foil(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(

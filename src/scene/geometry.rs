@@ -224,6 +224,21 @@ pub fn validate(scene: &Scene) -> Result<()> {
     check_finite("ambient", &scene.ambient)?;
     check_finite("background", &scene.background)?;
     for (mi, m) in scene.materials.iter().enumerate() {
+        let effects = [
+            ("brdf", m.brdf.is_some()),
+            ("roughness", m.roughness.is_some()),
+            ("ndf", m.ndf),
+        ];
+        let on: Vec<&str> = effects.iter().filter(|e| e.1).map(|e| e.0).collect();
+        if on.len() > 1 {
+            return Err(Error::field(
+                &format!("materials[{mi}]"),
+                format!(
+                    "{} are alternative shading models; choose one",
+                    on.join(" and ")
+                ),
+            ));
+        }
         if let Some(b) = &m.brdf {
             b.validate(&format!("materials[{mi}]"))?;
             if let Some(t) = b.exponent_map.filter(|&t| t >= scene.textures.len()) {

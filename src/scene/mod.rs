@@ -16,6 +16,7 @@ use glam::{DMat4, DVec3};
 pub mod as_scenes;
 mod catalogue;
 mod geometry;
+mod ndf_scenes;
 mod obj;
 pub mod rough_scenes;
 pub mod shapes;
@@ -97,7 +98,7 @@ pub struct Material {
     pub main_direction: MainDirection,
     /// Specular colour (per-pixel Blinn-Phong of bump-mapped materials).
     pub ks: [f32; 3],
-    /// Specular exponent.
+    /// Specular exponent (for NDF materials, the base shininess of the moment maps).
     pub shininess: u32,
     /// Roughness map of a bump material (Schilling 1997 roughness pyramid + modified
     /// Blinn-Phong, `pipeline::rough_stages`); `None`: plain Blinn-Phong.
@@ -105,6 +106,9 @@ pub struct Material {
     /// Ashikhmin-Shirley anisotropic Phong BRDF: shaded per pixel in the main-direction frame
     /// instead of Gouraud or Blinn-Phong (`pipeline::as_stages`).
     pub brdf: Option<AsBrdf>,
+    /// NDF mapping (Olano and North 1997): the `bump` map's normals become moment maps,
+    /// shaded by `ndf-fetch` and `ndf-shade` instead of the bump path's Blinn-Phong.
+    pub ndf: bool,
 }
 
 /// Which modified Blinn-Phong a roughness material uses.
@@ -207,6 +211,7 @@ impl Default for Material {
             shininess: 32,
             roughness: None,
             brdf: None,
+            ndf: false,
         }
     }
 }

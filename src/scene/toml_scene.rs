@@ -107,6 +107,8 @@ struct MaterialCfg {
     rd: Option<f64>,
     /// Exponent map: a texture name of `[[textures]]` (channel 0 scales `nu`, 1 scales `nv`).
     exponent_map: Option<String>,
+    /// NDF mapping of the `bump` map (Olano and North 1997).
+    ndf: Option<bool>,
 }
 
 /// The Ashikhmin-Shirley parameters of material `i` (defaults `nu = nv = 100`, `rs = 0.05`,
@@ -454,6 +456,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             ks: m.ks.unwrap_or(def.ks),
             shininess: m.shininess.unwrap_or(def.shininess),
             brdf: as_brdf(i, m, &tex_names)?,
+            ndf: m.ndf.unwrap_or(def.ndf),
         });
     }
     let mut default_mat: Option<usize> = None;

@@ -123,6 +123,7 @@ pub fn lookups(kind: StageKind, hw: &HwConfig) -> u32 {
     match kind {
         StageKind::Trilinear => hw.trilinear.aniso_probes.max(1),
         StageKind::BumpFetch | StageKind::RoughFetch => 1,
+        StageKind::NdfFetch => hw_model::ndf::ndf_lookups(&hw.ndf),
         _ => 0,
     }
 }
@@ -177,6 +178,7 @@ pub fn record_pixel(
             StageKind::Trilinear => plan.texture,
             StageKind::BumpFetch => plan.bump.as_ref().map(|b| b.map),
             StageKind::RoughFetch => plan.rough.as_ref().map(|r| r.map),
+            StageKind::NdfFetch => plan.ndf.as_ref().map(|n| n.maps),
             _ => None,
         };
         let Some(t) = t else { continue };
@@ -185,7 +187,7 @@ pub fn record_pixel(
         };
         let size = levels.first().map_or((1, 1), |l| (l.width, l.height));
         let probes = lookups(kind, hw);
-        if probes > 1 && plan.derivatives {
+        if kind == StageKind::Trilinear && probes > 1 && plan.derivatives {
             let fp = footprint(&uv, size, fb, probes, &hw.lod, &mut sat);
             let mut traces = [TrilinearTrace::default(); MAX_PROBES];
             let _ = footprint_filter(
@@ -215,19 +217,30 @@ pub fn record_pixel(
             let d = crate::pipeline::stages::texel_derivs(&uv, size.0, size.1);
             lod(d, fb, &hw.lod, &mut sat)
         };
-        let mut tr = TrilinearTrace::default();
-        let _ = trilinear(
-            levels,
-            u,
-            v,
-            fb,
-            lod_raw,
-            lfb,
-            plan.wrap,
-            &hw.trilinear,
-            Some(&mut tr),
-        );
-        push_trace(&mut ev.footprints, kind, 0, t, &tr);
+        // One lookup per map; the NDF fetch reads `probes` maps of one size from `t` on.
+        let maps = if kind == StageKind::NdfFetch {
+            probes
+        } else {
+            1
+        };
+        for i in 0..maps {
+            let Some(levels) = m.tex_fixed.get(t + i as usize) else {
+                continue;
+            };
+            let mut tr = TrilinearTrace::default();
+            let _ = trilinear(
+                levels,
+                u,
+                v,
+                fb,
+                lod_raw,
+                lfb,
+                plan.wrap,
+                &hw.trilinear,
+                Some(&mut tr),
+            );
+            push_trace(&mut ev.footprints, kind, i, t + i as usize, &tr);
+        }
     }
     ev.pixels.push(PixelEvent {
         plan: plan_index,

@@ -1,0 +1,240 @@
+//! NDF materials in the pipeline: the built-in scenes render in fixed point and float, the
+//! fixed image tracks the float one, `ndf-fetch` makes 3 lookups (4 with the normalization
+//! map) in the costs and in the timing model's events, and `exact` runs `ndf-shade` in float.
+
+use hw_model::ndf::NdfNorm;
+use hw_model::HwConfig;
+use texsim::pipeline::{Impl, StageKind};
+use texsim::render::{render, Maps, RenderOptions, Rendered};
+use texsim::scene::builtin;
+
+fn run(name: &str, hw: &HwConfig, timing: bool) -> Rendered {
+    let s = builtin(name).expect("scene");
+    let maps = Maps::new(&s, hw.trilinear.texel_bits);
+    let opts = RenderOptions {
+        timing,
+        ..RenderOptions::default()
+    };
+    render(&s, &maps, hw, &opts).expect("render")
+}
+
+fn stage(r: &Rendered, k: StageKind) -> &texsim::render::StageStats {
+    r.stats
+        .stages
+        .iter()
+        .find(|s| s.stage == k)
+        .expect("stage present")
+}
+
+#[test]
+fn scenes_render_and_fixed_tracks_float() {
+    let hw = HwConfig::texram16();
+    // Foil: the sparkles of 2x2-texel facets at shininess 256 have edges one texture-coordinate
+    // LSB wide, so the fixed barycentrics alone move a few pixels by up to 3 LSB
+    // (`texsim render --scene foil --isolate bary`).
+    for (name, bound) in [("ripple-sphere", 2), ("lod-pair", 2), ("foil", 4)] {
+        let r = run(name, &hw, false);
+        let fetch = stage(&r, StageKind::NdfFetch);
+        let shade = stage(&r, StageKind::NdfShade);
+        assert!(fetch.invocations > 1000, "{name}");
+        assert_eq!(fetch.invocations, shade.invocations);
+        assert_eq!(
+            fetch.texels,
+            8 * 3 * fetch.invocations,
+            "{name}: 3 trilinear lookups"
+        );
+        let e = r.stats.error_8bit.as_ref().expect("reference");
+        println!(
+            "{name}: max {} mean {:.4} (8-bit LSB)",
+            e.max_abs_lsb, e.mean_abs_lsb
+        );
+        assert!(e.max_abs_lsb <= bound, "{name}: {e:?}");
+        assert!(r
+            .stats
+            .stages
+            .iter()
+            .all(|s| s.stage != StageKind::Phong || s.invocations == 0));
+    }
+}
+
+#[test]
+fn map_normalization_adds_a_lookup_in_costs_and_timing() {
+    let mut hw = HwConfig::texram16();
+    hw.ndf.ndf_norm = NdfNorm::Map;
+    let r = run("lod-pair", &hw, true);
+    let fetch = stage(&r, StageKind::NdfFetch);
+    assert_eq!(fetch.texels, 8 * 4 * fetch.invocations);
+    let ev = r.events.as_ref().expect("events");
+    let k = StageKind::NdfFetch.index() as u8;
+    let lookups: std::collections::BTreeSet<u8> = ev
+        .footprints
+        .iter()
+        .filter(|f| f.stage == k)
+        .map(|f| f.lookup)
+        .collect();
+    assert_eq!(lookups.into_iter().collect::<Vec<_>>(), vec![0, 1, 2, 3]);
+    let e = r.stats.error_8bit.as_ref().expect("reference");
+    assert!(e.max_abs_lsb <= 2, "{e:?}");
+    let partial = run("lod-pair", &HwConfig::texram16(), true);
+    let t4 = texsim::timing::simulate(ev, &hw, "lod-pair").total_cycles;
+    let t3 = texsim::timing::simulate(partial.events.as_ref().expect("events"), &hw, "lod-pair")
+        .total_cycles;
+    assert!(t4 > t3, "{t4} <= {t3}");
+}
+
+#[test]
+fn exact_runs_ndf_shade_in_float() {
+    let mut hw = HwConfig::texram16();
+    hw.ndf.ndf_norm = NdfNorm::Exact;
+    let mut s = builtin("lod-pair").expect("scene");
+    s.width = 96;
+    s.height = 64;
+    let maps = Maps::new(&s, 16);
+    let r = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
+    assert_eq!(stage(&r, StageKind::NdfShade).imp, Impl::Float);
+    assert_eq!(stage(&r, StageKind::NdfFetch).imp, Impl::Fixed);
+}
+
+#[test]
+fn moment_bits_sweep_rebuilds_maps() {
+    let mut hw = HwConfig::texram16();
+    hw.ndf.moment_bits = 8;
+    let r8 = run("foil", &hw, false);
+    let r16 = run("foil", &HwConfig::texram16(), false);
+    let e8 = r8.stats.error_8bit.as_ref().expect("ref").mean_abs_lsb;
+    let e16 = r16.stats.error_8bit.as_ref().expect("ref").mean_abs_lsb;
+    println!("foil mean error: 8-bit moments {e8:.4}, 16-bit {e16:.4}");
+    assert!(e8 > e16);
+}
+
+/// `truth` renders the supersampled ground truth and separates the model error (float vs
+/// truth) from the quantization error (fixed vs float); the model error dominates.
+#[test]
+fn truth_separates_model_and_quantization_error() {
+    let s = builtin("ripple-sphere").expect("scene");
+    let hw = HwConfig::texram16();
+    let maps = Maps::new(&s, 16);
+    let opts = RenderOptions {
+        truth: 16,
+        ..RenderOptions::default()
+    };
+    let r = render(&s, &maps, &hw, &opts).expect("render");
+    assert!(r.truth_image.is_some());
+    let me = r.stats.model_error.as_ref().expect("model error");
+    let qe = r
+        .stats
+        .quantization_error
+        .as_ref()
+        .expect("quantization error");
+    println!(
+        "model {:.4} quantization {:.4}",
+        me.mean_abs_lsb, qe.mean_abs_lsb
+    );
+    assert!(me.mean_abs_lsb > qe.mean_abs_lsb);
+    let plain = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
+    assert!(plain.stats.model_error.is_none() && plain.truth_image.is_none());
+}
+
+/// A TOML material with `ndf = true` on a height map (the bump path's offsets give the
+/// normals) renders through the NDF stages; `ndf = "yes"` is an error naming the field.
+#[test]
+fn toml_ndf_material_from_a_height_map() {
+    let d = std::env::temp_dir().join(format!("texsim-ndf-toml-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("tmp");
+    let body = |ndf: &str| {
+        format!(
+            "[output]\nwidth = 96\nheight = 64\n\n[[textures]]\nname = \"bricks\"\nprocedural = \"bricks-height\"\nsize = 64\n\n[[materials]]\nname = \"m\"\nbump = \"bricks\"\nks = [0.5, 0.5, 0.5]\nshininess = 48\nndf = {ndf}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n\n[[lights]]\nkind = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\ncolor = [1.0, 1.0, 1.0]\n"
+        )
+    };
+    let p = d.join("ok.toml");
+    std::fs::write(&p, body("true")).expect("write");
+    let s = texsim::scene::load(&p).expect("load");
+    assert!(s.materials[0].ndf);
+    let hw = HwConfig::texram16();
+    let maps = Maps::new(&s, 16);
+    let r = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
+    assert!(stage(&r, StageKind::NdfShade).invocations > 100);
+    let e = r.stats.error_8bit.as_ref().expect("reference");
+    assert!(e.max_abs_lsb <= 2, "{e:?}");
+    let bad = d.join("bad.toml");
+    std::fs::write(&bad, body("\"yes\"")).expect("write");
+    let err = texsim::scene::load(&bad)
+        .expect_err("string for bool")
+        .to_string();
+    assert!(err.contains("ndf"), "{err}");
+}
+
+/// The NDF scenes (hardware, reference and truth) are bit-identical on 1 and 2 threads.
+#[test]
+fn deterministic_across_thread_counts() {
+    let mut s = builtin("ripple-sphere").expect("scene");
+    s.width = 160;
+    s.height = 100;
+    let mut hw = HwConfig::texram16();
+    hw.ndf.ndf_norm = NdfNorm::Map;
+    let maps = Maps::new(&s, 16);
+    let opts = RenderOptions {
+        truth: 16,
+        ..RenderOptions::default()
+    };
+    let go = |n: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .expect("pool");
+        pool.install(|| render(&s, &maps, &hw, &opts).expect("render"))
+    };
+    let (a, b) = (go(1), go(2));
+    assert_eq!(a.hw_image.px, b.hw_image.px);
+    assert_eq!(
+        a.ref_image.as_ref().map(|i| &i.px),
+        b.ref_image.as_ref().map(|i| &i.px)
+    );
+    assert_eq!(
+        a.truth_image.as_ref().map(|i| &i.px),
+        b.truth_image.as_ref().map(|i| &i.px)
+    );
+}
+
+/// Hardware files without an `[ndf]` section still load (the defaults); bad widths are errors
+/// naming the field; the knobs are sweep fields.
+#[test]
+fn hw_config_ndf_section() {
+    let full = texsim::hwconfig::to_toml(&HwConfig::texram16());
+    let start = full.find("[ndf]").expect("ndf section");
+    let end = full[start + 5..]
+        .find("\n[")
+        .map_or(full.len(), |i| start + 5 + i);
+    let old = format!("{}{}", &full[..start], &full[end..]);
+    assert!(!old.contains("moment_bits"));
+    let c: HwConfig = toml::from_str(&old).expect("old file parses");
+    assert_eq!(c.ndf, hw_model::ndf::NdfConfig::texram16());
+    let e = texsim::hwconfig::parse("[ndf]\nmoment_bits = 3\n").expect_err("too narrow");
+    assert!(e.to_string().contains("ndf.moment_bits"), "{e}");
+    let base = HwConfig::texram16();
+    let c = texsim::hwconfig::set_field(&base, "ndf_norm", "projected").expect("knob");
+    assert_eq!(c.ndf.ndf_norm, NdfNorm::Projected);
+    let c = texsim::hwconfig::set_field(&base, "pearson_m", "16").expect("knob");
+    assert_eq!(c.ndf.pearson_m, 16);
+    assert!(texsim::hwconfig::set_field(&base, "ndf_density", "cauchy").is_err());
+}
+
+/// Figure 2: the coarse (12x6) and fine (64x32) spheres of `lod-pair` get highlights of the
+/// same size, since the NDF is evaluated per pixel in the interpolated frame.
+#[test]
+fn lod_pair_highlights_agree() {
+    let r = run("lod-pair", &HwConfig::texram16(), false);
+    let img = &r.hw_image;
+    let w = img.width as usize;
+    let mut bright = [0u32; 2];
+    for (i, p) in img.px.iter().enumerate() {
+        if p[0] > 60_000 && p[2] > 60_000 {
+            bright[usize::from(i % w >= w / 2)] += 1;
+        }
+    }
+    println!("highlight pixels: coarse {} fine {}", bright[0], bright[1]);
+    assert!(bright[0] > 100 && bright[1] > 100);
+    let ratio = f64::from(bright[0]) / f64::from(bright[1]);
+    assert!((0.8..1.25).contains(&ratio), "{bright:?}");
+}
