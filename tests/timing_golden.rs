@@ -19,6 +19,17 @@ const GOLDEN: &[(&str, &str, u64, u64, u64, u64)] = &[
     ("w2-mesh", "d3d11", 1693909, 315656, 0, 18959),
     ("bumps", "texram16", 672732, 0, 0, 395720),
     ("bumps", "d3d11", 521201, 382201, 0, 9320),
+    ("lake", "texram16", 966324, 0, 0, 513808),
+    ("ripple-sphere", "texram16", 483653, 0, 0, 299457),
+    (
+        "ripple-sphere",
+        "texram16+ndf_norm=map",
+        633390,
+        0,
+        0,
+        399276,
+    ),
+    ("as-brushed", "texram16", 368300, 0, 0, 0),
     (
         "w1-plane",
         "texram16+bank_interleave=linear",
