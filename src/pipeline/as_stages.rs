@@ -370,15 +370,7 @@ pub fn run_as_shade(
                 acc[ch] += PI * (s + df * kd[ch]) * nl * light.color_f[ch];
             }
         }
-        for ch in 0..3 {
-            if !acc[ch].is_finite() {
-                c.nonfinite += 1;
-                acc[ch] = 0.0;
-            }
-            frag.out[ch] = acc[ch].clamp(0.0, 1.0);
-        }
-        frag.out[3] = 1.0;
-        frag.out_bits = 0;
+        super::bump_stages::float_output(acc, frag, c);
     }
     c.sat[k] = sat;
 }

@@ -408,7 +408,6 @@ pub fn run_bump_stage(
         }
         StageKind::Phong => {
             let cb = units.cfg.shade.shade_color_bits;
-            let max = (1u64 << cb) - 1;
             if fixed {
                 let rnd = units.cfg.shade.shade_rounding;
                 let n = if fixed_in(StageKind::Perturb) {
@@ -422,30 +421,16 @@ pub fn run_bump_stage(
                     raw3(&bf.to_eye, &m.vec_fmt, &mut sat)
                 };
                 let v = normalize3(&eye, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v;
-                let mut kd = bp.kd.map(|x| u64::from(to_unorm(x, cb)));
-                if plan.texture.is_some() {
-                    let tb = hw.trilinear.texel_bits;
-                    let tex = if fixed_in(StageKind::Trilinear) {
-                        frag.texel_x
-                    } else {
-                        frag.texel.map(|x| to_unorm(x, tb))
-                    };
-                    for ch in 0..3 {
-                        kd[ch] = u64::from(modulate(kd[ch] as u32, cb, tex[ch], tb, cb, rnd));
-                    }
-                }
-                let ks = bp.ks.map(|x| u64::from(to_unorm(x, cb)));
-                let mut acc = [0u64; 3];
-                for ch in 0..3 {
-                    acc[ch] = u64::from(modulate(
-                        m.ambient_x[ch] as u32,
-                        cb,
-                        kd[ch] as u32,
-                        cb,
-                        cb,
-                        rnd,
-                    ));
-                }
+                let (kd, ks, mut acc) = fixed_material(
+                    bp,
+                    m,
+                    plan.texture.is_some(),
+                    fixed_in(StageKind::Trilinear),
+                    frag.texel_x,
+                    frag.texel,
+                    cb,
+                    rnd,
+                );
                 for light in &m.lights {
                     let l = match light.point {
                         Some(pi) => {
@@ -473,17 +458,7 @@ pub fn run_bump_stage(
                         acc[ch] += r.color[ch];
                     }
                 }
-                for ch in 0..3 {
-                    if acc[ch] > max {
-                        acc[ch] = max;
-                        sat.saturated += 1;
-                    }
-                    frag.out_x[ch] = acc[ch] as u32;
-                    frag.out[ch] = acc[ch] as f64 / max as f64;
-                }
-                frag.out_x[3] = max as u32;
-                frag.out[3] = 1.0;
-                frag.out_bits = cb;
+                fixed_output(acc, frag, &mut sat, cb);
             } else {
                 let n = d3(&bf.normal);
                 let v = fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0;
@@ -509,18 +484,82 @@ pub fn run_bump_stage(
                         acc[ch] += col[ch];
                     }
                 }
-                for ch in 0..3 {
-                    if !acc[ch].is_finite() {
-                        c.nonfinite += 1;
-                        acc[ch] = 0.0;
-                    }
-                    frag.out[ch] = acc[ch].clamp(0.0, 1.0);
-                }
-                frag.out[3] = 1.0;
-                frag.out_bits = 0;
+                float_output(acc, frag, c);
             }
         }
         _ => {}
     }
     c.sat[k] = sat;
+}
+
+/// Ends a float shading stage: the RGB sum `acc` (a non-finite channel becomes 0 and is
+/// counted) clamped to [0, 1] into `frag.out`, alpha 1, as a float carrier.
+pub(super) fn float_output(acc: [f64; 3], frag: &mut Frag, c: &mut Counters) {
+    for (out, a) in frag.out.iter_mut().zip(acc) {
+        *out = if a.is_finite() {
+            a.clamp(0.0, 1.0)
+        } else {
+            c.nonfinite += 1;
+            0.0
+        };
+    }
+    frag.out[3] = 1.0;
+    frag.out_bits = 0;
+}
+
+/// The material of a fixed Blinn-Phong-type stage, `cb`-bit unorm: `kd` (times the texel
+/// when `textured`: `texel_x` if the trilinear stage ran fixed, else the quantized float
+/// `texel`), `ks`, and the ambient term `ambient x kd` that starts the light sum.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fixed_material(
+    bp: &BumpPlan,
+    m: &Machine,
+    textured: bool,
+    texel_fixed: bool,
+    texel_x: [u32; 4],
+    texel: [f64; 4],
+    cb: u32,
+    rnd: hw_model::fixed::Rounding,
+) -> ([u64; 3], [u64; 3], [u64; 3]) {
+    let mut kd = bp.kd.map(|x| u64::from(to_unorm(x, cb)));
+    if textured {
+        let tb = m.hw.trilinear.texel_bits;
+        let tex = if texel_fixed {
+            texel_x
+        } else {
+            texel.map(|x| to_unorm(x, tb))
+        };
+        for ch in 0..3 {
+            kd[ch] = u64::from(modulate(kd[ch] as u32, cb, tex[ch], tb, cb, rnd));
+        }
+    }
+    let ks = bp.ks.map(|x| u64::from(to_unorm(x, cb)));
+    let ambient = std::array::from_fn(|ch| {
+        u64::from(modulate(
+            m.ambient_x[ch] as u32,
+            cb,
+            kd[ch] as u32,
+            cb,
+            cb,
+            rnd,
+        ))
+    });
+    (kd, ks, ambient)
+}
+
+/// Ends a fixed shading stage: the `cb`-bit unorm sums `acc` saturated (counted) into
+/// `frag.out_x`, alpha 1, with their float carriers.
+pub(super) fn fixed_output(acc: [u64; 3], frag: &mut Frag, sat: &mut SatCounter, cb: u32) {
+    let max = (1u64 << cb) - 1;
+    for (ch, a) in acc.into_iter().enumerate() {
+        if a > max {
+            sat.saturated += 1;
+        }
+        let a = a.min(max);
+        frag.out_x[ch] = a as u32;
+        frag.out[ch] = a as f64 / max as f64;
+    }
+    frag.out_x[3] = max as u32;
+    frag.out[3] = 1.0;
+    frag.out_bits = cb;
 }

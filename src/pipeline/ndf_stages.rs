@@ -286,7 +286,6 @@ pub fn run_ndf_stage(
             let vc = &units.cfg.vector;
             let f = vc.vector_frac_bits;
             let cb = units.cfg.shade.shade_color_bits;
-            let max = (1u64 << cb) - 1;
             let spec_scale = 2.0 * std::f64::consts::PI / f64::from(np.shininess.max(1));
             if let Some(unit) = unit {
                 let rnd = units.cfg.shade.shade_rounding;
@@ -370,17 +369,7 @@ pub fn run_ndf_stage(
                             .saturating_add(sp.max(0) as u64);
                     }
                 }
-                for ch in 0..3 {
-                    if acc[ch] > max {
-                        acc[ch] = max;
-                        sat.saturated += 1;
-                    }
-                    frag.out_x[ch] = acc[ch] as u32;
-                    frag.out[ch] = acc[ch] as f64 / max as f64;
-                }
-                frag.out_x[3] = max as u32;
-                frag.out[3] = 1.0;
-                frag.out_bits = cb;
+                super::bump_stages::fixed_output(acc, frag, &mut sat, cb);
             } else {
                 let texel = if fixed_in(StageKind::NdfFetch) {
                     frag.ndf
@@ -439,15 +428,7 @@ pub fn run_ndf_stage(
                         acc[ch] += light.color_f[ch] * (bp.kd[ch] * ndl + bp.ks[ch] * spec);
                     }
                 }
-                for ch in 0..3 {
-                    if !acc[ch].is_finite() {
-                        c.nonfinite += 1;
-                        acc[ch] = 0.0;
-                    }
-                    frag.out[ch] = acc[ch].clamp(0.0, 1.0);
-                }
-                frag.out[3] = 1.0;
-                frag.out_bits = 0;
+                super::bump_stages::float_output(acc, frag, c);
             }
         }
         _ => {}

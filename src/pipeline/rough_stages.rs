@@ -34,7 +34,6 @@ use hw_model::blinn_phong::BlinnPhongInput;
 use hw_model::config::HwConfig;
 use hw_model::fixed::SatCounter;
 use hw_model::lod::lod;
-use hw_model::modulate::modulate;
 use hw_model::roughness::{
     decode_d, rough_blinn_phong, rough_blinn_phong_cost, scale_d, RoughShadeInput, RoughVariant,
 };
@@ -341,7 +340,6 @@ pub fn run_rough_stage(
         StageKind::RoughShade => {
             let bf = &frag.bump;
             let cb = units.cfg.shade.shade_color_bits;
-            let max = (1u64 << cb) - 1;
             if fixed {
                 let rnd = units.cfg.shade.shade_rounding;
                 let n = if fixed_in(StageKind::Perturb) {
@@ -377,29 +375,16 @@ pub fn run_rough_stage(
                     dv: scale_d(dv, len, lfb, iso, &mut sat),
                     t,
                 };
-                let mut kd = bp.kd.map(|x| u64::from(to_unorm(x, cb)));
-                if plan.texture.is_some() {
-                    let tex = if fixed_in(StageKind::Trilinear) {
-                        frag.texel_x
-                    } else {
-                        frag.texel.map(|x| to_unorm(x, tb))
-                    };
-                    for ch in 0..3 {
-                        kd[ch] = u64::from(modulate(kd[ch] as u32, cb, tex[ch], tb, cb, rnd));
-                    }
-                }
-                let ks = bp.ks.map(|x| u64::from(to_unorm(x, cb)));
-                let mut acc = [0u64; 3];
-                for ch in 0..3 {
-                    acc[ch] = u64::from(modulate(
-                        m.ambient_x[ch] as u32,
-                        cb,
-                        kd[ch] as u32,
-                        cb,
-                        cb,
-                        rnd,
-                    ));
-                }
+                let (kd, ks, mut acc) = super::bump_stages::fixed_material(
+                    bp,
+                    m,
+                    plan.texture.is_some(),
+                    fixed_in(StageKind::Trilinear),
+                    frag.texel_x,
+                    frag.texel,
+                    cb,
+                    rnd,
+                );
                 for light in &m.lights {
                     let l = match light.point {
                         Some(pi) => {
@@ -427,17 +412,7 @@ pub fn run_rough_stage(
                         acc[ch] += r.color[ch];
                     }
                 }
-                for ch in 0..3 {
-                    if acc[ch] > max {
-                        acc[ch] = max;
-                        sat.saturated += 1;
-                    }
-                    frag.out_x[ch] = acc[ch] as u32;
-                    frag.out[ch] = acc[ch] as f64 / max as f64;
-                }
-                frag.out_x[3] = max as u32;
-                frag.out[3] = 1.0;
-                frag.out_bits = cb;
+                super::bump_stages::fixed_output(acc, frag, &mut sat, cb);
             } else {
                 let v = fref::normalize_or(DVec3::from(bf.to_eye), DVec3::Z).0;
                 let mut kd = bp.kd;
@@ -526,15 +501,7 @@ pub fn run_rough_stage(
                         acc[ch] += col[ch];
                     }
                 }
-                for ch in 0..3 {
-                    if !acc[ch].is_finite() {
-                        c.nonfinite += 1;
-                        acc[ch] = 0.0;
-                    }
-                    frag.out[ch] = acc[ch].clamp(0.0, 1.0);
-                }
-                frag.out[3] = 1.0;
-                frag.out_bits = 0;
+                super::bump_stages::float_output(acc, frag, c);
             }
         }
         _ => {}
