@@ -1,15 +1,15 @@
 //! Every built-in scene, with every effect it uses (bumps, roughness, NDF, Ashikhmin-Shirley,
 //! footprint assembly), the ground truth and the timing model, renders bit-identically on 1
-//! and on 3 threads.
+//! and on 3 threads, and with the timing model off.
 
 use texsim::render::{render, Maps, RenderOptions, Rendered};
 use texsim::scene::{self, BUILTIN};
 use texsim::timing::simulate;
 
-fn render_on(threads: usize, s: &scene::Scene, hw: &hw_model::HwConfig) -> Rendered {
+fn render_on(threads: usize, s: &scene::Scene, hw: &hw_model::HwConfig, timing: bool) -> Rendered {
     let maps = Maps::new(s, hw.trilinear.texel_bits);
     let opts = RenderOptions {
-        timing: true,
+        timing,
         truth: 4,
         ..RenderOptions::default()
     };
@@ -35,11 +35,27 @@ fn every_builtin_scene_is_identical_on_1_and_3_threads() {
         let mut s = scene::builtin(name).expect("builtin");
         s.width = 96;
         s.height = 64;
-        let (a, b) = (render_on(1, &s, &hw), render_on(3, &s, &hw));
+        let (a, b) = (render_on(1, &s, &hw, true), render_on(3, &s, &hw, true));
         assert!(a.hw_image == b.hw_image, "{name}: hardware image");
         assert!(a.ref_image == b.ref_image, "{name}: reference image");
         assert!(a.truth_image == b.truth_image, "{name}: truth image");
         assert_eq!(stats_json(&a), stats_json(&b), "{name}: stats");
+        // The timing model never changes a pixel or a statistic.
+        let c = render_on(2, &s, &hw, false);
+        assert!(c.events.is_none(), "{name}: no events unless asked for");
+        assert!(
+            a.hw_image == c.hw_image,
+            "{name}: timing changed the hardware image"
+        );
+        assert!(
+            a.ref_image == c.ref_image,
+            "{name}: timing changed the reference image"
+        );
+        assert_eq!(
+            stats_json(&a),
+            stats_json(&c),
+            "{name}: timing changed the stats"
+        );
         let (ea, eb) = (a.events.expect("events"), b.events.expect("events"));
         assert_eq!(
             serde_json::to_value(simulate(&ea, &hw, name)).expect("json"),

@@ -6,8 +6,8 @@
 //! and say in the commit message which model change moved which number and why.
 
 use texsim::render::{render, Maps, RenderOptions};
-use texsim::scene;
-use texsim::timing::{cycles, simulate};
+use texsim::scene::{self, BUILTIN};
+use texsim::timing::{cycles, simulate, TimingReport};
 
 /// (scene, preset[+FIELD=VALUE], total cycles, cache hits, bank conflicts, DRAM page misses).
 const GOLDEN: &[(&str, &str, u64, u64, u64, u64)] = &[
@@ -40,6 +40,204 @@ const GOLDEN: &[(&str, &str, u64, u64, u64, u64)] = &[
     ),
     ("w1-plane", "texram16+aniso_probes=4", 738161, 0, 0, 362243),
     ("w1-plane", "d3d11+aniso_probes=4", 473543, 841033, 0, 5447),
+];
+
+/// Every built-in scene on two presets at 128x128: (scene, preset, total cycles, visibility
+/// pass, shading pass, sum of stall cycles, bottleneck, bottleneck cycles, texel accesses, DRAM
+/// page misses). Pins the split of the frame, the stall attribution and the bottleneck too.
+type Row = (
+    &'static str,
+    &'static str,
+    u64,
+    u64,
+    u64,
+    u64,
+    &'static str,
+    u64,
+    u64,
+    u64,
+);
+const EVERY_SCENE: &[Row] = &[
+    (
+        "demo", "texram16", 224683, 109331, 115352, 191202, "memory", 114431, 77880, 73822,
+    ),
+    (
+        "demo", "d3d11", 176991, 109331, 67660, 143188, "setup", 109328, 77688, 1309,
+    ),
+    (
+        "w1-plane", "texram16", 108841, 10806, 98035, 87401, "memory", 96450, 72672, 61432,
+    ),
+    (
+        "w1-plane", "d3d11", 47178, 10806, 36372, 25627, "memory", 36342, 72552, 436,
+    ),
+    (
+        "w2-mesh", "texram16", 1097490, 969857, 127633, 1024649, "setup", 969856, 85768, 84847,
+    ),
+    (
+        "w2-mesh", "d3d11", 1102398, 969857, 132541, 1029487, "setup", 969856, 85688, 3092,
+    ),
+    (
+        "sphere", "texram16", 162939, 44455, 118484, 130398, "memory", 118210, 80705, 78228,
+    ),
+    (
+        "sphere", "d3d11", 119418, 44455, 74963, 86893, "memory", 74927, 80265, 1456,
+    ),
+    (
+        "bumps", "texram16", 190112, 41736, 148376, 155164, "memory", 148267, 99425, 98685,
+    ),
+    (
+        "bumps", "d3d11", 131886, 41736, 90150, 96350, "memory", 90037, 99277, 1657,
+    ),
+    (
+        "as-metal", "texram16", 504241, 433569, 70672, 461849, "setup", 433568, 0, 0,
+    ),
+    (
+        "as-metal", "d3d11", 451321, 433569, 17752, 408929, "setup", 433568, 0, 0,
+    ),
+    (
+        "as-plastic",
+        "texram16",
+        504241,
+        433569,
+        70672,
+        461849,
+        "setup",
+        433568,
+        0,
+        0,
+    ),
+    (
+        "as-plastic",
+        "d3d11",
+        451321,
+        433569,
+        17752,
+        408929,
+        "setup",
+        433568,
+        0,
+        0,
+    ),
+    (
+        "as-brushed",
+        "texram16",
+        183625,
+        122049,
+        61576,
+        162950,
+        "setup",
+        122048,
+        0,
+        0,
+    ),
+    (
+        "as-brushed",
+        "d3d11",
+        137518,
+        122049,
+        15469,
+        116843,
+        "setup",
+        122048,
+        0,
+        0,
+    ),
+    (
+        "lake", "texram16", 234524, 8614, 225910, 217031, "memory", 193536, 121344, 121344,
+    ),
+    (
+        "lake", "d3d11", 133292, 8614, 124678, 114855, "memory", 58564, 121120, 754,
+    ),
+    (
+        "corrugated",
+        "texram16",
+        260154,
+        9156,
+        250998,
+        241607,
+        "memory",
+        215040,
+        141824,
+        141824,
+    ),
+    (
+        "corrugated",
+        "d3d11",
+        155512,
+        9156,
+        146356,
+        135643,
+        "memory",
+        74610,
+        141600,
+        1023,
+    ),
+    (
+        "brushed", "texram16", 312376, 11202, 301174, 289991, "memory", 258048, 172032, 172032,
+    ),
+    (
+        "brushed", "d3d11", 277815, 11202, 266613, 253550, "memory", 180583, 171600, 3808,
+    ),
+    (
+        "scratches",
+        "texram16",
+        282622,
+        10120,
+        272502,
+        262343,
+        "memory",
+        233472,
+        155648,
+        155648,
+    ),
+    (
+        "scratches",
+        "d3d11",
+        235494,
+        10120,
+        225374,
+        214895,
+        "memory",
+        147500,
+        155360,
+        3147,
+    ),
+    (
+        "ripple-sphere",
+        "texram16",
+        177285,
+        23095,
+        154190,
+        160648,
+        "memory",
+        154008,
+        102672,
+        102672,
+    ),
+    (
+        "ripple-sphere",
+        "d3d11",
+        153663,
+        23095,
+        130568,
+        136438,
+        "memory",
+        130382,
+        102432,
+        3076,
+    ),
+    (
+        "lod-pair", "texram16", 173510, 15198, 158312, 150245, "memory", 158130, 105420, 105420,
+    ),
+    (
+        "lod-pair", "d3d11", 45363, 15198, 30165, 21946, "memory", 29979, 105408, 105,
+    ),
+    (
+        "foil", "texram16", 190426, 5492, 184934, 179243, "memory", 184752, 123168, 123168,
+    ),
+    (
+        "foil", "d3d11", 92396, 5492, 86904, 81054, "memory", 86718, 123168, 1530,
+    ),
 ];
 
 fn config(spec: &str) -> hw_model::HwConfig {
@@ -134,5 +332,63 @@ fn modern_preset_is_faster_and_cached() {
         let used: u64 = r.stalls.iter().skip(1).map(|s| s.cycles).sum();
         assert!(used <= r.shading_pass_cycles, "stalls bounded by the pass");
         assert!(r.units.iter().all(|u| u.busy_cycles <= r.total_cycles));
+    }
+}
+
+fn row(name: &'static str, preset: &'static str, r: &TimingReport) -> String {
+    format!(
+        "    (\"{name}\", \"{preset}\", {}, {}, {}, {}, \"{}\", {}, {}, {}),",
+        r.total_cycles,
+        r.visibility_pass_cycles,
+        r.shading_pass_cycles,
+        r.stalls.iter().map(|s| s.cycles).sum::<u64>(),
+        r.bottleneck,
+        r.bottleneck_cycles,
+        r.memory.texel_accesses,
+        r.memory.dram_page_misses,
+    )
+}
+
+#[test]
+fn every_builtin_scene_on_two_presets() {
+    let mut got = Vec::new();
+    let mut want = Vec::new();
+    for &(name, _) in BUILTIN {
+        for preset in ["texram16", "d3d11"] {
+            let mut s = scene::builtin(name).expect("builtin scene");
+            s.width = 128;
+            s.height = 128;
+            let hw = config(preset);
+            let maps = Maps::new(&s, hw.trilinear.texel_bits);
+            let (_, r) = cycles(&s, &maps, &hw).expect("cycles");
+            got.push(row(name, preset, &r));
+        }
+    }
+    for &(n, p, t, v, sh, st, b, bc, ta, pm) in EVERY_SCENE {
+        want.push(format!(
+            "    (\"{n}\", \"{p}\", {t}, {v}, {sh}, {st}, \"{b}\", {bc}, {ta}, {pm}),"
+        ));
+    }
+    assert!(
+        got == want,
+        "golden cycle counts of the scene suite changed; got:\n{}",
+        got.join("\n")
+    );
+}
+
+/// The README and docs/TIMING.md print the golden table: every row's numbers are there.
+#[test]
+fn documented_tables_match_the_golden_counts() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    for doc in ["README.md", "docs/TIMING.md"] {
+        let text = std::fs::read_to_string(format!("{root}/{doc}")).expect("doc");
+        for &(name, preset, total, hits, conflicts, misses) in GOLDEN {
+            let cells = format!("| {total} | {hits} | {conflicts} | {misses} |");
+            assert!(
+                text.lines()
+                    .any(|l| l.starts_with(&format!("| {name} |")) && l.ends_with(&cells)),
+                "{doc}: no table row for {name} on {preset} ending in {cells}"
+            );
+        }
     }
 }

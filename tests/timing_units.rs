@@ -121,6 +121,16 @@ fn conflicts_are_counted_otherwise() {
         footprint_conflicts(&fp(4, 7, 18, 16), 18, 4, BankInterleave::Linear),
         0
     );
+    // Wrapping around an odd-sized level puts columns w - 1 and 0 (both even) side by side:
+    // under the tiled interleave both rows conflict.
+    assert_eq!(
+        footprint_conflicts(&fp(4, 2, 5, 8), 5, 4, BankInterleave::Tiled),
+        2
+    );
+    assert_eq!(
+        footprint_conflicts(&fp(3, 2, 5, 8), 5, 4, BankInterleave::Tiled),
+        0
+    );
     // A 1-texel-wide level reads the same texel twice: not a conflict.
     let thin = TexelFootprint {
         x: [0, 0],
@@ -230,4 +240,131 @@ fn filter_throughput_and_units() {
         .sum();
     assert_eq!(busy, 100);
     assert!(r.total_cycles >= 100);
+}
+
+/// A frame of `n` pixels whose plan is one arithmetic stage (`Phong`) of `cycles` cycles.
+fn alu_frame(n: usize, cycles: u32) -> FrameEvents {
+    FrameEvents {
+        width: 8,
+        height: 8,
+        plans: vec![PlanTiming {
+            stages: vec![(
+                StageKind::Phong,
+                UnitCost {
+                    ops: 1,
+                    cycles,
+                    texels: 0,
+                },
+            )],
+        }],
+        pixels: (0..n)
+            .map(|_| PixelEvent {
+                plan: 0,
+                tri: 0,
+                fp_end: 0,
+            })
+            .collect(),
+        ..FrameEvents::default()
+    }
+}
+
+fn stall(r: &texsim::timing::TimingReport, cause: &str) -> u64 {
+    r.stalls
+        .iter()
+        .find(|s| s.cause == cause)
+        .map_or_else(|| panic!("no stall cause {cause}"), |s| s.cycles)
+}
+
+#[test]
+fn visibility_pass_is_the_slower_stage_plus_one_item_of_the_other() {
+    // 10 triangles x 16 setup cycles = 160; traversal 40 spans x 2 + 400 fragments = 480,
+    // 48 per triangle: traversal-bound, 16 + 480 = 496.
+    let hw = HwConfig::texram16();
+    let ev = FrameEvents {
+        triangles: 10,
+        spans: 40,
+        fragments: 400,
+        ..FrameEvents::default()
+    };
+    let r = simulate(&ev, &hw, "t");
+    assert_eq!(r.visibility_pass_cycles, 496);
+    assert_eq!(r.total_cycles, 496);
+    assert_eq!(stall(&r, "traverse waits for setup"), 496 - 480);
+    // Setup-bound: 100 triangles (1600 cycles) with the same traversal: 1600 + 4 = 1604.
+    let r = simulate(
+        &FrameEvents {
+            triangles: 100,
+            ..ev
+        },
+        &hw,
+        "t",
+    );
+    assert_eq!(r.visibility_pass_cycles, 1604);
+    assert_eq!(r.bottleneck, "setup");
+    assert_eq!(r.bottleneck_cycles, 1600);
+}
+
+#[test]
+fn in_flight_window_stalls_are_latency_or_the_busy_unit() {
+    // Window of 2 pixels, one pixel per cycle, one 10-cycle arithmetic stage.
+    let mut hw = HwConfig::texram16();
+    hw.timing.shade_pixels_in_flight = 2;
+    hw.timing.shade_pixels_per_cycle = 1;
+    // Pipelined: p0 0..10, p1 1..11, p2 waits for p0 (8 cycles, latency: p0 never waited)
+    // 10..20, p3 issues at 11 (one after p2), no wait: 11..21.
+    hw.timing.alu_pipelined = true;
+    let r = simulate(&alu_frame(4, 10), &hw, "t");
+    assert_eq!(r.shading_pass_cycles, 21);
+    assert_eq!(stall(&r, "latency"), 8);
+    assert_eq!(stall(&r, "phong busy"), 0);
+    assert_eq!(r.bottleneck, texsim::timing::LATENCY_BOTTLENECK);
+    // Not pipelined: the unit is busy 10 cycles per pixel. p0 0..10, p1 waits for the unit
+    // 10..20, p2 waits 8 for p0 (latency) then the unit: 20..30, p3 waits 9 for p1, which
+    // had waited for the unit (phong busy): 30..40.
+    hw.timing.alu_pipelined = false;
+    let r = simulate(&alu_frame(4, 10), &hw, "t");
+    assert_eq!(r.shading_pass_cycles, 40);
+    assert_eq!(stall(&r, "latency"), 8);
+    assert_eq!(stall(&r, "phong busy"), 9);
+    assert_eq!(r.bottleneck, "phong");
+    assert_eq!(r.bottleneck_cycles, 40);
+    // Two pixels issue per cycle into a wide window, but the pipelined unit accepts one per
+    // cycle: pixel i starts at i and finishes at i + 10.
+    hw.timing.alu_pipelined = true;
+    hw.timing.shade_pixels_per_cycle = 2;
+    hw.timing.shade_pixels_in_flight = 64;
+    let r = simulate(&alu_frame(8, 10), &hw, "t");
+    assert_eq!(r.shading_pass_cycles, 7 + 10);
+    assert_eq!(stall(&r, "latency"), 0);
+}
+
+#[test]
+fn two_bilinears_per_cycle_halve_the_trilinear_filter_time() {
+    // 100 pixels, each one trilinear lookup: footprints on levels 0 and 1.
+    let mut ev = frame(&[]);
+    ev.textures = vec![vec![(64, 64), (32, 32)]];
+    for i in 0..100u32 {
+        ev.footprints.push(fp(2, 2, 64, 64));
+        ev.footprints.push(TexelFootprint {
+            level: 1,
+            ..fp(1, 1, 32, 32)
+        });
+        ev.pixels.push(PixelEvent {
+            plan: 0,
+            tri: 0,
+            fp_end: 2 * i + 2,
+        });
+    }
+    let busy = |bpc: u32| {
+        let mut hw = HwConfig::texram16();
+        hw.timing.bilinear_per_cycle = bpc;
+        simulate(&ev, &hw, "t")
+            .units
+            .iter()
+            .filter(|u| u.unit.starts_with("filter"))
+            .map(|u| u.busy_cycles)
+            .sum::<u64>()
+    };
+    assert_eq!(busy(1), 200);
+    assert_eq!(busy(2), 100);
 }

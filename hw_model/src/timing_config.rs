@@ -15,7 +15,9 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "kebab-case")]
 pub enum BankInterleave {
     /// 2D interleave: `bank = (x mod bx) + bx (y mod by)` with `bx * by = banks`, `bx >= by`
-    /// (powers of two). With 4 or more banks any 2x2 footprint is conflict-free.
+    /// (powers of two). With 4 or more banks any 2x2 footprint is conflict-free on levels whose
+    /// sides are multiples of `bx` and `by`; a footprint that wraps around an odd-sized level
+    /// (texel `w - 1` next to texel 0) can conflict, and is counted.
     Tiled,
     /// Linear interleave of the row-major texel index: `bank = (y * width + x) mod banks`.
     /// Vertical neighbours collide whenever `width` is a multiple of `banks`.

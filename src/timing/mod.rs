@@ -10,7 +10,7 @@ pub mod model;
 pub mod report;
 
 pub use events::{FrameEvents, PixelEvent, RowEvents, TexelFootprint};
-pub use model::{simulate, Cache, TimingReport};
+pub use model::{simulate, Cache, TimingReport, LATENCY_BOTTLENECK};
 
 use crate::render::{render, Maps, RenderOptions, Rendered};
 use crate::scene::Scene;

@@ -93,8 +93,12 @@ pub struct TimingReport {
     pub bank_conflict_cycles: u64,
     /// Memory cycles caused by cache and page misses (beyond a hit's).
     pub miss_cycles: u64,
-    /// The unit with the most busy cycles.
+    /// The unit with the most busy cycles, or [`LATENCY_BOTTLENECK`] when the shading pass
+    /// loses more cycles to latency stalls (a full in-flight window whose oldest pixel never
+    /// waited for a busy unit) than the busiest unit is busy.
     pub bottleneck: String,
+    /// The bottleneck's busy cycles (or latency stall cycles).
+    pub bottleneck_cycles: u64,
     /// Events consumed (pixels + footprints + triangles + spans).
     pub events: u64,
 }
@@ -108,6 +112,9 @@ pub struct Cache {
 }
 
 const EMPTY: u64 = u64::MAX;
+
+/// The bottleneck's name when latency, not throughput, limits the shading pass.
+pub const LATENCY_BOTTLENECK: &str = "latency (in-flight window)";
 
 impl Cache {
     /// A cache of `sets` x `ways` lines (both at least 1).
@@ -564,13 +571,20 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
             utilization: util(f.busy),
         });
     }
-    let bottleneck = units
+    let busiest = units
         .iter()
         .fold(None::<&UnitReport>, |best, u| match best {
             Some(b) if b.busy_cycles >= u.busy_cycles => Some(b),
             _ => Some(u),
         })
-        .map_or_else(String::new, |u| u.unit.clone());
+        .map_or((String::new(), 0), |u| (u.unit.clone(), u.busy_cycles));
+    // A frame whose pixels mostly wait for results (the in-flight window is too small for the
+    // pipeline's latency) is bound by latency, not by any unit's throughput.
+    let (bottleneck, bottleneck_cycles) = if stall_by[c_lat] > busiest.1 {
+        (LATENCY_BOTTLENECK.to_string(), stall_by[c_lat])
+    } else {
+        busiest
+    };
     let mut stalls = vec![StallReport {
         cause: "traverse waits for setup".into(),
         cycles: vis.saturating_sub(traverse_busy),
@@ -612,6 +626,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
         bank_conflict_cycles: mem.conflict_cycles,
         miss_cycles: mem.miss_cycles,
         bottleneck,
+        bottleneck_cycles,
         events: ev.len(),
     }
 }

@@ -63,6 +63,10 @@ pub fn text(r: &TimingReport) -> String {
         "memory cycles from bank conflicts {}, from cache/page misses {}",
         r.bank_conflict_cycles, r.miss_cycles
     );
-    let _ = writeln!(o, "bottleneck: {}; {} events", r.bottleneck, r.events);
+    let _ = writeln!(
+        o,
+        "bottleneck: {} ({} cycles); {} events",
+        r.bottleneck, r.bottleneck_cycles, r.events
+    );
     o
 }
