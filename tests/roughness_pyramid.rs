@@ -4,10 +4,10 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use hw_model::roughness::{decode_d, RoughnessConfig};
+use hw_model::roughness::{decode_d, RoughnessConfig, D2_CHANNEL};
 use texsim::shading::roughness::{
-    build_rough_pyramid, d_factor, d_product, decode_d_texels, lambda1, quantize_rough_chain,
-    rough_mip_chain, RoughParams, RoughnessEncoding, UNIFORM_CORRECTION,
+    build_rough_pyramid, d_factor, d_product, decode_d_texels, lambda1, quantize_d_channel,
+    quantize_rough_chain, rough_mip_chain, RoughParams, RoughnessEncoding, UNIFORM_CORRECTION,
 };
 
 struct Rng(u64);
@@ -301,13 +301,117 @@ fn quantized_chain_has_d_bits_resolution() {
             let q = quantize_rough_chain(&chain, bits, 16);
             for (fl, ql) in chain.levels.iter().zip(&q.levels) {
                 for (ft, qt) in fl.texels.iter().zip(&ql.texels) {
-                    for c in 0..3 {
+                    for c in [0, 2] {
                         let v = f64::from(qt[c]) / 65535.0;
                         let e = (v - f64::from(ft[c])).abs();
                         assert!(e <= 0.5 / ((1u32 << bits) - 1) as f64 + 2e-5, "{bits} {e}");
                     }
+                    // d2, offset-binary: (t - 2^15) / 2^16 + 1/2, half a step of 2^-bits.
+                    let v = (f64::from(qt[1]) - 32768.0) / 65536.0 + 0.5;
+                    let e = (v - f64::from(ft[1])).abs();
+                    assert!(e <= 0.5 / f64::from(1u32 << bits) + 1e-7, "{bits} d2 {e}");
                 }
             }
+        }
+    }
+}
+
+/// The stored-and-widened D texels of one D value at `d_bits`, through the host encoder and
+/// quantizer the renderer uses (`RoughnessEncoding::encode` + `quantize_rough_chain`).
+fn stored_texels(enc: &RoughnessEncoding, d: [f64; 3], d_bits: u32) -> [u64; 3] {
+    let (ch, _) = enc.encode(d);
+    let chain = texsim::maps::MipChain {
+        levels: vec![texsim::maps::MipLevel {
+            width: 1,
+            height: 1,
+            texels: vec![[ch[0], ch[1], ch[2], 1.0]],
+        }],
+    };
+    let q = quantize_rough_chain(&chain, d_bits, 16);
+    let t = q.levels[0].texels[0];
+    [0, 1, 2].map(|i| u64::from(t[i]))
+}
+
+#[test]
+fn flat_texels_decode_to_zero_shear_at_every_d_bits() {
+    // A flat region (K = 0) stores K' = m s0^2 I: d2 = 0. Bit-replicating the centre code
+    // 2^(d-1) gave 0x8080 at 8 bits, i.e. d2 = +2R/255 (+0.27 at 4 bits): flat texels sheared.
+    let offs = vec![[0.25f32, -0.5]; 8 * 8];
+    let pyr = build_rough_pyramid(&offs, 8, 8).expect("valid");
+    for range_exp in -4..=4 {
+        let cfg = RoughnessConfig {
+            rough_range_exp: range_exp,
+            ..RoughnessConfig::texram16()
+        };
+        let enc = RoughnessEncoding::for_range_exp(range_exp);
+        for shininess in [1u32, 16, 400] {
+            let params = RoughParams::for_material(shininess, shininess, false);
+            let (chain, _) = rough_mip_chain(&pyr, &params, &enc, false);
+            for d_bits in 2..=16 {
+                let q = quantize_rough_chain(&chain, d_bits, 16);
+                for lev in &q.levels {
+                    for t in &lev.texels {
+                        let t = [0, 1, 2].map(|i| u64::from(t[i]));
+                        let (raw, _) = decode_d(t, 16, &cfg);
+                        let f = decode_d_texels(t, 16, range_exp);
+                        assert_eq!(raw[1], 0, "e {range_exp} s {shininess} d_bits {d_bits}");
+                        assert_eq!(f[1], 0.0, "e {range_exp} s {shininess} d_bits {d_bits}");
+                        assert_eq!(raw[0], raw[2], "isotropic K': d1 = d3");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn d2_quantization_is_unbiased_symmetric_and_within_half_a_step() {
+    let mut r = Rng(9);
+    for range_exp in [-2, 0, 2, 4] {
+        let cfg = RoughnessConfig {
+            rough_range_exp: range_exp,
+            ..RoughnessConfig::texram16()
+        };
+        let enc = RoughnessEncoding::for_range_exp(range_exp);
+        let big_r = enc.range;
+        for d_bits in 2..=16u32 {
+            let step = 2.0 * big_r / f64::from(1u32 << d_bits);
+            let top = big_r - step;
+            let (mut sum, n) = (0.0, 20_000);
+            for _ in 0..n {
+                let x = (r.unit() * 2.0 - 1.0) * top;
+                let t = stored_texels(&enc, [0.5 * big_r, x, 0.5 * big_r], d_bits);
+                let got = decode_d_texels(t, 16, range_exp)[1];
+                let (raw, frac) = decode_d(t, 16, &cfg);
+                assert_eq!(raw[1] as f64 * (-f64::from(frac)).exp2(), got);
+                let e = got - x;
+                // Half a step, plus the f32 rounding of the channel value 1/2 + x / (2R).
+                let tol = 0.5 * step + 2.0 * big_r * 2f64.powi(-24);
+                assert!(e.abs() <= tol, "{d_bits} {x} {e}");
+                sum += e;
+            }
+            // Symmetric: channel values 1/2 +- j 2^-20 (exact in f32) give mirrored codes.
+            let half = 1u64 << (d_bits - 1);
+            for j in 0..(1u32 << 19) {
+                let y = f64::from(j) * 2f64.powi(-20);
+                let (up, down) = (
+                    quantize_d_channel((0.5 + y) as f32, D2_CHANNEL, d_bits),
+                    quantize_d_channel((0.5 - y) as f32, D2_CHANNEL, d_bits),
+                );
+                if up < 2 * half - 1 {
+                    assert_eq!(up - half, half - down, "{d_bits} {y}");
+                }
+            }
+            let mean = sum / f64::from(n);
+            assert!(
+                mean.abs() < 0.02 * step,
+                "e {range_exp} d_bits {d_bits}: bias {mean}"
+            );
+            // The ends: -R exactly; +R clamps to the top code R - step.
+            let lo = stored_texels(&enc, [0.0, -big_r, 0.0], d_bits);
+            let hi = stored_texels(&enc, [0.0, big_r, 0.0], d_bits);
+            assert_eq!(decode_d_texels(lo, 16, range_exp)[1], -big_r);
+            assert_eq!(decode_d_texels(hi, 16, range_exp)[1], top);
         }
     }
 }

@@ -19,10 +19,11 @@
 //! `|d|^4/|Dd|^2 <= |d|^2 / sigma_min^2 -> 0`); `M = 0` (D singular along d, d != 0) gives 0
 //! and counts a saturation; `Q >= 2^`[`Q_CAP_BITS`] gives 0 and counts a saturation.
 //!
-//! Datapath: `d`, `cos a` in vector format (s1.F); the D channels are filtered unorm texels
-//! `t` (`texel_bits`) decoded exactly as `d1 = t 2^(e - bits)`, `d2 = (t - 2^(bits-1))
+//! Datapath: `d`, `cos a` in vector format (s1.F); the D channels are filtered texels `t`
+//! (`texel_bits`) decoded exactly as `d1 = t 2^(e - bits)`, `d2 = (t - 2^(bits-1))
 //! 2^(e + 1 - bits)`, `d3` like `d1` (`e = rough_range_exp`, channel range `[0, 2^e)`,
-//! `d2` in `[-2^e, 2^e)`). `N` and `M` are exact integers; the divider returns `N / M` with
+//! `d2` in `[-2^e, 2^e)`); `d1`, `d3` are stored unorm, `d2` offset-binary so that 0 is
+//! exact at every stored width ([`widen_d_channel`]). `N` and `M` are exact integers; the divider returns `N / M` with
 //! `rough_div_bits` significant bits (round half even, exact remainder); `Q` is formed with
 //! `W = 4F + 8` fraction bits; the square root of `Q + cos^2 a` has `rough_sqrt_bits`
 //! significant bits (correctly rounded); the divider then forms `cos a / sqrt(...)`, rounded
@@ -231,8 +232,36 @@ pub fn expand_channel(q: u64, d_bits: u32, texel_bits: u32) -> u64 {
     out
 }
 
+/// Index of the signed D channel (`d2`), stored offset-binary ([`widen_d_channel`]).
+pub const D2_CHANNEL: usize = 1;
+
+/// Widens stored D channel `channel` (`d_bits` wide) to `texel_bits`, what texture memory
+/// holds. `d1`, `d3` (and lambda1) are unorm: bit replication ([`expand_channel`]). `d2` is
+/// signed, stored offset-binary, `q = 2^(d-1) + round(d2 2^d / (2R))`, i.e.
+/// `d2 = (q - 2^(d-1)) 2R / 2^d`; it is widened by zero padding, `q 2^(T-d)`, which keeps that
+/// value exactly (`d2 = (t - 2^(T-1)) 2R / 2^T`, the form [`decode_d`] decodes), so `d2 = 0`
+/// (every flat texel) stays exactly 0 at every `d_bits`. Bit replication would move the
+/// centre code `2^(d-1)` to `2^(T-1) + 2^(T-1-d) + ...` (8 bits: `0x8080`), a shear of
+/// `+2R / (2^d - 1)` on flat texels (+0.016 at 8 bits, +0.27 at 4 bits, `R = 4`).
+#[must_use]
+pub fn widen_d_channel(q: u64, channel: usize, d_bits: u32, texel_bits: u32) -> u64 {
+    if channel != D2_CHANNEL {
+        return expand_channel(q, d_bits, texel_bits);
+    }
+    let d = d_bits.clamp(1, 32);
+    let t = texel_bits.clamp(1, 32);
+    let q = q.min((1u64 << d) - 1);
+    if d >= t {
+        q >> (d - t)
+    } else {
+        q << (t - d)
+    }
+}
+
 /// Raw D values `[d1, d2, d3]` with `T = texel_bits - rough_range_exp` fraction bits, decoded
-/// exactly from filtered texels (module doc). Returns the values and `T`.
+/// exactly from filtered texels (module doc). Returns the values and `T`. `d2` is decoded
+/// around `2^(texel_bits - 1)`, the widened centre code of [`widen_d_channel`] at every
+/// `d_bits`, so a flat texel (`d2 = 0`) decodes to exactly 0.
 #[must_use]
 pub fn decode_d(t: [u64; 3], texel_bits: u32, cfg: &RoughnessConfig) -> ([i64; 3], u32) {
     let bits = texel_bits.clamp(1, 16);
