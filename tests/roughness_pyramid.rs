@@ -415,3 +415,158 @@ fn d2_quantization_is_unbiased_symmetric_and_within_half_a_step() {
         }
     }
 }
+
+#[test]
+fn lod_past_the_last_level_reads_the_last_texel_through_the_real_path() {
+    // The renderer's path: finest offsets -> covariance pyramid -> D chain -> rough_d_bits
+    // quantization -> the trilinear unit (fixed) / trilinear_f64 (float) at an LOD far past
+    // the last level -> decode -> the modified Blinn-Phong unit and its twin.
+    use hw_model::fixed::SatCounter;
+    use hw_model::lod::lod;
+    use hw_model::roughness::{rough_cos, RoughInput, RoughVariant};
+    use hw_model::trilinear::{trilinear, Level};
+    use hw_model::wrap::WrapMode;
+    use texsim::reference::{trilinear_f64, LevelF};
+    use texsim::shading::roughness::rough_cos_twin;
+    let mut r = Rng(10);
+    let (w, h) = (12u32, 6u32);
+    let offs: Vec<[f32; 2]> = (0..w * h)
+        .map(|_| [(r.unit() - 0.5) as f32, (r.unit() * 0.6 - 0.3) as f32])
+        .collect();
+    let pyr = build_rough_pyramid(&offs, w, h).expect("valid");
+    let hw = hw_model::HwConfig::texram16();
+    let tb = hw.trilinear.texel_bits;
+    let lf = hw.lod.lod_frac_bits;
+    let frac = 20u32;
+    let mut sat = SatCounter::default();
+    let wraps = [
+        [WrapMode::Repeat, WrapMode::Repeat],
+        [WrapMode::ClampToEdge, WrapMode::Mirror],
+    ];
+    for (variant, iso) in [
+        (RoughVariant::Directional, false),
+        (RoughVariant::Mahalanobis, false),
+        (RoughVariant::Isotropic, true),
+    ] {
+        for d_bits in [4u32, 8, 16] {
+            let cfg = RoughnessConfig {
+                rough_variant: variant,
+                rough_d_bits: d_bits,
+                ..RoughnessConfig::texram16()
+            };
+            let enc = RoughnessEncoding::for_range_exp(cfg.rough_range_exp);
+            let params = RoughParams::for_material(32, 32, false);
+            let (chain, clamped) = rough_mip_chain(&pyr, &params, &enc, iso);
+            assert_eq!(clamped, 0);
+            let q = quantize_rough_chain(&chain, d_bits, tb);
+            let fixed: Vec<Level> = q
+                .levels
+                .iter()
+                .map(|l| Level {
+                    width: l.width,
+                    height: l.height,
+                    texels: &l.texels,
+                })
+                .collect();
+            let float: Vec<LevelF> = chain
+                .levels
+                .iter()
+                .map(|l| LevelF {
+                    width: l.width,
+                    height: l.height,
+                    texels: &l.texels,
+                })
+                .collect();
+            let last = fixed.len() as i64 - 1;
+            let (last_x, last_f) = (
+                q.levels[last as usize].texels[0],
+                chain.levels[last as usize].texels[0],
+            );
+            // LODs from the LOD unit with huge derivatives, and raw ones far past the end.
+            let huge = lod([1 << 45, 0, 0, 1 << 44], frac, &hw.lod, &mut sat);
+            assert!(huge > (last + 20) << lf, "{huge}");
+            assert_eq!(sat.saturated, 0, "lod");
+            for l in [
+                last << lf,
+                (last << lf) + 1,
+                (last + 1) << lf,
+                63 << lf,
+                huge,
+                i64::MAX,
+            ] {
+                for _ in 0..200 {
+                    let u = (r.next() >> 20) as i64 - (1i64 << 43);
+                    let v = (r.next() >> 20) as i64 - (1i64 << 43);
+                    for wrap in wraps {
+                        let t = trilinear(&fixed, u, v, frac, l, lf, wrap, &hw.trilinear, None);
+                        assert_eq!(t, last_x, "lod {l} ({u}, {v})");
+                        let (uf, vf) = (
+                            u as f64 * (-f64::from(frac)).exp2(),
+                            v as f64 * (-f64::from(frac)).exp2(),
+                        );
+                        for lod_f in [l as f64 * (-f64::from(lf)).exp2(), 1e300, f64::INFINITY] {
+                            let tf = trilinear_f64(&float, uf, vf, lod_f, wrap);
+                            assert_eq!(tf, last_f.map(f64::from), "lod {lod_f}");
+                        }
+                    }
+                }
+            }
+            // Decode the last texel both ways, and against the float model's decode of the
+            // unquantized chain: finite, within the d_bits quantization step.
+            let tex = [0, 1, 2].map(|i| u64::from(last_x[i]));
+            let (raw, frac_t) = decode_d(tex, tb, &cfg);
+            let dq = decode_d_texels(tex, tb, cfg.rough_range_exp);
+            let df = enc.decode([0, 1, 2].map(|i| f64::from(last_f[i])));
+            let big_r = enc.range;
+            let step = big_r * 2f64.powi(-(d_bits as i32));
+            for i in 0..3 {
+                assert_eq!(raw[i] as f64 * (-f64::from(frac_t)).exp2(), dq[i]);
+                assert!(dq[i].is_finite() && df[i].is_finite());
+                let tol = if i == 1 {
+                    step
+                } else {
+                    0.5 * step * 1.07 + big_r * 2f64.powi(-16)
+                };
+                assert!(
+                    (dq[i] - df[i]).abs() <= tol,
+                    "{variant:?} {d_bits} ch {i}: {} vs {}",
+                    dq[i],
+                    df[i]
+                );
+            }
+            // The shading unit on the last texel: finite, in [0, 1], within the unit's bound.
+            let f = 14u32;
+            let one = f64::from(1u32 << f);
+            let b = 1.5 * (-f64::from(cfg.rough_div_bits)).exp2()
+                + (-f64::from(cfg.rough_sqrt_bits)).exp2()
+                + (-17f64).exp2()
+                + (-20f64).exp2();
+            for _ in 0..2_000 {
+                let a = r.unit() * std::f64::consts::FRAC_PI_2;
+                let phi = r.unit() * std::f64::consts::TAU;
+                let inp = RoughInput {
+                    cos_a: (a.cos() * one).round() as i64,
+                    d: [
+                        (a.sin() * phi.cos() * one).round() as i64,
+                        (a.sin() * phi.sin() * one).round() as i64,
+                    ],
+                    dch: tex,
+                    texel_bits: tb,
+                };
+                let o = rough_cos(&inp, &cfg, f, 16, &mut sat);
+                assert!(o.cos_mod <= 1 << 16);
+                assert_eq!(sat.saturated, 0, "{inp:?} {o:?}");
+                let twin = rough_cos_twin(
+                    variant,
+                    inp.cos_a as f64 / one,
+                    [inp.d[0] as f64 / one, inp.d[1] as f64 / one],
+                    dq,
+                );
+                assert!(twin.is_finite() && (0.0..=1.0).contains(&twin));
+                let e = (o.cos_mod as f64 / 65536.0 - twin).abs();
+                assert!(e <= b, "{variant:?} {d_bits}: {inp:?} {e} > {b}");
+            }
+        }
+    }
+    assert_eq!(sat.saturated, 0);
+}
