@@ -561,3 +561,60 @@ fn d_raw_limit_and_q_cap_saturate_to_zero_or_clamp_and_are_counted() {
     assert_eq!(o.color, [0; 3]);
     assert_eq!(sat.saturated, 1);
 }
+
+#[test]
+fn flat_texels_shade_as_plain_blinn_phong_only_in_an_orthonormal_frame() {
+    // A flat texel (K = 0) stores K' = s (0 + s0^2 I) = I with s0 = 1/sqrt(s) (material
+    // mode), so the modified Blinn-Phong is the plain one: tan a' = tan a. That needs
+    // |d| = sin a, i.e. t_u, t_v an orthonormal basis of the tangent plane of the shading
+    // normal (the main frame with an unperturbed normal, lengths 1). A normal tilted off the
+    // frame (a constant nonzero offset) or a natural frame breaks it.
+    use texsim::shading::roughness::{d_factor, RoughParams};
+    let mut rng = Rng(43);
+    let (mut worst_main, mut worst_tilt, mut worst_natural) = (0.0f64, 0.0f64, 0.0f64);
+    for _ in 0..200_000 {
+        let s = 1 + rng.below(1024) as u32;
+        let dv = d_factor(RoughParams::for_material(s, s, false).stored_cov([0.0; 3]));
+        let n = rng.dir();
+        let a = n.any_orthonormal_vector();
+        let phi = rng.unit() * std::f64::consts::TAU;
+        let tu = a * phi.cos() + n.cross(a) * phi.sin();
+        let tv = n.cross(tu);
+        let v = rng.dir();
+        let v = if v.dot(n) < 0.0 { -v } else { v };
+        let l = ((2.0 * n.dot(v) * n - v) + rng.dir() * (0.5 * rng.unit())).normalize();
+        let white = [1.0; 3];
+        let cols = [[0.0; 3], white, white];
+        let plain = |nn: DVec3| r::blinn_phong(nn, l, v, s, [0.0; 3], white, white).0[0];
+        for variant in [
+            RoughVariant::Published,
+            RoughVariant::Directional,
+            RoughVariant::Mahalanobis,
+            RoughVariant::Isotropic,
+        ] {
+            let d = if variant == RoughVariant::Isotropic {
+                [dv[0], 0.0, 0.0]
+            } else {
+                dv
+            };
+            let main = rough_blinn_phong_f(n, l, v, [tu, tv], d, variant, s, 1.0, cols).0[0];
+            worst_main = worst_main.max((main - plain(n)).abs());
+            // The shading normal tilted by a constant offset 0.3 along t_u (flat, K = 0).
+            let nt = (n + 0.3 * tu).normalize();
+            let tilt = rough_blinn_phong_f(nt, l, v, [tu, tv], d, variant, s, 1.0, cols).0[0];
+            worst_tilt = worst_tilt.max((tilt - plain(nt)).abs());
+            // A natural frame: sheared tangents, lengths 2 and 1/2 (D scaled by them).
+            let tvn = (tv + 0.5 * tu).normalize();
+            let dn = scale_d_f(d, [2.0, 0.5], variant == RoughVariant::Isotropic);
+            let nat = rough_blinn_phong_f(n, l, v, [tu, tvn], dn, variant, s, 1.0, cols).0[0];
+            worst_natural = worst_natural.max((nat - plain(n)).abs());
+        }
+    }
+    println!(
+        "flat texel vs plain Blinn-Phong, max |difference| of the specular term: main frame \
+         {worst_main:.2e}, normal tilted 0.3 off the frame {worst_tilt:.3}, natural frame \
+         {worst_natural:.3}"
+    );
+    assert!(worst_main < 1e-12, "{worst_main}");
+    assert!(worst_tilt > 0.01 && worst_natural > 0.1);
+}

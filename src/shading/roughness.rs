@@ -20,7 +20,9 @@
 //! half-width `w` has standard deviation `w / sqrt(3)`, so scaling K by 3 makes the ellipse
 //! `x^T K^-1 x = 1` reach the edge of the distribution), `s0` the material's base roughness
 //! (no texel is a mirror; `s0 = 1/sqrt(shininess)` reproduces Blinn-Phong of that shininess
-//! on flat areas, since `cos^m a` has slope variance about `1/m`) and `m` the exponent the
+//! on flat areas, since `cos^m a` has slope variance about `1/m`, when the frame's tangents
+//! are an orthonormal basis of the shading normal's tangent plane: docs/ROUGHNESS.md) and
+//! `m` the exponent the
 //! shading uses (with exponent `m`, `cos^m a'` has slope variance `sigma^2 / m`).
 //!
 //! D factor: `d3 = sqrt(c)`, `d2 = b / d3` (clamped to `|d2| <= sqrt(a)`, which Cauchy-Schwarz
