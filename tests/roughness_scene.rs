@@ -12,11 +12,18 @@ fn lum(img: &Image, x: u32, y: u32) -> f64 {
     (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / (3.0 * 65535.0)
 }
 
-/// Full width at half maximum of the highlight in row `y` (pixels above half the row's peak
-/// over its floor, contiguous around the peak).
-fn fwhm(img: &Image, y: u32) -> f64 {
-    let w = img.width;
-    let row: Vec<f64> = (0..w).map(|x| lum(img, x, y)).collect();
+/// Mean luminance of rows `ys`, per column: the glitter path's cross-section over a band of
+/// rows (averaging rows makes the width that of the path, not of single near-field glints).
+fn band_profile(img: &Image, ys: std::ops::Range<u32>) -> Vec<f64> {
+    let n = f64::from(ys.end - ys.start);
+    (0..img.width)
+        .map(|x| ys.clone().map(|y| lum(img, x, y)).sum::<f64>() / n)
+        .collect()
+}
+
+/// Full width at half maximum of a profile, in pixels (samples above half the peak over the
+/// floor, contiguous around the peak), and the peak.
+fn fwhm(row: &[f64]) -> (f64, f64) {
     let floor = row.iter().copied().fold(f64::MAX, f64::min);
     let (px, peak) = row
         .iter()
@@ -31,11 +38,12 @@ fn fwhm(img: &Image, y: u32) -> f64 {
     while r + 1 < row.len() && row[r + 1] >= half {
         r += 1;
     }
-    (r - l + 1) as f64
+    ((r - l + 1) as f64, peak)
 }
 
 /// Mean absolute difference between vertically adjacent pixels of the highlight path in rows
-/// `y0..y1` (columns `x0..x1`): sparkle, i.e. aliasing of the highlight.
+/// `y0..y1` (columns `x0..x1`): sparkle. A render that aliases the highlight shows more of it
+/// than the box-filtered truth; a filtered one shows less.
 fn sparkle(img: &Image, y0: u32, y1: u32, x0: u32, x1: u32) -> f64 {
     let mut s = 0.0;
     let mut n = 0.0;
@@ -54,6 +62,18 @@ fn with_variant(s: &Scene, v: RoughVariant) -> Scene {
         m.roughness = Some(RoughChoice::Variant(v));
     }
     s
+}
+
+/// Mean |img - truth| over rows `ys`, in 8-bit LSBs of luminance.
+fn err_vs(img: &Image, truth: &Image, ys: std::ops::Range<u32>) -> f64 {
+    let (mut s, mut n) = (0.0, 0.0);
+    for y in ys {
+        for x in 0..img.width {
+            s += (lum(img, x, y) - lum(truth, x, y)).abs() * 255.0;
+            n += 1.0;
+        }
+    }
+    s / n
 }
 
 #[test]
@@ -83,50 +103,57 @@ fn lake_highlight_widens_with_distance_and_the_model_follows_the_truth() {
     )
     .expect("baseline");
     let base = base.ref_image.as_ref().expect("baseline float");
-    // Rows 78..100 are the far water (the horizon is near row 77), 130..160 the near water.
-    let band = |img: &Image, ys: std::ops::Range<u32>| {
-        let n = f64::from(ys.end - ys.start);
-        ys.map(|y| fwhm(img, y)).sum::<f64>() / n
-    };
+    let mut hwn = hw.clone();
+    hwn.roughness.rough_normalize = true;
+    let normed = render(&sc, &maps, &hwn, &RenderOptions::default()).expect("normalized");
+    let normed = normed.ref_image.as_ref().expect("normalized float");
+    // Rows 79..100 are the far water (the horizon is near row 77), 130..159 the near water.
     let (far, near) = (79..100, 130..159);
-    let (tf, mf, bf) = (
-        band(truth, far.clone()),
-        band(model, far.clone()),
-        band(base, far.clone()),
+    let w = |img: &Image, ys: std::ops::Range<u32>| fwhm(&band_profile(img, ys));
+    let [(tf, tpf), (mf, mpf), (bf, bpf), (_, npf)] =
+        [truth, model, base, normed].map(|i| w(i, far.clone()));
+    let [(tn, _), (mn, _), (bn, _)] = [truth, model, base].map(|i| w(i, near.clone()));
+    println!("path FWHM far rows:  truth {tf} model {mf} baseline {bf}");
+    println!("path FWHM near rows: truth {tn} model {mn} baseline {bn}");
+    println!(
+        "path peak far rows: truth {tpf:.3} model {mpf:.3} normalized {npf:.3} baseline {bpf:.3}"
     );
-    let (tn, mn, bn) = (
-        band(truth, near.clone()),
-        band(model, near.clone()),
-        band(base, near.clone()),
-    );
-    let (ts, ms, bs) = (
-        sparkle(truth, 79, 100, 100, 140),
-        sparkle(model, 79, 100, 100, 140),
-        sparkle(base, 79, 100, 100, 140),
-    );
-    println!("FWHM far rows:  truth {tf:.2} model {mf:.2} baseline {bf:.2}");
-    println!("FWHM near rows: truth {tn:.2} model {mn:.2} baseline {bn:.2}");
-    println!("sparkle far rows: truth {ts:.4} model {ms:.4} baseline {bs:.4}");
-    let err = |img: &Image, ys: std::ops::Range<u32>| {
-        let (mut s, mut n) = (0.0, 0.0);
-        for y in ys {
-            for x in 0..img.width {
-                s += (lum(img, x, y) - lum(truth, x, y)).abs() * 255.0;
-                n += 1.0;
-            }
-        }
-        s / n
-    };
-    let (me, be) = (err(model, far.clone()), err(base, far.clone()));
-    let (men, ben) = (err(model, near.clone()), err(base, near.clone()));
-    println!("mean |x - truth| (8-bit) far: model {me:.3} baseline {be:.3}; near: model {men:.3} baseline {ben:.3}");
-    // The truth's highlight is wider in the far rows than the filtered bump map's (whose
-    // bumps have been averaged away); the roughness model widens it and lands closer.
-    assert!(tf > bf, "truth {tf} vs baseline {bf}");
-    assert!(mf > bf, "model {mf} vs baseline {bf}");
+    let [ts, ms, bs, ns] = [truth, model, base, normed].map(|i| sparkle(i, 79, 100, 100, 140));
+    println!("sparkle far rows: truth {ts:.4} model {ms:.4} normalized {ns:.4} baseline {bs:.4}");
+    let [me, be, ne] = [model, base, normed].map(|i| err_vs(i, truth, far.clone()));
+    let [men, ben] = [model, base].map(|i| err_vs(i, truth, near.clone()));
+    println!("mean |x - truth| (8-bit) far: model {me:.3} normalized {ne:.3} baseline {be:.3}; near: model {men:.3} baseline {ben:.3}");
+    // Near, the bumps are resolved: model and plain filtered bump map draw the same path.
+    assert!((mn - bn).abs() <= 1.0, "near: model {mn} baseline {bn}");
+    assert!((mn - tn).abs() <= 3.0, "near: model {mn} truth {tn}");
+    // Far, the filtered bump map has lost its bumps and its path narrows below the truth's;
+    // the roughness model keeps the truth's width, i.e. it widens relative to the baseline
+    // from near to far.
+    assert!(tf >= bf + 2.0, "far: truth {tf} baseline {bf}");
+    assert!((mf - tf).abs() <= 1.0, "far: model {mf} truth {tf}");
     assert!(
-        (mf - tf).abs() < (bf - tf).abs(),
-        "model {mf} baseline {bf} truth {tf}"
+        mf / bf >= mn / bn + 0.1,
+        "model/baseline width ratio near {} far {}",
+        mn / bn,
+        mf / bf
+    );
+    // Neither filtered render aliases here: both sparkle far less than the box-filtered truth
+    // (whose pixel-scale glitter the isotropic trilinear filter removes), so there is no
+    // aliasing for the model to remove on this scene (docs/ROUGHNESS.md).
+    assert!(
+        ts > 2.0 * bs && ts > 2.0 * ms,
+        "truth {ts} model {ms} baseline {bs}"
+    );
+    // As published the widened lobe keeps its peak (too bright far away, worse than the
+    // baseline against the truth); with rough_normalize the peak and the error follow the truth.
+    assert!(bpf > 1.15 * tpf && mpf > 1.15 * tpf, "{tpf} {mpf} {bpf}");
+    assert!(
+        (npf - tpf).abs() < 0.05 * tpf,
+        "normalized peak {npf} truth {tpf}"
+    );
+    assert!(
+        me > be && ne < 0.5 * be,
+        "far error: model {me} normalized {ne} baseline {be}"
     );
     let rs = r.stats.roughness.as_ref().expect("rough stats");
     assert_eq!(rs.truth_samples, 16);

@@ -1,7 +1,8 @@
 //! The fixed-point modified Blinn-Phong unit (`hw_model::roughness`, Schilling 1997 Appendix A)
 //! against its float twin (`texsim::shading::roughness::rough_cos_twin`) on the same quantized
-//! inputs: seeded random millions of cases, an exhaustive sweep of `d` (2^20 per variant), the
-//! hard cases of issue 4, the meaning of each variant, and the cost function.
+//! inputs: seeded random millions of cases, an exhaustive sweep of `d` over the F = 10 grid
+//! (2^22 points per variant, 78.5% of them inside the unit disc), the hard cases of issue 4,
+//! the meaning of each variant, and the cost function.
 
 #![allow(clippy::needless_range_loop)]
 
@@ -120,8 +121,9 @@ fn random_cases_meet_the_bound_for_every_variant_and_width() {
 
 #[test]
 fn exhaustive_d_sweep_meets_the_bound() {
-    // F = 10: every d = (x, y) in [-2^10, 2^10)^2 (2^20 cases) per variant, with cos a from
-    // |d| where |d| <= 1 and a fixed anisotropic D.
+    // F = 10: every d = (x, y) in [-2^10, 2^10)^2 (2^22 grid points) per variant, with a
+    // fixed anisotropic D and cos a = sqrt(1 - |d|^2) rounded. Outside the unit disc (21.5%)
+    // cos a is 0, which only exercises the `cos a = 0` guard; the count inside is asserted.
     let f = 10u32;
     let one = 1i64 << f;
     let mut sat = SatCounter::default();
@@ -132,10 +134,12 @@ fn exhaustive_d_sweep_meets_the_bound() {
         };
         let b = bound(&cfg, 16);
         let mut worst = 0.0f64;
+        let mut inside = 0u64;
         for x in -one..one {
             for y in -one..one {
                 let dd = (x * x + y * y) as f64 / (one * one) as f64;
                 let c = ((1.0 - dd).max(0.0).sqrt() * one as f64).round() as i64;
+                inside += u64::from(c > 0);
                 let inp = RoughInput {
                     cos_a: c,
                     d: [x, y],
@@ -147,7 +151,11 @@ fn exhaustive_d_sweep_meets_the_bound() {
                 assert!(e <= b, "{v:?} {inp:?} {e}");
             }
         }
-        println!("{:<12} exhaustive d: worst {worst:.3e}", v.name());
+        println!(
+            "{:<12} exhaustive d: {inside} cases with cos a > 0, worst {worst:.3e}",
+            v.name()
+        );
+        assert!(inside > 3_290_000 && inside < 3_300_000, "{inside}");
     }
 }
 

@@ -19,10 +19,11 @@
 //! `|d|^4/|Dd|^2 <= |d|^2 / sigma_min^2 -> 0`); `M = 0` (D singular along d, d != 0) gives 0
 //! and counts a saturation; `Q >= 2^`[`Q_CAP_BITS`] gives 0 and counts a saturation.
 //!
-//! Datapath: `d`, `cos a` in vector format (s1.F); the D channels are filtered unorm texels
-//! `t` (`texel_bits`) decoded exactly as `d1 = t 2^(e - bits)`, `d2 = (t - 2^(bits-1))
+//! Datapath: `d`, `cos a` in vector format (s1.F); the D channels are filtered texels `t`
+//! (`texel_bits`) decoded exactly as `d1 = t 2^(e - bits)`, `d2 = (t - 2^(bits-1))
 //! 2^(e + 1 - bits)`, `d3` like `d1` (`e = rough_range_exp`, channel range `[0, 2^e)`,
-//! `d2` in `[-2^e, 2^e)`). `N` and `M` are exact integers; the divider returns `N / M` with
+//! `d2` in `[-2^e, 2^e)`); `d1`, `d3` are stored unorm, `d2` offset-binary so that 0 is
+//! exact at every stored width ([`widen_d_channel`]). `N` and `M` are exact integers; the divider returns `N / M` with
 //! `rough_div_bits` significant bits (round half even, exact remainder); `Q` is formed with
 //! `W = 4F + 8` fraction bits; the square root of `Q + cos^2 a` has `rough_sqrt_bits`
 //! significant bits (correctly rounded); the divider then forms `cos a / sqrt(...)`, rounded
@@ -231,8 +232,36 @@ pub fn expand_channel(q: u64, d_bits: u32, texel_bits: u32) -> u64 {
     out
 }
 
+/// Index of the signed D channel (`d2`), stored offset-binary ([`widen_d_channel`]).
+pub const D2_CHANNEL: usize = 1;
+
+/// Widens stored D channel `channel` (`d_bits` wide) to `texel_bits`, what texture memory
+/// holds. `d1`, `d3` (and lambda1) are unorm: bit replication ([`expand_channel`]). `d2` is
+/// signed, stored offset-binary, `q = 2^(d-1) + round(d2 2^d / (2R))`, i.e.
+/// `d2 = (q - 2^(d-1)) 2R / 2^d`; it is widened by zero padding, `q 2^(T-d)`, which keeps that
+/// value exactly (`d2 = (t - 2^(T-1)) 2R / 2^T`, the form [`decode_d`] decodes), so `d2 = 0`
+/// (every flat texel) stays exactly 0 at every `d_bits`. Bit replication would move the
+/// centre code `2^(d-1)` to `2^(T-1) + 2^(T-1-d) + ...` (8 bits: `0x8080`), a shear of
+/// `+2R / (2^d - 1)` on flat texels (+0.016 at 8 bits, +0.27 at 4 bits, `R = 4`).
+#[must_use]
+pub fn widen_d_channel(q: u64, channel: usize, d_bits: u32, texel_bits: u32) -> u64 {
+    if channel != D2_CHANNEL {
+        return expand_channel(q, d_bits, texel_bits);
+    }
+    let d = d_bits.clamp(1, 32);
+    let t = texel_bits.clamp(1, 32);
+    let q = q.min((1u64 << d) - 1);
+    if d >= t {
+        q >> (d - t)
+    } else {
+        q << (t - d)
+    }
+}
+
 /// Raw D values `[d1, d2, d3]` with `T = texel_bits - rough_range_exp` fraction bits, decoded
-/// exactly from filtered texels (module doc). Returns the values and `T`.
+/// exactly from filtered texels (module doc). Returns the values and `T`. `d2` is decoded
+/// around `2^(texel_bits - 1)`, the widened centre code of [`widen_d_channel`] at every
+/// `d_bits`, so a flat texel (`d2 = 0`) decodes to exactly 0.
 #[must_use]
 pub fn decode_d(t: [u64; 3], texel_bits: u32, cfg: &RoughnessConfig) -> ([i64; 3], u32) {
     let bits = texel_bits.clamp(1, 16);
@@ -377,6 +406,12 @@ pub const D_RAW_LIMIT: i64 = 1 << 20;
 /// covariance in tangent-plane units (the perturbation is `f_u len_u t_u + f_v len_v t_v`).
 /// Rounded half even back to `t` fraction bits; magnitudes above [`D_RAW_LIMIT`] saturate
 /// (counted). The isotropic lambda1 (channel 0) is scaled by `max(len_u, len_v)`.
+///
+/// ERROR BOUND: each entry within 1/2 LSB (`2^-(t+1)`) of the exact product, i.e. of the
+/// float twin `texsim::shading::roughness::scale_d_f` on the same decoded D and lengths;
+/// a saturated entry is exactly `+-D_RAW_LIMIT` and counts one saturation. Tested in
+/// `tests/roughness_shade.rs` (2 M random D texels, range exponents, lengths over the whole
+/// length format, `len_frac_bits` 4..16).
 #[must_use]
 pub fn scale_d(
     dv: [i64; 3],
@@ -571,8 +606,32 @@ pub struct RoughShadeInput {
 /// (`d = (h_t . t_u, h_t . t_v)`, `h_t = h - (n.h) n` the tangent-plane projection of `h`)
 /// and the exponent of the configured mode (`inp.shininess` is the material's).
 ///
-/// ERROR BOUND: that of `blinn_phong` with the power unit's input error increased by the
-/// [`rough_cos`] bound (module doc).
+/// ERROR BOUND (absolute, per colour channel, against the float twin
+/// `texsim::shading::roughness::rough_blinn_phong_f` on the same quantized `n`, `l`, `v`,
+/// `t_u`, `t_v` and colours, with D the same texels decoded and scaled in float; `F`, `P`,
+/// `C` the vector, power and colour fraction bits, `e` the mode's exponent, `x` the twin's
+/// `cos a'`): `light (ks S + kd 2^-(F+1)) + 2^-C`, with the specular error
+/// `S = E_pow(x_hi) + e x_hi^(e-1) Dx`, `x_hi = min(1, x + Dx)`, `E_pow` the power unit's
+/// bound (`crate::pow` module doc) and `Dx = E_cos + E_in`:
+/// - `E_cos`: the [`rough_cos`] bound (module doc); `none`: `2^-(P+1)`;
+/// - `E_in`: how far the rounding of this unit's own inputs moves the twin's
+///   `cos a' = (1 + u^2)^(-1/2)` (monotone in `u = tan a' = W / c`, with `W = |d|^2/|D^T d|`
+///   directional, `|d|^2/|D d|` published, `|D^-1 d|` Mahalanobis, `|d|/d1` isotropic):
+///   `cos'(u_lo) - cos'(u_hi)` over the range of `u` when `c = n.h` is off by
+///   `dc = (sqrt(3) eps_h |n| + 1/2) 2^-F`, each component of `d` by
+///   `dd = (sqrt(3) eps_h (|t| + |n| |n.t|) + |n.t|/2 + 3/2) 2^-F + dc 2^-F` and each D entry
+///   by `2^-(t+1)` ([`scale_d`]); `eps_h` is [`crate::vector::normalize3`]'s per-component
+///   bound in ulp (`rsqrt bound * 2^F + 1/2`, 0.607 at texram16); `none`: `E_in = dc`.
+///
+/// With `rough_normalize` (ignored for `none`) `S` becomes `f_hi S + x^e (f_hi - f_lo) +
+/// 2^-(P+1)`, `[f_lo, f_hi]` the range of `min(1, (e/s) / (d1 d3))` with the divider's
+/// `2^-div_bits` and D off by `2^-(t+1)` per entry (`[0, 1]` if `d1` or `d3 <= 2^-(t+1)`).
+/// Within 1 ulp of `n.l = 0` the specular term may switch on or off (the whole term is
+/// allowed); D saturated by [`scale_d`] (counted) is outside the bound. Measured in
+/// `tests/roughness_shade.rs`: 1.2 M random cases over variants, normalization, exponent
+/// modes, `F` 8..15, `P` 12..24, range exponents -4..4, divider and root widths, orthonormal
+/// and sheared frames, lengths 0..16 and D texels; worst error / bound 0.995 (where the bound
+/// exceeds 8 LSB; the diffuse `n.l` rounding term is what is tight).
 #[must_use]
 pub fn rough_blinn_phong(
     inp: &BlinnPhongInput,
@@ -612,7 +671,7 @@ pub fn rough_blinn_phong(
         ro = rough_cos_d(ndh, d, ri.dv, ri.t, cfg, f, p, sat);
         let e = cfg.exponent(inp.shininess);
         let sp = units.pow.pow(ro.cos_mod, e, sat);
-        if cfg.rough_normalize {
+        if cfg.rough_normalize && cfg.rough_variant != RoughVariant::None {
             normalize_spec(sp, e, inp.shininess, ri, cfg) as i64
         } else {
             sp as i64
@@ -632,6 +691,11 @@ pub fn rough_blinn_phong(
 /// The energy normalization of [`RoughnessConfig::rough_normalize`]: `spec * min(1, (e / s) /
 /// (d1 d3))` with `d1 d3` from the scaled D (`t` fraction bits; isotropic `d1^2`), one divide
 /// of `rough_div_bits` and one rounding (half even). `d1 d3 = 0` leaves `spec` unchanged.
+///
+/// ERROR BOUND (in LSBs of `spec`, against `spec min(1, (e/s)/(d1 d3))` of the same D in
+/// float, `texsim::shading::roughness::normalize_factor`): `spec f 2^-div_bits + 1/2`, and
+/// never above `spec`. Tested in `tests/roughness_unit.rs` (200 000 random cases per
+/// variant).
 #[must_use]
 pub fn normalize_spec(
     spec: u64,

@@ -437,7 +437,7 @@ pub fn run_rough_stage(
                 let rexp = rcfg.exponent(bp.shininess);
                 let enc = RoughnessEncoding::for_range_exp(rcfg.rough_range_exp);
                 let dv = scale_d_f(enc.decode(frag.rough), bf.fr_len, iso);
-                let norm = if rcfg.rough_normalize {
+                let norm = if rcfg.rough_normalize && rp.variant != RoughVariant::None {
                     normalize_factor(dv, rp.variant, rexp, bp.shininess)
                 } else {
                     1.0

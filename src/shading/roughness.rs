@@ -20,7 +20,9 @@
 //! half-width `w` has standard deviation `w / sqrt(3)`, so scaling K by 3 makes the ellipse
 //! `x^T K^-1 x = 1` reach the edge of the distribution), `s0` the material's base roughness
 //! (no texel is a mirror; `s0 = 1/sqrt(shininess)` reproduces Blinn-Phong of that shininess
-//! on flat areas, since `cos^m a` has slope variance about `1/m`) and `m` the exponent the
+//! on flat areas, since `cos^m a` has slope variance about `1/m`, when the frame's tangents
+//! are an orthonormal basis of the shading normal's tangent plane: docs/ROUGHNESS.md) and
+//! `m` the exponent the
 //! shading uses (with exponent `m`, `cos^m a'` has slope variance `sigma^2 / m`).
 //!
 //! D factor: `d3 = sqrt(c)`, `d2 = b / d3` (clamped to `|d2| <= sqrt(a)`, which Cauchy-Schwarz
@@ -32,13 +34,15 @@
 //! Encoding ([`RoughnessEncoding`], range `R = 2^rough_range_exp`): channels
 //! `(d1 / R, 1/2 + d2 / (2R), d3 / R, 1)`, clamped to `[0, 1]` and counted; isotropic:
 //! `(lambda1 / R, 1/2, 0, 1)`. The channels are then quantized to `rough_d_bits` and widened
-//! to the texel width by bit replication ([`quantize_rough_chain`]); the trilinear unit
-//! filters them like any texture, and `hw_model::roughness::decode_d` decodes them.
+//! to the texel width ([`quantize_rough_chain`]: `d1`, `d3` unorm with bit replication, `d2`
+//! offset-binary with zero padding, so `d2 = 0` stays exactly 0 at every width); the
+//! trilinear unit filters them like any texture, and `hw_model::roughness::decode_d` decodes
+//! them.
 
 use crate::error::{Error, Result};
 use crate::maps::{next_level_size, quantize_unorm, FixedLevel, FixedMipChain, MipChain, MipLevel};
 use glam::DVec3;
-use hw_model::roughness::{expand_channel, RoughVariant, Q_CAP_BITS};
+use hw_model::roughness::{widen_d_channel, RoughVariant, D2_CHANNEL, Q_CAP_BITS};
 
 /// Correction factor on K for uniformly distributed offsets (module doc).
 pub const UNIFORM_CORRECTION: f64 = 3.0;
@@ -306,8 +310,28 @@ pub fn rough_mip_chain(
     (MipChain { levels }, clamped)
 }
 
-/// Quantizes D channels to `d_bits` and widens them to `texel_bits` by bit replication
-/// (`hw_model::roughness::expand_channel`): what texture memory holds.
+/// Quantizes a D channel value to its stored `d_bits` code: `d1`, `d3` (and lambda1, alpha)
+/// unorm ([`quantize_unorm`]); `d2` (channel `hw_model::roughness::D2_CHANNEL`, value
+/// `c = 1/2 + d2 / (2R)`) offset-binary, `2^(d-1) + round((c - 1/2) 2^d)` (ties to even, so
+/// `+x` and `-x` quantize symmetrically and `d2 = 0` to the centre code exactly), clamped to
+/// `[0, 2^d - 1]` (the top code is `d2 = R (1 - 2^(1-d))`); NaN gives the centre.
+#[must_use]
+pub fn quantize_d_channel(c: f32, channel: usize, d_bits: u32) -> u64 {
+    let db = d_bits.clamp(2, 16);
+    if channel != D2_CHANNEL {
+        return u64::from(quantize_unorm(c, db));
+    }
+    let half = 1i64 << (db - 1);
+    if c.is_nan() {
+        return half as u64;
+    }
+    let off = ((f64::from(c) - 0.5) * f64::from(1u32 << db)).round_ties_even();
+    (off.clamp(-(half as f64), (half - 1) as f64) as i64 + half) as u64
+}
+
+/// Quantizes D channels to `d_bits` ([`quantize_d_channel`]) and widens them to `texel_bits`
+/// (`hw_model::roughness::widen_d_channel`: bit replication for the unorm channels, zero
+/// padding for the offset-binary `d2`): what texture memory holds.
 #[must_use]
 pub fn quantize_rough_chain(chain: &MipChain, d_bits: u32, texel_bits: u32) -> FixedMipChain {
     let db = d_bits.clamp(2, 16);
@@ -324,7 +348,11 @@ pub fn quantize_rough_chain(chain: &MipChain, d_bits: u32, texel_bits: u32) -> F
                     .texels
                     .iter()
                     .map(|t| {
-                        t.map(|c| expand_channel(u64::from(quantize_unorm(c, db)), db, tb) as u16)
+                        let mut out = [0u16; 4];
+                        for (i, (o, &c)) in out.iter_mut().zip(t).enumerate() {
+                            *o = widen_d_channel(quantize_d_channel(c, i, db), i, db, tb) as u16;
+                        }
+                        out
                     })
                     .collect(),
             })
