@@ -270,14 +270,14 @@ fn validation_and_reports() {
     );
     assert!(albedo_report(&p, 90.0, None).is_err());
     assert!(albedo_report(&p, f64::NAN, None).is_err());
-    let e = eval_report(&p, DVec3::Z, dir_from_angles(10.0, 0.0)).expect("report");
+    let e = eval_report(&p, DVec3::Z, dir_from_angles(10.0, 0.0), None).expect("report");
     let last: f64 = e
         .lines()
         .last()
         .and_then(|l| l.trim().parse().ok())
         .expect("number");
     assert!((last - p.eval(DVec3::Z, dir_from_angles(10.0, 0.0))).abs() < 1e-5 * last);
-    assert!(eval_report(&p, DVec3::ZERO, DVec3::Z).is_err());
+    assert!(eval_report(&p, DVec3::ZERO, DVec3::Z, None).is_err());
     let s = sample_report(&p, dir_from_angles(30.0, 0.0), 20_000, 5).expect("report");
     assert!(s.lines().last().is_some_and(|l| l.ends_with("pass")), "{s}");
     assert!(sample_report(&p, -DVec3::Z, 20_000, 5).is_err());
