@@ -392,3 +392,63 @@ fn albedo_report_with_fixed_unit() {
         .err()
         .is_some_and(|e| e.message().contains("'nu'")));
 }
+
+/// Reciprocity of the unit (eqs. 10 and 16 are symmetric in `k1, k2`): swapping `n.k1` and
+/// `n.k2` of the same quantized inputs (`h` and `k.h` are shared by both directions) changes
+/// only the order of the diffuse product's roundings, so both outputs are within the unit's
+/// declared `2e-4` of the same (symmetric) twin value, hence within `4e-4` of each other
+/// (`1e-15` absolute below the floor). End to end, the unit fed `Dots::from_dirs(k2, k1)`
+/// (whose `k.h` is computed as `k2.h` and may round to another LSB) differs from it fed
+/// `(k1, k2)` by at most the twin's own difference plus `4e-4` (the same triangle inequality).
+/// 2^18 seeded cases, saturated outputs excluded. Measured: 83% bit-identical, worst 6.0e-5
+/// in both checks.
+#[test]
+fn unit_is_reciprocal_within_its_bound() {
+    let cfg = cfg16();
+    let mut r = Rng(99);
+    let (mut worst, mut worst_e2e, mut exact, mut n) = (0.0f64, 0.0f64, 0u64, 0u64);
+    for _ in 0..1 << 18 {
+        let p = r.model();
+        let (k1, k2) = r.pair(&p);
+        let (Some(d12), Some(d21)) = (Dots::from_dirs(k1, k2), Dots::from_dirs(k2, k1)) else {
+            continue;
+        };
+        let a = quantize(&p, &d12, &cfg);
+        let swapped = AnisoPhongInputs {
+            nk1: a.nk2,
+            nk2: a.nk1,
+            ..a
+        };
+        let b = quantize(&p, &d21, &cfg);
+        let mut sat = SatCounter::default();
+        let (oa, os, ob) = (
+            pf_to_f64(aniso_phong(&a, &cfg, &mut sat).total),
+            pf_to_f64(aniso_phong(&swapped, &cfg, &mut sat).total),
+            pf_to_f64(aniso_phong(&b, &cfg, &mut sat).total),
+        );
+        if sat.saturated > 0 {
+            continue;
+        }
+        n += 1;
+        exact += u64::from(oa == os);
+        let big = oa.max(os);
+        if big >= FLOOR {
+            worst = worst.max((oa - os).abs() / big);
+        } else {
+            assert!((oa - os).abs() <= FLOOR, "{a:?}: {oa} {os}");
+        }
+        let (ts_a, td_a) = twin_pi_rho(&a, &cfg);
+        let (ts_b, td_b) = twin_pi_rho(&b, &cfg);
+        let (ta, tb) = (ts_a + td_a, ts_b + td_b);
+        if ta.max(tb) >= FLOOR {
+            let e2e = (oa - ob).abs() - (ta - tb).abs();
+            worst_e2e = worst_e2e.max(e2e / ta.max(tb));
+        }
+    }
+    println!(
+        "unit reciprocity over {n} cases: {exact} bit-identical, worst rel {worst:.2e}, end to end beyond the twin's own change {worst_e2e:.2e}"
+    );
+    assert!(n > 200_000, "{n}");
+    assert!(worst <= 4e-4, "{worst}");
+    assert!(worst_e2e <= 4e-4, "{worst_e2e}");
+}
