@@ -246,7 +246,7 @@ fn hard_cases_are_finite_and_bounded() {
                     // (the two twins agree within 6e-2 here, see below).
                     let stage_sat = cnt.sat[StageKind::AsShade.index()].saturated;
                     let top = raw.iter().copied().fold(0.0, f64::max);
-                    if fx.iter().any(|&x| x == 1.0) {
+                    if fx.contains(&1.0) {
                         assert!(stage_sat > 0, "clipped but not counted: {fx:?} {raw:?}");
                         clipped += 1;
                     }

@@ -212,7 +212,8 @@ fn reflected_direction_chi_square_rejects_wrong_samplers() {
         k1,
         &mut |xi| {
             count += 1;
-            if count % 1000 == 0 {
+            if count == 1000 {
+                count = 0;
                 None
             } else {
                 p.sample_sphere(k1, xi)

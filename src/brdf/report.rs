@@ -234,7 +234,7 @@ pub fn sample_report(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64)
             );
         }
     }
-    let passed = chi_h.passed && chi_k2.as_ref().map_or(true, |c| c.passed);
+    let passed = chi_h.passed && chi_k2.iter().all(|c| c.passed);
     let _ = write!(
         s,
         "chi-square ({} at the 99.9% level): {}",

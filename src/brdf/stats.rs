@@ -92,7 +92,10 @@ pub fn wilson_hilferty(dof: f64, z: f64) -> f64 {
 /// infinite (it is not diluted by merging). Returns `(statistic, merged bin count)`.
 #[must_use]
 pub fn chi2_merged(pairs: &[(f64, f64)], min_expected: f64) -> (f64, usize) {
-    if pairs.iter().any(|&(o, e)| !(e > 0.0) && o > 0.0) {
+    if pairs
+        .iter()
+        .any(|&(o, e)| (e <= 0.0 || e.is_nan()) && o > 0.0)
+    {
         return (f64::INFINITY, pairs.len());
     }
     let mut groups: Vec<(f64, f64)> = Vec::new();
