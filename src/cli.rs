@@ -80,20 +80,32 @@ pub enum BrdfCmd {
         #[arg(long, default_value = "texram16")]
         hw: String,
     },
-    /// BRDF value for the directions (theta1, phi1) and (theta2, phi2), in degrees.
+    /// BRDF value for the directions (theta1, phi1) and (theta2, phi2), in degrees. The last
+    /// line is rho(k1, k2); --fixed gives the fixed-point unit's.
     Eval {
         #[command(flatten)]
         p: BrdfParams,
+        /// Polar angle of k1 (toward the light) from the normal, in degrees.
         #[arg(long, default_value_t = 30.0)]
         theta1: f64,
+        /// Azimuth of k1 from the tangent u (the n_u axis), in degrees.
         #[arg(long, default_value_t = 0.0)]
         phi1: f64,
+        /// Polar angle of k2 (toward the viewer) from the normal, in degrees.
         #[arg(long, default_value_t = 30.0)]
         theta2: f64,
+        /// Azimuth of k2 from the tangent u, in degrees.
         #[arg(long, default_value_t = 180.0)]
         phi2: f64,
+        /// Also evaluate the fixed-point unit of --hw (integer exponents required).
+        #[arg(long)]
+        fixed: bool,
+        /// Hardware preset or file (for --fixed).
+        #[arg(long, default_value = "texram16")]
+        hw: String,
     },
-    /// Sampler statistics and a chi-square goodness-of-fit test against the pdf.
+    /// Sampler statistics and chi-square goodness-of-fit tests against the pdf: of the half
+    /// vectors (any anisotropy) and, for anisotropy ratios up to 10, of the reflected directions.
     Sample {
         #[command(flatten)]
         p: BrdfParams,
@@ -648,11 +660,21 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
             phi1,
             theta2,
             phi2,
-        } => eval_report(
-            &brdf_model(p)?,
-            dir_from_angles(*theta1, *phi1),
-            dir_from_angles(*theta2, *phi2),
-        )?,
+            fixed,
+            hw,
+        } => {
+            let cfg = if *fixed {
+                Some(hwconfig::resolve(hw)?.aniso_phong)
+            } else {
+                None
+            };
+            eval_report(
+                &brdf_model(p)?,
+                dir_from_angles(*theta1, *phi1),
+                dir_from_angles(*theta2, *phi2),
+                cfg.as_ref(),
+            )?
+        }
         BrdfCmd::Sample {
             p,
             theta,

@@ -1,9 +1,10 @@
-//! Property tests of the Ashikhmin-Shirley reference (eqs. 10-22): reciprocity, finiteness and
-//! non-negativity over random and boundary inputs, agreement of the dot-product form with the
+//! Property tests of the Ashikhmin-Shirley reference (eqs. 10-22): reciprocity, finiteness,
+//! non-negativity and the stated upper bounds over random and boundary inputs, agreement of the dot-product form with the
 //! vector form, the eq. 16 constant, the h -> n limit, and the report functions.
 
 use glam::DVec3;
 use std::f64::consts::PI;
+use texsim::brdf::ashikhmin_shirley::{BRDF_MAX, DENOM_FLOOR, EXPONENT_MAX};
 use texsim::brdf::{
     albedo_report, dir_from_angles, eval_report, sample_report, AshikhminShirley, Dots,
 };
@@ -62,7 +63,7 @@ impl Rng {
 
 /// Reciprocity eval(k1,k2) == eval(k2,k1). Eq. 10 and 16 are symmetric by construction (F uses
 /// k.h, and k1.h = k2.h); the only asymmetry is f64 rounding in forming h and k.h, so the bound
-/// is relative 1e-9 (values can be up to ~1e17 at the denominator floor).
+/// is relative 1e-9 (values reach `BRDF_MAX`, about 4e16, at the denominator floor).
 #[test]
 fn reciprocity() {
     let mut r = Rng(1);
@@ -77,11 +78,16 @@ fn reciprocity() {
     }
 }
 
-/// Finite, non-negative, never NaN: eval, pdf, pdf_h, sample and sample_h over random and boundary
+/// Finite, non-negative, never NaN, and within the bounds stated in the module doc of
+/// `texsim::brdf::ashikhmin_shirley` (computed here from the formulas): eval, specular,
+/// diffuse, the dot-product form, pdf, pdf_h, sample and sample_h over random and boundary
 /// inputs including directions below the horizon, k1 = -k2, h = n, exponents 0 and 1e6.
 #[test]
-fn finite_and_non_negative_everywhere() {
+fn finite_non_negative_and_bounded_everywhere() {
     let mut r = Rng(2);
+    // Relative slack for the f64 rounding of the products that form each value.
+    let tol = 1.0 + 1e-12;
+    let mut near_floor = 0;
     for i in 0..300_000 {
         let p = r.model();
         let k1 = if i % 3 == 0 { r.dir() } else { r.upper() };
@@ -91,15 +97,48 @@ fn finite_and_non_negative_everywhere() {
             2 => r.dir(),
             _ => r.upper(),
         };
-        for v in [
-            p.eval(k1, k2),
-            p.specular(k1, k2),
-            p.diffuse(k1, k2),
-            p.pdf(k1, k2),
-            p.pdf_mixture(k1, k2),
+        let root = ((p.nu + 1.0) * (p.nv + 1.0)).sqrt();
+        let spec_max = root / (8.0 * PI * DENOM_FLOOR);
+        let diff_max = 28.0 * p.rd * (1.0 - p.rs) / (23.0 * PI);
+        let pdf_max = root / (4.0 * PI * (k1 + k2).length());
+        let mixture_max = pdf_max + 1.0 / PI;
+        let (e, sp, df) = (p.eval(k1, k2), p.specular(k1, k2), p.diffuse(k1, k2));
+        let (pd, pm) = (p.pdf(k1, k2), p.pdf_mixture(k1, k2));
+        for (what, v, hi) in [
+            ("eval", e, spec_max + diff_max),
+            ("specular", sp, spec_max),
+            ("diffuse", df, diff_max),
+            ("pdf", pd, pdf_max),
+            ("pdf_mixture", pm, mixture_max),
         ] {
-            assert!(v.is_finite() && v >= 0.0, "{p:?} {k1} {k2}: {v}");
+            assert!(
+                v.is_finite() && v >= 0.0 && v <= hi * tol,
+                "{what} {p:?} {k1} {k2}: {v} (bound {hi})"
+            );
         }
+        assert!(e <= BRDF_MAX * tol, "{p:?} {k1} {k2}: {e}");
+        assert!(sp <= p.specular_max() * tol && df <= p.diffuse_max() * tol);
+        if sp > 1e-3 * spec_max {
+            near_floor += 1;
+        }
+        // The dot-product form with arbitrary dots (the float twin's entry point).
+        let d = Dots {
+            hn: 2.0 * r.f() - 0.5,
+            hu: 2.0 * r.f() - 1.0,
+            hv: 2.0 * r.f() - 1.0,
+            kh: if i % 2 == 0 { 1e-300 * r.f() } else { r.f() },
+            nk1: if i % 3 == 0 { 1e-200 * r.f() } else { r.f() },
+            nk2: 1.5 * r.f(),
+        };
+        let (ds, dd) = p.eval_from_dots(&d);
+        assert!(
+            ds.is_finite() && ds >= 0.0 && ds <= spec_max * tol,
+            "{p:?} {d:?}: {ds}"
+        );
+        assert!(
+            dd.is_finite() && dd >= 0.0 && dd <= diff_max * tol,
+            "{p:?} {d:?}: {dd}"
+        );
         let xi = [r.f(), r.f()];
         let xi = match i % 7 {
             0 => [0.0, 0.0],
@@ -112,7 +151,8 @@ fn finite_and_non_negative_everywhere() {
             h.is_finite() && (h.length() - 1.0).abs() < 1e-12 && h.z >= 0.0,
             "{p:?} {xi:?} {h}"
         );
-        assert!(p.pdf_h(h).is_finite());
+        let ph = p.pdf_h(h);
+        assert!(ph.is_finite() && ph >= 0.0 && ph <= root / (2.0 * PI) * tol);
         if let Some((k, pdf)) = p.sample(k1, xi) {
             assert!(
                 k.z > 0.0 && pdf.is_finite() && pdf > 0.0,
@@ -120,6 +160,22 @@ fn finite_and_non_negative_everywhere() {
             );
         }
     }
+    // Random grazing pairs get close to the floor (the bound is not vacuous).
+    assert!(near_floor > 100, "{near_floor}");
+    // The floor is reached: h = k1 = k2 at 1e-13 degrees above the horizon (k.h = 1,
+    // n.k = 1.7e-15 < DENOM_FLOOR), exponents 0 (power 1), Rs = 1 (F = 1).
+    let g = dir_from_angles(90.0 - 1e-13, 0.0);
+    let p = AshikhminShirley::new(0.0, 0.0, 1.0, 0.0).expect("valid");
+    let at = p.specular(g, g);
+    assert!(
+        (at - 1.0 / (8.0 * PI * DENOM_FLOOR)).abs() <= 1e-12 * at,
+        "{at}"
+    );
+    let p = AshikhminShirley::new(EXPONENT_MAX, EXPONENT_MAX, 1.0, 0.0).expect("valid");
+    assert!(
+        p.specular_max() <= BRDF_MAX && BRDF_MAX < 4.0e16,
+        "{BRDF_MAX}"
+    );
     let p = AshikhminShirley::new(0.0, 0.0, 0.0, 1.0).expect("valid");
     assert_eq!(p.eval(DVec3::Z, -DVec3::Z), 0.0, "k1 = -k2");
     let g = dir_from_angles(90.0, 0.0);
@@ -214,14 +270,14 @@ fn validation_and_reports() {
     );
     assert!(albedo_report(&p, 90.0, None).is_err());
     assert!(albedo_report(&p, f64::NAN, None).is_err());
-    let e = eval_report(&p, DVec3::Z, dir_from_angles(10.0, 0.0)).expect("report");
+    let e = eval_report(&p, DVec3::Z, dir_from_angles(10.0, 0.0), None).expect("report");
     let last: f64 = e
         .lines()
         .last()
         .and_then(|l| l.trim().parse().ok())
         .expect("number");
     assert!((last - p.eval(DVec3::Z, dir_from_angles(10.0, 0.0))).abs() < 1e-5 * last);
-    assert!(eval_report(&p, DVec3::ZERO, DVec3::Z).is_err());
+    assert!(eval_report(&p, DVec3::ZERO, DVec3::Z, None).is_err());
     let s = sample_report(&p, dir_from_angles(30.0, 0.0), 20_000, 5).expect("report");
     assert!(s.lines().last().is_some_and(|l| l.ends_with("pass")), "{s}");
     assert!(sample_report(&p, -DVec3::Z, 20_000, 5).is_err());

@@ -1,11 +1,13 @@
 //! The sampler of eqs. 19-22 against its densities, eqs. 5 and 20: both densities integrate to
 //! 1 (numerically, independently of the sampler's mapping), and chi-square goodness of fit of
-//! the half vectors (binned in (phi, cos theta), own implementation here) and of the reflected
-//! directions (library `chi2_k2`).
+//! the half vectors (library `chi2_h`, valid at any anisotropy) and of the reflected directions
+//! (library `chi2_k2`, anisotropy up to 10), each with negative controls.
 
 use glam::DVec3;
 use std::f64::consts::PI;
-use texsim::brdf::stats::{chi2_k2, wilson_hilferty, Z_95, Z_999};
+use texsim::brdf::stats::{
+    chi2_h, chi2_h_of, chi2_k2, chi2_k2_of, chi2_merged, wilson_hilferty, Z_999,
+};
 use texsim::brdf::{dir_from_angles, AshikhminShirley};
 
 struct Rng(u64);
@@ -137,141 +139,126 @@ fn direction_pdf_integrates_to_one_over_sphere() {
     }
 }
 
-/// Chi-square of sampled half vectors against eq. 5. Bins: 32 in phi with edges
-/// phi = atan(a tan(psi)) for psi uniform per quadrant (a = sqrt((nu+1)/(nv+1)); any fixed edges
-/// are valid, these follow the lobe), times 16 in cos(theta) with edges mu_k = (k/16)^(1/(E_j+1))
-/// where E_j is the exponent at the phi-bin centre. Expected probability of a bin = integral over
-/// its phi range of integral of eq. 5 over mu, i.e. sqrt((nu+1)(nv+1))/(2 pi) (mu_hi^(E+1) -
-/// mu_lo^(E+1)) / (E+1) with E = E(phi), by 32-node Gauss-Legendre in phi. Bins expecting < 5
-/// are merged. The statistic must stay below the 99.9% Wilson-Hilferty value (a false alarm
-/// rate of 1e-3 per case; the seeds are fixed, so the outcome is deterministic).
+/// Chi-square of sampled half vectors against eq. 5 (library `chi2_h`, the test `texsim brdf
+/// sample` reports; binning in its module doc): the expected probabilities sum to 1 within
+/// 1e-6 and the statistic stays below the 99.9% Wilson-Hilferty value (a false alarm rate of
+/// 1e-3 per case; the seeds are fixed, so the outcome is deterministic), for anisotropy up to
+/// 1e4 and exponents up to 1e5.
 #[test]
 fn half_vector_chi_square() {
-    const NP: usize = 32;
-    const NC: usize = 16;
-    const N: usize = 200_000;
-    let mut rng = Rng(11);
-    for (nu, nv) in CASES {
+    for (i, (nu, nv)) in CASES.into_iter().enumerate() {
         let p = AshikhminShirley::new(nu, nv, 1.0, 0.0).expect("valid");
-        let a = ((nu + 1.0) / (nv + 1.0)).sqrt();
-        let q = NP / 4;
-        // phi(psi) per quadrant, increasing in psi, mirrored in odd quadrants so that the lobe
-        // (symmetric about both axes) is followed in every quadrant; and dphi/dpsi.
-        let first = |psi: f64| (a * psi.sin()).atan2(psi.cos());
-        let jac = |psi: f64| a / (psi.cos().powi(2) + a * a * psi.sin().powi(2));
-        let phi_of = |quad: usize, psi: f64| {
-            if quad & 1 == 0 {
-                0.5 * PI * quad as f64 + first(psi)
-            } else {
-                0.5 * PI * (quad + 1) as f64 - first(0.5 * PI - psi)
-            }
-        };
-        let dphi = |quad: usize, psi: f64| {
-            if quad & 1 == 0 {
-                jac(psi)
-            } else {
-                jac(0.5 * PI - psi)
-            }
-        };
-        let mut edges = Vec::with_capacity(NP + 1);
-        for quad in 0..4 {
-            for i in 0..q {
-                edges.push(phi_of(quad, 0.5 * PI * i as f64 / q as f64));
-            }
-        }
-        edges.push(2.0 * PI);
-        let e_of = |phi: f64| nu * phi.cos().powi(2) + nv * phi.sin().powi(2);
-        let ej: Vec<f64> = (0..NP)
-            .map(|j| e_of(0.5 * (edges[j] + edges[j + 1])))
-            .collect();
-        let mu_edge = |j: usize, k: usize| (k as f64 / NC as f64).powf(1.0 / (ej[j] + 1.0));
-        let norm = ((nu + 1.0) * (nv + 1.0)).sqrt() / (2.0 * PI);
-        let mut expected = vec![0.0; NP * NC];
-        for j in 0..NP {
-            // Integrate in psi: a smooth change of variables that follows the lobe.
-            let (quad, i) = (j / q, j % q);
-            let sub = uniform_edges(
-                0.5 * PI * i as f64 / q as f64,
-                0.5 * PI * (i + 1) as f64 / q as f64,
-                8,
-            );
-            for k in 0..NC {
-                let (lo, hi) = (mu_edge(j, k), mu_edge(j, k + 1));
-                expected[j * NC + k] = gl(&sub, |psi| {
-                    let e1 = e_of(phi_of(quad, psi)) + 1.0;
-                    norm * (hi.powf(e1) - lo.powf(e1)) / e1 * dphi(quad, psi)
-                }) * N as f64;
-            }
-        }
-        let total: f64 = expected.iter().sum::<f64>() / N as f64;
-        assert!(
-            (total - 1.0).abs() < 1e-6,
-            "expected probabilities sum {total}"
+        let r = chi2_h(&p, 200_000, 11 + i as u64);
+        println!(
+            "h chi2 nu {nu} nv {nv}: {:.1} dof {} crit95 {:.1} crit99.9 {:.1}",
+            r.statistic, r.dof, r.critical_95, r.critical_999
         );
-        let mut observed = vec![0.0; NP * NC];
-        for _ in 0..N {
-            let h = p.sample_h(rng.f(), rng.f());
-            let mut phi = h.y.atan2(h.x);
-            if phi < 0.0 {
-                phi += 2.0 * PI;
-            }
-            let j = edges.partition_point(|&e| e <= phi).clamp(1, NP) - 1;
-            let t = h.z.clamp(0.0, 1.0).powf(ej[j] + 1.0);
-            let k = ((t * NC as f64) as usize).min(NC - 1);
-            observed[j * NC + k] += 1.0;
-        }
-        let (stat, groups) = merged_chi2(&observed, &expected);
-        let dof = (groups - 1) as f64;
-        let (c95, c999) = (wilson_hilferty(dof, Z_95), wilson_hilferty(dof, Z_999));
-        println!("h chi2 nu {nu} nv {nv}: {stat:.1} dof {dof} crit95 {c95:.1} crit99.9 {c999:.1}");
         assert!(
-            stat < c999,
-            "nu {nu} nv {nv}: chi2 {stat} >= {c999} (dof {dof})"
+            (r.total_probability - 1.0).abs() < 1e-6,
+            "expected probabilities sum {}",
+            r.total_probability
         );
+        assert!(r.dof > 400 && r.lost == 0, "{r:?}");
+        assert!(r.passed, "nu {nu} nv {nv}: {r:?}");
     }
 }
 
-fn merged_chi2(obs: &[f64], exp: &[f64]) -> (f64, usize) {
-    let mut groups = Vec::new();
-    let (mut o, mut e) = (0.0, 0.0);
-    for (&ob, &ex) in obs.iter().zip(exp) {
-        o += ob;
-        e += ex;
-        if e >= 5.0 {
-            groups.push((o, e));
-            (o, e) = (0.0, 0.0);
-        }
+/// Negative controls of `chi2_h` at the anisotropy `texsim brdf sample` advertises
+/// (`nu = 1000, nv = 10`) and beyond: a sampler whose `nu` is 5% off, one with the axes
+/// swapped, one for `(1e5, 10)` fed `(1e5, 12)` and an isotropic one 5% off are all rejected
+/// at 99.9%, while the right sampler passes with the same seed.
+#[test]
+fn half_vector_chi_square_rejects_wrong_samplers() {
+    for (truth, wrong) in [
+        ((1000.0, 10.0), (1050.0, 10.0)),
+        ((1000.0, 10.0), (10.0, 1000.0)),
+        ((100_000.0, 10.0), (100_000.0, 12.0)),
+        ((10.0, 10.0), (10.5, 10.5)),
+    ] {
+        let p = AshikhminShirley::new(truth.0, truth.1, 1.0, 0.0).expect("valid");
+        let q = AshikhminShirley::new(wrong.0, wrong.1, 1.0, 0.0).expect("valid");
+        let ok = chi2_h(&p, 200_000, 3);
+        let bad = chi2_h_of(&p, &mut |a, b| q.sample_h(a, b), 200_000, 3);
+        println!(
+            "truth {truth:?}: {:.1}; sampler of {wrong:?}: {:.1} (crit99.9 {:.1})",
+            ok.statistic, bad.statistic, bad.critical_999
+        );
+        assert!(ok.passed, "{truth:?}: {ok:?}");
+        assert!(!bad.passed, "{truth:?} vs {wrong:?}: {bad:?}");
     }
-    if let Some(l) = groups.last_mut() {
-        l.0 += o;
-        l.1 += e;
-    }
-    (
-        groups.iter().map(|&(o, e)| (o - e) * (o - e) / e).sum(),
-        groups.len(),
-    )
 }
 
-/// A sampler with a wrong exponent must be rejected by the same test: sanity that the
-/// half-vector chi-square has power (E off by 5% at nu = nv = 100 is detected).
+/// Negative controls of `chi2_k2`: a sampler with a 5% wrong exponent (within its anisotropy
+/// range) is rejected; a sampler that loses 0.1% of its samples (returns `None`, which the
+/// density says has probability 0) is rejected with an infinite statistic; and `chi2_merged`
+/// scores a bin that expects 0 but holds samples as infinite even where it would be merged
+/// into a neighbour.
+#[test]
+fn reflected_direction_chi_square_rejects_wrong_samplers() {
+    let k1 = dir_from_angles(30.0, 33.0);
+    let p = AshikhminShirley::new(100.0, 100.0, 0.5, 0.5).expect("valid");
+    let q = AshikhminShirley::new(105.0, 105.0, 0.5, 0.5).expect("valid");
+    let ok = chi2_k2(&p, k1, 200_000, 3);
+    let bad = chi2_k2_of(&p, k1, &mut |xi| q.sample_sphere(k1, xi), 200_000, 3);
+    println!(
+        "k2 chi2 (100, 100): {:.1}; sampler of (105, 105): {:.1} (crit99.9 {:.1})",
+        ok.statistic, bad.statistic, bad.critical_999
+    );
+    assert!(ok.passed && ok.lost == 0, "{ok:?}");
+    assert!(!bad.passed, "{bad:?}");
+    let mut count = 0u64;
+    let lossy = chi2_k2_of(
+        &p,
+        k1,
+        &mut |xi| {
+            count += 1;
+            if count == 1000 {
+                count = 0;
+                None
+            } else {
+                p.sample_sphere(k1, xi)
+            }
+        },
+        200_000,
+        3,
+    );
+    assert_eq!(lossy.lost, 200);
+    assert!(lossy.statistic.is_infinite() && !lossy.passed, "{lossy:?}");
+    // (observed, expected): the last bin expects 0 but holds one sample.
+    let (stat, _) = chi2_merged(&[(100.0, 100.0), (50.0, 50.0), (1.0, 0.0)], 5.0);
+    assert!(stat.is_infinite(), "{stat}");
+    let (stat, groups) = chi2_merged(&[(100.0, 100.0), (50.0, 50.0), (0.0, 0.0)], 5.0);
+    assert_eq!((stat, groups), (0.0, 2));
+}
+
+/// An independent binning (not the library's): for `nu = nv = 100`, `t = (h.n)^101` is uniform
+/// on [0, 1] under eq. 5, so 32 equal bins in `t` each expect `n / 32`. The right sampler
+/// passes at 99.9% and a sampler with a 5% wrong exponent is rejected.
 #[test]
 fn chi_square_detects_a_wrong_sampler() {
     let truth = AshikhminShirley::new(100.0, 100.0, 1.0, 0.0).expect("valid");
     let wrong = AshikhminShirley::new(105.0, 105.0, 1.0, 0.0).expect("valid");
-    let mut rng = Rng(5);
     let nc = 32;
     let n = 200_000usize;
-    let mut observed = vec![0.0; nc];
-    for _ in 0..n {
-        let h = wrong.sample_h(rng.f(), rng.f());
-        let t = h.z.powf(101.0);
-        observed[((t * nc as f64) as usize).min(nc - 1)] += 1.0;
-    }
-    // Under the truth, t = mu^101 is uniform: every bin expects n / nc.
-    let expected = vec![n as f64 / nc as f64; nc];
-    let (stat, groups) = merged_chi2(&observed, &expected);
-    assert!(stat > wilson_hilferty((groups - 1) as f64, Z_999), "{stat}");
-    let _ = truth;
+    let stat_of = |p: &AshikhminShirley| {
+        let mut rng = Rng(5);
+        let mut observed = vec![0.0; nc];
+        for _ in 0..n {
+            let h = p.sample_h(rng.f(), rng.f());
+            let t = h.z.powf(101.0);
+            observed[((t * nc as f64) as usize).min(nc - 1)] += 1.0;
+        }
+        let pairs: Vec<(f64, f64)> = observed
+            .into_iter()
+            .map(|o| (o, n as f64 / nc as f64))
+            .collect();
+        let (stat, groups) = chi2_merged(&pairs, 5.0);
+        (stat, wilson_hilferty((groups - 1) as f64, Z_999))
+    };
+    let (ok, crit) = stat_of(&truth);
+    assert!(ok < crit, "{ok} {crit}");
+    let (bad, crit) = stat_of(&wrong);
+    assert!(bad > crit, "{bad} {crit}");
 }
 
 /// Chi-square of reflected directions k2 (eqs. 19-20) for moderate anisotropy, binned around

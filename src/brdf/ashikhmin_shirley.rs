@@ -27,6 +27,18 @@
 //! Guards: directions at or below the horizon give 0; `k1 = -k2` (no halfway vector) gives 0;
 //! the specular denominator `(h.k) max(n.k1, n.k2)` is floored at [`DENOM_FLOOR`] so the value
 //! stays finite at grazing (the true lobe is unbounded there only for exponents below 1).
+//!
+//! Bounds (asserted by `tests/brdf_props.rs` over random and boundary inputs, and reached: the
+//! floor is hit at grazing with `h = k1 = k2`): for every input, including the dot-product form
+//! [`AshikhminShirley::eval_from_dots`] with any dots,
+//! - `0 <= rho_s <= sqrt((nu+1)(nv+1)) / (8 pi DENOM_FLOOR)` (power and Fresnel are in
+//!   `[0, 1]`), at most `3.98e16` for exponents up to [`EXPONENT_MAX`];
+//! - `0 <= rho_d <= 28 Rd (1 - Rs) / (23 pi) <= 0.388`;
+//! - `0 <= pdf(k1, k2) <= sqrt((nu+1)(nv+1)) / (4 pi |k1 + k2|)` (eq. 20 with
+//!   `k1.h = |k1 + k2| / 2`; finite because a halfway vector needs `|k1 + k2| > 1e-300`), and
+//!   `0 <= pdf_h <= sqrt((nu+1)(nv+1)) / (2 pi)`.
+//!
+//! [`BRDF_MAX`] is the largest of these bounds on `rho`.
 
 // `!(x > 0.0)` is used on purpose: it is true for NaN, which must take the guarded path.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -41,6 +53,27 @@ pub const DENOM_FLOOR: f64 = 1.0e-12;
 
 /// Largest accepted Phong exponent.
 pub const EXPONENT_MAX: f64 = 1.0e6;
+
+impl AshikhminShirley {
+    /// Upper bound of [`AshikhminShirley::specular`] (and of the specular part of
+    /// [`AshikhminShirley::eval_from_dots`]) for these parameters: the denominator floor with
+    /// power and Fresnel at 1 (module doc, "Bounds").
+    #[must_use]
+    pub fn specular_max(&self) -> f64 {
+        ((self.nu + 1.0) * (self.nv + 1.0)).sqrt() / (8.0 * PI * DENOM_FLOOR)
+    }
+
+    /// Upper bound of [`AshikhminShirley::diffuse`]: `28 Rd (1 - Rs) / (23 pi)` (eq. 16 with
+    /// both `n.k` at 1).
+    #[must_use]
+    pub fn diffuse_max(&self) -> f64 {
+        28.0 * self.rd * (1.0 - self.rs) / (23.0 * PI)
+    }
+}
+
+/// Largest value of `rho` for any valid parameters and directions: the specular bound at
+/// `nu = nv = EXPONENT_MAX` plus the largest diffuse value (about `3.98e16`).
+pub const BRDF_MAX: f64 = (EXPONENT_MAX + 1.0) / (8.0 * PI * DENOM_FLOOR) + 28.0 / (23.0 * PI);
 
 /// Parameters of the model: Phong exponents along `u` and `v`, normal-incidence specular
 /// reflectance `Rs` (eq. 11) and diffuse albedo `Rd` (eq. 16).

@@ -8,7 +8,7 @@ use glam::DVec3;
 use hw_model::aniso_phong::{
     aniso_phong, AnisoPhongConfig, AnisoPhongInputs, AnisoPhongOut, PseudoFloat,
 };
-use hw_model::SatCounter;
+use hw_model::{Rounding, SatCounter};
 use std::f64::consts::PI;
 
 /// Value of a pseudo-float.
@@ -154,4 +154,34 @@ pub fn albedo_fixed(
     );
     sat.add(&sat_d);
     Ok((s + d, s, d))
+}
+
+/// Terms of the declared error bound of the power stage `hw_model::aniso_phong::aniso_power`
+/// (its doc derives them) at `X = E L / 2`, `L = -log2(1 - s)`, when the `E` the stage is fed
+/// is within `e_err` of the exact one (0 for an exact `aniso_ratio_bits` value, `2^-(r+1)`
+/// after the exponent divider): `(dX, dE)`, the bound on `|X_fixed - X|` and the relative error
+/// of the exp2 step.
+#[must_use]
+pub fn power_error_terms(cfg: &AnisoPhongConfig, x: f64, l: f64, e_err: f64) -> (f64, f64) {
+    let u = if cfg.aniso_rounding == Rounding::Truncate {
+        1.0
+    } else {
+        0.5
+    };
+    let f = 2f64.powi(-(cfg.aniso_pow_frac_bits as i32));
+    let h2 = 2f64.powi(-2 * cfg.aniso_pow_lut_bits as i32 - 3);
+    let eps = 2.0 * u * f + 2f64.powi(-40);
+    let ln2 = std::f64::consts::LN_2;
+    let dl = eps + h2 / ln2;
+    let dx = x * dl + u * f + 0.5 * l * (1.0 + dl) * e_err;
+    let de = 2.0 * (eps + ln2 * ln2 * h2);
+    (dx, de)
+}
+
+/// The declared relative error bound `2^dX (1 + dE) - 1` of `aniso_power` at `X`, `L` and
+/// `e_err` (see [`power_error_terms`]); it holds for every non-zero output.
+#[must_use]
+pub fn power_rel_bound(cfg: &AnisoPhongConfig, x: f64, l: f64, e_err: f64) -> f64 {
+    let (dx, de) = power_error_terms(cfg, x, l, e_err);
+    2f64.powf(dx) * (1.0 + de) - 1.0
 }

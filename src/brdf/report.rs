@@ -5,8 +5,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use super::ashikhmin_shirley::{dir_from_angles, AshikhminShirley, Dots, SplitMix64};
-use super::fixed_twin::albedo_fixed;
-use super::stats::chi2_k2;
+use super::fixed_twin::{albedo_fixed, check_params, eval_fixed_parts};
+use super::stats::{anisotropy_ratio, chi2_h, chi2_k2, Chi2Result, K2_MAX_ANISOTROPY};
 use crate::error::{Error, Result};
 use glam::DVec3;
 use hw_model::aniso_phong::AnisoPhongConfig;
@@ -85,9 +85,19 @@ pub fn albedo_report(
 }
 
 /// The BRDF at one direction pair (local frame, `n = z`; inputs are normalized): dot products,
-/// exponent, Fresnel, parts and the sampling density. The last line is `rho(k1, k2)`.
-pub fn eval_report(p: &AshikhminShirley, k1: DVec3, k2: DVec3) -> Result<String> {
+/// exponent, Fresnel, parts and the sampling density; with `fixed`, also the fixed unit's parts
+/// for the same directions (its dot products rounded to the unit's inputs). The last line is
+/// `rho(k1, k2)`: the fixed unit's when `fixed` is given, else the float model's.
+pub fn eval_report(
+    p: &AshikhminShirley,
+    k1: DVec3,
+    k2: DVec3,
+    fixed: Option<&AnisoPhongConfig>,
+) -> Result<String> {
     check_model(p)?;
+    if let Some(cfg) = fixed {
+        check_params(p, cfg)?;
+    }
     let k1 = check_dir("k1", k1)?;
     let k2 = check_dir("k2", k2)?;
     let mut s = String::new();
@@ -124,12 +134,40 @@ pub fn eval_report(p: &AshikhminShirley, k1: DVec3, k2: DVec3) -> Result<String>
         "specular {sp:.6e}  diffuse {df:.6e}  pdf(k2|k1) {:.6e}",
         p.pdf(k1, k2)
     );
-    let _ = write!(s, "{:.6e}", sp + df);
+    let mut last = sp + df;
+    if let Some(cfg) = fixed {
+        let mut sat = SatCounter::default();
+        let (fs, fd) = eval_fixed_parts(p, k1, k2, cfg, &mut sat);
+        let _ = writeln!(
+            s,
+            "fixed unit: specular {fs:.6e}  diffuse {fd:.6e}  (float - fixed {:.2e}, saturated {})",
+            last - (fs + fd),
+            sat.saturated
+        );
+        last = fs + fd;
+    }
+    let _ = write!(s, "{last:.6e}");
     Ok(s)
 }
 
-/// Sampler statistics for `k1`: valid fraction, mean density of valid samples, the MC albedo and
-/// the chi-square test of the reflected directions (statistic, dof, critical values, verdict).
+/// One line of a chi-square result.
+fn chi2_line(what: &str, c: &Chi2Result) -> String {
+    format!(
+        "{what} chi-square {:.2} dof {} critical95 {:.2} critical99.9 {:.2} (bins hold {:.6} of the pdf, {} lost): {}",
+        c.statistic,
+        c.dof,
+        c.critical_95,
+        c.critical_999,
+        c.total_probability,
+        c.lost,
+        if c.passed { "pass" } else { "FAIL" }
+    )
+}
+
+/// Sampler statistics for `k1`: valid fraction, mean density of valid samples, the MC albedo,
+/// the chi-square test of the half vectors (valid at any anisotropy) and, when the anisotropy
+/// ratio is within [`K2_MAX_ANISOTROPY`], of the reflected directions (otherwise a line says it
+/// was skipped and why). The last line is the verdict of the tests that ran.
 pub fn sample_report(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64) -> Result<String> {
     check_model(p)?;
     let k1 = check_dir("k1", k1)?;
@@ -151,7 +189,9 @@ pub fn sample_report(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64)
         }
     }
     let mc = p.albedo_mc(k1, samples, seed ^ 0x5DEE_CE66);
-    let chi = chi2_k2(p, k1, samples, seed ^ 0xA5A5_A5A5);
+    let chi_h = chi2_h(p, samples, seed ^ 0x3C3C_3C3C);
+    let ratio = anisotropy_ratio(p);
+    let chi_k2 = (ratio <= K2_MAX_ANISOTROPY).then(|| chi2_k2(p, k1, samples, seed ^ 0xA5A5_A5A5));
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -174,15 +214,36 @@ pub fn sample_report(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64)
         }
     );
     let _ = writeln!(s, "mc albedo {:.6} +- {:.6}", mc.albedo, mc.std_error);
-    let _ = writeln!(s, "pdf integral over bins {:.6}", chi.total_probability);
+    let _ = writeln!(
+        s,
+        "{}",
+        chi2_line("half-vector (eqs. 21-22 vs eq. 5)", &chi_h)
+    );
+    match &chi_k2 {
+        Some(c) => {
+            let _ = writeln!(
+                s,
+                "{}",
+                chi2_line("reflected-direction (eq. 19 vs eq. 20)", c)
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "reflected-direction chi-square skipped: anisotropy ratio {ratio:.1} > {K2_MAX_ANISOTROPY} is beyond its binning (the half-vector test holds at any anisotropy)"
+            );
+        }
+    }
+    let passed = chi_h.passed && chi_k2.iter().all(|c| c.passed);
     let _ = write!(
         s,
-        "chi-square {:.2} dof {} critical95 {:.2} critical99.9 {:.2}: {}",
-        chi.statistic,
-        chi.dof,
-        chi.critical_95,
-        chi.critical_999,
-        if chi.passed { "pass" } else { "FAIL" }
+        "chi-square ({} at the 99.9% level): {}",
+        if chi_k2.is_some() {
+            "half-vector and reflected-direction"
+        } else {
+            "half-vector"
+        },
+        if passed { "pass" } else { "FAIL" }
     );
     Ok(s)
 }

@@ -1,14 +1,26 @@
-//! Chi-square goodness-of-fit of the Ashikhmin-Shirley reflected-direction sampler (eqs. 19-22)
-//! against its density (eq. 20), with Wilson-Hilferty critical values (Wilson & Hilferty 1931:
+//! Chi-square goodness-of-fit tests of the Ashikhmin-Shirley sampler (eqs. 19-22) against its
+//! densities, with Wilson-Hilferty critical values (Wilson & Hilferty 1931:
 //! `chi2_p(k) ~ k (1 - 2/(9k) + z_p sqrt(2/(9k)))^3`).
 //!
-//! Bins cover the whole sphere of `k2` in a frame centred on the mirror direction `r` of `k1`:
-//! `24` bins in `t` where `1 - cos(angle to r) = 2 (e^(lambda t) - 1)/(e^lambda - 1)` (fine near
-//! the lobe, `lambda = ln(1 + 2 sqrt((nu+1)(nv+1)))`) times `16` bins of the azimuth around `r`. The
-//! expected probability of a bin is the integral of [`AshikhminShirley::pdf`] over it, by 8x8
-//! sub-cells of 4x4 Gauss-Legendre nodes. Bins expecting fewer than 5 samples are merged in
-//! index order. The binning resolves lobes whose anisotropy ratio `max/min` of `(n+1)` is up
-//! to about 10; stronger anisotropy needs the half-vector test of `tests/brdf_sampling.rs`.
+//! - [`chi2_h`]: sampled half vectors (eqs. 21-22) against eq. 5, valid at ANY anisotropy:
+//!   `32` azimuth bins whose edges follow the lobe (`phi = atan(a tan(psi))`, `psi` uniform per
+//!   quadrant, `a = sqrt((nu+1)/(nv+1))`) times `16` bins in `cos(theta)` with edges
+//!   `mu_k = (k/16)^(1/(E_j+1))` (`E_j` the exponent at the azimuth bin's centre), so every bin
+//!   holds a comparable share of the lobe however narrow or anisotropic it is. The expected
+//!   probability of a bin is eq. 5 integrated in closed form over `mu` and by 8 cells of
+//!   4-point Gauss-Legendre over `psi`.
+//! - [`chi2_k2`]: reflected directions `k2` (eq. 19) against eq. 20, over the whole sphere, in
+//!   a frame centred on the mirror direction `r` of `k1`: `24` bins in `t` where
+//!   `1 - cos(angle to r) = 2 (e^(lambda t) - 1)/(e^lambda - 1)` (fine near the lobe,
+//!   `lambda = ln(1 + 2 sqrt((nu+1)(nv+1)))`) times `16` bins of the azimuth around `r`; expected
+//!   probabilities by 8x8 sub-cells of 4x4 Gauss-Legendre nodes. This binning is round around
+//!   `r`, so it resolves lobes whose anisotropy ratio ([`anisotropy_ratio`]) is at most
+//!   [`K2_MAX_ANISOTROPY`]; beyond that use [`chi2_h`].
+//!
+//! Bins expecting fewer than 5 samples are merged in index order ([`chi2_merged`]). A sample
+//! the sampler could not place (`None`: a density of 0 or not finite) has probability 0 under
+//! the density, so any such "lost" sample makes the statistic infinite: it is never merged into
+//! a bin that expects samples.
 
 use super::ashikhmin_shirley::{AshikhminShirley, SplitMix64};
 use glam::DVec3;
@@ -32,8 +44,38 @@ pub struct Chi2Result {
     pub critical_999: f64,
     /// Integral of the density over all bins (should be 1).
     pub total_probability: f64,
+    /// Samples the sampler could not place (probability 0 under the density; any makes the
+    /// statistic infinite).
+    pub lost: usize,
     /// `statistic < critical_999`.
     pub passed: bool,
+}
+
+/// Largest anisotropy ratio [`chi2_k2`] is valid for (its binning is round around the mirror
+/// direction; `tests/brdf_sampling.rs` checks it up to a ratio of 9.2).
+pub const K2_MAX_ANISOTROPY: f64 = 10.0;
+
+/// Anisotropy ratio of the lobe: `max(nu+1, nv+1) / min(nu+1, nv+1)`.
+#[must_use]
+pub fn anisotropy_ratio(p: &AshikhminShirley) -> f64 {
+    let (a, b) = (p.nu + 1.0, p.nv + 1.0);
+    a.max(b) / a.min(b)
+}
+
+/// The result of a statistic over `groups` merged bins.
+#[must_use]
+fn result(statistic: f64, groups: usize, total_probability: f64, lost: usize) -> Chi2Result {
+    let dof = groups.saturating_sub(1).max(1);
+    let critical_999 = wilson_hilferty(dof as f64, Z_999);
+    Chi2Result {
+        statistic,
+        dof,
+        critical_95: wilson_hilferty(dof as f64, Z_95),
+        critical_999,
+        total_probability,
+        lost,
+        passed: statistic < critical_999,
+    }
 }
 
 /// Wilson-Hilferty approximation of the chi-square quantile for `dof` degrees of freedom and
@@ -45,9 +87,17 @@ pub fn wilson_hilferty(dof: f64, z: f64) -> f64 {
 }
 
 /// Chi-square statistic over `(observed, expected)` pairs after merging bins expecting fewer
-/// than `min_expected`, in order. Returns `(statistic, merged bin count)`.
+/// than `min_expected`, in order (the remainder joins the last group). A bin that expects
+/// exactly 0 but holds samples is an impossible event under the density: the statistic is
+/// infinite (it is not diluted by merging). Returns `(statistic, merged bin count)`.
 #[must_use]
 pub fn chi2_merged(pairs: &[(f64, f64)], min_expected: f64) -> (f64, usize) {
+    if pairs
+        .iter()
+        .any(|&(o, e)| (e <= 0.0 || e.is_nan()) && o > 0.0)
+    {
+        return (f64::INFINITY, pairs.len());
+    }
     let mut groups: Vec<(f64, f64)> = Vec::new();
     let (mut o, mut e) = (0.0, 0.0);
     for &(ob, ex) in pairs {
@@ -83,6 +133,9 @@ pub fn chi2_merged(pairs: &[(f64, f64)], min_expected: f64) -> (f64, usize) {
     (stat, groups.len())
 }
 
+/// Azimuth and `cos(theta)` bins of [`chi2_h`].
+const NP: usize = 32;
+const NC: usize = 16;
 const NT: usize = 24;
 const NB: usize = 16;
 const SUB: usize = 8;
@@ -104,9 +157,23 @@ fn frame(k1: DVec3) -> (DVec3, DVec3, DVec3) {
 }
 
 /// Chi-square test of [`AshikhminShirley::sample_sphere`] against [`AshikhminShirley::pdf`]
-/// for a fixed `k1` (must be above the horizon), with `samples` samples from `seed`.
+/// for a fixed `k1` (must be above the horizon), with `samples` samples from `seed`. Valid for
+/// an [`anisotropy_ratio`] up to [`K2_MAX_ANISOTROPY`].
 #[must_use]
 pub fn chi2_k2(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64) -> Chi2Result {
+    chi2_k2_of(p, k1, &mut |xi| p.sample_sphere(k1, xi), samples, seed)
+}
+
+/// [`chi2_k2`] of any sampler of reflected directions (`None`: a lost sample) against the
+/// density of `p`: the negative controls of the tests feed it a wrong sampler.
+#[must_use]
+pub fn chi2_k2_of(
+    p: &AshikhminShirley,
+    k1: DVec3,
+    sampler: &mut dyn FnMut([f64; 2]) -> Option<(DVec3, f64)>,
+    samples: usize,
+    seed: u64,
+) -> Chi2Result {
     let em = ((p.nu + 1.0) * (p.nv + 1.0)).sqrt() - 1.0;
     let lambda = (1.0 + 2.0 * (em + 1.0)).ln().max(1.0);
     let el = lambda.exp_m1();
@@ -147,10 +214,10 @@ pub fn chi2_k2(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64) -> Ch
     // Observed counts.
     let mut observed = vec![0.0; NT * NB];
     let mut rng = SplitMix64(seed);
-    let mut lost = 0.0;
+    let mut lost = 0usize;
     for _ in 0..samples {
         let xi = [rng.next_f64(), rng.next_f64()];
-        match p.sample_sphere(k1, xi) {
+        match sampler(xi) {
             Some((k2, _)) => {
                 let c = k2.dot(r).clamp(-1.0, 1.0);
                 let w = 1.0 - c;
@@ -163,26 +230,113 @@ pub fn chi2_k2(p: &AshikhminShirley, k1: DVec3, samples: usize, seed: u64) -> Ch
                 let ib = ((beta / (2.0 * PI) * NB as f64) as usize).min(NB - 1);
                 observed[it * NB + ib] += 1.0;
             }
-            None => lost += 1.0,
+            None => lost += 1,
         }
     }
     let n = samples as f64;
-    let mut pairs: Vec<(f64, f64)> = observed
+    let pairs: Vec<(f64, f64)> = observed
         .iter()
         .zip(&expected)
         .map(|(&o, &e)| (o, e * n))
         .collect();
-    // Samples the sampler could not place count against a bin of expectation 0.
-    pairs.push((lost, 0.0));
     let (statistic, groups) = chi2_merged(&pairs, 5.0);
-    let dof = groups.saturating_sub(1).max(1);
-    let critical_999 = wilson_hilferty(dof as f64, Z_999);
-    Chi2Result {
-        statistic,
-        dof,
-        critical_95: wilson_hilferty(dof as f64, Z_95),
-        critical_999,
-        total_probability,
-        passed: statistic < critical_999,
+    let statistic = if lost > 0 { f64::INFINITY } else { statistic };
+    result(statistic, groups, total_probability, lost)
+}
+
+/// Chi-square test of the half-vector sampler [`AshikhminShirley::sample_h`] (eqs. 21-22)
+/// against its density [`AshikhminShirley::pdf_h`] (eq. 5) with `samples` samples from
+/// `seed`; valid at any anisotropy (module doc).
+#[must_use]
+pub fn chi2_h(p: &AshikhminShirley, samples: usize, seed: u64) -> Chi2Result {
+    chi2_h_of(p, &mut |x1, x2| p.sample_h(x1, x2), samples, seed)
+}
+
+/// [`chi2_h`] of any half-vector sampler against the density of `p` (negative controls).
+#[must_use]
+pub fn chi2_h_of(
+    p: &AshikhminShirley,
+    sampler: &mut dyn FnMut(f64, f64) -> DVec3,
+    samples: usize,
+    seed: u64,
+) -> Chi2Result {
+    let (nu, nv) = (p.nu, p.nv);
+    let a = ((nu + 1.0) / (nv + 1.0)).sqrt();
+    let q = NP / 4;
+    // phi(psi) per quadrant, increasing in psi, mirrored in odd quadrants so that the lobe
+    // (symmetric about both axes) is followed in every quadrant; and dphi/dpsi.
+    let first = |psi: f64| (a * psi.sin()).atan2(psi.cos());
+    let jac = |psi: f64| a / (psi.cos().powi(2) + a * a * psi.sin().powi(2));
+    let phi_of = |quad: usize, psi: f64| {
+        if quad & 1 == 0 {
+            0.5 * PI * quad as f64 + first(psi)
+        } else {
+            0.5 * PI * (quad + 1) as f64 - first(0.5 * PI - psi)
+        }
+    };
+    let dphi = |quad: usize, psi: f64| {
+        if quad & 1 == 0 {
+            jac(psi)
+        } else {
+            jac(0.5 * PI - psi)
+        }
+    };
+    let mut edges = Vec::with_capacity(NP + 1);
+    for quad in 0..4 {
+        for i in 0..q {
+            edges.push(phi_of(quad, 0.5 * PI * i as f64 / q as f64));
+        }
     }
+    edges.push(2.0 * PI);
+    let e_of = |phi: f64| nu * phi.cos().powi(2) + nv * phi.sin().powi(2);
+    let ej: Vec<f64> = (0..NP)
+        .map(|j| e_of(0.5 * (edges[j] + edges[j + 1])))
+        .collect();
+    let mu_edge = |j: usize, k: usize| (k as f64 / NC as f64).powf(1.0 / (ej[j] + 1.0));
+    let norm = ((nu + 1.0) * (nv + 1.0)).sqrt() / (2.0 * PI);
+    let n = samples as f64;
+    let mut expected = vec![0.0; NP * NC];
+    for j in 0..NP {
+        // Integrate in psi: a smooth change of variables that follows the lobe.
+        let (quad, i) = (j / q, j % q);
+        let (lo_psi, hi_psi) = (
+            0.5 * PI * i as f64 / q as f64,
+            0.5 * PI * (i + 1) as f64 / q as f64,
+        );
+        let cell = (hi_psi - lo_psi) / SUB as f64;
+        for k in 0..NC {
+            let (lo, hi) = (mu_edge(j, k), mu_edge(j, k + 1));
+            let mut acc = 0.0;
+            for c in 0..SUB {
+                for (g, w) in GL4 {
+                    let psi = lo_psi + (c as f64 + g) * cell;
+                    let e1 = e_of(phi_of(quad, psi)) + 1.0;
+                    acc += w * cell * norm * (hi.powf(e1) - lo.powf(e1)) / e1 * dphi(quad, psi);
+                }
+            }
+            expected[j * NC + k] = acc;
+        }
+    }
+    let total_probability: f64 = expected.iter().sum();
+    let mut observed = vec![0.0; NP * NC];
+    let mut rng = SplitMix64(seed);
+    for _ in 0..samples {
+        let (x1, x2) = (rng.next_f64(), rng.next_f64());
+        let h = sampler(x1, x2);
+        let mut phi = h.y.atan2(h.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        let j = edges.partition_point(|&e| e <= phi).clamp(1, NP) - 1;
+        let t = h.z.clamp(0.0, 1.0).powf(ej[j] + 1.0);
+        let k = ((t * NC as f64) as usize).min(NC - 1);
+        observed[j * NC + k] += 1.0;
+    }
+    let pairs: Vec<(f64, f64)> = observed
+        .iter()
+        .zip(&expected)
+        .map(|(&o, &e)| (o, e * n))
+        .collect();
+    let (statistic, groups) = chi2_merged(&pairs, 5.0);
+    result(statistic, groups, total_probability, 0)
 }
