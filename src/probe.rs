@@ -70,7 +70,8 @@ pub fn probe_report(
         })
         .collect();
     let i = &hw.interp;
-    let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding);
+    let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
+        .with_overflow(i.texcoord_overflow);
     let lfb = hw.lod.lod_frac_bits;
     let lod_fmt = Format::signed(8, lfb, Rounding::Truncate);
     let mut sat = SatCounter::default();
@@ -104,8 +105,7 @@ pub fn probe_report(
         chain.levels.len(),
         hw.name
     );
-    let _ =
-        writeln!(
+    let _ = writeln!(
         o,
         "input: u={u} v={v} lod={lod} -> fixed u={} v={} ({} frac bits), lod={} ({} frac bits){}",
         from_raw(ur, uv_fmt.frac_bits),
@@ -113,7 +113,12 @@ pub fn probe_report(
         uv_fmt.frac_bits,
         from_raw(lr, lfb),
         lfb,
-        if sat.saturated > 0 { "  [input saturated]" } else { "" }
+        match (sat.saturated > 0, sat.wrapped > 0) {
+            (true, true) => "  [input saturated and wrapped]",
+            (true, false) => "  [input saturated]",
+            (false, true) => "  [input wrapped]",
+            (false, false) => "",
+        }
     );
     for l in 0..tr.levels_used as usize {
         let b = &tr.level[l];

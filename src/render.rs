@@ -620,6 +620,8 @@ pub struct RenderStats {
     pub covered_pixels: u64,
     /// Host-to-hardware conversions that saturated (vertex attributes out of format range).
     pub input_saturated: u64,
+    /// Host-to-hardware conversions that wrapped (formats whose overflow rule is `wrap`).
+    pub input_wrapped: u64,
     /// Bump-mapping events of the hardware pass (all zero without bump materials).
     pub bump: BumpStats,
     pub stages: Vec<StageStats>,
@@ -1092,6 +1094,7 @@ pub fn render(
             raster: raster_stats,
             covered_pixels: covered,
             input_saturated: input_sat.saturated,
+            input_wrapped: input_sat.wrapped,
             bump: BumpStats {
                 frame_fallback: counters.frame_fallback,
                 zero_normal: counters.zero_normal,

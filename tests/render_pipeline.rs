@@ -189,6 +189,42 @@ fn independent_coverage_compares_more_pixels_or_equal() {
     );
 }
 
+/// `interp.texcoord_overflow` reaches the texture coordinates: on the demo's floor (texture
+/// coordinates spanning dozens of repeats) a 2-bit integer part overflows, and each rule counts
+/// its own events, per stage (the interpolator's helper samples) and on vertex input.
+#[test]
+fn texcoord_overflow_rule_is_counted_per_stage() {
+    let s = small("demo", 320, 240);
+    let maps = Maps::new(&s, 16);
+    let run = |ov: hw_model::fixed::Overflow| {
+        let mut hw = hw_model::HwConfig::texram16();
+        hw.interp.texcoord_int_bits = 2;
+        hw.interp.texcoord_overflow = ov;
+        render(&s, &maps, &hw, &RenderOptions::default()).expect("render")
+    };
+    let sat = run(hw_model::fixed::Overflow::Saturate);
+    let wrap = run(hw_model::fixed::Overflow::Wrap);
+    let tc = |r: &Rendered| {
+        let st = &r.stats.stages[StageKind::Texcoord.index()];
+        (st.saturated, st.wrapped)
+    };
+    let (ts, tw) = tc(&sat);
+    assert!(
+        ts > 0 && tw == 0,
+        "saturate: texcoord {ts} saturated, {tw} wrapped"
+    );
+    let (ws, ww) = tc(&wrap);
+    assert!(
+        ww > 0 && ws == 0,
+        "wrap: texcoord {ws} saturated, {ww} wrapped"
+    );
+    assert!(sat.stats.input_saturated > 0 && sat.stats.input_wrapped == 0);
+    assert!(wrap.stats.input_wrapped > 0 && wrap.stats.input_saturated == 0);
+    let json = serde_json::to_value(&wrap.stats).expect("json");
+    assert_eq!(json["input_wrapped"], wrap.stats.input_wrapped);
+    assert_ne!(sat.hw_image, wrap.hw_image);
+}
+
 #[test]
 fn golden_fixed_image_of_w1_plane() {
     // The fixed path is bit-exact by design: any change to this hash must be deliberate
