@@ -2,7 +2,7 @@
 
 use crate::hwconfig;
 use crate::pipeline::{Impl, StageImpls, StageKind};
-use crate::render::{render, CoverageMode, Maps, RenderOptions, Rendered};
+use crate::render::{progress_line, render, CoverageMode, Maps, RenderOptions, Rendered};
 use crate::report::{self, OutputSet};
 use crate::scene::{self, Scene};
 use crate::{Error, Result};
@@ -369,11 +369,14 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         sc.triangle_count(),
         hw.name
     );
+    let elapsed_ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    let t = std::time::Instant::now();
     let maps = Maps::with_offset_bits(
         &sc,
         hw.trilinear.texel_bits,
         hw.shading.vector.offset_int_bits,
     );
+    progress_line(true, "texture maps", elapsed_ms(t));
     let opts = RenderOptions {
         hw_impls: impls,
         reference: !a.no_reference || a.truth,
@@ -383,8 +386,10 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
             CoverageArg::Independent => CoverageMode::Independent,
         },
         truth: if a.truth { a.truth_samples } else { 0 },
+        progress: true,
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
+    let t = std::time::Instant::now();
     let mut out = OutputSet::new();
     stage_images(&r, a.png16, &mut out)?;
     if a.truth {
@@ -401,6 +406,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
     );
     let written = out.write_to(&a.scene.out)?;
+    progress_line(true, "writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
     println!("wrote:");
     for p in written {

@@ -36,6 +36,25 @@ fn render_writes_every_output() {
         "{}",
         text(&o)
     );
+    // Progress: one line per phase on stderr, in order; stdout stays the summary.
+    let err = String::from_utf8_lossy(&o.stderr);
+    let mut at = 0;
+    for phase in [
+        "texture maps",
+        "setup",
+        "raster",
+        "hardware shading",
+        "reference",
+        "writing outputs",
+    ] {
+        let line = err[at..]
+            .lines()
+            .find(|l| l.starts_with("texsim:") && l.contains(phase) && l.ends_with(" ms"))
+            .unwrap_or_else(|| panic!("no progress line '{phase}' in order: {err}"));
+        at += err[at..].find(line).expect("line") + line.len();
+    }
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(!out.lines().any(|l| l.starts_with("texsim:")), "{out}");
 }
 
 #[test]
