@@ -57,6 +57,42 @@ fn render_writes_every_output() {
     assert!(!out.lines().any(|l| l.starts_with("texsim:")), "{out}");
 }
 
+/// README command 1: `texsim` alone renders the demo into ./out (`cargo run --release`).
+#[test]
+fn no_arguments_renders_the_demo_into_out() {
+    let d = tmp("noargs");
+    let t = std::time::Instant::now();
+    let o = texsim(&[], &d);
+    println!(
+        "texsim (demo, 1024x768): {:.2} s",
+        t.elapsed().as_secs_f64()
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    for f in [
+        "hw.png",
+        "ref.png",
+        "error.png",
+        "sheet.png",
+        "summary.json",
+    ] {
+        let p = d.join("out").join(f);
+        assert!(p.is_file(), "missing out/{f}");
+        assert!(std::fs::metadata(&p).unwrap().len() > 0, "empty out/{f}");
+    }
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("out/summary.json")).unwrap()).unwrap();
+    assert_eq!(j["scene"], "demo");
+    assert_eq!(j["hw_config"]["name"], "texram16");
+    assert_eq!(
+        (j["stats"]["width"].as_u64(), j["stats"]["height"].as_u64()),
+        (Some(1024), Some(768))
+    );
+    assert_eq!(j["stats"]["coverage"], "shared");
+    assert!(j["stats"]["error_8bit"]["max_abs_lsb"].is_u64());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("out/summary.json"), "{out}");
+}
+
 #[test]
 fn bad_inputs_fail_cleanly_and_write_nothing() {
     let d = tmp("bad");
