@@ -252,8 +252,30 @@ pub struct ProbeArgs {
     #[arg(long, default_value = "texram16")]
     pub hw: String,
     /// Wrap mode of both axes.
-    #[arg(long, default_value = "repeat")]
-    pub wrap: String,
+    #[arg(long, value_enum, default_value = "repeat")]
+    pub wrap: WrapArg,
+}
+
+/// Texture addressing mode of `texsim probe --wrap`.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WrapArg {
+    /// Coordinates repeat with period 1 (GL_REPEAT).
+    Repeat,
+    /// Texel indices clamp to the edge (GL_CLAMP_TO_EDGE).
+    #[value(alias = "clamp")]
+    ClampToEdge,
+    /// Coordinates reflect every period (GL_MIRRORED_REPEAT).
+    Mirror,
+}
+
+impl From<WrapArg> for crate::scene::WrapMode {
+    fn from(w: WrapArg) -> Self {
+        match w {
+            WrapArg::Repeat => Self::Repeat,
+            WrapArg::ClampToEdge => Self::ClampToEdge,
+            WrapArg::Mirror => Self::Mirror,
+        }
+    }
 }
 
 /// Runs the parsed command line.

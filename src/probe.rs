@@ -12,18 +12,6 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::trilinear::{trilinear, Level, TrilinearTrace};
 use std::fmt::Write;
 
-fn wrap_mode(s: &str) -> Result<WrapMode> {
-    match s {
-        "repeat" => Ok(WrapMode::Repeat),
-        "clamp-to-edge" | "clamp" => Ok(WrapMode::ClampToEdge),
-        "mirror" => Ok(WrapMode::Mirror),
-        _ => Err(Error::field(
-            "--wrap",
-            format!("'{s}' is not repeat, clamp-to-edge or mirror"),
-        )),
-    }
-}
-
 /// Runs the probe and prints the report.
 pub fn probe_cmd(a: &ProbeArgs) -> Result<()> {
     for (name, v) in [("--u", a.u), ("--v", a.v), ("--lod", a.lod)] {
@@ -32,7 +20,7 @@ pub fn probe_cmd(a: &ProbeArgs) -> Result<()> {
         }
     }
     let hw = hwconfig::resolve(&a.hw)?;
-    let wrap = wrap_mode(&a.wrap)?;
+    let wrap = a.wrap.into();
     let tex = decode_texture(&a.texture)?;
     print!("{}", probe_report(&tex, &hw, a.u, a.v, a.lod, [wrap, wrap]));
     Ok(())

@@ -226,6 +226,64 @@ fn hw_show_round_trips_and_sweep_writes_table() {
     assert!(d.join("s/sweep.json").is_file());
 }
 
+/// The README's probe example runs as printed (from the repository root); `--wrap` lists its
+/// values in `--help` and rejects others.
+#[test]
+fn probe_readme_example_and_wrap_values() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let line = readme
+        .lines()
+        .find(|l| l.starts_with("texsim probe "))
+        .expect("README probe example");
+    let cmd = line.split('#').next().unwrap_or(line);
+    let args: Vec<&str> = cmd.split_whitespace().skip(1).collect();
+    let o = texsim(&args, root);
+    assert!(o.status.success(), "{line}: {}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("checker64.png"), "{out}");
+    assert!(out.contains("weights"), "{out}");
+
+    let help = text(&texsim(&["probe", "--help"], root));
+    for v in ["repeat", "clamp-to-edge", "mirror"] {
+        assert!(help.contains(v), "--help does not list '{v}': {help}");
+    }
+    let tex = root.join("scenes/checker64.png");
+    let t = tex.to_str().unwrap();
+    let probe = |wrap: &str| {
+        texsim(
+            &[
+                "probe",
+                "--texture",
+                t,
+                "--u",
+                "1.3",
+                "--v",
+                "0.2",
+                "--lod",
+                "0",
+                "--wrap",
+                wrap,
+            ],
+            root,
+        )
+    };
+    let bad = probe("wrapped");
+    assert!(!bad.status.success());
+    assert!(text(&bad).contains("clamp-to-edge"), "{}", text(&bad));
+    let outs: Vec<String> = ["repeat", "clamp-to-edge", "mirror", "clamp"]
+        .iter()
+        .map(|w| {
+            let o = probe(w);
+            assert!(o.status.success(), "{w}: {}", text(&o));
+            String::from_utf8_lossy(&o.stdout).to_string()
+        })
+        .collect();
+    assert_ne!(outs[0], outs[1], "repeat vs clamp-to-edge at u = 1.3");
+    assert_ne!(outs[0], outs[2], "repeat vs mirror at u = 1.3");
+    assert_eq!(outs[1], outs[3], "clamp is an alias of clamp-to-edge");
+}
+
 #[test]
 fn scenes_lists_the_catalogue() {
     let o = texsim(&["scenes"], &std::env::temp_dir());
