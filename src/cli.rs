@@ -427,6 +427,8 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         "summary.json",
         serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
     );
+    out.family(RENDER_OUTPUTS);
+    let stale = out.stale_in(&a.scene.out);
     let written = out.write_to(&a.scene.out)?;
     progress_line(true, "writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
@@ -434,8 +436,28 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     for p in written {
         println!("  {}", p.display());
     }
+    if !stale.is_empty() {
+        println!("removed (outputs of an earlier run that this run did not produce):");
+        for p in stale {
+            println!("  {}", p.display());
+        }
+    }
     Ok(())
 }
+
+/// Every file `texsim render` may write; those a run does not produce are removed from its
+/// output directory, so no earlier run's image stays beside a new `summary.json`.
+pub const RENDER_OUTPUTS: &[&str] = &[
+    "hw.png",
+    "hw16.png",
+    "ref.png",
+    "ref16.png",
+    "error.png",
+    "sheet.png",
+    "truth.png",
+    "baseline.png",
+    "summary.json",
+];
 
 /// Writes truth.png and fills the baseline error: the same scene with every roughness material
 /// switched to `none` (plain filtered bump map), all stages float, against the truth.

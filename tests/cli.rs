@@ -93,6 +93,57 @@ fn no_arguments_renders_the_demo_into_out() {
     assert!(out.contains("out/summary.json"), "{out}");
 }
 
+/// A render removes the outputs an earlier render left that it does not produce itself (and
+/// nothing else): a full run writes every name of `RENDER_OUTPUTS`, a reduced one leaves two.
+#[test]
+fn render_removes_its_own_stale_outputs_only() {
+    let d = tmp("stale");
+    let small = ["--width", "64", "--height", "48", "--out", "o"];
+    let mut full = vec![
+        "render",
+        "--scene",
+        "lake",
+        "--truth",
+        "--truth-samples",
+        "2",
+        "--png16",
+    ];
+    full.extend(small);
+    let o = texsim(&full, &d);
+    assert!(o.status.success(), "{}", text(&o));
+    let list = |dir: &Path| {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    let mut every: Vec<String> = texsim::cli::RENDER_OUTPUTS
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    every.sort();
+    assert_eq!(
+        list(&d.join("o")),
+        every,
+        "a full run writes every render output"
+    );
+    std::fs::write(d.join("o/notes.txt"), "mine").unwrap();
+    std::fs::write(d.join("o/cycles.json"), "{}").unwrap();
+
+    let mut reduced = vec!["render", "--scene", "demo", "--no-reference"];
+    reduced.extend(small);
+    let o = texsim(&reduced, &d);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        list(&d.join("o")),
+        ["cycles.json", "hw.png", "notes.txt", "summary.json"]
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("removed") && out.contains("ref.png"), "{out}");
+}
+
 #[test]
 fn bad_inputs_fail_cleanly_and_write_nothing() {
     let d = tmp("bad");
