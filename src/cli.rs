@@ -2,7 +2,7 @@
 
 use crate::hwconfig;
 use crate::pipeline::{Impl, StageImpls, StageKind};
-use crate::render::{render, CoverageMode, Maps, RenderOptions, Rendered};
+use crate::render::{progress_line, render, CoverageMode, Maps, RenderOptions, Rendered};
 use crate::report::{self, OutputSet};
 use crate::scene::{self, Scene};
 use crate::{Error, Result};
@@ -264,8 +264,30 @@ pub struct ProbeArgs {
     #[arg(long, default_value = "texram16")]
     pub hw: String,
     /// Wrap mode of both axes.
-    #[arg(long, default_value = "repeat")]
-    pub wrap: String,
+    #[arg(long, value_enum, default_value = "repeat")]
+    pub wrap: WrapArg,
+}
+
+/// Texture addressing mode of `texsim probe --wrap`.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WrapArg {
+    /// Coordinates repeat with period 1 (GL_REPEAT).
+    Repeat,
+    /// Texel indices clamp to the edge (GL_CLAMP_TO_EDGE).
+    #[value(alias = "clamp")]
+    ClampToEdge,
+    /// Coordinates reflect every period (GL_MIRRORED_REPEAT).
+    Mirror,
+}
+
+impl From<WrapArg> for crate::scene::WrapMode {
+    fn from(w: WrapArg) -> Self {
+        match w {
+            WrapArg::Repeat => Self::Repeat,
+            WrapArg::ClampToEdge => Self::ClampToEdge,
+            WrapArg::Mirror => Self::Mirror,
+        }
+    }
 }
 
 /// Runs the parsed command line.
@@ -381,11 +403,14 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         sc.triangle_count(),
         hw.name
     );
+    let elapsed_ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    let t = std::time::Instant::now();
     let maps = Maps::with_offset_bits(
         &sc,
         hw.trilinear.texel_bits,
         hw.shading.vector.offset_int_bits,
     );
+    progress_line(true, "texture maps", elapsed_ms(t));
     let opts = RenderOptions {
         hw_impls: impls,
         reference: !a.no_reference || a.truth,
@@ -395,8 +420,10 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
             CoverageArg::Independent => CoverageMode::Independent,
         },
         truth: if a.truth { a.truth_samples } else { 0 },
+        progress: true,
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
+    let t = std::time::Instant::now();
     let mut out = OutputSet::new();
     stage_images(&r, a.png16, &mut out)?;
     if a.truth {
@@ -412,14 +439,37 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         "summary.json",
         serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
     );
+    out.family(RENDER_OUTPUTS);
+    let stale = out.stale_in(&a.scene.out);
     let written = out.write_to(&a.scene.out)?;
+    progress_line(true, "writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
     println!("wrote:");
     for p in written {
         println!("  {}", p.display());
     }
+    if !stale.is_empty() {
+        println!("removed (outputs of an earlier run that this run did not produce):");
+        for p in stale {
+            println!("  {}", p.display());
+        }
+    }
     Ok(())
 }
+
+/// Every file `texsim render` may write; those a run does not produce are removed from its
+/// output directory, so no earlier run's image stays beside a new `summary.json`.
+pub const RENDER_OUTPUTS: &[&str] = &[
+    "hw.png",
+    "hw16.png",
+    "ref.png",
+    "ref16.png",
+    "error.png",
+    "sheet.png",
+    "truth.png",
+    "baseline.png",
+    "summary.json",
+];
 
 /// Writes truth.png and fills the baseline error: the same scene with every roughness material
 /// switched to `none` (plain filtered bump map), all stages float, against the truth.

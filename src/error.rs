@@ -49,6 +49,32 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// `line L, column C (`source line`)` of byte `offset` in `text` (1-based, columns in chars).
+#[must_use]
+pub fn text_position(text: &str, offset: usize) -> String {
+    let mut start = offset.min(text.len());
+    while !text.is_char_boundary(start) {
+        start -= 1;
+    }
+    let before = &text[..start];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before[line_start..].chars().count() + 1;
+    let src = text[line_start..].lines().next().unwrap_or("").trim();
+    format!("line {line}, column {col} (`{src}`)")
+}
+
+/// One-line form of a toml error: `line L, column C (`source line`): message` (the message
+/// alone when toml gives no position).
+#[must_use]
+pub fn toml_message(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().trim_end().replace('\n', " ");
+    match e.span() {
+        Some(span) => format!("{}: {msg}", text_position(text, span.start)),
+        None => msg,
+    }
+}
+
 impl From<hw_model::ConfigError> for Error {
     fn from(e: hw_model::ConfigError) -> Self {
         Self { msg: e.to_string() }

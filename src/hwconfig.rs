@@ -23,42 +23,176 @@ pub fn resolve(spec: &str) -> Result<HwConfig> {
     parse(&text).map_err(|e| e.context(path.display()))
 }
 
-/// Parses a hw config TOML text (see [`resolve`]).
+/// Parses a hw config TOML text (see [`resolve`]). Every error names the field and, when the
+/// field is in `text`, its line and column.
 pub fn parse(text: &str) -> Result<HwConfig> {
-    let mut table: toml::Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| Error::msg(e.message().to_string()))?;
+    let mut table: toml::Table =
+        toml::from_str(text).map_err(|e| Error::msg(crate::error::toml_message(text, &e)))?;
+    let spans = key_spans(text);
+    let at = |field: &str, e: Error| match locate(&spans, field) {
+        Some(offset) => e.context(crate::error::text_position(text, offset)),
+        None => e,
+    };
     let base_name = match table.remove("base") {
         None => "texram16".to_string(),
         Some(toml::Value::String(s)) => s,
         Some(v) => {
-            return Err(Error::field(
+            return Err(at(
                 "base",
-                format!("expected a preset name, found {v}"),
+                Error::field("base", format!("expected a preset name, found {v}")),
             ))
         }
     };
     let base = HwConfig::preset(&base_name).ok_or_else(|| {
-        Error::field(
+        at(
             "base",
-            format!(
-                "unknown preset '{base_name}' (presets: {})",
-                PRESETS.join(", ")
+            Error::field(
+                "base",
+                format!(
+                    "unknown preset '{base_name}' (presets: {})",
+                    PRESETS.join(", ")
+                ),
             ),
         )
     })?;
     let given_name = table.get("name").cloned();
-    let mut merged = to_table(&base);
-    merge(&mut merged, table, "")?;
+    let base_table = to_table(&base);
+    let mut merged = base_table.clone();
+    merge(&mut merged, table.clone(), "").map_err(|(path, e)| at(&path, e))?;
     if !matches!(given_name, Some(toml::Value::String(_))) {
         let custom = toml::Value::String(format!("{base_name}+custom"));
         merged.insert("name".into(), custom);
     }
-    let cfg: HwConfig = toml::Value::Table(merged)
-        .try_into()
-        .map_err(|e: toml::de::Error| Error::msg(e.message().to_string()))?;
-    cfg.validate()?;
+    let cfg: HwConfig = match toml::Value::Table(merged).try_into() {
+        Ok(c) => c,
+        Err(e) => return Err(culprit(&base_table, &table, &at, &e)),
+    };
+    cfg.validate().map_err(|e| {
+        let field = e.field.clone();
+        at(&field, e.into())
+    })?;
     Ok(cfg)
+}
+
+/// The error of the first leaf of `user` that does not deserialize on its own over `base`
+/// (base values are valid, so a failing leaf is the one at fault), located by `at`.
+fn culprit(
+    base: &toml::Table,
+    user: &toml::Table,
+    at: &dyn Fn(&str, Error) -> Error,
+    whole: &toml::de::Error,
+) -> Error {
+    let mut leaves = Vec::new();
+    leaf_values(user, "", &mut leaves);
+    for (path, value) in leaves {
+        let mut one = base.clone();
+        if !set_leaf(&mut one, &path, value) {
+            continue;
+        }
+        if let Err(e) = toml::Value::Table(one).try_into::<HwConfig>() {
+            let msg = e.message().trim_end().replace('\n', " ");
+            return at(&path, Error::field(&path, msg));
+        }
+    }
+    Error::msg(whole.to_string().trim_end().replace('\n', " "))
+}
+
+/// Sets the leaf at dotted `path` of `t` (its tables must exist); false if they do not.
+fn set_leaf(t: &mut toml::Table, path: &str, value: toml::Value) -> bool {
+    match path.split_once('.') {
+        None => {
+            t.insert(path.to_string(), value);
+            true
+        }
+        Some((head, rest)) => match t.get_mut(head) {
+            Some(toml::Value::Table(s)) => set_leaf(s, rest, value),
+            _ => false,
+        },
+    }
+}
+
+/// Every leaf of `t` (arrays are leaves) as (dotted path, value).
+fn leaf_values(t: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
+    for (k, v) in t {
+        let path = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        match v {
+            toml::Value::Table(s) => leaf_values(s, &path, out),
+            other => out.push((path, other.clone())),
+        }
+    }
+}
+
+/// Every key path of `text` with the byte offset of its value (tables: of their header), read
+/// line by line: `[table]` headers, `key = value` and dotted keys, one level of inline table.
+/// Only used to point an error at a line; a key it cannot find gets no position.
+fn key_spans(text: &str) -> Vec<(String, usize)> {
+    fn key_path(k: &str) -> String {
+        k.split('.')
+            .map(|p| p.trim().trim_matches(|c| c == '"' || c == '\''))
+            .collect::<Vec<_>>()
+            .join(".")
+    }
+    fn join(a: &str, b: &str) -> String {
+        if a.is_empty() {
+            b.to_string()
+        } else {
+            format!("{a}.{b}")
+        }
+    }
+    let mut out = Vec::new();
+    let mut header = String::new();
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let start = offset;
+        offset += line.len();
+        let t = line.trim_start();
+        let lead = line.len() - t.len();
+        if t.starts_with('#') {
+            continue;
+        }
+        if let Some(h) = t.strip_prefix('[') {
+            let h = h.trim_start_matches('[');
+            header = key_path(h.split(']').next().unwrap_or(""));
+            out.push((header.clone(), start + lead));
+            continue;
+        }
+        let Some((k, v)) = t.split_once('=') else {
+            continue;
+        };
+        let path = join(&header, &key_path(k));
+        let v_at = start + lead + k.len() + 1 + (v.len() - v.trim_start().len());
+        out.push((path.clone(), v_at));
+        let Some(inner) = v.trim_start().strip_prefix('{') else {
+            continue;
+        };
+        let mut at = v_at + 1;
+        for pair in inner.split([',', '}']) {
+            if let Some((ik, iv)) = pair.split_once('=') {
+                let iv_at = at + ik.len() + 1 + (iv.len() - iv.trim_start().len());
+                out.push((join(&path, &key_path(ik)), iv_at));
+            }
+            at += pair.len() + 1;
+        }
+    }
+    out
+}
+
+/// The offset of `field` in the text: its exact dotted path, else the one key whose path ends
+/// with it (leaf names are unique, and validation names some fields by a partial path).
+fn locate(spans: &[(String, usize)], field: &str) -> Option<usize> {
+    if let Some((_, o)) = spans.iter().find(|(p, _)| p == field) {
+        return Some(*o);
+    }
+    let suffix = format!(".{field}");
+    let mut hits = spans.iter().filter(|(p, _)| p.ends_with(&suffix));
+    match (hits.next(), hits.next()) {
+        (Some((_, o)), None) => Some(*o),
+        _ => None,
+    }
 }
 
 fn to_table(c: &HwConfig) -> toml::Table {
@@ -69,7 +203,12 @@ fn to_table(c: &HwConfig) -> toml::Table {
 }
 
 /// Merges `over` into `into`; every key of `over` must exist in `into` with the same shape.
-fn merge(into: &mut toml::Table, over: toml::Table, prefix: &str) -> Result<()> {
+/// An error comes with the dotted path at fault.
+fn merge(
+    into: &mut toml::Table,
+    over: toml::Table,
+    prefix: &str,
+) -> std::result::Result<(), (String, Error)> {
     for (k, v) in over {
         let path = if prefix.is_empty() {
             k.clone()
@@ -79,13 +218,14 @@ fn merge(into: &mut toml::Table, over: toml::Table, prefix: &str) -> Result<()> 
         match (into.get_mut(&k), v) {
             (Some(toml::Value::Table(dst)), toml::Value::Table(src)) => merge(dst, src, &path)?,
             (Some(toml::Value::Table(_)), other) => {
-                return Err(Error::field(
-                    &path,
-                    format!("expected a table, found {other}"),
-                ))
+                let e = Error::field(&path, format!("expected a table, found {other}"));
+                return Err((path, e));
             }
             (Some(dst), v) => *dst = v,
-            (None, _) => return Err(Error::field(&path, "unknown field")),
+            (None, _) => {
+                let e = Error::field(&path, "unknown field");
+                return Err((path, e));
+            }
         }
     }
     Ok(())

@@ -12,18 +12,6 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::trilinear::{trilinear, Level, TrilinearTrace};
 use std::fmt::Write;
 
-fn wrap_mode(s: &str) -> Result<WrapMode> {
-    match s {
-        "repeat" => Ok(WrapMode::Repeat),
-        "clamp-to-edge" | "clamp" => Ok(WrapMode::ClampToEdge),
-        "mirror" => Ok(WrapMode::Mirror),
-        _ => Err(Error::field(
-            "--wrap",
-            format!("'{s}' is not repeat, clamp-to-edge or mirror"),
-        )),
-    }
-}
-
 /// Runs the probe and prints the report.
 pub fn probe_cmd(a: &ProbeArgs) -> Result<()> {
     for (name, v) in [("--u", a.u), ("--v", a.v), ("--lod", a.lod)] {
@@ -32,7 +20,7 @@ pub fn probe_cmd(a: &ProbeArgs) -> Result<()> {
         }
     }
     let hw = hwconfig::resolve(&a.hw)?;
-    let wrap = wrap_mode(&a.wrap)?;
+    let wrap = a.wrap.into();
     let tex = decode_texture(&a.texture)?;
     print!("{}", probe_report(&tex, &hw, a.u, a.v, a.lod, [wrap, wrap]));
     Ok(())
@@ -70,7 +58,8 @@ pub fn probe_report(
         })
         .collect();
     let i = &hw.interp;
-    let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding);
+    let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
+        .with_overflow(i.texcoord_overflow);
     let lfb = hw.lod.lod_frac_bits;
     let lod_fmt = Format::signed(8, lfb, Rounding::Truncate);
     let mut sat = SatCounter::default();
@@ -104,8 +93,7 @@ pub fn probe_report(
         chain.levels.len(),
         hw.name
     );
-    let _ =
-        writeln!(
+    let _ = writeln!(
         o,
         "input: u={u} v={v} lod={lod} -> fixed u={} v={} ({} frac bits), lod={} ({} frac bits){}",
         from_raw(ur, uv_fmt.frac_bits),
@@ -113,7 +101,12 @@ pub fn probe_report(
         uv_fmt.frac_bits,
         from_raw(lr, lfb),
         lfb,
-        if sat.saturated > 0 { "  [input saturated]" } else { "" }
+        match (sat.saturated > 0, sat.wrapped > 0) {
+            (true, true) => "  [input saturated and wrapped]",
+            (true, false) => "  [input saturated]",
+            (false, true) => "  [input wrapped]",
+            (false, false) => "",
+        }
     );
     for l in 0..tr.levels_used as usize {
         let b = &tr.level[l];

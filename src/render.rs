@@ -506,6 +506,9 @@ pub struct RenderOptions {
     /// (`pipeline::ndf_stages::NdfTruth`); the stats gain `model_error` (float vs truth) and
     /// `quantization_error` (hardware vs float).
     pub truth: u32,
+    /// Print one line per finished phase (setup, raster, hardware shading, reference shading,
+    /// ground truth) with its wall time on stderr (`texsim render`).
+    pub progress: bool,
 }
 
 impl Default for RenderOptions {
@@ -516,7 +519,15 @@ impl Default for RenderOptions {
             coverage: CoverageMode::Shared,
             timing: false,
             truth: 0,
+            progress: false,
         }
+    }
+}
+
+/// One progress line on stderr: a finished phase and its wall time.
+pub fn progress_line(on: bool, phase: &str, ms: f64) {
+    if on {
+        eprintln!("texsim:   {phase:<18} {ms:>9.1} ms");
     }
 }
 
@@ -620,6 +631,8 @@ pub struct RenderStats {
     pub covered_pixels: u64,
     /// Host-to-hardware conversions that saturated (vertex attributes out of format range).
     pub input_saturated: u64,
+    /// Host-to-hardware conversions that wrapped (formats whose overflow rule is `wrap`).
+    pub input_wrapped: u64,
     /// Bump-mapping events of the hardware pass (all zero without bump materials).
     pub bump: BumpStats,
     pub stages: Vec<StageStats>,
@@ -865,6 +878,8 @@ pub fn render(
     opts: &RenderOptions,
 ) -> crate::Result<Rendered> {
     hw.validate()?;
+    let progress = |phase: &str, ms: f64| progress_line(opts.progress, phase, ms);
+    let t_start = Instant::now();
     let mut tm = Timings::default();
     let t = Instant::now();
     let mut geo = Geometry::new(scene);
@@ -934,10 +949,12 @@ pub fn render(
     let costs: Vec<[UnitCost; StageKind::COUNT]> =
         geo.plans.iter().map(|p| m.plan_costs(p)).collect();
     tm.setup_ms = ms(t);
+    progress("setup", ms(t_start));
 
     let t = Instant::now();
     let (vis, raster_stats) = raster::rasterize(&setup, Coverage::Fixed, true);
     tm.raster_ms = ms(t);
+    progress("raster", tm.raster_ms);
 
     let bg = scene.background.map(|c| to_unorm(f64::from(c), 16) as u16);
     let t = Instant::now();
@@ -969,6 +986,7 @@ pub fn render(
             .collect();
     }
     tm.shade_hw_ms = ms(t);
+    progress("hardware shading", tm.shade_hw_ms);
     tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
 
     let mut mask: Vec<bool> = vis.tri.iter().map(|&t| t != NO_TRI).collect();
@@ -976,6 +994,7 @@ pub fn render(
     let mut ref_nonfinite = 0;
     let (mut e8, mut e16) = (None, None);
     if opts.reference {
+        let t_ref = Instant::now();
         let ref_vis;
         let rv = match opts.coverage {
             CoverageMode::Shared => {
@@ -1001,6 +1020,7 @@ pub fn render(
         );
         ref_nonfinite = rc.nonfinite;
         tm.shade_ref_ms = ms(t);
+        progress("reference", ms(t_ref));
         tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
         e8 = Some(compare(&hw_image, &img, 8, Some(&mask)));
         e16 = Some(compare(&hw_image, &img, 16, Some(&mask)));
@@ -1009,6 +1029,7 @@ pub fn render(
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
     if opts.truth > 0 && (has_rough || has_ndf) {
+        let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
         // bump map (`rough_stages::truth_plans`), NDF materials their supersampled finest normal
         // map (`ndf_stages::NdfTruth`), all others are their own float reference.
@@ -1032,6 +1053,7 @@ pub fn render(
         let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, false);
         geo.plans = saved;
         truth_image = Some(img);
+        progress("ground truth", ms(t_truth));
     }
     let model_error = match (&ref_image, &truth_image) {
         (Some(r), Some(t)) => Some(compare(r, t, 8, Some(&mask))),
@@ -1092,6 +1114,7 @@ pub fn render(
             raster: raster_stats,
             covered_pixels: covered,
             input_saturated: input_sat.saturated,
+            input_wrapped: input_sat.wrapped,
             bump: BumpStats {
                 frame_fallback: counters.frame_fallback,
                 zero_normal: counters.zero_normal,

@@ -65,6 +65,9 @@ pub fn text(s: &RenderStats) -> String {
             s.input_saturated
         );
     }
+    if s.input_wrapped > 0 {
+        let _ = writeln!(o, "vertex attributes wrapped on input: {}", s.input_wrapped);
+    }
     let b = &s.bump;
     if !b.frame.is_empty() {
         let _ = writeln!(
@@ -128,7 +131,8 @@ impl SweepRow {
                 .iter()
                 .map(|x| x.saturated + x.wrapped)
                 .sum::<u64>()
-                + s.input_saturated,
+                + s.input_saturated
+                + s.input_wrapped,
             texels: s.stages.iter().map(|x| x.texels).sum(),
             cycles: s.cycles.total,
             cycles_per_pixel: s.cycles.per_covered_pixel,

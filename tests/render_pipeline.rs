@@ -171,22 +171,89 @@ fn output_is_identical_for_any_thread_count() {
     );
 }
 
+/// Independent coverage: the reference rasterizes on its own in float, so its fragments differ
+/// from the hardware's (snapped vertices: 2 sub-pixel bits make the difference reach the
+/// silhouette). Reusing the shared coverage would give the same reference image and mask.
 #[test]
-fn independent_coverage_compares_more_pixels_or_equal() {
-    let s = small("demo", 200, 150);
-    let shared = go(&s, &RenderOptions::default());
-    let ind = go(
-        &s,
-        &RenderOptions {
-            coverage: CoverageMode::Independent,
+fn independent_coverage_rasterizes_the_reference_on_its_own() {
+    let s = small("sphere", 200, 150);
+    let mut hw = hw_model::HwConfig::texram16();
+    hw.raster.subpixel_bits = 2;
+    let maps = Maps::new(&s, hw.trilinear.texel_bits);
+    let run = |coverage| {
+        let opts = RenderOptions {
+            coverage,
             ..Default::default()
-        },
+        };
+        render(&s, &maps, &hw, &opts).expect("render")
+    };
+    let shared = run(CoverageMode::Shared);
+    let ind = run(CoverageMode::Independent);
+    assert_eq!(
+        shared.hw_image, ind.hw_image,
+        "the hardware pass is the same"
     );
-    let cnt = |r: &Rendered| r.mask.iter().filter(|&&m| m).count();
-    assert!(cnt(&ind) >= cnt(&shared));
+    let (sr, ir) = (
+        shared.ref_image.as_ref().expect("ref"),
+        ind.ref_image.as_ref().expect("ref"),
+    );
+    // Shared coverage: the reference shades exactly the hardware's fragments.
+    let bg = shared.hw_image.px[0];
+    assert!(!shared.mask[0], "corner is background");
+    for (i, &m) in shared.mask.iter().enumerate() {
+        if !m {
+            assert_eq!(sr.px[i], bg, "shared reference shaded uncovered pixel {i}");
+        }
+    }
+    assert!(shared.mask.iter().zip(&ind.mask).all(|(&a, &b)| !a || b));
+    let float_only = (0..ind.mask.len())
+        .filter(|&i| ind.mask[i] && !shared.mask[i] && ir.px[i] != bg)
+        .count();
+    let changed = sr.px.iter().zip(&ir.px).filter(|(a, b)| a != b).count();
+    println!("float-only pixels {float_only}, reference pixels changed {changed}");
+    assert!(float_only > 0, "no pixel covered by the float raster alone");
+    // Inside the silhouette too, interior edges fall elsewhere: other triangles shade.
     assert!(
-        ind.stats.error_16bit.unwrap().rmse_lsb >= shared.stats.error_16bit.unwrap().rmse_lsb * 0.5
+        changed > float_only,
+        "{changed} changed, {float_only} float-only"
     );
+    assert_eq!(ind.stats.coverage, CoverageMode::Independent);
+}
+
+/// `interp.texcoord_overflow` reaches the texture coordinates: on the demo's floor (texture
+/// coordinates spanning dozens of repeats) a 2-bit integer part overflows, and each rule counts
+/// its own events, per stage (the interpolator's helper samples) and on vertex input.
+#[test]
+fn texcoord_overflow_rule_is_counted_per_stage() {
+    let s = small("demo", 320, 240);
+    let maps = Maps::new(&s, 16);
+    let run = |ov: hw_model::fixed::Overflow| {
+        let mut hw = hw_model::HwConfig::texram16();
+        hw.interp.texcoord_int_bits = 2;
+        hw.interp.texcoord_overflow = ov;
+        render(&s, &maps, &hw, &RenderOptions::default()).expect("render")
+    };
+    let sat = run(hw_model::fixed::Overflow::Saturate);
+    let wrap = run(hw_model::fixed::Overflow::Wrap);
+    let tc = |r: &Rendered| {
+        let st = &r.stats.stages[StageKind::Texcoord.index()];
+        (st.saturated, st.wrapped)
+    };
+    let (ts, tw) = tc(&sat);
+    assert!(
+        ts > 0 && tw == 0,
+        "saturate: texcoord {ts} saturated, {tw} wrapped"
+    );
+    let (ws, ww) = tc(&wrap);
+    assert!(
+        ww > 0 && ws == 0,
+        "wrap: texcoord {ws} saturated, {ww} wrapped"
+    );
+    assert!(sat.stats.input_saturated > 0 && sat.stats.input_wrapped == 0);
+    assert!(wrap.stats.input_wrapped > 0 && wrap.stats.input_saturated == 0);
+    let json = serde_json::to_value(&wrap.stats).expect("json");
+    assert_eq!(json["input_wrapped"], wrap.stats.input_wrapped);
+    assert_ne!(sat.hw_image, wrap.hw_image);
 }
 
 #[test]

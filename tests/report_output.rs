@@ -119,3 +119,64 @@ fn failed_write_removes_temps_already_written() {
     assert_eq!(listing(&root), [blocker]);
     fs::remove_dir_all(&root).expect("cleanup");
 }
+
+/// Outputs of an earlier run that this run did not produce are removed, but only names of the
+/// set's family, only files, and only once every new file is in place.
+#[test]
+fn removes_stale_family_files_and_nothing_else() {
+    let root = scratch("stale");
+    let family = ["hw.png", "ref.png", "error.png", "hw16.png", "metrics.json"];
+    let mut first = sample();
+    first.add("error.png", vec![5]);
+    first.add("hw16.png", vec![6]);
+    first.family(&family);
+    first.write_to(&root).expect("first");
+    fs::write(root.join("notes.txt"), b"mine").expect("foreign file");
+    fs::write(root.join("sheet.png"), b"not in the family").expect("foreign png");
+    fs::create_dir(root.join("sub")).expect("dir");
+
+    let mut second = OutputSet::new();
+    second.add("hw.png", vec![8]);
+    second.add("metrics.json", b"[]".to_vec());
+    second.family(&family);
+    let stale = second.stale_in(&root);
+    assert_eq!(
+        stale,
+        ["ref.png", "error.png", "hw16.png"].map(|n| root.join(n))
+    );
+    second.write_to(&root).expect("second");
+    assert_eq!(
+        listing(&root),
+        ["hw.png", "metrics.json", "notes.txt", "sheet.png", "sub"]
+    );
+    assert_eq!(fs::read(root.join("hw.png")).expect("read"), [8]);
+    assert_eq!(fs::read(root.join("notes.txt")).expect("read"), b"mine");
+
+    // A failed write removes nothing: the earlier set stays whole.
+    let mut third = sample();
+    third.family(&family);
+    fs::write(root.join("ref.png"), b"old").expect("old ref");
+    fs::write(root.join("error.png"), b"old").expect("old error");
+    let blocker = format!("metrics.json.tmp-{}", std::process::id());
+    fs::create_dir(root.join(&blocker)).expect("dir");
+    let mut fourth = OutputSet::new();
+    fourth.add("metrics.json", vec![1]);
+    fourth.family(&family);
+    fourth.write_to(&root).expect_err("blocked");
+    assert_eq!(fs::read(root.join("error.png")).expect("kept"), b"old");
+    assert_eq!(fs::read(root.join("ref.png")).expect("kept"), b"old");
+    fs::remove_dir(root.join(&blocker)).expect("unblock");
+    third.write_to(&root).expect("third");
+    assert!(!root.join("error.png").exists(), "error.png is stale");
+    assert_eq!(
+        fs::read(root.join("ref.png")).expect("read"),
+        vec![4u8; 1000]
+    );
+    // A family name that is not a plain file name is refused before anything is written.
+    let mut bad = OutputSet::new();
+    bad.add("hw.png", vec![0]);
+    bad.family(&["../notes.txt"]);
+    assert!(bad.write_to(&root.join("never")).is_err());
+    assert!(!root.join("never").exists());
+    fs::remove_dir_all(&root).expect("cleanup");
+}

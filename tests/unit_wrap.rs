@@ -1,6 +1,7 @@
 //! Wrap unit vs an exact integer model (floor division, rational weight rounding, independent
-//! wrap formulas): exhaustive over a coordinate/size/mode/width grid, seeded random beyond it,
-//! and vs the f64 twin.
+//! wrap formulas): exhaustive at 8 bits (all 2^24 pairs of a 16-bit coordinate with 8 fraction
+//! bits and a size 1..=256, every rounding and mode), a coordinate/size/mode/width grid for the
+//! other widths, seeded random beyond it, and vs the f64 twin.
 
 use hw_model::config::{HwConfig, TrilinearConfig};
 use hw_model::fixed::Rounding;
@@ -169,4 +170,45 @@ fn twin_agrees() {
             assert!((wq - w).abs() <= tol + 1e-12, "w {wq} vs {w}");
         }
     }
+}
+
+/// Exhaustive at 8 bits: every 16-bit coordinate with 8 fraction bits (-128.0 .. 128.0 in
+/// steps of 1/256) on every texture size 1..=256, i.e. all 2^24 (coordinate, size) pairs, each
+/// for the three roundings and the three modes at 8 weight bits, against the exact rational.
+#[test]
+fn exhaustive_8_bit() {
+    let cfgs = ROUNDINGS.map(|r| tcfg(8, r));
+    let mut n = 0u64;
+    for size in 1u32..=256 {
+        let sz = i128::from(size);
+        for coord in i64::from(i16::MIN)..=i64::from(i16::MAX) {
+            // s = coord * size / 256 - 1/2 = num / 512.
+            let num = i128::from(coord) * sz * 2 - 256;
+            let (q, r) = (num.div_euclid(512), num.rem_euclid(512));
+            for (rnd, c) in ROUNDINGS.iter().zip(&cfgs) {
+                // weight = r * 2^8 / 512 = r / 2, rounded; a carry to 256 moves to the next texel.
+                let (wq, half) = (r / 2, r % 2 == 1);
+                let w = match rnd {
+                    Rounding::Truncate => wq,
+                    Rounding::HalfUp => wq + i128::from(half),
+                    Rounding::HalfEven => wq + i128::from(half && wq % 2 == 1),
+                };
+                let (i0, w) = if w == 256 { (q + 1, 0) } else { (q, w) };
+                for mode in MODES {
+                    let want = WrapOut {
+                        i0: model_index(i0, sz, mode),
+                        i1: model_index(i0 + 1, sz, mode),
+                        weight: w as u32,
+                    };
+                    assert_eq!(
+                        wrap(coord, 8, size, mode, c),
+                        want,
+                        "coord={coord} size={size} {mode:?} {rnd:?}"
+                    );
+                    n += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(n, 9 << 24);
 }

@@ -7,7 +7,7 @@
 
 use crate::aniso_phong::AnisoPhongConfig;
 use crate::blinn_phong::ShadingConfig;
-use crate::fixed::Rounding;
+use crate::fixed::{Overflow, Rounding};
 use crate::roughness::RoughnessConfig;
 use crate::timing_config::TimingConfig;
 use serde::{Deserialize, Serialize};
@@ -38,6 +38,11 @@ fn check(field: &str, value: u32, lo: u32, hi: u32) -> Result<(), ConfigError> {
         });
     }
     Ok(())
+}
+
+/// The default overflow rule of the datapath formats (fields absent in older files).
+const fn saturate() -> Overflow {
+    Overflow::Saturate
 }
 
 /// Rasterizer: vertex snapping, depth, and its timing costs.
@@ -86,6 +91,12 @@ pub struct InterpConfig {
     pub texcoord_int_bits: u32,
     /// Rounding of interpolation results.
     pub interp_rounding: Rounding,
+    /// What a texture coordinate outside +-2^texcoord_int_bits does (vertex input and
+    /// interpolated result): `saturate` (clamp, counted) or `wrap` (keep the low bits, counted;
+    /// with `repeat` addressing a wrap by a whole number of repeats changes no texel).
+    /// Absent in older files: `saturate`.
+    #[serde(default = "saturate")]
+    pub texcoord_overflow: Overflow,
     /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
     pub bary_cycles: u32,
     /// Cycles per interpolated scalar attribute.
@@ -134,6 +145,10 @@ pub struct ColorConfig {
     pub color_bits: u32,
     /// Rounding of the modulate multiply.
     pub color_rounding: Rounding,
+    /// What an interpolated colour channel outside the unorm range does: `saturate` or
+    /// `wrap` (both counted in the `color` stage). Absent in older files: `saturate`.
+    #[serde(default = "saturate")]
+    pub color_overflow: Overflow,
     /// Cycles of one modulate (4 channels in parallel).
     pub modulate_cycles: u32,
 }
@@ -193,6 +208,7 @@ impl HwConfig {
                 texcoord_frac_bits: 24,
                 texcoord_int_bits: 8,
                 interp_rounding: Rounding::HalfEven,
+                texcoord_overflow: Overflow::Saturate,
                 bary_cycles: 2,
                 attr_cycles: 1,
             },
@@ -213,6 +229,7 @@ impl HwConfig {
             color: ColorConfig {
                 color_bits: 16,
                 color_rounding: Rounding::HalfEven,
+                color_overflow: Overflow::Saturate,
                 modulate_cycles: 1,
             },
             shading: ShadingConfig::texram16(),

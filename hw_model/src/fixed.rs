@@ -86,6 +86,12 @@ impl Format {
         }
     }
 
+    /// This format with the overflow rule `overflow`.
+    #[must_use]
+    pub const fn with_overflow(self, overflow: Overflow) -> Self {
+        Self { overflow, ..self }
+    }
+
     /// Total storage bits (sign + integer + fraction).
     #[must_use]
     pub const fn total_bits(&self) -> u32 {

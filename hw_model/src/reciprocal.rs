@@ -17,11 +17,12 @@
 //! ERROR BOUND (relative, `e` = |1/x - result| * x): let `e_0 = 2^-(L+1) + 2^-P` and
 //! `e_{k+1} = e_k^2 + 4 * 2^-P`; then `e <= e_N + 2^-M` (in result ulps, where one ulp is
 //! `2^-shift`: at most `2^(M+1) e_N + 1`, or `+ 0.5` for the round-to-nearest modes). The seed
-//! error halves per LUT bit and squares per iteration, so texram16 (L=8, N=1, M=24) is limited by
-//! the seed (~2^-18) and two iterations reach the rounding floor. Measured max error (ulps,
-//! M = 24, HalfEven; `cargo test --test unit_reciprocal -- --nocapture`): (L,N) = (8,0) 65352,
-//! (8,1) 128.0 (exhaustive over all 24-bit x), (10,1) 8.3, (12,1) 1.16, (6,2) 0.82,
-//! (8,2) 0.75, (4,3) 0.74, (16,0) 256.
+//! error halves per LUT bit and squares per iteration: with L = 8 and M = 24, one iteration is
+//! limited by the seed (~2^-18, 128 ulps), so texram16 (L=8, N=2, M=24) uses two, which reach
+//! the rounding floor (<= 1 ulp). Measured max error (ulps, M = 24, HalfEven;
+//! `cargo test --test unit_reciprocal -- --nocapture`): (L,N) = (8,0) 65352, (8,1) 128.0 and
+//! (8,2) 0.75 (both exhaustive over all 24-bit x), (10,1) 8.3, (12,1) 1.16, (6,2) 0.82,
+//! (4,3) 0.74, (16,0) 256.
 
 use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;

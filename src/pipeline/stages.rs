@@ -126,8 +126,10 @@ impl<'a> Machine<'a> {
         Self {
             hw,
             recip: Reciprocal::new(&hw.reciprocal),
-            uv_fmt: Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding),
-            color_fmt: Format::unsigned(0, hw.color.color_bits, hw.color.color_rounding),
+            uv_fmt: Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
+                .with_overflow(i.texcoord_overflow),
+            color_fmt: Format::unsigned(0, hw.color.color_bits, hw.color.color_rounding)
+                .with_overflow(hw.color.color_overflow),
             lod_fmt: Format::signed(8, hw.lod.lod_frac_bits, Rounding::Truncate),
             bary_fmt: Format::signed(16, i.bary_bits, i.interp_rounding),
             tex_fixed: fixed

@@ -4,6 +4,10 @@
 //! then rename each over `NAME` in insertion order. A failure while writing removes the temp
 //! files written so far, so no output file is touched. Renames within one directory are atomic
 //! per file; should one fail, the remaining temp files are removed and the error names it.
+//! Only after every file is in place, the files of the set's family ([`OutputSet::family`]:
+//! the names a run of this kind may write) that this set does not contain are removed, so an
+//! earlier run's optional outputs (say `ref.png` before a `--no-reference` run) do not stay
+//! beside the new ones. No other file is ever touched.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -14,6 +18,7 @@ use crate::{Error, Result};
 #[derive(Clone, Debug, Default)]
 pub struct OutputSet {
     files: Vec<(String, Vec<u8>)>,
+    family: Vec<String>,
 }
 
 /// Whether `name` is a plain file name: non-empty, no path separators, no `..`, no NUL.
@@ -48,6 +53,24 @@ impl OutputSet {
         }
     }
 
+    /// Declares the names a run of this kind may write: [`OutputSet::write_to`] removes those
+    /// of them, left in the directory by an earlier run, that this set does not contain.
+    pub fn family(&mut self, names: &[&str]) {
+        self.family = names.iter().map(|n| (*n).to_string()).collect();
+    }
+
+    /// Files of the family in `dir` that this set does not contain: what
+    /// [`OutputSet::write_to`] will remove.
+    #[must_use]
+    pub fn stale_in(&self, dir: &Path) -> Vec<PathBuf> {
+        self.family
+            .iter()
+            .filter(|f| !self.files.iter().any(|(n, _)| n == *f))
+            .map(|f| dir.join(f))
+            .filter(|p| p.is_file())
+            .collect()
+    }
+
     /// File names in insertion order.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.files.iter().map(|(n, _)| n.as_str())
@@ -65,10 +88,11 @@ impl OutputSet {
         self.files.is_empty()
     }
 
-    /// Writes every file into `dir` (created if missing) and returns their paths in insertion
-    /// order. Errors name the directory or file at fault; see the module docs for the protocol.
+    /// Writes every file into `dir` (created if missing), removes the stale files of the
+    /// family, and returns the written paths in insertion order. Errors name the directory or
+    /// file at fault; see the module docs for the protocol.
     pub fn write_to(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        for (name, _) in &self.files {
+        for name in self.files.iter().map(|(n, _)| n).chain(&self.family) {
             check_name(name)?;
         }
         if dir.exists() && !dir.is_dir() {
@@ -108,6 +132,14 @@ impl OutputSet {
                     format!("cannot rename temp file into place: {e}"),
                 ));
             }
+        }
+        for stale in self.stale_in(dir) {
+            fs::remove_file(&stale).map_err(|e| {
+                Error::file(
+                    &stale,
+                    format!("cannot remove this output of an earlier run: {e}"),
+                )
+            })?;
         }
         Ok(finals)
     }

@@ -335,22 +335,9 @@ pub fn load_toml(path: &Path) -> Result<Scene> {
     let mut text = String::new();
     std::io::Read::read_to_string(&mut open_regular(path, "a TOML scene file")?, &mut text)
         .map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let cfg: SceneFile =
-        toml::from_str(&text).map_err(|e| Error::file(path, toml_error(&text, &e)))?;
+    let cfg: SceneFile = toml::from_str(&text)
+        .map_err(|e| Error::file(path, crate::error::toml_message(&text, &e)))?;
     build(path, cfg).map_err(|e| e.context(path.display()))
-}
-
-/// One-line form of a toml error: `line L, column C (`source line`): message`.
-fn toml_error(text: &str, e: &toml::de::Error) -> String {
-    let msg = e.message().trim_end().replace('\n', " ");
-    let Some(span) = e.span() else { return msg };
-    let start = span.start.min(text.len());
-    let before = text.get(..start).unwrap_or("");
-    let line = before.matches('\n').count() + 1;
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let col = before[line_start..].chars().count() + 1;
-    let src = text[line_start..].lines().next().unwrap_or("").trim();
-    format!("line {line}, column {col} (`{src}`): {msg}")
 }
 
 fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {

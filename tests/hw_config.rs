@@ -1,0 +1,185 @@
+//! Hardware configurations: the presets pinned to the numbers of the APIs they model, full TOML
+//! round trips, errors that name the field with its line and column, and the overflow rules.
+
+use hw_model::config::PRESETS;
+use hw_model::fixed::{Overflow, Rounding, SatCounter};
+use hw_model::wrap::{wrap, WrapMode};
+use hw_model::HwConfig;
+use texsim::hwconfig::{parse, set_field, to_toml};
+
+fn preset(name: &str) -> HwConfig {
+    HwConfig::preset(name).expect("preset")
+}
+
+#[test]
+fn every_preset_round_trips_through_toml() {
+    for &name in PRESETS {
+        let p = preset(name);
+        p.validate().expect("preset valid");
+        let text = to_toml(&p);
+        assert_eq!(parse(&text).expect("parse"), p, "{name}:\n{text}");
+        // `texsim hw show` output is a complete file: a `base` of another preset changes nothing.
+        let rebased = format!("base = \"vulkan-min\"\n{text}");
+        assert_eq!(parse(&rebased).expect("parse"), p, "{name} over vulkan-min");
+    }
+}
+
+#[test]
+fn presets_have_the_api_precision_floors() {
+    // (name, sub-pixel, sub-texel = weight fraction bits, LOD fraction bits)
+    let floors = [
+        ("texram16", 8, 16, 16),
+        ("d3d11", 8, 8, 8),
+        ("vulkan-min", 4, 4, 4),
+        ("cuda", 8, 8, 8),
+    ];
+    for (name, sub_px, sub_texel, lod_frac) in floors {
+        let p = preset(name);
+        assert_eq!(p.name, name);
+        assert_eq!(p.raster.subpixel_bits, sub_px, "{name} sub-pixel bits");
+        assert_eq!(p.trilinear.weight_bits, sub_texel, "{name} sub-texel bits");
+        assert_eq!(p.lod.lod_frac_bits, lod_frac, "{name} LOD fraction bits");
+        // Only the floors differ; every datapath format is saturating unless a file says so.
+        assert_eq!(p.interp.texcoord_overflow, Overflow::Saturate, "{name}");
+        assert_eq!(p.color.color_overflow, Overflow::Saturate, "{name}");
+    }
+    // texram16: 16 bits throughout the texture datapath.
+    let t = preset("texram16");
+    assert_eq!(
+        [
+            t.trilinear.texel_bits,
+            t.trilinear.weight_bits,
+            t.lod.lod_frac_bits,
+            t.color.color_bits
+        ],
+        [16; 4]
+    );
+    // The API floors keep texram16's 16-bit texels: only the precision floors differ.
+    for name in ["d3d11", "vulkan-min", "cuda"] {
+        assert_eq!(preset(name).trilinear.texel_bits, 16, "{name}");
+    }
+}
+
+/// CUDA's filter weights are 9-bit fixed point with 8 fraction bits: the unit's weight of the
+/// second texel takes every value k/256, k in 0..=255, so the first texel's weight 1 - w takes
+/// every k/256 in 1..=256: 256 needs the ninth bit, no finer step is representable.
+#[test]
+fn cuda_weights_are_9_bit_with_8_fraction_bits() {
+    let c = preset("cuda");
+    assert_eq!(c.trilinear.weight_rounding, Rounding::HalfEven);
+    let one = 1u32 << c.trilinear.weight_bits;
+    let mut seen = vec![false; one as usize + 1];
+    // Coordinates with 16 fraction bits over 4 texels: every sub-texel position.
+    for coord in 0..(1i64 << 16) {
+        let o = wrap(coord, 16, 4, WrapMode::Repeat, &c.trilinear);
+        seen[o.weight as usize] = true;
+        seen[(one - o.weight) as usize] = true;
+    }
+    assert_eq!(one, 256, "8 fraction bits");
+    assert!(seen.iter().all(|&s| s), "every k/256, 0..=256, occurs");
+    assert_eq!(32 - (one).leading_zeros(), 9, "1.0 = 256 needs 9 bits");
+}
+
+#[test]
+fn syntax_errors_give_line_and_column() {
+    let e = parse("[interp]\nbary_bits = 20\n[trilinear\nweight_bits = 3\n").expect_err("syntax");
+    let m = e.to_string();
+    assert!(m.contains("line 3, column"), "{m}");
+    assert!(m.contains("[trilinear"), "{m}");
+}
+
+#[test]
+fn field_errors_name_the_field_with_its_line_and_column() {
+    let cases: [(&str, &str, &str); 7] = [
+        (
+            "base = \"d3d11\"\n[interp]\ntexcoord_overflow = \"clamp\"\n",
+            "line 3, column 21",
+            "interp.texcoord_overflow",
+        ),
+        (
+            "[trilinear]\n# sub-texel\nweight_bits = 99\n",
+            "line 3, column 15",
+            "trilinear.weight_bits",
+        ),
+        (
+            "[trilinear]\nweight_bits = \"eight\"\n",
+            "line 2, column 15",
+            "trilinear.weight_bits",
+        ),
+        (
+            "[color]\ncolor_bits = 8\ncolour_overflow = \"wrap\"\n",
+            "line 3, column 19",
+            "color.colour_overflow",
+        ),
+        (
+            "shading.rsqrt.rsqrt_mantissa_bits = 99\n",
+            "line 1, column 37",
+            "rsqrt_mantissa_bits",
+        ),
+        (
+            "color = { color_overflow = \"wrap\", color_bits = 0 }\n",
+            "line 1, column 49",
+            "color.color_bits",
+        ),
+        ("\nbase = \"d3d12\"\n", "line 2, column 8", "base"),
+    ];
+    for (text, at, field) in cases {
+        let m = parse(text).expect_err(text).to_string();
+        assert!(m.contains(at), "{text:?}: no '{at}' in: {m}");
+        assert!(m.contains(field), "{text:?}: no '{field}' in: {m}");
+    }
+}
+
+#[test]
+fn overflow_rules_are_config_fields() {
+    let c = parse("[interp]\ntexcoord_overflow = \"wrap\"\n[color]\ncolor_overflow = \"wrap\"\n")
+        .expect("parse");
+    assert_eq!(c.interp.texcoord_overflow, Overflow::Wrap);
+    assert_eq!(c.color.color_overflow, Overflow::Wrap);
+    assert!(to_toml(&c).contains("texcoord_overflow = \"wrap\""));
+    // Files written before the fields existed still load, saturating.
+    let full = to_toml(&HwConfig::texram16());
+    let old: String = full
+        .lines()
+        .filter(|l| !l.contains("_overflow"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(!old.contains("overflow"));
+    let o: HwConfig = toml::from_str(&old).expect("old file parses");
+    assert_eq!(o, HwConfig::texram16());
+    // Sweepable by bare name or dotted path; a bad value names the field.
+    let base = HwConfig::texram16();
+    let s = set_field(&base, "texcoord_overflow", "wrap").expect("bare name");
+    assert_eq!(s.interp.texcoord_overflow, Overflow::Wrap);
+    let s = set_field(&base, "color.color_overflow", "wrap").expect("dotted path");
+    assert_eq!(s.color.color_overflow, Overflow::Wrap);
+    let e = set_field(&base, "color_overflow", "clamp").expect_err("bad value");
+    assert!(e.to_string().contains("color.color_overflow"), "{e}");
+    assert!(e.to_string().contains("saturate"), "{e}");
+}
+
+#[test]
+fn the_machine_formats_follow_the_overflow_fields() {
+    let mut hw = HwConfig::texram16();
+    hw.interp.texcoord_int_bits = 2;
+    let m = texsim::pipeline::stages::Machine::new(&hw, &[], &[]);
+    assert_eq!(m.uv_fmt.overflow, Overflow::Saturate);
+    assert_eq!(m.color_fmt.overflow, Overflow::Saturate);
+    // Texture coordinates in [-4, 4): u = 5.25 saturates to just below 4, or wraps by the
+    // period 8 to -2.75 (the same texel under `repeat`: a whole number of repeats).
+    let mut sat = SatCounter::default();
+    let raw = texsim::fixedpoint::to_raw(5.25, &m.uv_fmt, &mut sat);
+    assert_eq!(
+        (raw, sat.saturated, sat.wrapped),
+        (m.uv_fmt.max_raw(), 1, 0)
+    );
+    hw.interp.texcoord_overflow = Overflow::Wrap;
+    hw.color.color_overflow = Overflow::Wrap;
+    let m = texsim::pipeline::stages::Machine::new(&hw, &[], &[]);
+    assert_eq!(m.uv_fmt.overflow, Overflow::Wrap);
+    assert_eq!(m.color_fmt.overflow, Overflow::Wrap);
+    let mut sat = SatCounter::default();
+    let raw = texsim::fixedpoint::to_raw(5.25, &m.uv_fmt, &mut sat);
+    let fb = m.uv_fmt.frac_bits;
+    assert_eq!((raw, sat.saturated, sat.wrapped), (-11 << (fb - 2), 0, 1));
+}
