@@ -6,9 +6,10 @@
 //! product), the Mahalanobis distance `d = (h - mu)^T Sigma^-1 (h - mu)` of the halfway vector
 //! and the elliptically contoured density `g(d)`:
 //! - `pearson`: Pearson Type II `g(t) = (1 - t/(2m))^m` for `t < 2m`, else 0. Both copies of
-//!   the paper print the denominator as `2^m`; with m = 8 that is `(1 - t/256)^8 ~ exp(-t/32)`,
-//!   sixteen times too wide, while `(1 - t/(2m))^m -> exp(-t/2)` as m grows (the Gaussian the
-//!   paper says it approximates). `tests/ndf_unit.rs` checks both limits. m = 8 is three
+//!   the paper print the denominator as `2^m`; that form is `(1 - t/2^m)^m ~ exp(-t m/2^m)`,
+//!   with m = 8 `(1 - t/256)^8 ~ exp(-t/32)`: `d` scaled down 16 times (a variance 16 times too
+//!   large, a lobe 4 times too wide in angle), while `(1 - t/(2m))^m -> exp(-t/2)` as m grows
+//!   (the Gaussian the paper says it approximates). `tests/ndf_unit.rs` checks both limits. m = 8 is three
 //!   squarings.
 //! - `gauss`: `exp(-t/2) = 2^(-t log2(e)/2)`: integer part by shift, fraction by a `2^f` table
 //!   of `2^ndf_exp_lut_bits + 1` entries with linear interpolation.

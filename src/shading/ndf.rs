@@ -324,8 +324,9 @@ pub fn density(t: f64, cfg: &NdfConfig) -> f64 {
         NdfDensity::Gauss => (-0.5 * t).exp(),
         NdfDensity::Pearson => {
             let m = f64::from(cfg.pearson_m);
-            // (1 - t/(2m))^m -> exp(-t/2); the paper's printed `2^m` denominator would give
-            // exp(-t m / 2^(m+1)) instead (tested in tests/ndf_unit.rs).
+            // (1 - t/(2m))^m -> exp(-t/2). The paper's printed `2^m` denominator gives
+            // (1 - t/2^m)^m = exp(m ln(1 - t/2^m)) ~ exp(-t m / 2^m) instead (ln(1 - x) ~ -x
+            // for the small x = t/2^m): exp(-t/32) for m = 8 (tested in tests/ndf_unit.rs).
             let b = 1.0 - t / (2.0 * m);
             if b <= 0.0 {
                 0.0
