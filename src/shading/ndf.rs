@@ -555,7 +555,8 @@ pub fn raw_to_f64(x: i64, frac: u32) -> f64 {
 
 /// Procedural normal maps for the NDF scenes: `ripple` (concentric sine ripples), `foil`
 /// (hashed random facets, crumpled-and-flattened foil), `grooves` (parallel V-grooves along
-/// x: rank-deficient coarse levels).
+/// x: rank-deficient coarse levels), `waves` ([`WAVES`] sine waves along u, slope
+/// [`wave_slope`]). `amplitude` is the largest slope.
 pub fn procedural_normals(kind: &str, w: u32, h: u32, amplitude: f64) -> Result<Vec<DVec3>> {
     let mut out = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
@@ -569,6 +570,7 @@ pub fn procedural_normals(kind: &str, w: u32, h: u32, amplitude: f64) -> Result<
                     let s = amplitude * (r * 2.0 * PI * 8.0).cos();
                     (s * cx / r, s * cy / r)
                 }
+                "waves" => (wave_slope(u, amplitude), 0.0),
                 "grooves" => {
                     let ph = (u * 16.0).fract();
                     (if ph < 0.5 { amplitude } else { -amplitude }, 0.0)
@@ -594,6 +596,16 @@ pub fn procedural_normals(kind: &str, w: u32, h: u32, amplitude: f64) -> Result<
         }
     }
     Ok(out)
+}
+
+/// Sine waves across u of the `waves` normal map.
+pub const WAVES: f64 = 8.0;
+
+/// Slope `dh/du` (in the tangent frame, per unit length) of the `waves` map at `u`: the
+/// tangent-space normal is `normalize(-slope, 0, 1)`.
+#[must_use]
+pub fn wave_slope(u: f64, amplitude: f64) -> f64 {
+    amplitude * (2.0 * PI * WAVES * u).cos()
 }
 
 /// Quantizes moments into the unit's texels as the maps store them (`inv_z` into the
