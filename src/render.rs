@@ -215,7 +215,7 @@ impl Maps {
                     && (o.ndf_norm != NdfNorm::Map
                         || o.ndf_density != cfg.ndf_density
                         || o.pearson_m != cfg.pearson_m
-                        || o.ndf_min_variance_bits != cfg.ndf_min_variance_bits)))
+                        || o.min_variance_bits() != cfg.min_variance_bits())))
     }
 
     /// Rebuilds the moment maps for `cfg` if [`Maps::ndf_stale`].

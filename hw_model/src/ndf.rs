@@ -29,9 +29,17 @@
 //!    `E_ij = 2^k (q/(2^B-1) - 1/2)` (k = `moment_scale_bits`), each by a constant division
 //!    (a constant multiplier in hardware) rounded once to W bits.
 //! 2. `Sigma` products rounded to W. GRACEFUL DEGRADATION: each diagonal is clamped to at least
-//!    `2^-ndf_min_variance_bits`; if a leading minor is then not positive (quantization made the
-//!    matrix indefinite: shiny texels, rank-deficient grooves) the off-diagonals are dropped
-//!    (a diagonal matrix with positive entries) and one saturation is counted.
+//!    the minimum variance `2^-v` ([`NdfConfig::min_variance_bits`]; by default `v = B - 3`,
+//!    tied to the moment quantization: a diagonal `E_ii - mu_i^2` computed from stored and
+//!    trilinearly filtered channels errs by up to one LSB of `E_ii` (`2^k 2^-B`: half from the
+//!    storage rounding, half from the filter's output rounding) plus `2 |mu_i|` times one LSB
+//!    of `mu_i` (`2^(1-B)`), at most `(2^k + 4) 2^-B <= 2^(3-B)` for `k <= 2`; the storage half
+//!    is checked in `tests/ndf_unit.rs`); each clamp is counted
+//!    as a saturation. Below that floor the stored variance is quantization noise, so a lobe
+//!    sharper than `s = 2^v` degrades to the floor's broader lobe instead of an arbitrarily
+//!    sharp one. If a leading minor is then not positive (quantization made the matrix
+//!    indefinite: rank-deficient grooves, `mu ~ 0`) the off-diagonals are dropped (a diagonal
+//!    matrix with positive entries) and one more saturation is counted.
 //! 3. Cofactors and determinant exact (i128). Adjugate block-normalized to `ndf_inverse_bits`
 //!    significant bits (one shared exponent), determinant through the reciprocal unit.
 //! 4. `d` rounded to F fraction bits, clamped to `[0, 2^DMAX_INT_BITS)` (`g` is 0 there at F <= 28
@@ -102,7 +110,8 @@ pub struct NdfConfig {
     pub moment_scale_bits: u32,
     /// Significant bits of the block-normalized adjugate. 4..=30.
     pub ndf_inverse_bits: u32,
-    /// Smallest variance on the diagonal of `Sigma` is `2^-bits`. 4..=30.
+    /// Smallest variance on the diagonal of `Sigma` is `2^-bits`. 4..=30, or 0: derived from
+    /// the moment quantization, `moment_bits - 3` ([`NdfConfig::min_variance_bits`]).
     pub ndf_min_variance_bits: u32,
     /// Index bits of the `2^f` table of the Gaussian. 2..=12.
     pub ndf_exp_lut_bits: u32,
@@ -133,7 +142,7 @@ impl NdfConfig {
             moment_bits: 16,
             moment_scale_bits: 1,
             ndf_inverse_bits: 24,
-            ndf_min_variance_bits: 24,
+            ndf_min_variance_bits: 0,
             ndf_exp_lut_bits: 10,
             ndf_frac_bits: 24,
             pearson_m: 8,
@@ -152,16 +161,32 @@ impl NdfConfig {
         range("ndf.moment_bits", self.moment_bits, 4, 16)?;
         range("ndf.moment_scale_bits", self.moment_scale_bits, 0, 2)?;
         range("ndf.ndf_inverse_bits", self.ndf_inverse_bits, 4, 30)?;
-        range(
-            "ndf.ndf_min_variance_bits",
-            self.ndf_min_variance_bits,
-            4,
-            30,
-        )?;
+        if self.ndf_min_variance_bits != 0 {
+            range(
+                "ndf.ndf_min_variance_bits",
+                self.ndf_min_variance_bits,
+                4,
+                30,
+            )?;
+        }
         range("ndf.ndf_exp_lut_bits", self.ndf_exp_lut_bits, 2, 12)?;
         range("ndf.ndf_frac_bits", self.ndf_frac_bits, 12, 28)?;
         range("ndf.pearson_m", self.pearson_m, 1, 64)?;
         Ok(())
+    }
+}
+
+impl NdfConfig {
+    /// The minimum variance of `Sigma`'s diagonal is `2^-min_variance_bits()`: the configured
+    /// `ndf_min_variance_bits`, or for 0 the quantization floor `moment_bits - 3` (module doc,
+    /// step 2), at least 1.
+    #[must_use]
+    pub fn min_variance_bits(&self) -> u32 {
+        if self.ndf_min_variance_bits == 0 {
+            self.moment_bits.saturating_sub(3).max(1)
+        } else {
+            self.ndf_min_variance_bits
+        }
     }
 }
 
@@ -195,6 +220,20 @@ pub struct NdfOut {
     pub g: i64,
     /// The Mahalanobis distance `d` (clamped).
     pub dist: i64,
+    /// The regularization dropped the off-diagonals (of `Sigma`, or of `Sigma_p` for
+    /// `projected`).
+    pub fallback: bool,
+}
+
+/// Result of the regularization (step 2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Regularized {
+    /// The regularized `Sigma` (W bits, symmetric order).
+    pub sigma: [i64; 6],
+    /// Diagonal entries raised to the minimum variance (0..=3).
+    pub clamped: u32,
+    /// The off-diagonals were dropped (a leading minor was not positive).
+    pub fallback: bool,
 }
 
 /// The unit with its reciprocal, rsqrt and `2^f` tables built.
@@ -307,23 +346,41 @@ impl NdfUnit {
         ]
     }
 
-    /// Step 2 of the module doc: minimum variance and the positive-definite fallback.
+    /// Step 2 of the module doc: minimum variance and the positive-definite fallback; each
+    /// clamped diagonal and the fallback are counted in `sat`.
     #[must_use]
     pub fn regularize(&self, s: &[i64; 6], sat: &mut SatCounter) -> [i64; 6] {
-        let vmin = 1i64 << (NDF_FRAC - self.cfg.ndf_min_variance_bits.min(NDF_FRAC));
+        let r = self.regularize_flags(s);
+        sat.saturated += u64::from(r.clamped) + u64::from(r.fallback);
+        r.sigma
+    }
+
+    /// Step 2 without counting: the regularized matrix, how many diagonals were clamped to the
+    /// minimum variance and whether the off-diagonals were dropped.
+    #[must_use]
+    pub fn regularize_flags(&self, s: &[i64; 6]) -> Regularized {
+        let vmin = 1i64 << (NDF_FRAC - self.cfg.min_variance_bits().min(NDF_FRAC));
         let mut r = *s;
+        let mut clamped = 0;
         for v in r.iter_mut().take(3) {
-            *v = (*v).max(vmin);
+            if *v < vmin {
+                *v = vmin;
+                clamped += 1;
+            }
         }
         let (_, det) = cofactors(&r);
         let m2 = i128::from(r[0]) * i128::from(r[1]) - i128::from(r[3]) * i128::from(r[3]);
-        if m2 <= 0 || det <= 0 {
-            sat.saturated += 1;
+        let fallback = m2 <= 0 || det <= 0;
+        if fallback {
             r[3] = 0;
             r[4] = 0;
             r[5] = 0;
         }
-        r
+        Regularized {
+            sigma: r,
+            clamped,
+            fallback,
+        }
     }
 
     /// `d = v^T S^-1 v` with F fraction bits (clamped) for a regularized `S` and `v` (W bits),
@@ -464,7 +521,9 @@ impl NdfUnit {
         let sigma = self.covariance(&mu, &e);
         match self.cfg.ndf_norm {
             NdfNorm::Partial | NdfNorm::Map | NdfNorm::Exact => {
-                let s = self.regularize(&sigma, sat);
+                let reg = self.regularize_flags(&sigma);
+                sat.saturated += u64::from(reg.clamped) + u64::from(reg.fallback);
+                let s = reg.sigma;
                 let v = [h[0] - mu[0], h[1] - mu[1], h[2] - mu[2]];
                 let (dist, det) = self.mahalanobis(&s, &v, sat);
                 let g = self.density(dist);
@@ -482,7 +541,12 @@ impl NdfUnit {
                 } else {
                     self.scale_by(g, K3_Q30, det, sat)
                 };
-                NdfOut { d_value, g, dist }
+                NdfOut {
+                    d_value,
+                    g,
+                    dist,
+                    fallback: reg.fallback,
+                }
             }
             NdfNorm::Projected => {
                 let n = self.mean_direction(&mu, sat);
@@ -493,9 +557,13 @@ impl NdfUnit {
                 if hn <= 0 {
                     return NdfOut::default();
                 }
-                let s = self.regularize(&sigma, sat);
-                let sp = project(&s, &n, rnd);
-                let sp = self.regularize(&sp, sat);
+                let reg = self.regularize_flags(&sigma);
+                let sp = project(&reg.sigma, &n, rnd);
+                let reg_p = self.regularize_flags(&sp);
+                sat.saturated += u64::from(reg.clamped + reg_p.clamped)
+                    + u64::from(reg.fallback)
+                    + u64::from(reg_p.fallback);
+                let sp = reg_p.sigma;
                 let y = [h[0] - p(hn, n[0]), h[1] - p(hn, n[1]), h[2] - p(hn, n[2])];
                 let (dist, det) = self.mahalanobis(&sp, &y, sat);
                 let g = self.density(dist);
@@ -512,7 +580,12 @@ impl NdfUnit {
                 };
                 // det(Sigma_p) = det2 * 1: the same inverse square root.
                 let d_value = self.scale_by(g, k2, det, sat);
-                NdfOut { d_value, g, dist }
+                NdfOut {
+                    d_value,
+                    g,
+                    dist,
+                    fallback: reg.fallback || reg_p.fallback,
+                }
             }
         }
     }

@@ -298,10 +298,11 @@ pub fn regularize_float(m: &Moments, cfg: &NdfConfig) -> (DVec3, [f64; 6]) {
     (m.mu, regularize_sigma(&m.covariance(), cfg).0)
 }
 
-/// Regularizes `Sigma`; the flag says the off-diagonals were dropped.
+/// Regularizes `Sigma` (minimum variance `2^-cfg.min_variance_bits()` on the diagonal); the
+/// flag says the off-diagonals were dropped.
 #[must_use]
 pub fn regularize_sigma(s: &[f64; 6], cfg: &NdfConfig) -> ([f64; 6], bool) {
-    let vmin = (-f64::from(cfg.ndf_min_variance_bits)).exp2();
+    let vmin = (-f64::from(cfg.min_variance_bits())).exp2();
     let mut r = *s;
     for v in r.iter_mut().take(3) {
         *v = v.max(vmin);
