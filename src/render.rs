@@ -1014,7 +1014,8 @@ pub fn render(
         // map (`ndf_stages::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough_stages::truth_plans(&geo.plans, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
-        let ndf_truth = crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans);
+        let ndf_truth =
+            crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)
             .with_lights(&scene.lights, scene.ambient)
             .with_bump_attrs(&battrs)

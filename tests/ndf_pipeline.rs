@@ -133,6 +133,120 @@ fn truth_separates_model_and_quantization_error() {
     assert!(plain.stats.model_error.is_none() && plain.truth_image.is_none());
 }
 
+/// `--truth N` sets the truth's sub-samples: N x N per pixel at least (more where the footprint
+/// crosses more texels). The truth changes with N and converges: against N = 32, N = 16 is
+/// closer than N = 4, which is closer than N = 1.
+#[test]
+fn truth_samples_matter_and_converge() {
+    let mut s = builtin("ripple-sphere").expect("scene");
+    s.width = 160;
+    s.height = 100;
+    let hw = HwConfig::texram16();
+    let maps = Maps::new(&s, 16);
+    let truth = |n: u32| {
+        let opts = RenderOptions {
+            truth: n,
+            ..RenderOptions::default()
+        };
+        let r = render(&s, &maps, &hw, &opts).expect("render");
+        r.truth_image.expect("truth")
+    };
+    let t32 = truth(32);
+    let diff = |a: &texsim::report::Image| -> f64 {
+        let mut d = 0.0;
+        for (p, q) in a.px.iter().zip(&t32.px) {
+            for ch in 0..3 {
+                d += (f64::from(p[ch]) - f64::from(q[ch])).abs();
+            }
+        }
+        d / 257.0 / (3.0 * a.px.len() as f64)
+    };
+    let e: Vec<f64> = [1, 4, 16].map(|n| diff(&truth(n))).to_vec();
+    println!(
+        "truth vs N = 32, mean 8-bit LSB: N = 1 {:.4}, 4 {:.4}, 16 {:.4}",
+        e[0], e[1], e[2]
+    );
+    assert!(e[0] > e[1] && e[1] > e[2] && e[2] > 0.0, "{e:?}");
+}
+
+/// The truth of a footprint of exactly 4 x 4 texels of a checker of two normals is the mean of
+/// the two lobes for any N <= 4 (at least one sample per texel: 4 per axis), and the same lobe
+/// for a uniform map at any N; sub-texel footprints are widened to one texel.
+#[test]
+fn ground_truth_samples_every_texel() {
+    use glam::DVec3;
+    use texsim::shading::ndf::{base_lobe, ground_truth, truth_samples_per_axis};
+    let (n1, n2) = (
+        DVec3::new(0.3, 0.0, 1.0).normalize(),
+        DVec3::new(-0.2, 0.1, 1.0).normalize(),
+    );
+    let normals: Vec<DVec3> = (0..64)
+        .map(|i| if (i % 8 + i / 8) % 2 == 0 { n1 } else { n2 })
+        .collect();
+    let h = DVec3::new(0.1, 0.0, 1.0).normalize();
+    let s = 64.0;
+    let want = 0.5 * (base_lobe(h, n1, s) + base_lobe(h, n2, s));
+    for n in [1, 2, 3, 4] {
+        assert_eq!(truth_samples_per_axis(4.0, n), 4);
+        let got = ground_truth(
+            &normals,
+            8,
+            8,
+            s,
+            [4.0, 4.0],
+            [[4.0, 0.0], [0.0, 4.0]],
+            n,
+            h,
+        );
+        assert!(
+            (got - want).abs() < 1e-12 * want,
+            "N = {n}: {got} vs {want}"
+        );
+    }
+    let uniform = vec![n1; 64];
+    for n in [1, 5, 16] {
+        let got = ground_truth(
+            &uniform,
+            8,
+            8,
+            s,
+            [2.3, 5.1],
+            [[0.01, 0.0], [0.0, 7.0]],
+            n,
+            h,
+        );
+        assert!((got - base_lobe(h, n1, s)).abs() < 1e-12 * got);
+    }
+    // A sub-texel footprint at a texel edge is widened to one texel: both lobes, half each.
+    let edge = ground_truth(
+        &normals,
+        8,
+        8,
+        s,
+        [4.0, 4.5],
+        [[0.1, 0.0], [0.0, 0.1]],
+        2,
+        h,
+    );
+    assert!((edge - want).abs() < 1e-12 * want, "{edge} vs {want}");
+    // Bad input: a map of the wrong size, non-finite axes.
+    assert_eq!(
+        ground_truth(&normals, 9, 8, s, [0.0; 2], [[1.0, 0.0], [0.0, 1.0]], 4, h),
+        0.0
+    );
+    let nan = ground_truth(
+        &normals,
+        8,
+        8,
+        s,
+        [4.0, 4.0],
+        [[f64::NAN, 0.0], [0.0, f64::INFINITY]],
+        4,
+        h,
+    );
+    assert!(nan.is_finite());
+}
+
 /// A TOML material with `ndf = true` on a height map (the bump path's offsets give the
 /// normals) renders through the NDF stages; `ndf = "yes"` is an error naming the field.
 #[test]

@@ -498,9 +498,25 @@ pub fn base_lobe(h: DVec3, n: DVec3, shininess: f64) -> f64 {
     k * (k * (h.dot(n) - 1.0)).exp() / (2.0 * PI * (1.0 - (-2.0 * k).exp()))
 }
 
-/// Ground truth: the base lobes of the finest normals averaged over a square footprint of side
-/// `side` texels centred at texel coordinates `(cu, cv)` (texel centres at `i + 0.5`),
-/// `k x k` sub-samples, nearest texel, repeat wrap.
+/// Sub-samples per footprint axis of [`ground_truth`] for an axis `len` texels long (after its
+/// clamp to `[1, size]`) and the requested `n`: `max(n, ceil(len))`, so that every texel the
+/// axis crosses gets at least one sample.
+#[must_use]
+pub fn truth_samples_per_axis(len: f64, n: u32) -> u32 {
+    (len.ceil() as u32).max(n).max(1)
+}
+
+/// Ground truth of one pixel: the exactly normalized base lobes ([`base_lobe`]) of the finest
+/// unit normals (`w x h`, nearest texel, repeat wrap) averaged over the pixel's footprint in
+/// texel space, the parallelogram `c + s a + t b`, `s, t` in `[-1/2, 1/2]` (`c` the pixel's
+/// texel coordinates, texel centres at `i + 0.5`; `a`, `b` the texel-space derivatives of the
+/// texture coordinates along x and y: the footprint of the roughness truth,
+/// `pipeline::rough_stages`). Each axis is clamped to `[1, max(w, h)]` texels (a one-texel box
+/// over the nearest-texel lobes interpolates them linearly between texel centres, as the
+/// bilinear filter does with the moments; a footprint larger than the map covers all of it)
+/// and sampled at the centres of [`truth_samples_per_axis`]`(len, n)` equal steps: `n x n`
+/// samples at least, one per crossed texel at least. Degenerate or non-finite axes count as
+/// one texel along u (a) or v (b).
 #[must_use]
 #[allow(clippy::too_many_arguments)]
 pub fn ground_truth(
@@ -508,30 +524,43 @@ pub fn ground_truth(
     w: u32,
     h: u32,
     shininess: f64,
-    cu: f64,
-    cv: f64,
-    side: f64,
-    k: u32,
+    c: [f64; 2],
+    axes: [[f64; 2]; 2],
+    n: u32,
     hv: DVec3,
 ) -> f64 {
-    let k = k.max(1);
+    if normals.len() != (w as usize) * (h as usize) || normals.is_empty() {
+        return 0.0;
+    }
+    let size = f64::from(w.max(h));
+    let axis = |a: [f64; 2], unit: [f64; 2]| -> ([f64; 2], u32) {
+        let len = (a[0] * a[0] + a[1] * a[1]).sqrt();
+        if !(len.is_finite() && len > 0.0) {
+            return (unit, truth_samples_per_axis(1.0, n));
+        }
+        let l = len.clamp(1.0, size);
+        (
+            [a[0] * l / len, a[1] * l / len],
+            truth_samples_per_axis(l, n),
+        )
+    };
+    let (a, ka) = axis(axes[0], [1.0, 0.0]);
+    let (b, kb) = axis(axes[1], [0.0, 1.0]);
+    let k = shininess;
+    let scale = k / (2.0 * PI * (1.0 - (-2.0 * k).exp()));
     let mut acc = 0.0;
-    for j in 0..k {
-        for i in 0..k {
-            let u = cu + side * ((f64::from(i) + 0.5) / f64::from(k) - 0.5);
-            let v = cv + side * ((f64::from(j) + 0.5) / f64::from(k) - 0.5);
+    for j in 0..kb {
+        let t = (f64::from(j) + 0.5) / f64::from(kb) - 0.5;
+        for i in 0..ka {
+            let s = (f64::from(i) + 0.5) / f64::from(ka) - 0.5;
+            let u = c[0] + s * a[0] + t * b[0];
+            let v = c[1] + s * a[1] + t * b[1];
             let x = (u.floor() as i64).rem_euclid(i64::from(w)) as usize;
             let y = (v.floor() as i64).rem_euclid(i64::from(h)) as usize;
-            let n = normals[y * w as usize + x];
-            let n = if n.length() > 0.0 {
-                n.normalize()
-            } else {
-                DVec3::Z
-            };
-            acc += base_lobe(hv, n, shininess);
+            acc += (k * (hv.dot(normals[y * w as usize + x]) - 1.0)).exp();
         }
     }
-    acc / f64::from(k * k)
+    scale * acc / (f64::from(ka) * f64::from(kb))
 }
 
 /// `h` (unit) to the fixed unit's W = `NDF_FRAC` fraction bits.
