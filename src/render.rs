@@ -591,6 +591,10 @@ pub struct CycleEstimate {
     pub stages: u64,
     pub total: u64,
     pub per_covered_pixel: f64,
+    /// Set when a stage ran without a hardware cost model (`ndf_norm = exact`): the totals
+    /// leave its unit out and are no machine's cost; sweeps print `-`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_modelled: Option<&'static str>,
 }
 
 /// Everything one render produced.
@@ -1075,6 +1079,11 @@ pub fn render(
     };
     cycles.total = cycles.setup + cycles.spans + cycles.stages;
     cycles.per_covered_pixel = cycles.total as f64 / covered.max(1) as f64;
+    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+        && counters.invocations[StageKind::NdfShade.index()] > 0
+    {
+        cycles.not_modelled = Some(crate::pipeline::ndf_stages::EXACT_NOT_MODELLED);
+    }
 
     Ok(Rendered {
         hw_image,

@@ -678,9 +678,10 @@ pub fn ndf_lookups(cfg: &NdfConfig) -> u32 {
 /// `ndf_lookups x trilinear_cost`. Ops: decode 9, Sigma 12, clamp/minors 6, cofactors and
 /// determinant 23, adjugate normalization 7, quadratic form 17, reciprocal, scale 2;
 /// density: Pearson 2 + 2 log2(m) (m = 8: three squarings), Gauss 7 (table, lerp, shift);
-/// partial 3 + rsqrt, map 2, projected 40 + 2 rsqrt.
+/// partial 3 + rsqrt, map 2, projected 40 + 2 rsqrt. `None` for `exact`: a numerical integral
+/// over the sphere per pixel has no datapath here (float only), so it has no cost to report.
 #[must_use]
-pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> UnitCost {
+pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> Option<UnitCost> {
     let mc = cfg.ndf_mul_cycles;
     let ac = cfg.ndf_add_cycles;
     // (multiplies, adds)
@@ -703,7 +704,8 @@ pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> UnitC
     let rs = rsqrt_cost(rsqrt);
     let mut extra = UnitCost::default();
     match cfg.ndf_norm {
-        NdfNorm::Partial | NdfNorm::Exact => {
+        NdfNorm::Exact => return None,
+        NdfNorm::Partial => {
             mul += 2;
             add += 1;
             extra = rs;
@@ -717,11 +719,13 @@ pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> UnitC
             extra = rs.plus(rs);
         }
     }
-    UnitCost {
-        ops: mul + add + lut,
-        cycles: mul * mc + add * ac + lut * cfg.ndf_lut_cycles,
-        texels: 8 * ndf_lookups(cfg),
-    }
-    .plus(*recip)
-    .plus(extra)
+    Some(
+        UnitCost {
+            ops: mul + add + lut,
+            cycles: mul * mc + add * ac + lut * cfg.ndf_lut_cycles,
+            texels: 8 * ndf_lookups(cfg),
+        }
+        .plus(*recip)
+        .plus(extra),
+    )
 }

@@ -171,7 +171,10 @@ pub fn ndf_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
                 cycles: u.cfg.shade.shade_cycles,
                 texels: 0,
             };
-            let mut unit = ndf_cost(&hw.ndf, &m.recip.cost(), &hw.shading.rsqrt);
+            // `exact` has no unit cost (float only): the stage's cost is then incomplete and
+            // `render` marks the cycle estimate as not modelled ([`EXACT_NOT_MODELLED`]).
+            let mut unit =
+                ndf_cost(&hw.ndf, &m.recip.cost(), &hw.shading.rsqrt).unwrap_or_default();
             unit.texels = 0;
             // Per light: l (point lights), h, h in the frame (3 dots), n.l, D, two MACs.
             unit.times(lights)
@@ -451,3 +454,7 @@ pub fn run_ndf_stage(
 pub fn shade_is_float_only(hw: &HwConfig) -> bool {
     hw.ndf.ndf_norm == NdfNorm::Exact
 }
+
+/// Why a render with `ndf_norm = exact` has no cycle count (`CycleEstimate::not_modelled`).
+pub const EXACT_NOT_MODELLED: &str =
+    "ndf-shade with ndf_norm = exact is float only: no hardware cost model";
