@@ -381,6 +381,69 @@ fn hard_grooves_mu_zero_horizon_garbage() {
     }
 }
 
+/// Garbage at the maximum widths (16-bit moments with scale 2^2, 30-bit adjugate, F = 28,
+/// 30-bit reciprocal and rsqrt mantissas, m = 64, 4096-entry exp table): random texels
+/// (non-normalized means, indefinite moments) and random halfway vectors, also far from unit
+/// length, never overflow (this test runs with overflow checks in the test profile) and stay
+/// in range, for every fixed option and both densities.
+#[test]
+fn garbage_at_max_widths_never_overflows() {
+    let mut hw = HwConfig::texram16();
+    hw.reciprocal.recip_mantissa_bits = 30;
+    let rs = RsqrtConfig {
+        rsqrt_mantissa_bits: 30,
+        ..RsqrtConfig::texram16()
+    };
+    let mut r = Rng(0xBAD);
+    for norm in [NdfNorm::Partial, NdfNorm::Map, NdfNorm::Projected] {
+        for dens in [NdfDensity::Pearson, NdfDensity::Gauss] {
+            let c = NdfConfig {
+                moment_bits: 16,
+                moment_scale_bits: 2,
+                ndf_inverse_bits: 30,
+                ndf_frac_bits: 28,
+                ndf_exp_lut_bits: 12,
+                pearson_m: 64,
+                ndf_min_variance_bits: 30,
+                ..cfg(norm, dens)
+            };
+            let u = hw_model::ndf::NdfUnit::new(&c, &hw.reciprocal, &rs).expect("max widths");
+            let mut sat = SatCounter::default();
+            for i in 0..100_000 {
+                let mut t = NdfTexels::default();
+                for ch in 0..3 {
+                    t.mean[ch] = r.next() as u16;
+                    t.diag[ch] = r.next() as u16;
+                    t.off[ch] = r.next() as u16;
+                }
+                // Extremes: all-zero and all-one channels, mean at a corner of the cube.
+                if i % 7 == 0 {
+                    t.mean = [0, 0, 0, 0];
+                    t.diag = [u16::MAX; 4];
+                }
+                if i % 11 == 0 {
+                    t.off = [if i % 2 == 0 { 0 } else { u16::MAX }; 4];
+                }
+                t.norm[0] = r.next() as u16;
+                t.norm_exp = (r.next() % 41) as u32;
+                let h = if i % 5 == 0 {
+                    [r.next() as i64, r.next() as i64, (r.next() >> 1) as i64]
+                } else {
+                    h_to_fixed(r.tilted(1.5))
+                };
+                let out = u.eval(&t, &h, &mut sat);
+                assert!(out.d_value >= 0 && out.d_value <= D_MAX_RAW, "{out:?}");
+                assert!(out.g >= 0 && out.g <= 1i64 << c.ndf_frac_bits, "{out:?}");
+                assert!(
+                    out.dist >= 0 && out.dist < 128i64 << c.ndf_frac_bits,
+                    "{out:?}"
+                );
+            }
+            assert!(sat.saturated > 0);
+        }
+    }
+}
+
 /// Saturation is counted when the regularization falls back.
 #[test]
 fn fallback_is_counted() {

@@ -107,6 +107,9 @@ pub struct NdfConfig {
     /// Unorm bits of each of the nine moment channels (and of the normalization map). 4..=16.
     pub moment_bits: u32,
     /// Second moments are stored as `E / 2^k` (diagonal) and `1/2 + E / 2^k` (off-diagonal). 0..=2.
+    /// Only this scale is configurable; the biases (`(mu + 1)/2` for the mean, `1/2` for the
+    /// off-diagonals) are fixed. `k = 0` clamps `E_ii > 1` (every texel with `n_i^2 + 1/s > 1`,
+    /// e.g. `E_zz` of a flat texel; counted by the map builder); `k = 1` covers `s >= 1`.
     pub moment_scale_bits: u32,
     /// Significant bits of the block-normalized adjugate. 4..=30.
     pub ndf_inverse_bits: u32,
@@ -384,7 +387,12 @@ impl NdfUnit {
     }
 
     /// `d = v^T S^-1 v` with F fraction bits (clamped) for a regularized `S` and `v` (W bits),
-    /// and `det(S)` exact (3W fraction bits).
+    /// and `det(S)` exact (3W fraction bits). Input range (what [`NdfUnit::eval`] produces):
+    /// `|S_ij| < 2^(W+2)` (moments decoded with `k <= 2`), `|v_i| <= 2^(W+1)`; then the
+    /// cofactors stay below `2^(2W+5)`, `det` below `2^(3W+9)` and the quadratic form below
+    /// `9 * 2^(I+2W+2)` (`I = ndf_inverse_bits`), all in `i128`; its product with the reciprocal
+    /// mantissa is pre-shifted to stay below `2^126` (only at the widest settings, truncating
+    /// bits far below the result's).
     #[must_use]
     pub fn mahalanobis(&self, s: &[i64; 6], v: &[i64; 3], sat: &mut SatCounter) -> (i64, i128) {
         let rnd = self.cfg.ndf_rounding;
@@ -408,9 +416,10 @@ impl NdfUnit {
         let r = self.recip.eval(det_n, sat);
         // d 2^F = q 2^sh mant 2^(F - W - dsh - shift).
         let e = sh as i32 + f as i32 - NDF_FRAC as i32 - dsh as i32 - r.shift;
-        let q = q.max(0);
-        let qm = (q >> 2) * i128::from(r.mant);
-        let e = e + 2;
+        let q = q.max(0) >> 2;
+        let pre = (bitlen(q as u128) + bitlen(u128::from(r.mant))).saturating_sub(126);
+        let qm = (q >> pre) * i128::from(r.mant);
+        let e = e + 2 + pre as i32;
         let dmax = ((1i64 << DMAX_INT_BITS) << f) - 1;
         let dist = if e >= 0 {
             if bitlen(qm as u128) + e as u32 > 62 {
@@ -516,6 +525,13 @@ impl NdfUnit {
         if h[2] <= 0 {
             return NdfOut::default();
         }
+        // A unit `h` has components in [-1, 1]; anything outside is clamped (counted), which
+        // bounds `h - mu` by 2 for the datapath's widths.
+        let one = 1i64 << NDF_FRAC;
+        if h.iter().any(|c| c.unsigned_abs() > one.unsigned_abs()) {
+            sat.saturated += 1;
+        }
+        let h = &h.map(|c| c.clamp(-one, one));
         let rnd = self.cfg.ndf_rounding;
         let (mu, e) = self.decode(t);
         let sigma = self.covariance(&mu, &e);

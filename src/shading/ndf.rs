@@ -16,8 +16,9 @@
 //!
 //! Encoding (`k` = `moment_scale_bits`, all channels unorm `moment_bits`): map A holds
 //! `(mu + 1)/2`, map B `E_ii / 2^k`, map C `1/2 + E_ij / 2^k`; the normalization map holds
-//! `(1/Z) / 2^norm_exp` in channel 0 with `norm_exp` the smallest power of two covering the
-//! largest `1/Z` of the chain. For a single lobe `E_ii = n_i^2 + 1/s <= 1 + 1/s` and
+//! `(1/Z) / 2^norm_exp` in channel 0 with `norm_exp = ceil(log2(s/2))` fixed by the base
+//! shininess ([`norm_exp_for`]: a bound on the largest `1/Z` of any chain of that shininess,
+//! not the chain's own maximum, so the plan knows it before the maps are built). For a single lobe `E_ii = n_i^2 + 1/s <= 1 + 1/s` and
 //! `|E_ij| = |n_i n_j| <= 1/2`, so `k = 1` covers every shininess >= 1 (values above are
 //! clamped and counted in [`NdfMaps::clamped`]).
 
