@@ -658,13 +658,18 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         };
         let r = render(&sc, &maps, cfg, &opts)?;
         let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        let cpp = row
+            .cycles_per_pixel
+            .map_or_else(|| "-".into(), |c| format!("{c:.2}"));
         if let (Some(m), Some(q)) = (&row.model_error, &row.error_8bit) {
             eprintln!(
-                "  model_error (vs truth) mean {:.3} rmse {:.3}; quantization_error mean {:.4} rmse {:.4}; {:.2} cycles/px",
-                m.mean_abs_lsb, m.rmse_lsb, q.mean_abs_lsb, q.rmse_lsb, row.cycles_per_pixel
+                "  model_error (vs truth) mean {:.3} rmse {:.3}; quantization_error mean {:.4} rmse {:.4}; {cpp} cycles/px",
+                m.mean_abs_lsb, m.rmse_lsb, q.mean_abs_lsb, q.rmse_lsb
             );
         }
-        if let Some(ev) = &r.events {
+        if let Some(why) = r.stats.cycles.not_modelled {
+            eprintln!("  no cycles: {why}");
+        } else if let Some(ev) = &r.events {
             row.timing_cycles = Some(crate::timing::simulate(ev, cfg, &sc.name).total_cycles);
         }
         rows.push(row);

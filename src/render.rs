@@ -215,7 +215,7 @@ impl Maps {
                     && (o.ndf_norm != NdfNorm::Map
                         || o.ndf_density != cfg.ndf_density
                         || o.pearson_m != cfg.pearson_m
-                        || o.ndf_min_variance_bits != cfg.ndf_min_variance_bits)))
+                        || o.min_variance_bits() != cfg.min_variance_bits())))
     }
 
     /// Rebuilds the moment maps for `cfg` if [`Maps::ndf_stale`].
@@ -602,6 +602,10 @@ pub struct CycleEstimate {
     pub stages: u64,
     pub total: u64,
     pub per_covered_pixel: f64,
+    /// Set when a stage ran without a hardware cost model (`ndf_norm = exact`): the totals
+    /// leave its unit out and are no machine's cost; sweeps print `-`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_modelled: Option<&'static str>,
 }
 
 /// Everything one render produced.
@@ -1035,7 +1039,8 @@ pub fn render(
         // map (`ndf_stages::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough_stages::truth_plans(&geo.plans, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
-        let ndf_truth = crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans);
+        let ndf_truth =
+            crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)
             .with_lights(&scene.lights, scene.ambient)
             .with_bump_attrs(&battrs)
@@ -1096,6 +1101,11 @@ pub fn render(
     };
     cycles.total = cycles.setup + cycles.spans + cycles.stages;
     cycles.per_covered_pixel = cycles.total as f64 / covered.max(1) as f64;
+    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+        && counters.invocations[StageKind::NdfShade.index()] > 0
+    {
+        cycles.not_modelled = Some(crate::pipeline::ndf_stages::EXACT_NOT_MODELLED);
+    }
 
     Ok(Rendered {
         hw_image,

@@ -82,6 +82,9 @@ pub fn text(s: &RenderStats) -> String {
         "cycles (first estimate, units x cycles/op): {} total = {} setup + {} spans + {} stages; {:.2} per covered pixel",
         c.total, c.setup, c.spans, c.stages, c.per_covered_pixel
     );
+    if let Some(why) = c.not_modelled {
+        let _ = writeln!(o, "  (incomplete: {why})");
+    }
     let t = &s.timings;
     let _ = writeln!(
         o,
@@ -104,10 +107,17 @@ pub struct SweepRow {
     pub settings: Vec<(String, String)>,
     pub error_8bit: Option<ErrorMetrics>,
     pub error_16bit: Option<ErrorMetrics>,
+    /// Saturations of the hardware pass (per stage, wrapped, vertex inputs) plus the NDF
+    /// moment-map channels clamped by their encoding (`ndf_clamped`).
     pub saturated: u64,
+    /// NDF moment-map channels clamped by their encoding.
+    pub ndf_clamped: u64,
     pub texels: u64,
-    pub cycles: u64,
-    pub cycles_per_pixel: f64,
+    /// Cycle estimate; `None` when a stage has no hardware cost model (`ndf_norm = exact`).
+    pub cycles: Option<u64>,
+    pub cycles_per_pixel: Option<f64>,
+    /// ALU ops of the stages per covered pixel (`None` as `cycles`).
+    pub ops_per_pixel: Option<f64>,
     pub hw_ms: f64,
     pub ref_ms: f64,
     /// Total cycles of the timing model (`texsim sweep --cycles`), else `None`.
@@ -122,6 +132,8 @@ impl SweepRow {
     /// The row of one render.
     #[must_use]
     pub fn new(settings: Vec<(String, String)>, s: &RenderStats) -> Self {
+        let px = s.covered_pixels.max(1) as f64;
+        let modelled = s.cycles.not_modelled.is_none();
         Self {
             settings,
             error_8bit: s.error_8bit.clone(),
@@ -132,22 +144,24 @@ impl SweepRow {
                 .map(|x| x.saturated + x.wrapped)
                 .sum::<u64>()
                 + s.input_saturated
-                + s.input_wrapped,
+                + s.input_wrapped
+                + s.bump.ndf_clamped,
+            ndf_clamped: s.bump.ndf_clamped,
             texels: s.stages.iter().map(|x| x.texels).sum(),
-            cycles: s.cycles.total,
-            cycles_per_pixel: s.cycles.per_covered_pixel,
+            cycles: modelled.then_some(s.cycles.total),
+            cycles_per_pixel: modelled.then_some(s.cycles.per_covered_pixel),
+            ops_per_pixel: modelled
+                .then(|| s.stages.iter().map(|x| x.ops).sum::<u64>() as f64 / px),
             hw_ms: s.timings.hw_total_ms,
             ref_ms: s.timings.ref_total_ms,
             timing_cycles: None,
-            lookups_per_pixel: s.stages.iter().map(|x| x.texels).sum::<u64>() as f64
-                / 8.0
-                / s.covered_pixels.max(1) as f64,
+            lookups_per_pixel: s.stages.iter().map(|x| x.texels).sum::<u64>() as f64 / 8.0 / px,
             model_error: s.model_error.clone(),
         }
     }
 }
 
-const HEADER: [&str; 13] = [
+const HEADER: [&str; 14] = [
     "max8",
     "mean8",
     "rmse8",
@@ -158,6 +172,7 @@ const HEADER: [&str; 13] = [
     "sat",
     "cycles",
     "cyc/px",
+    "ops/px",
     "lookups/px",
     "model_mean8",
     "hw_ms",
@@ -187,8 +202,9 @@ fn cells(r: &SweepRow) -> Vec<String> {
         e16.map_or("-".into(), |e| e.max_abs_lsb.to_string()),
         e16.map_or("-".into(), |e| format!("{:.2}", e.rmse_lsb)),
         r.saturated.to_string(),
-        r.cycles.to_string(),
-        format!("{:.2}", r.cycles_per_pixel),
+        r.cycles.map_or("-".into(), |c| c.to_string()),
+        r.cycles_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
+        r.ops_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
         format!("{:.2}", r.lookups_per_pixel),
         r.model_error
             .as_ref()

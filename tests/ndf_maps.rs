@@ -104,3 +104,56 @@ fn sphere_integral_of_the_base_lobe_is_the_vmf_constant() {
         assert!((z / want - 1.0).abs() < 1e-6, "{s}: {z} {want}");
     }
 }
+
+/// The normalization map's scale `2^norm_exp`, `norm_exp = ceil(log2(s/2))` from the base
+/// shininess alone (`norm_exp_for`), covers the largest `1/Z` of the chain (no clamp) for both
+/// densities and m = 1, 8, 64, from s = 1 up to the variance floor `2^(B-3)`, and wastes at
+/// most 3 bits of the channel there (`2^norm_exp <= 8 max 1/Z` from s = 16 on).
+#[test]
+fn normalization_map_scale_covers_the_largest_inverse_z() {
+    use hw_model::ndf::NdfNorm;
+    use texsim::shading::ndf::norm_exp_for;
+    let flat = vec![DVec3::Z; 4];
+    let rip = procedural_normals("ripple", 8, 8, 0.4).expect("map");
+    for dens in [NdfDensity::Pearson, NdfDensity::Gauss] {
+        for m in [1, 8, 64] {
+            let cfg = NdfConfig {
+                ndf_norm: NdfNorm::Map,
+                ndf_density: dens,
+                pearson_m: m,
+                ..NdfConfig::texram16()
+            };
+            for s in [1.0, 2.0, 7.0, 16.0, 64.0, 1000.0, 8192.0] {
+                for (n, w) in [(&flat, 2), (&rip, 8)] {
+                    let maps = build_ndf_maps(n, w, w, s, &cfg).expect("maps");
+                    assert_eq!(maps.norm_exp, norm_exp_for(s));
+                    let top = maps.inv_z.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
+                    let scale = f64::from(maps.norm_exp).exp2();
+                    assert!(
+                        top <= scale && maps.clamped == 0,
+                        "{dens:?} m={m} s={s}: {top} > {scale}"
+                    );
+                    if s >= 16.0 && w == 2 {
+                        assert!(scale <= 8.0 * top, "{dens:?} m={m} s={s}: {scale} vs {top}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `moment_scale_bits = 0` stores `E_ii` unscaled: `E_zz = n_z^2 + 1/s > 1` of a flat texel is
+/// clamped (and counted), at every level; `k = 1` stores it without a clamp.
+#[test]
+fn scale_zero_clamps_the_diagonal_of_flat_texels() {
+    let flat = vec![DVec3::Z; 16];
+    for (k, clamps) in [(0u32, true), (1, false), (2, false)] {
+        let cfg = NdfConfig {
+            moment_scale_bits: k,
+            ..NdfConfig::texram16()
+        };
+        let maps = build_ndf_maps(&flat, 4, 4, 64.0, &cfg).expect("maps");
+        // 16 + 4 + 1 texels, one E_zz channel each.
+        assert_eq!(maps.clamped, if clamps { 21 } else { 0 }, "k = {k}");
+    }
+}

@@ -6,9 +6,10 @@
 //! product), the Mahalanobis distance `d = (h - mu)^T Sigma^-1 (h - mu)` of the halfway vector
 //! and the elliptically contoured density `g(d)`:
 //! - `pearson`: Pearson Type II `g(t) = (1 - t/(2m))^m` for `t < 2m`, else 0. Both copies of
-//!   the paper print the denominator as `2^m`; with m = 8 that is `(1 - t/256)^8 ~ exp(-t/32)`,
-//!   sixteen times too wide, while `(1 - t/(2m))^m -> exp(-t/2)` as m grows (the Gaussian the
-//!   paper says it approximates). `tests/ndf_unit.rs` checks both limits. m = 8 is three
+//!   the paper print the denominator as `2^m`; that form is `(1 - t/2^m)^m ~ exp(-t m/2^m)`,
+//!   with m = 8 `(1 - t/256)^8 ~ exp(-t/32)`: `d` scaled down 16 times (a variance 16 times too
+//!   large, a lobe 4 times too wide in angle), while `(1 - t/(2m))^m -> exp(-t/2)` as m grows
+//!   (the Gaussian the paper says it approximates). `tests/ndf_unit.rs` checks both limits. m = 8 is three
 //!   squarings.
 //! - `gauss`: `exp(-t/2) = 2^(-t log2(e)/2)`: integer part by shift, fraction by a `2^f` table
 //!   of `2^ndf_exp_lut_bits + 1` entries with linear interpolation.
@@ -28,9 +29,17 @@
 //!    `E_ij = 2^k (q/(2^B-1) - 1/2)` (k = `moment_scale_bits`), each by a constant division
 //!    (a constant multiplier in hardware) rounded once to W bits.
 //! 2. `Sigma` products rounded to W. GRACEFUL DEGRADATION: each diagonal is clamped to at least
-//!    `2^-ndf_min_variance_bits`; if a leading minor is then not positive (quantization made the
-//!    matrix indefinite: shiny texels, rank-deficient grooves) the off-diagonals are dropped
-//!    (a diagonal matrix with positive entries) and one saturation is counted.
+//!    the minimum variance `2^-v` ([`NdfConfig::min_variance_bits`]; by default `v = B - 3`,
+//!    tied to the moment quantization: a diagonal `E_ii - mu_i^2` computed from stored and
+//!    trilinearly filtered channels errs by up to one LSB of `E_ii` (`2^k 2^-B`: half from the
+//!    storage rounding, half from the filter's output rounding) plus `2 |mu_i|` times one LSB
+//!    of `mu_i` (`2^(1-B)`), at most `(2^k + 4) 2^-B <= 2^(3-B)` for `k <= 2`; the storage half
+//!    is checked in `tests/ndf_unit.rs`); each clamp is counted
+//!    as a saturation. Below that floor the stored variance is quantization noise, so a lobe
+//!    sharper than `s = 2^v` degrades to the floor's broader lobe instead of an arbitrarily
+//!    sharp one. If a leading minor is then not positive (quantization made the matrix
+//!    indefinite: rank-deficient grooves, `mu ~ 0`) the off-diagonals are dropped (a diagonal
+//!    matrix with positive entries) and one more saturation is counted.
 //! 3. Cofactors and determinant exact (i128). Adjugate block-normalized to `ndf_inverse_bits`
 //!    significant bits (one shared exponent), determinant through the reciprocal unit.
 //! 4. `d` rounded to F fraction bits, clamped to `[0, 2^DMAX_INT_BITS)` (`g` is 0 there at F <= 28
@@ -98,10 +107,14 @@ pub struct NdfConfig {
     /// Unorm bits of each of the nine moment channels (and of the normalization map). 4..=16.
     pub moment_bits: u32,
     /// Second moments are stored as `E / 2^k` (diagonal) and `1/2 + E / 2^k` (off-diagonal). 0..=2.
+    /// Only this scale is configurable; the biases (`(mu + 1)/2` for the mean, `1/2` for the
+    /// off-diagonals) are fixed. `k = 0` clamps `E_ii > 1` (every texel with `n_i^2 + 1/s > 1`,
+    /// e.g. `E_zz` of a flat texel; counted by the map builder); `k = 1` covers `s >= 1`.
     pub moment_scale_bits: u32,
     /// Significant bits of the block-normalized adjugate. 4..=30.
     pub ndf_inverse_bits: u32,
-    /// Smallest variance on the diagonal of `Sigma` is `2^-bits`. 4..=30.
+    /// Smallest variance on the diagonal of `Sigma` is `2^-bits`. 4..=30, or 0: derived from
+    /// the moment quantization, `moment_bits - 3` ([`NdfConfig::min_variance_bits`]).
     pub ndf_min_variance_bits: u32,
     /// Index bits of the `2^f` table of the Gaussian. 2..=12.
     pub ndf_exp_lut_bits: u32,
@@ -132,7 +145,7 @@ impl NdfConfig {
             moment_bits: 16,
             moment_scale_bits: 1,
             ndf_inverse_bits: 24,
-            ndf_min_variance_bits: 24,
+            ndf_min_variance_bits: 0,
             ndf_exp_lut_bits: 10,
             ndf_frac_bits: 24,
             pearson_m: 8,
@@ -151,16 +164,32 @@ impl NdfConfig {
         range("ndf.moment_bits", self.moment_bits, 4, 16)?;
         range("ndf.moment_scale_bits", self.moment_scale_bits, 0, 2)?;
         range("ndf.ndf_inverse_bits", self.ndf_inverse_bits, 4, 30)?;
-        range(
-            "ndf.ndf_min_variance_bits",
-            self.ndf_min_variance_bits,
-            4,
-            30,
-        )?;
+        if self.ndf_min_variance_bits != 0 {
+            range(
+                "ndf.ndf_min_variance_bits",
+                self.ndf_min_variance_bits,
+                4,
+                30,
+            )?;
+        }
         range("ndf.ndf_exp_lut_bits", self.ndf_exp_lut_bits, 2, 12)?;
         range("ndf.ndf_frac_bits", self.ndf_frac_bits, 12, 28)?;
         range("ndf.pearson_m", self.pearson_m, 1, 64)?;
         Ok(())
+    }
+}
+
+impl NdfConfig {
+    /// The minimum variance of `Sigma`'s diagonal is `2^-min_variance_bits()`: the configured
+    /// `ndf_min_variance_bits`, or for 0 the quantization floor `moment_bits - 3` (module doc,
+    /// step 2), at least 1.
+    #[must_use]
+    pub fn min_variance_bits(&self) -> u32 {
+        if self.ndf_min_variance_bits == 0 {
+            self.moment_bits.saturating_sub(3).max(1)
+        } else {
+            self.ndf_min_variance_bits
+        }
     }
 }
 
@@ -194,6 +223,20 @@ pub struct NdfOut {
     pub g: i64,
     /// The Mahalanobis distance `d` (clamped).
     pub dist: i64,
+    /// The regularization dropped the off-diagonals (of `Sigma`, or of `Sigma_p` for
+    /// `projected`).
+    pub fallback: bool,
+}
+
+/// Result of the regularization (step 2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Regularized {
+    /// The regularized `Sigma` (W bits, symmetric order).
+    pub sigma: [i64; 6],
+    /// Diagonal entries raised to the minimum variance (0..=3).
+    pub clamped: u32,
+    /// The off-diagonals were dropped (a leading minor was not positive).
+    pub fallback: bool,
 }
 
 /// The unit with its reciprocal, rsqrt and `2^f` tables built.
@@ -306,27 +349,50 @@ impl NdfUnit {
         ]
     }
 
-    /// Step 2 of the module doc: minimum variance and the positive-definite fallback.
+    /// Step 2 of the module doc: minimum variance and the positive-definite fallback; each
+    /// clamped diagonal and the fallback are counted in `sat`.
     #[must_use]
     pub fn regularize(&self, s: &[i64; 6], sat: &mut SatCounter) -> [i64; 6] {
-        let vmin = 1i64 << (NDF_FRAC - self.cfg.ndf_min_variance_bits.min(NDF_FRAC));
+        let r = self.regularize_flags(s);
+        sat.saturated += u64::from(r.clamped) + u64::from(r.fallback);
+        r.sigma
+    }
+
+    /// Step 2 without counting: the regularized matrix, how many diagonals were clamped to the
+    /// minimum variance and whether the off-diagonals were dropped.
+    #[must_use]
+    pub fn regularize_flags(&self, s: &[i64; 6]) -> Regularized {
+        let vmin = 1i64 << (NDF_FRAC - self.cfg.min_variance_bits().min(NDF_FRAC));
         let mut r = *s;
+        let mut clamped = 0;
         for v in r.iter_mut().take(3) {
-            *v = (*v).max(vmin);
+            if *v < vmin {
+                *v = vmin;
+                clamped += 1;
+            }
         }
         let (_, det) = cofactors(&r);
         let m2 = i128::from(r[0]) * i128::from(r[1]) - i128::from(r[3]) * i128::from(r[3]);
-        if m2 <= 0 || det <= 0 {
-            sat.saturated += 1;
+        let fallback = m2 <= 0 || det <= 0;
+        if fallback {
             r[3] = 0;
             r[4] = 0;
             r[5] = 0;
         }
-        r
+        Regularized {
+            sigma: r,
+            clamped,
+            fallback,
+        }
     }
 
     /// `d = v^T S^-1 v` with F fraction bits (clamped) for a regularized `S` and `v` (W bits),
-    /// and `det(S)` exact (3W fraction bits).
+    /// and `det(S)` exact (3W fraction bits). Input range (what [`NdfUnit::eval`] produces):
+    /// `|S_ij| < 2^(W+2)` (moments decoded with `k <= 2`), `|v_i| <= 2^(W+1)`; then the
+    /// cofactors stay below `2^(2W+5)`, `det` below `2^(3W+9)` and the quadratic form below
+    /// `9 * 2^(I+2W+2)` (`I = ndf_inverse_bits`), all in `i128`; its product with the reciprocal
+    /// mantissa is pre-shifted to stay below `2^126` (only at the widest settings, truncating
+    /// bits far below the result's).
     #[must_use]
     pub fn mahalanobis(&self, s: &[i64; 6], v: &[i64; 3], sat: &mut SatCounter) -> (i64, i128) {
         let rnd = self.cfg.ndf_rounding;
@@ -350,9 +416,10 @@ impl NdfUnit {
         let r = self.recip.eval(det_n, sat);
         // d 2^F = q 2^sh mant 2^(F - W - dsh - shift).
         let e = sh as i32 + f as i32 - NDF_FRAC as i32 - dsh as i32 - r.shift;
-        let q = q.max(0);
-        let qm = (q >> 2) * i128::from(r.mant);
-        let e = e + 2;
+        let q = q.max(0) >> 2;
+        let pre = (bitlen(q as u128) + bitlen(u128::from(r.mant))).saturating_sub(126);
+        let qm = (q >> pre) * i128::from(r.mant);
+        let e = e + 2 + pre as i32;
         let dmax = ((1i64 << DMAX_INT_BITS) << f) - 1;
         let dist = if e >= 0 {
             if bitlen(qm as u128) + e as u32 > 62 {
@@ -458,12 +525,21 @@ impl NdfUnit {
         if h[2] <= 0 {
             return NdfOut::default();
         }
+        // A unit `h` has components in [-1, 1]; anything outside is clamped (counted), which
+        // bounds `h - mu` by 2 for the datapath's widths.
+        let one = 1i64 << NDF_FRAC;
+        if h.iter().any(|c| c.unsigned_abs() > one.unsigned_abs()) {
+            sat.saturated += 1;
+        }
+        let h = &h.map(|c| c.clamp(-one, one));
         let rnd = self.cfg.ndf_rounding;
         let (mu, e) = self.decode(t);
         let sigma = self.covariance(&mu, &e);
         match self.cfg.ndf_norm {
             NdfNorm::Partial | NdfNorm::Map | NdfNorm::Exact => {
-                let s = self.regularize(&sigma, sat);
+                let reg = self.regularize_flags(&sigma);
+                sat.saturated += u64::from(reg.clamped) + u64::from(reg.fallback);
+                let s = reg.sigma;
                 let v = [h[0] - mu[0], h[1] - mu[1], h[2] - mu[2]];
                 let (dist, det) = self.mahalanobis(&s, &v, sat);
                 let g = self.density(dist);
@@ -481,7 +557,12 @@ impl NdfUnit {
                 } else {
                     self.scale_by(g, K3_Q30, det, sat)
                 };
-                NdfOut { d_value, g, dist }
+                NdfOut {
+                    d_value,
+                    g,
+                    dist,
+                    fallback: reg.fallback,
+                }
             }
             NdfNorm::Projected => {
                 let n = self.mean_direction(&mu, sat);
@@ -492,9 +573,13 @@ impl NdfUnit {
                 if hn <= 0 {
                     return NdfOut::default();
                 }
-                let s = self.regularize(&sigma, sat);
-                let sp = project(&s, &n, rnd);
-                let sp = self.regularize(&sp, sat);
+                let reg = self.regularize_flags(&sigma);
+                let sp = project(&reg.sigma, &n, rnd);
+                let reg_p = self.regularize_flags(&sp);
+                sat.saturated += u64::from(reg.clamped + reg_p.clamped)
+                    + u64::from(reg.fallback)
+                    + u64::from(reg_p.fallback);
+                let sp = reg_p.sigma;
                 let y = [h[0] - p(hn, n[0]), h[1] - p(hn, n[1]), h[2] - p(hn, n[2])];
                 let (dist, det) = self.mahalanobis(&sp, &y, sat);
                 let g = self.density(dist);
@@ -511,7 +596,12 @@ impl NdfUnit {
                 };
                 // det(Sigma_p) = det2 * 1: the same inverse square root.
                 let d_value = self.scale_by(g, k2, det, sat);
-                NdfOut { d_value, g, dist }
+                NdfOut {
+                    d_value,
+                    g,
+                    dist,
+                    fallback: reg.fallback || reg_p.fallback,
+                }
             }
         }
     }
@@ -604,9 +694,10 @@ pub fn ndf_lookups(cfg: &NdfConfig) -> u32 {
 /// `ndf_lookups x trilinear_cost`. Ops: decode 9, Sigma 12, clamp/minors 6, cofactors and
 /// determinant 23, adjugate normalization 7, quadratic form 17, reciprocal, scale 2;
 /// density: Pearson 2 + 2 log2(m) (m = 8: three squarings), Gauss 7 (table, lerp, shift);
-/// partial 3 + rsqrt, map 2, projected 40 + 2 rsqrt.
+/// partial 3 + rsqrt, map 2, projected 40 + 2 rsqrt. `None` for `exact`: a numerical integral
+/// over the sphere per pixel has no datapath here (float only), so it has no cost to report.
 #[must_use]
-pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> UnitCost {
+pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> Option<UnitCost> {
     let mc = cfg.ndf_mul_cycles;
     let ac = cfg.ndf_add_cycles;
     // (multiplies, adds)
@@ -629,7 +720,8 @@ pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> UnitC
     let rs = rsqrt_cost(rsqrt);
     let mut extra = UnitCost::default();
     match cfg.ndf_norm {
-        NdfNorm::Partial | NdfNorm::Exact => {
+        NdfNorm::Exact => return None,
+        NdfNorm::Partial => {
             mul += 2;
             add += 1;
             extra = rs;
@@ -643,11 +735,13 @@ pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> UnitC
             extra = rs.plus(rs);
         }
     }
-    UnitCost {
-        ops: mul + add + lut,
-        cycles: mul * mc + add * ac + lut * cfg.ndf_lut_cycles,
-        texels: 8 * ndf_lookups(cfg),
-    }
-    .plus(*recip)
-    .plus(extra)
+    Some(
+        UnitCost {
+            ops: mul + add + lut,
+            cycles: mul * mc + add * ac + lut * cfg.ndf_lut_cycles,
+            texels: 8 * ndf_lookups(cfg),
+        }
+        .plus(*recip)
+        .plus(extra),
+    )
 }

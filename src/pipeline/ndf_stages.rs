@@ -83,11 +83,12 @@ pub fn with_ndf(mut plan: Plan, maps: usize, shininess: u32, norm_exp: u32) -> P
     plan
 }
 
-/// The ground truth of one set of moment maps: the finest normals (tangent space), their size
-/// and the base shininess. The truth of a pixel is [`crate::shading::ndf::ground_truth`]: the
-/// exactly normalized base lobes of the finest normals averaged over a square footprint of
-/// side `2^lod` texels (the pixel's footprint on the map) with `k x k` samples,
-/// `k = clamp(ceil(2 side), 2, 32)`.
+/// The ground truth of one set of moment maps: the finest unit normals (tangent space), their
+/// size, the base shininess and the requested sub-samples per axis. The truth of a pixel is
+/// [`crate::shading::ndf::ground_truth`]: the exactly normalized base lobes of the finest
+/// normals averaged over the pixel's footprint parallelogram in texture space (the texture
+/// coordinates' derivatives), `samples x samples` sub-samples at least and at least one per
+/// texel the footprint crosses.
 #[derive(Clone, Debug)]
 pub struct NdfTruth {
     /// Index of moment map A of the set (as in [`NdfPlan::maps`]).
@@ -96,14 +97,18 @@ pub struct NdfTruth {
     pub height: u32,
     pub normals: Vec<DVec3>,
     pub shininess: f64,
+    /// Sub-samples per footprint axis at least (`--truth N`).
+    pub samples: u32,
 }
 
-/// The truth data of every NDF plan in `plans` from the maps' finest offsets.
+/// The truth data of every NDF plan in `plans` from the maps' finest offsets, with at least
+/// `samples x samples` sub-samples per pixel.
 #[must_use]
 pub fn truth_maps(
     maps: &crate::render::Maps,
     scene: &crate::scene::Scene,
     plans: &[Plan],
+    samples: u32,
 ) -> Vec<NdfTruth> {
     let first = scene.textures.len() + maps.bump_offsets.len();
     let mut out: Vec<NdfTruth> = Vec::new();
@@ -123,9 +128,17 @@ pub fn truth_maps(
             height: *h,
             normals: offs
                 .iter()
-                .map(|o| DVec3::new(f64::from(o[0]), f64::from(o[1]), 1.0).normalize())
+                .map(|o| {
+                    let n = DVec3::new(f64::from(o[0]), f64::from(o[1]), 1.0).normalize();
+                    if n.is_finite() {
+                        n
+                    } else {
+                        DVec3::Z
+                    }
+                })
                 .collect(),
             shininess: f64::from(s),
+            samples: samples.max(1),
         });
     }
     out
@@ -158,7 +171,10 @@ pub fn ndf_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
                 cycles: u.cfg.shade.shade_cycles,
                 texels: 0,
             };
-            let mut unit = ndf_cost(&hw.ndf, &m.recip.cost(), &hw.shading.rsqrt);
+            // `exact` has no unit cost (float only): the stage's cost is then incomplete and
+            // `render` marks the cycle estimate as not modelled ([`EXACT_NOT_MODELLED`]).
+            let mut unit =
+                ndf_cost(&hw.ndf, &m.recip.cost(), &hw.shading.rsqrt).unwrap_or_default();
             unit.texels = 0;
             // Per light: l (point lights), h, h in the frame (3 dots), n.l, D, two MACs.
             unit.times(lights)
@@ -403,21 +419,18 @@ pub fn run_ndf_stage(
                             .0;
                     let d = match truth {
                         Some(tr) => {
-                            let side = frag
-                                .lod
-                                .exp2()
-                                .clamp(1.0, f64::from(tr.width.max(tr.height)));
-                            let ks = (2.0 * side).ceil().clamp(2.0, 32.0) as u32;
-                            let [u, vv] = frag.uv[0];
+                            let (wf, hf) = (f64::from(tr.width), f64::from(tr.height));
+                            let uv = &frag.uv;
+                            let d =
+                                |k: usize| [(uv[k][0] - uv[0][0]) * wf, (uv[k][1] - uv[0][1]) * hf];
                             ground_truth(
                                 &tr.normals,
                                 tr.width,
                                 tr.height,
                                 tr.shininess,
-                                u * f64::from(tr.width),
-                                vv * f64::from(tr.height),
-                                side,
-                                ks,
+                                [uv[0][0] * wf, uv[0][1] * hf],
+                                [d(1), d(2)],
+                                tr.samples,
                                 ht,
                             )
                         }
@@ -441,3 +454,7 @@ pub fn run_ndf_stage(
 pub fn shade_is_float_only(hw: &HwConfig) -> bool {
     hw.ndf.ndf_norm == NdfNorm::Exact
 }
+
+/// Why a render with `ndf_norm = exact` has no cycle count (`CycleEstimate::not_modelled`).
+pub const EXACT_NOT_MODELLED: &str =
+    "ndf-shade with ndf_norm = exact is float only: no hardware cost model";

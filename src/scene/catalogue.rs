@@ -26,7 +26,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("brushed", "roughness: brushed metal plate (anisotropic streaks), 480x320"),
     ("scratches", "roughness: small scratches on a glossy surface, 480x320"),
     ("ripple-sphere", "NDF mapping (Olano-North Fig. 1): a rippled sphere at three distances, highlight blurs and stretches with the MIP level, 480x320"),
-    ("lod-pair", "NDF mapping (Olano-North Fig. 2): a smooth sphere at two polygon counts, consistent highlights, 480x320"),
+    ("lod-pair", "NDF mapping (Olano-North Fig. 2): a wavy sphere at two polygon counts, per-vertex normals vs NDF map, 480x320"),
     ("foil", "NDF mapping: crumpled foil tile, shininess 256, 480x320"),
 ];
 

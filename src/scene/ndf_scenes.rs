@@ -1,12 +1,12 @@
 //! Built-in scenes of NDF mapping (Olano and North 1997), shaded by `ndf-fetch`/`ndf-shade`
 //! (see `crate::pipeline::ndf_stages`): `ripple-sphere` (their Figure 1: one rippled sphere at
 //! three distances, the highlight blurs and stretches along the ripples as the MIP level
-//! coarsens), `lod-pair` (their Figure 2: one smooth object at two polygon counts; the per-pixel
-//! NDF keeps the highlights alike), `foil` (crumpled foil: many small facets whose coarse
+//! coarsens), `lod-pair` (their Figure 2: one wavy object at two polygon counts, per-vertex
+//! normals against the NDF map), `foil` (crumpled foil: many small facets whose coarse
 //! levels become a broad, anisotropic lobe).
 
 use super::{shapes, Camera, Light, Material, Mesh, Scene, TextureImage};
-use crate::shading::ndf::procedural_normals;
+use crate::shading::ndf::{procedural_normals, wave_slope};
 use glam::{DMat4, DVec3};
 
 /// A tangent-space normal map texture (`rgb = n/2 + 1/2`, 16-bit) of a procedural kind.
@@ -94,28 +94,83 @@ pub fn ripple_sphere() -> Scene {
     )
 }
 
-/// `lod-pair`: one smooth sphere at 12x6 and at 64x32 quads, shininess 128, flat normals: the
-/// per-pixel NDF of the interpolated frame gives the same highlight on both.
+/// Sphere tessellations of `lod-pair`: coarse 12x6 and fine 64x32 quads.
+pub const LOD_PAIR_TESSELLATIONS: [(u32, u32); 2] = [(12, 6), (64, 32)];
+/// Largest slope of the `waves` normal map of `lod-pair`.
+pub const LOD_PAIR_AMPLITUDE: f64 = 0.3;
+
+/// A sphere whose vertex normals sample the wavy surface of `lod-pair`: the `waves` normal map
+/// applied at each vertex as the bump and NDF paths apply it per pixel (offset
+/// `f_u = -n_x/n_z = slope` along `t_u` of the default main frame, `t_u = -normalize(p_v x n)`):
+/// what per-vertex normals of that smooth object are.
+fn wavy_vertex_normals(mut m: Mesh) -> Mesh {
+    for (n, uv) in m.normals.iter_mut().zip(&m.uvs) {
+        let nn = DVec3::from(n.map(f64::from));
+        let (phi, th) = (
+            2.0 * std::f64::consts::PI * f64::from(uv[0]),
+            std::f64::consts::PI * f64::from(uv[1]),
+        );
+        let pv = DVec3::new(th.cos() * phi.sin(), -th.sin(), th.cos() * phi.cos());
+        let tu = -pv.cross(nn).normalize_or_zero();
+        let w = (nn + tu * wave_slope(f64::from(uv[0]), LOD_PAIR_AMPLITUDE)).normalize();
+        *n = [w.x as f32, w.y as f32, w.z as f32];
+    }
+    m
+}
+
+/// `lod-pair` (Olano and North, Figure 2): one wavy object (a sphere with 8 sine waves across u,
+/// slope up to 0.3) at two polygon counts, 12x6 (left) and 64x32 (right), shininess 128.
+/// Top row, the paper's a) and b): per-vertex normals of the wavy surface, Phong-interpolated
+/// and shaded per pixel with Blinn-Phong (a bump material on a flat normal map): the fine mesh
+/// resolves the waves (8 vertices per wave), the coarse one aliases them (1.5 per wave), so the
+/// highlight changes with the polygon count. Bottom row, c) and d): the smooth sphere's normals
+/// with the waves in an NDF map (texture 0): the per-pixel NDF in the interpolated frame keeps
+/// the highlights alike on both meshes, and its coarse MIP levels carry the waves' spread.
 pub fn lod_pair() -> Scene {
-    scene(
+    let [(cs, cr), (fs, fr)] = LOD_PAIR_TESSELLATIONS;
+    let r = 0.62;
+    let (x, y) = (1.05, 0.72);
+    let mut phong = ndf_material("phong", [0.6, 0.3, 0.25], 128);
+    phong.ndf = false;
+    phong.bump = Some(1);
+    let mut sc = scene(
         "lod-pair",
         vec![
             placed(
-                shapes::sphere(1.0, 12, 6),
-                "coarse",
-                DVec3::new(-1.1, 0.0, 0.0),
-                1.0,
+                shapes::sphere(1.0, cs, cr),
+                "ndf-coarse",
+                DVec3::new(-x, -y, 0.0),
+                r,
             ),
             placed(
-                shapes::sphere(1.0, 64, 32),
-                "fine",
-                DVec3::new(1.1, 0.0, 0.0),
-                1.0,
+                shapes::sphere(1.0, fs, fr),
+                "ndf-fine",
+                DVec3::new(x, -y, 0.0),
+                r,
+            ),
+            placed(
+                wavy_vertex_normals(shapes::sphere(1.0, cs, cr)),
+                "phong-coarse",
+                DVec3::new(-x, y, 0.0),
+                r,
+            ),
+            placed(
+                wavy_vertex_normals(shapes::sphere(1.0, fs, fr)),
+                "phong-fine",
+                DVec3::new(x, y, 0.0),
+                r,
             ),
         ],
-        vec![ndf_material("smooth", [0.6, 0.3, 0.25], 128)],
-        normal_texture("ripple", 16, 0.0),
-    )
+        vec![ndf_material("ndf", [0.6, 0.3, 0.25], 128), phong],
+        normal_texture("waves", 128, LOD_PAIR_AMPLITUDE),
+    );
+    for m in &mut sc.meshes[2..] {
+        m.material = 1;
+    }
+    let mut flat = normal_texture("waves", 16, 0.0);
+    flat.name = "flat normals".into();
+    sc.textures.push(flat);
+    sc
 }
 
 /// `foil`: crumpled foil (random facets, 2x2 texels each), shininess 256, as a near tile (the

@@ -16,8 +16,9 @@
 //!
 //! Encoding (`k` = `moment_scale_bits`, all channels unorm `moment_bits`): map A holds
 //! `(mu + 1)/2`, map B `E_ii / 2^k`, map C `1/2 + E_ij / 2^k`; the normalization map holds
-//! `(1/Z) / 2^norm_exp` in channel 0 with `norm_exp` the smallest power of two covering the
-//! largest `1/Z` of the chain. For a single lobe `E_ii = n_i^2 + 1/s <= 1 + 1/s` and
+//! `(1/Z) / 2^norm_exp` in channel 0 with `norm_exp = ceil(log2(s/2))` fixed by the base
+//! shininess ([`norm_exp_for`]: a bound on the largest `1/Z` of any chain of that shininess,
+//! not the chain's own maximum, so the plan knows it before the maps are built). For a single lobe `E_ii = n_i^2 + 1/s <= 1 + 1/s` and
 //! `|E_ij| = |n_i n_j| <= 1/2`, so `k = 1` covers every shininess >= 1 (values above are
 //! clamped and counted in [`NdfMaps::clamped`]).
 
@@ -298,10 +299,11 @@ pub fn regularize_float(m: &Moments, cfg: &NdfConfig) -> (DVec3, [f64; 6]) {
     (m.mu, regularize_sigma(&m.covariance(), cfg).0)
 }
 
-/// Regularizes `Sigma`; the flag says the off-diagonals were dropped.
+/// Regularizes `Sigma` (minimum variance `2^-cfg.min_variance_bits()` on the diagonal); the
+/// flag says the off-diagonals were dropped.
 #[must_use]
 pub fn regularize_sigma(s: &[f64; 6], cfg: &NdfConfig) -> ([f64; 6], bool) {
-    let vmin = (-f64::from(cfg.ndf_min_variance_bits)).exp2();
+    let vmin = (-f64::from(cfg.min_variance_bits())).exp2();
     let mut r = *s;
     for v in r.iter_mut().take(3) {
         *v = v.max(vmin);
@@ -324,8 +326,9 @@ pub fn density(t: f64, cfg: &NdfConfig) -> f64 {
         NdfDensity::Gauss => (-0.5 * t).exp(),
         NdfDensity::Pearson => {
             let m = f64::from(cfg.pearson_m);
-            // (1 - t/(2m))^m -> exp(-t/2); the paper's printed `2^m` denominator would give
-            // exp(-t m / 2^(m+1)) instead (tested in tests/ndf_unit.rs).
+            // (1 - t/(2m))^m -> exp(-t/2). The paper's printed `2^m` denominator gives
+            // (1 - t/2^m)^m = exp(m ln(1 - t/2^m)) ~ exp(-t m / 2^m) instead (ln(1 - x) ~ -x
+            // for the small x = t/2^m): exp(-t/32) for m = 8 (tested in tests/ndf_unit.rs).
             let b = 1.0 - t / (2.0 * m);
             if b <= 0.0 {
                 0.0
@@ -496,9 +499,25 @@ pub fn base_lobe(h: DVec3, n: DVec3, shininess: f64) -> f64 {
     k * (k * (h.dot(n) - 1.0)).exp() / (2.0 * PI * (1.0 - (-2.0 * k).exp()))
 }
 
-/// Ground truth: the base lobes of the finest normals averaged over a square footprint of side
-/// `side` texels centred at texel coordinates `(cu, cv)` (texel centres at `i + 0.5`),
-/// `k x k` sub-samples, nearest texel, repeat wrap.
+/// Sub-samples per footprint axis of [`ground_truth`] for an axis `len` texels long (after its
+/// clamp to `[1, size]`) and the requested `n`: `max(n, ceil(len))`, so that every texel the
+/// axis crosses gets at least one sample.
+#[must_use]
+pub fn truth_samples_per_axis(len: f64, n: u32) -> u32 {
+    (len.ceil() as u32).max(n).max(1)
+}
+
+/// Ground truth of one pixel: the exactly normalized base lobes ([`base_lobe`]) of the finest
+/// unit normals (`w x h`, nearest texel, repeat wrap) averaged over the pixel's footprint in
+/// texel space, the parallelogram `c + s a + t b`, `s, t` in `[-1/2, 1/2]` (`c` the pixel's
+/// texel coordinates, texel centres at `i + 0.5`; `a`, `b` the texel-space derivatives of the
+/// texture coordinates along x and y: the footprint of the roughness truth,
+/// `pipeline::rough_stages`). Each axis is clamped to `[1, max(w, h)]` texels (a one-texel box
+/// over the nearest-texel lobes interpolates them linearly between texel centres, as the
+/// bilinear filter does with the moments; a footprint larger than the map covers all of it)
+/// and sampled at the centres of [`truth_samples_per_axis`]`(len, n)` equal steps: `n x n`
+/// samples at least, one per crossed texel at least. Degenerate or non-finite axes count as
+/// one texel along u (a) or v (b).
 #[must_use]
 #[allow(clippy::too_many_arguments)]
 pub fn ground_truth(
@@ -506,30 +525,43 @@ pub fn ground_truth(
     w: u32,
     h: u32,
     shininess: f64,
-    cu: f64,
-    cv: f64,
-    side: f64,
-    k: u32,
+    c: [f64; 2],
+    axes: [[f64; 2]; 2],
+    n: u32,
     hv: DVec3,
 ) -> f64 {
-    let k = k.max(1);
+    if normals.len() != (w as usize) * (h as usize) || normals.is_empty() {
+        return 0.0;
+    }
+    let size = f64::from(w.max(h));
+    let axis = |a: [f64; 2], unit: [f64; 2]| -> ([f64; 2], u32) {
+        let len = (a[0] * a[0] + a[1] * a[1]).sqrt();
+        if !(len.is_finite() && len > 0.0) {
+            return (unit, truth_samples_per_axis(1.0, n));
+        }
+        let l = len.clamp(1.0, size);
+        (
+            [a[0] * l / len, a[1] * l / len],
+            truth_samples_per_axis(l, n),
+        )
+    };
+    let (a, ka) = axis(axes[0], [1.0, 0.0]);
+    let (b, kb) = axis(axes[1], [0.0, 1.0]);
+    let k = shininess;
+    let scale = k / (2.0 * PI * (1.0 - (-2.0 * k).exp()));
     let mut acc = 0.0;
-    for j in 0..k {
-        for i in 0..k {
-            let u = cu + side * ((f64::from(i) + 0.5) / f64::from(k) - 0.5);
-            let v = cv + side * ((f64::from(j) + 0.5) / f64::from(k) - 0.5);
+    for j in 0..kb {
+        let t = (f64::from(j) + 0.5) / f64::from(kb) - 0.5;
+        for i in 0..ka {
+            let s = (f64::from(i) + 0.5) / f64::from(ka) - 0.5;
+            let u = c[0] + s * a[0] + t * b[0];
+            let v = c[1] + s * a[1] + t * b[1];
             let x = (u.floor() as i64).rem_euclid(i64::from(w)) as usize;
             let y = (v.floor() as i64).rem_euclid(i64::from(h)) as usize;
-            let n = normals[y * w as usize + x];
-            let n = if n.length() > 0.0 {
-                n.normalize()
-            } else {
-                DVec3::Z
-            };
-            acc += base_lobe(hv, n, shininess);
+            acc += (k * (hv.dot(normals[y * w as usize + x]) - 1.0)).exp();
         }
     }
-    acc / f64::from(k * k)
+    scale * acc / (f64::from(ka) * f64::from(kb))
 }
 
 /// `h` (unit) to the fixed unit's W = `NDF_FRAC` fraction bits.
@@ -554,7 +586,8 @@ pub fn raw_to_f64(x: i64, frac: u32) -> f64 {
 
 /// Procedural normal maps for the NDF scenes: `ripple` (concentric sine ripples), `foil`
 /// (hashed random facets, crumpled-and-flattened foil), `grooves` (parallel V-grooves along
-/// x: rank-deficient coarse levels).
+/// x: rank-deficient coarse levels), `waves` ([`WAVES`] sine waves along u, slope
+/// [`wave_slope`]). `amplitude` is the largest slope.
 pub fn procedural_normals(kind: &str, w: u32, h: u32, amplitude: f64) -> Result<Vec<DVec3>> {
     let mut out = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
@@ -568,6 +601,7 @@ pub fn procedural_normals(kind: &str, w: u32, h: u32, amplitude: f64) -> Result<
                     let s = amplitude * (r * 2.0 * PI * 8.0).cos();
                     (s * cx / r, s * cy / r)
                 }
+                "waves" => (wave_slope(u, amplitude), 0.0),
                 "grooves" => {
                     let ph = (u * 16.0).fract();
                     (if ph < 0.5 { amplitude } else { -amplitude }, 0.0)
@@ -593,6 +627,16 @@ pub fn procedural_normals(kind: &str, w: u32, h: u32, amplitude: f64) -> Result<
         }
     }
     Ok(out)
+}
+
+/// Sine waves across u of the `waves` normal map.
+pub const WAVES: f64 = 8.0;
+
+/// Slope `dh/du` (in the tangent frame, per unit length) of the `waves` map at `u`: the
+/// tangent-space normal is `normalize(-slope, 0, 1)`.
+#[must_use]
+pub fn wave_slope(u: f64, amplitude: f64) -> f64 {
+    amplitude * (2.0 * PI * WAVES * u).cos()
 }
 
 /// Quantizes moments into the unit's texels as the maps store them (`inv_z` into the
