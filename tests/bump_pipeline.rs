@@ -12,7 +12,9 @@ use hw_model::vector::normalize_cost;
 use hw_model::HwConfig;
 use texsim::pipeline::StageKind;
 use texsim::render::{render, Maps, RenderOptions, Rendered};
-use texsim::scene::{self, FrameKind, Scene};
+use texsim::report::compare;
+use texsim::scene::texture::bricks_height;
+use texsim::scene::{self, Camera, FrameKind, Light, MainDirection, Material, Mesh, Scene};
 
 const BUMP_STAGES: [StageKind; 5] = [
     StageKind::Normal,
@@ -231,4 +233,121 @@ fn real_mesh_with_height_png_renders_in_every_frame() {
     let r = go(&o, &HwConfig::texram16());
     assert!(stage(&r, StageKind::Phong).invocations > 1_000);
     assert_eq!(stage(&r, StageKind::Color).invocations, 0);
+}
+
+/// A flat grid in y = 0 over `[-1.5, 1.5]^2`, normals `+y`, `p_u = +x`, `p_v = -z` (UVs 0..2;
+/// `(p_u, p_v, n)` right-handed), or with `u` running the other way (mirrored).
+fn flat_grid(mirrored: bool) -> Mesh {
+    let n = 8u32;
+    let mut m = Mesh {
+        name: "grid".into(),
+        ..Mesh::default()
+    };
+    for i in 0..=n {
+        for j in 0..=n {
+            let (a, b) = (j as f32 / n as f32, i as f32 / n as f32);
+            m.positions.push([-1.5 + 3.0 * a, 0.0, 1.5 - 3.0 * b]);
+            m.normals.push([0.0, 1.0, 0.0]);
+            let u = if mirrored { 2.0 * (1.0 - a) } else { 2.0 * a };
+            m.uvs.push([u, 2.0 * b]);
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            let a = i * (n + 1) + j;
+            m.indices.push([a, a + 1, a + n + 2]);
+            m.indices.push([a, a + n + 2, a + n + 1]);
+        }
+    }
+    m
+}
+
+fn grid_scene(mirrored: bool, frame: FrameKind, main: MainDirection, scale: f32) -> Scene {
+    Scene {
+        name: "grid".into(),
+        width: 128,
+        height: 96,
+        camera: Camera {
+            eye: [0.3, 2.6, 1.4],
+            target: [0.0, 0.0, 0.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 60.0,
+            near: 0.1,
+            far: 20.0,
+            view_override: None,
+        },
+        lights: vec![
+            Light::Directional {
+                direction: [-0.8, -0.45, 0.4],
+                color: [0.9; 3],
+            },
+            Light::Point {
+                position: [0.5, 1.0, -0.5],
+                color: [0.3; 3],
+            },
+        ],
+        ambient: [0.1; 3],
+        background: [0.0, 0.0, 0.0, 1.0],
+        meshes: vec![flat_grid(mirrored)],
+        materials: vec![Material {
+            name: "bump".into(),
+            kd: [0.7, 0.6, 0.5],
+            bump: Some(0),
+            bump_scale: scale,
+            frame: Some(frame),
+            main_direction: main,
+            ks: [0.4; 3],
+            shininess: 16,
+            ..Material::default()
+        }],
+        textures: vec![bricks_height(64)],
+        hw: None,
+        warnings: Vec::new(),
+    }
+}
+
+/// One offset map gives the same bumps in every frame (Schilling 1997, frame 3 with
+/// `m = p_u`, `m = p_v` or a constant `m`, against frame 2): on a flat grid, right-handed and
+/// mirrored, the fixed and the float images of the main frame with each main direction are
+/// within 1 LSB (8-bit) of the unit frame's, while the bumps themselves change the image by far
+/// more (so a frame that turned them would fail).
+#[test]
+fn main_frame_shades_like_the_unit_frame_for_every_main_direction() {
+    let hw = HwConfig::texram16();
+    for mirrored in [false, true] {
+        let unit = go(
+            &grid_scene(mirrored, FrameKind::Unit, MainDirection::Pv, 3.0),
+            &hw,
+        );
+        let flat = go(
+            &grid_scene(mirrored, FrameKind::Unit, MainDirection::Pv, 0.0),
+            &hw,
+        );
+        assert!(unit.stats.covered_pixels > 5_000);
+        let bumps = compare(&unit.hw_image, &flat.hw_image, 8, None);
+        assert!(bumps.max_abs_lsb > 40, "bumps too weak: {bumps:?}");
+        let unit_ref = unit.ref_image.as_ref().expect("reference");
+        for main in [
+            MainDirection::Pu,
+            MainDirection::Pv,
+            MainDirection::Constant([0.0, 0.0, -1.0]),
+        ] {
+            let r = go(&grid_scene(mirrored, FrameKind::Main, main, 3.0), &hw);
+            assert_eq!(r.stats.bump.frame_fallback, 0);
+            let e_hw = compare(&r.hw_image, &unit.hw_image, 8, None);
+            let e_ref = compare(r.ref_image.as_ref().expect("reference"), unit_ref, 8, None);
+            eprintln!(
+                "mirrored {mirrored} {main:?}: hw max8 {} rmse8 {:.4}, ref max8 {} (bumps: max8 {})",
+                e_hw.max_abs_lsb, e_hw.rmse_lsb, e_ref.max_abs_lsb, bumps.max_abs_lsb
+            );
+            assert!(
+                e_hw.max_abs_lsb <= 1,
+                "mirrored {mirrored} {main:?}: {e_hw:?}"
+            );
+            assert!(
+                e_ref.max_abs_lsb <= 1,
+                "mirrored {mirrored} {main:?}: {e_ref:?}"
+            );
+        }
+    }
 }

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use hw_model::blinn_phong::{bump_shade, BlinnPhongInput, BumpPixel, ShadingConfig, ShadingUnits};
-use hw_model::frame::FrameKind;
+use hw_model::frame::{FrameKind, MainRole};
 use hw_model::SatCounter;
 use texsim::shading::bump::OffsetEncoding;
 use texsim::shading::reference as r;
@@ -60,6 +60,11 @@ fn bump_shade_matches_twin_all_frames() {
             let lens = [0.5 + unif(&mut s), 0.5 + unif(&mut s)];
             let texels = [0; 2].map(|_: u64| 32768 - 8192 + splitmix(&mut s) % 16384);
             let q = |v: DVec3| r::to_vec3x(v, F);
+            let bits = splitmix(&mut s);
+            let main_role = MainRole {
+                m_is_u: bits & 1 == 1,
+                mirrored: bits & 2 == 2,
+            };
             let px = BumpPixel {
                 n_i: q(n_i),
                 d_u: q(du),
@@ -67,6 +72,7 @@ fn bump_shade_matches_twin_all_frames() {
                 len_u: r::to_fixed(lens[0], lfb),
                 len_v: r::to_fixed(lens[1], lfb),
                 m: q(m),
+                main_role,
                 offset_texels: texels,
                 texel_bits: 16,
             };
@@ -96,6 +102,7 @@ fn bump_shade_matches_twin_all_frames() {
                 dq(&px.d_v),
                 lens_q,
                 dq(&px.m),
+                main_role,
                 offs,
                 cfg.frame.frame_min_sin_bits,
                 dq(&sh.l),

@@ -207,6 +207,8 @@ pub struct BumpPixel {
     pub len_v: i64,
     /// Main direction (main frame).
     pub m: Vec3x,
+    /// What `m` stands for and whether the texture coordinates are mirrored (main frame).
+    pub main_role: crate::frame::MainRole,
     /// The two filtered offset channels as returned by the texture unit.
     pub offset_texels: [u64; 2],
     /// Bits of those texel channels.
@@ -240,7 +242,15 @@ pub fn bump_shade(
     let f_u = crate::vector::offset_from_texel(px.offset_texels[0], px.texel_bits, vc, sat);
     let f_v = crate::vector::offset_from_texel(px.offset_texels[1], px.texel_bits, vc, sat);
     let fr = crate::frame::build_frame(
-        &px.n_i, &px.d_u, &px.d_v, px.len_u, px.len_v, &px.m, units, sat,
+        &px.n_i,
+        &px.d_u,
+        &px.d_v,
+        px.len_u,
+        px.len_v,
+        &px.m,
+        px.main_role,
+        units,
+        sat,
     );
     let n = crate::frame::perturb_normal(&fr, f_u, f_v, units, sat).v;
     let bp = blinn_phong(&BlinnPhongInput { n, ..*sh }, units, sat);

@@ -16,9 +16,21 @@
 //!    `e1` is perpendicular to the plane of `n` and `m`, `e2` lies in it. (The converted paper
 //!    text also says the opposite in one sentence, "e2 is perpendicular to m and e1 is in the
 //!    plane of n and m"; the formula, the bullet list after it and the earth example, where
-//!    `e1` points east, agree with each other, so the formula is implemented.) For the offsets
-//!    `t_u = -e1`, `t_v = -e2`: with `m = p_v` and orthogonal `p_u, p_v` this equals frame 2
-//!    (`n x p_v = -p_u` direction), so one offset map tilts the normal downhill in every frame.
+//!    `e1` points east, agree with each other, so the formula is implemented.)
+//!
+//!    Which of `e1`, `e2` carries `f_u` and which `f_v` depends on what `m` stands for
+//!    ([`MainRole`]); the assignment makes frame 3 equal frame 2 wherever `p_u`, `p_v` and `n` are
+//!    mutually perpendicular, so one offset map gives the same bumps in every frame:
+//!    - `m = p_v`, or a constant `m` (which stands for the v direction, as the paper's earth
+//!      axis: `e1` east = u, `e2` north = v): `t_u = -e1` (`-e1 = n x p_v / |n x p_v|`, exactly
+//!      the direction of `s_u`), `t_v = -e2`;
+//!    - `m = p_u`: `t_v = e1` (`e1 = p_u x n / |p_u x n|`, exactly the direction of `s_v`),
+//!      `t_u = -e2`.
+//!
+//!    The vector along `m` (`-e2`) is `s_u` or `s_v` only when `(p_u, p_v, n)` is
+//!    right-handed; with mirrored texture coordinates (`n . (p_u x p_v) < 0`, a flag per
+//!    triangle, [`MainRole::mirrored`]) frames 1 and 2 flip that axis, so frame 3 uses `+e2`
+//!    there. A sign select: no arithmetic, no cost.
 //!
 //! Near-parallel main direction: if `|m^ x n|^2 < 2^(-2 t)` (`t = frame_min_sin_bits`, i.e.
 //! the angle between `m` and `n` is below `asin(2^-t)`, 0.9 degrees for t = 6), or `m` is zero,
@@ -59,6 +71,19 @@ pub enum FrameKind {
     Unit,
     /// Orthonormal frame from the normal and a main direction `m`.
     Main,
+}
+
+/// What the main direction `m` of frame 3 stands for, and the orientation of the texture
+/// coordinates: together they select which of `e1`, `e2` (and with which sign) carries `f_u`
+/// and which `f_v` (module doc, frame 3). The default is a constant `m` (or `m = p_v`) on
+/// right-handed texture coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct MainRole {
+    /// `m` is `p_u` (interpolated per pixel). `false`: `m` is `p_v`, or a constant per object,
+    /// which stands for the v direction.
+    pub m_is_u: bool,
+    /// `(p_u, p_v, n)` is left-handed (mirrored texture coordinates), per triangle.
+    pub mirrored: bool,
 }
 
 /// Frame unit configuration.
@@ -199,16 +224,33 @@ fn neg(v: &Vec3x, fmt: &Format, sat: &mut SatCounter) -> Vec3x {
     v.map(|x| fmt.fit(-x, sat))
 }
 
-/// Frame 3 as a [`Frame`]: `t_u = -e1`, `t_v = -e2`, lengths 1.
+/// Frame 3 as a [`Frame`], lengths 1: `t_u = -e1`, `t_v = -e2` for `m = p_v` or a constant
+/// `m`; `t_u = -e2`, `t_v = e1` for `m = p_u`; `e2` instead of `-e2` when mirrored (module doc).
 #[must_use]
-pub fn main_frame(n_i: &Vec3x, m: &Vec3x, units: &ShadingUnits, sat: &mut SatCounter) -> Frame {
+pub fn main_frame(
+    n_i: &Vec3x,
+    m: &Vec3x,
+    role: MainRole,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> Frame {
     let mf = main_direction_frame(n_i, m, units, sat);
     let fmt = vector_format(&units.cfg.vector);
     let one = 1i64 << units.cfg.frame.frame_len_frac_bits;
+    let along_m = if role.mirrored {
+        mf.e2
+    } else {
+        neg(&mf.e2, &fmt, sat)
+    };
+    let (t_u, t_v) = if role.m_is_u {
+        (along_m, mf.e1)
+    } else {
+        (neg(&mf.e1, &fmt, sat), along_m)
+    };
     Frame {
         n: mf.n,
-        t_u: neg(&mf.e1, &fmt, sat),
-        t_v: neg(&mf.e2, &fmt, sat),
+        t_u,
+        t_v,
         len_u: one,
         len_v: one,
         fallback: mf.fallback,
@@ -255,7 +297,7 @@ pub fn unit_frame(
     let one = 1i64 << units.cfg.frame.frame_len_frac_bits;
     if su.zero || sv.zero {
         let axis = least_aligned_axis(&nn.v, f);
-        let mut fr = main_frame(&nn.v, &axis, units, sat);
+        let mut fr = main_frame(&nn.v, &axis, MainRole::default(), units, sat);
         fr.fallback = true;
         fr.zero_normal = nn.zero;
         return fr;
@@ -271,8 +313,8 @@ pub fn unit_frame(
     }
 }
 
-/// The frame of `units.cfg.frame.frame_kind` from all per-pixel inputs (`m` is used by the
-/// main frame only; `d_u`, `d_v`, lengths by the other two).
+/// The frame of `units.cfg.frame.frame_kind` from all per-pixel inputs (`m` and `role` are
+/// used by the main frame only; `d_u`, `d_v`, lengths by the other two).
 #[must_use]
 #[allow(clippy::too_many_arguments)]
 pub fn build_frame(
@@ -282,13 +324,14 @@ pub fn build_frame(
     len_u: i64,
     len_v: i64,
     m: &Vec3x,
+    role: MainRole,
     units: &ShadingUnits,
     sat: &mut SatCounter,
 ) -> Frame {
     match units.cfg.frame.frame_kind {
         FrameKind::Natural => natural_frame(n_i, d_u, d_v, len_u, len_v, units, sat),
         FrameKind::Unit => unit_frame(n_i, d_u, d_v, units, sat),
-        FrameKind::Main => main_frame(n_i, m, units, sat),
+        FrameKind::Main => main_frame(n_i, m, role, units, sat),
     }
 }
 

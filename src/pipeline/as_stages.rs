@@ -5,8 +5,11 @@
 //! An AS material runs `bary` (+ `texcoord`, `lod`, `trilinear` when textured), `normal`,
 //! (`bump-fetch` of its exponent map, when it has one), `frame` and `as-shade`: the bump
 //! stages' interpolation and Schilling's main-direction frame
-//! (frame 3: `n`, `u = e1 = m x n / |m x n|`, `v = e2 = n x e1`) supply the anisotropy axes, so
-//! one main direction gives brushed metal on any mesh. Per light `k1 = l`, with `k2` the
+//! (frame 3: `n`, `e1 = m x n / |m x n|`, `e2 = n x e1`; the axes `u = t_u`, `v = t_v` of
+//! `hw_model::frame::main_frame`: `u = -e1`, `v = -e2` for a constant `m` or `m = p_v`,
+//! `u = -e2`, `v = e1` for `m = p_u` (the axis along `m` negated on mirrored texture
+//! coordinates; only squares of `h.u`, `h.v` enter), so `u` follows the texture's u direction)
+//! supply the anisotropy axes, so one main direction gives brushed metal on any mesh. Per light `k1 = l`, with `k2` the
 //! direction to the eye:
 //!
 //! `L = pi (rho_s + kd rho_d) (n.l) E_light` per channel (`E = pi` times the light colour, so a
