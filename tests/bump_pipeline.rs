@@ -3,12 +3,12 @@
 //! and the real mesh (OBJ + 16-bit height PNG) in TOML and MTL form.
 
 use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
-use hw_model::frame::{frame_cost, perturb_cost};
+use hw_model::frame::frame_cost;
 use hw_model::interpolator::interpolate_cost;
 use hw_model::lod::lod_cost;
 use hw_model::rsqrt::rsqrt_cost;
 use hw_model::trilinear::trilinear_cost;
-use hw_model::vector::normalize_cost;
+use hw_model::vector::{madd_cost, normalize_cost};
 use hw_model::HwConfig;
 use texsim::pipeline::StageKind;
 use texsim::render::{render, Maps, RenderOptions, Rendered};
@@ -94,43 +94,60 @@ fn each_frame_fixed_vs_float_error_is_bounded() {
     }
 }
 
-/// Per-frame cycles of the `normal` and `frame` stages equal invocations x the unit costs
-/// (an independent sum from the hw_model cost functions), so natural > unit > main in the
-/// interpolator and main > natural > unit in the frame unit.
+/// Per-frame cycles of the `normal`, `frame` and `perturb` stages equal invocations x the unit
+/// costs (an independent sum from the hw_model cost functions), so natural > unit > main in
+/// the interpolator and main > natural > unit in the frame unit; the perturbation costs the
+/// same in every frame (the natural frame's length multiplies are charged once, in its frame
+/// cost). The main frame interpolates `m` (3 scalars) only on the objects with `m = p_u` or
+/// `p_v`: their pixel count comes from a second render in which the constant-`m` object has no
+/// bump map (same geometry, so the same visibility).
 #[test]
 fn per_frame_costs_follow_the_units() {
     let s = small("bumps", 160, 120);
     let mut normal = Vec::new();
     let mut frame = Vec::new();
+    let mut perturb = Vec::new();
     for kind in FRAMES {
         let hw = hw_with(kind);
         let r = go(&s, &hw);
         let units = ShadingUnits::new(&hw.shading);
         let ic = u64::from(interpolate_cost(&hw.interp).cycles);
-        // Per object (in mesh order): sphere m = p_v, torus m = p_u, tile m constant.
-        let mut exp_normal = 0u64;
-        let mut exp_frame = 0u64;
-        let per_pixel_frame = u64::from(frame_cost(kind, &units).cycles);
-        // Count pixels per mesh from the total: only the tile has a constant m. Use the
-        // whole-scene identity instead: every pixel pays n (3) + eye (3) + one point light (3).
+        // Every pixel interpolates n (3), the eye vector (3) and one point light (3).
         let inv = stage(&r, StageKind::Normal).invocations;
         let base = 9 * ic * inv;
-        exp_frame += per_pixel_frame * inv;
-        match kind {
-            FrameKind::Natural => exp_normal += base + 8 * ic * inv,
-            FrameKind::Unit => exp_normal += base + 6 * ic * inv,
+        let exp_normal = match kind {
+            FrameKind::Natural => base + 8 * ic * inv,
+            FrameKind::Unit => base + 6 * ic * inv,
             FrameKind::Main => {
-                // 3 more per pixel on the sphere and torus (m interpolated), 0 on the tile.
-                let extra = stage(&r, StageKind::Normal).cycles - base;
-                assert_eq!(extra % (3 * ic), 0);
-                assert!(extra > 0 && extra < 3 * ic * inv, "{extra}");
-                exp_normal += base + extra;
+                let mut no_const = s.clone();
+                for m in &mut no_const.materials {
+                    if matches!(m.main_direction, MainDirection::Constant(_)) {
+                        m.bump = None;
+                    }
+                }
+                let r2 = go(&no_const, &hw);
+                assert_eq!(r2.stats.covered_pixels, r.stats.covered_pixels);
+                let interpolated_m = stage(&r2, StageKind::Normal).invocations;
+                assert!(
+                    interpolated_m > 0 && interpolated_m < inv,
+                    "{interpolated_m}"
+                );
+                base + 3 * ic * interpolated_m
             }
-        }
+        };
+        let exp_frame = u64::from(frame_cost(kind, &units).cycles) * inv;
         assert_eq!(stage(&r, StageKind::Normal).cycles, exp_normal, "{kind:?}");
         assert_eq!(stage(&r, StageKind::Frame).cycles, exp_frame, "{kind:?}");
-        let pert = u64::from(perturb_cost(&units).cycles) * inv;
-        assert_eq!(stage(&r, StageKind::Perturb).cycles, pert);
+        let nz = normalize_cost(&hw.shading.vector, rsqrt_cost(&hw.shading.rsqrt));
+        let pert = u64::from(madd_cost(&hw.shading.vector).plus(nz).cycles) * inv;
+        assert_eq!(stage(&r, StageKind::Perturb).cycles, pert, "{kind:?}");
+        let len = u64::from(hw.shading.frame.frame_len_cycles);
+        let frame_nz = u64::from(nz.times(3).cycles);
+        match kind {
+            FrameKind::Natural => assert_eq!(exp_frame, (frame_nz + len) * inv),
+            FrameKind::Unit => assert_eq!(exp_frame, frame_nz * inv),
+            FrameKind::Main => assert!(exp_frame > frame_nz * inv),
+        }
         let fetch = u64::from(
             lod_cost(&hw.lod)
                 .plus(trilinear_cost(&hw.trilinear, 2))
@@ -140,7 +157,6 @@ fn per_frame_costs_follow_the_units() {
         assert_eq!(stage(&r, StageKind::BumpFetch).texels, 8 * inv);
         // Two lights (directional + point): two Blinn-Phong, eye + point-light normalize,
         // three colour multiply-adds (ambient + one per light).
-        let nz = normalize_cost(&hw.shading.vector, rsqrt_cost(&hw.shading.rsqrt));
         let phong = u64::from(
             blinn_phong_cost(&units).times(2).cycles
                 + nz.times(2).cycles
@@ -148,11 +164,16 @@ fn per_frame_costs_follow_the_units() {
         ) * inv;
         assert_eq!(stage(&r, StageKind::Phong).cycles, phong);
         normal.push(stage(&r, StageKind::Normal).cycles);
-        frame.push(stage(&r, StageKind::Frame).cycles);
+        frame.push(stage(&r, StageKind::Frame).cycles / inv);
+        perturb.push(stage(&r, StageKind::Perturb).cycles / inv);
     }
-    eprintln!("normal cycles {normal:?} frame cycles {frame:?}");
+    eprintln!("normal cycles {normal:?} frame cycles/px {frame:?} perturb cycles/px {perturb:?}");
     assert!(normal[0] > normal[1] && normal[1] > normal[2], "{normal:?}");
     assert!(frame[2] > frame[0] && frame[0] > frame[1], "{frame:?}");
+    assert!(
+        perturb[0] == perturb[1] && perturb[1] == perturb[2],
+        "{perturb:?}"
+    );
 }
 
 #[test]

@@ -365,7 +365,10 @@ pub fn perturb_normal(
     normalize3(&w, fr.n, &units.rsqrt, vc, sat)
 }
 
-/// Cost of building one frame of `kind` (normalizer costs include the rsqrt).
+/// Cost of building one frame of `kind` (normalizer costs include the rsqrt). The natural
+/// frame includes its length scaling: the two scalar multiplies `f_u len_u`, `f_v len_v`
+/// (`frame_len_cycles`), which [`perturb_normal`] performs but only the natural frame needs
+/// (the unit and main frames have lengths 1), so they are charged here, once.
 #[must_use]
 pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
     let c = &units.cfg;
@@ -373,7 +376,7 @@ pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
     match kind {
         FrameKind::Unit => nz.times(3),
         FrameKind::Natural => nz.times(3).plus(UnitCost {
-            ops: 0,
+            ops: 2,
             cycles: c.frame.frame_len_cycles,
             texels: 0,
         }),
@@ -384,16 +387,11 @@ pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
     }
 }
 
-/// Cost of one [`perturb_normal`]: two length multiplies, the multiply-add, a normalize.
+/// Cost of one [`perturb_normal`] of any frame: the multiply-add and a normalize (the natural
+/// frame's length multiplies are in [`frame_cost`]).
 #[must_use]
 pub fn perturb_cost(units: &ShadingUnits) -> UnitCost {
     let c = &units.cfg;
     let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt));
-    UnitCost {
-        ops: 2,
-        cycles: c.frame.frame_len_cycles,
-        texels: 0,
-    }
-    .plus(madd_cost(&c.vector))
-    .plus(nz)
+    madd_cost(&c.vector).plus(nz)
 }
