@@ -92,7 +92,7 @@ fn bump_shade_matches_twin_all_frames() {
             };
             let out = bump_shade(&px, &sh, &u, &mut sat);
             let offs = texels.map(|t| f64::from(enc.decode(t as f32 / 65536.0)));
-            let fc = |c: [u64; 3]| c.map(|x| x as f64 / 65536.0);
+            let fc = |c: [u64; 3]| c.map(|x| x as f64 / 65535.0);
             let dq = |v: &[i64; 3]| r::from_vec3x(v, F);
             let lens_q = [px.len_u, px.len_v].map(|x| r::from_fixed(x, lfb));
             let (want, wn, _, _) = r::bump_shade(
@@ -117,8 +117,8 @@ fn bump_shade_matches_twin_all_frames() {
             for k in 0..3 {
                 let b = fc(light)[k]
                     * (fc(kd)[k] * 40.0 * ulp + fc(ks)[k] * (sf * 40.0 * ulp + 4e-4))
-                    + 2.0 / 65536.0;
-                let e = (out.color[k] as f64 / 65536.0 - want[k]).abs();
+                    + 2.0 / 65535.0;
+                let e = (out.color[k] as f64 / 65535.0 - want[k]).abs();
                 worst_c = worst_c.max(e);
                 assert!(e <= b, "{kind:?} ch {k}: err {e} > {b}");
             }

@@ -4,7 +4,10 @@
 //!
 //! Directional and point lights are handled by the caller, which passes the unit vector `l`
 //! towards the light (per pixel for a point light) and `v` towards the eye, in vector format.
-//! Colours are unsigned normalized with `shade_color_bits`; the sum saturates at 1.0 (counted).
+//! Colours are unsigned normalized with `shade_color_bits` (raw `x` means `x / (2^C - 1)`, as
+//! in `modulate` and the pipeline): the products are divided by `2^C - 1` exactly
+//! ([`crate::fixed::round_div_wide`]), so white times white is white. The sum saturates at
+//! 1.0 (counted).
 //! `l = -v` exactly (h undefined) gives no specular term and sets `h_zero`.
 //!
 //! Also defines the bundle [`ShadingConfig`] of all bump/shading unit configs and
@@ -16,7 +19,7 @@
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
-use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
+use crate::fixed::{round_div_wide, Format, Rounding, SatCounter};
 use crate::frame::FrameConfig;
 use crate::pow::{pow_cost, Pow, PowConfig};
 use crate::rsqrt::{range, rsqrt_cost, Rsqrt, RsqrtConfig};
@@ -163,11 +166,14 @@ pub fn blinn_phong(
         units.pow.pow(x as u64, inp.shininess, sat) as i64
     };
     let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
+    // Unorm products: colour raw x means x / (2^C - 1), so `(kd n.l + ks spec) light` in
+    // raw units is `acc light / ((2^C - 1) 2^(F + P))`, one exact rounded division.
+    let den = ((1i128 << c) - 1) << (f + p);
     let color = [0usize, 1, 2].map(|i| {
         let acc = i128::from(inp.kd[i]) * i128::from(ndl) * (1i128 << p)
             + i128::from(inp.ks[i]) * i128::from(spec) * (1i128 << f);
         let lit = acc * i128::from(inp.light[i]);
-        let r = round_shift_right_wide(lit, c + f + p, units.cfg.shade.shade_rounding);
+        let r = round_div_wide(lit, den, units.cfg.shade.shade_rounding);
         out_fmt.fit(r, sat) as u64
     });
     BlinnPhongOut { color, h_zero }

@@ -27,7 +27,8 @@
 //! `L` is one exact integer product, aligned with [`GUARD`] guard bits, summed over the lights
 //! and rounded once to `shade_color_bits` unorm (saturating, counted). `kd`, the light colour
 //! and the ambient are `shade_color_bits` unorms whose scale `2^bits - 1` is taken as `2^bits`
-//! in the diffuse and ambient products (as the Blinn-Phong stage does; at most 1 LSB).
+//! in the diffuse and ambient products (at most 1 LSB; the Blinn-Phong unit divides by
+//! `2^bits - 1` exactly).
 //! `l + v = 0` (`k1 = -k2`) gives no contribution and is counted in `h_zero`.
 
 use super::stages::{Counters, Machine};
