@@ -209,7 +209,7 @@ fn unit_and_natural_frames_match_twin() {
     let mut s = 31u64;
     let mut sat = SatCounter::default();
     let mut worst = 0.0f64;
-    for _ in 0..300_000 {
+    for _ in 0..1_000_000 {
         let n_i = rand_dir(&mut s) * (0.1 + unif(&mut s));
         let du = rand_dir(&mut s) * (0.1 + unif(&mut s));
         let dv = rand_dir(&mut s) * (0.1 + unif(&mut s));
