@@ -50,7 +50,7 @@ const FRAMES: [FrameKind; 3] = [FrameKind::Natural, FrameKind::Unit, FrameKind::
 
 /// texram16 is 16 bits throughout the shading units: measured on `bumps` at 320x240 the
 /// fixed image is within 1 LSB (8-bit) of the float twin on every pixel; max 16-bit error
-/// natural 158, unit 100, main 93 LSB, RMSE16 9.0 / 7.4 / 7.4 (specular highlights with
+/// natural 142, unit 96, main 100 LSB, RMSE16 8.9 / 7.3 / 7.3 (specular highlights with
 /// shininess 24 amplify the ~1 ulp s1.14 normal error; the natural frame adds the u8.8 length
 /// rounding). Asserted with ~2.5x margin for other tessellations of the same error sources:
 /// 8-bit max <= 2, >= 99.5% within 1 LSB, 16-bit max <= 400, RMSE16 <= 16, and not identical
