@@ -658,6 +658,20 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         };
         let r = render(&sc, &maps, cfg, &opts)?;
         let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        let varies_frame = set
+            .iter()
+            .any(|(f, _)| f == "frame" || f == "frame_kind" || f.ends_with(".frame_kind"));
+        let kind = match cfg.shading.frame.frame_kind {
+            hw_model::frame::FrameKind::Natural => "natural",
+            hw_model::frame::FrameKind::Unit => "unit",
+            hw_model::frame::FrameKind::Main => "main",
+        };
+        let used = &row.frame_used;
+        if varies_frame && !used.is_empty() && !used.split('+').any(|u| u == kind) {
+            eprintln!(
+                "warning: frame_kind={kind} has no effect: every bump material sets its own `frame` (used: {used})"
+            );
+        }
         let cpp = row
             .cycles_per_pixel
             .map_or_else(|| "-".into(), |c| format!("{c:.2}"));

@@ -45,8 +45,11 @@ pub struct Maps {
     pub bump_offsets: Vec<(u32, u32, String, Vec<[f32; 2]>)>,
     /// `offset_int_bits` of the offset encoding (range `2^bits`).
     pub offset_int_bits: u32,
-    /// Offsets clamped by the encoding (all offset maps).
+    /// Offsets clamped (all offset maps): by the encoding, plus `normal_nz_clamped`.
     pub bump_clamped: u64,
+    /// Normal-map texels whose `n_z` was clamped to `shading::bump::NORMAL_MAP_MIN_Z` (all
+    /// normal maps), which bounds their offsets before the encoding.
+    pub normal_nz_clamped: u64,
     /// NDF moment maps ([`ndf_sources`]): four chains each (A, B, C, normalization) after the
     /// offset maps, quantized to `moment_bits`, and the config they were built for.
     pub ndf: Vec<(usize, u32)>,
@@ -151,6 +154,7 @@ impl Maps {
     pub fn with_offset_bits(scene: &Scene, texel_bits: u32, offset_int_bits: u32) -> Self {
         let mut float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
         let mut bump_offsets = Vec::new();
+        let mut normal_nz_clamped = 0;
         for b in bump_sources(scene) {
             let tex = &scene.textures[b.texture];
             let p = BumpParams {
@@ -158,7 +162,8 @@ impl Maps {
                 v_up: false,
             };
             let offs = if b.normal_map {
-                normal_map_to_offsets(tex, true).map(|(o, _)| {
+                normal_map_to_offsets(tex, true).map(|(o, nz)| {
+                    normal_nz_clamped += nz;
                     o.into_iter()
                         .map(|f| f.map(|x| x * b.scale))
                         .collect::<Vec<_>>()
@@ -170,7 +175,7 @@ impl Maps {
             .unwrap_or_else(|_| vec![[0.0; 2]; tex.texels.len()]);
             bump_offsets.push((tex.width, tex.height, tex.name.clone(), offs));
         }
-        let mut bump_clamped = 0;
+        let mut bump_clamped = normal_nz_clamped;
         for (w, h, name, offs) in &bump_offsets {
             let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
             float.push(c);
@@ -186,6 +191,7 @@ impl Maps {
             bump_offsets,
             offset_int_bits,
             bump_clamped,
+            normal_nz_clamped,
             ndf: ndf_sources(scene),
             ndf_cfg: hw_model::ndf::NdfConfig::texram16(),
             ndf_clamped: 0,
@@ -264,7 +270,7 @@ impl Maps {
         }
         let first = self.float.len() - self.bump_offsets.len() - self.ndf_chains();
         let texel_bits = self.fixed.first().map_or(16, |f| f.texel_bits);
-        self.bump_clamped = 0;
+        self.bump_clamped = self.normal_nz_clamped;
         for (k, (w, h, name, offs)) in self.bump_offsets.iter().enumerate() {
             let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
             self.fixed[first + k] = quantize_chain(&c, texel_bits);
@@ -547,7 +553,8 @@ pub struct StageStats {
 
 /// Bump-mapping events: frames from a fallback, zero interpolated normals, `l + v = 0`,
 /// non-finite float carriers (hardware and reference pass), offsets clamped by the map
-/// encoding. Format saturations are in the per-stage `saturated` counts.
+/// encoding (including normal-map texels whose `n_z` was clamped, [`Maps::bump_clamped`]).
+/// Format saturations are in the per-stage `saturated` counts.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct BumpStats {
     pub frame_fallback: u64,

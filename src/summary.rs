@@ -126,6 +126,14 @@ pub struct SweepRow {
     pub lookups_per_pixel: f64,
     /// `texsim sweep --truth`: float reference vs ground truth, 8-bit LSBs.
     pub model_error: Option<ErrorMetrics>,
+    /// The frames the bump materials used (`natural`, `unit`, `main`, joined by `+`; empty
+    /// without bump materials). A material's own `frame` overrides a swept `frame_kind`.
+    pub frame_used: String,
+    /// Bump events: frames from a fallback, zero interpolated normals, offsets clamped by the
+    /// maps (`render::BumpStats`).
+    pub frame_fallback: u64,
+    pub zero_normal: u64,
+    pub offset_clamped: u64,
 }
 
 impl SweepRow {
@@ -157,8 +165,38 @@ impl SweepRow {
             timing_cycles: None,
             lookups_per_pixel: s.stages.iter().map(|x| x.texels).sum::<u64>() as f64 / 8.0 / px,
             model_error: s.model_error.clone(),
+            frame_used: s.bump.frame.clone(),
+            frame_fallback: s.bump.frame_fallback,
+            zero_normal: s.bump.zero_normal,
+            offset_clamped: s.bump.offset_clamped,
         }
     }
+}
+
+/// Columns of the bump frame and events (present when any row has bump materials).
+const BUMP_HEADER: [&str; 4] = [
+    "frame_used",
+    "frame_fallbacks",
+    "zero_normals",
+    "offsets_clamped",
+];
+
+fn bumped(rows: &[SweepRow]) -> bool {
+    rows.iter().any(|r| !r.frame_used.is_empty())
+}
+
+fn bump_cells(r: &SweepRow) -> [String; 4] {
+    let used = if r.frame_used.is_empty() {
+        "-".into()
+    } else {
+        r.frame_used.clone()
+    };
+    [
+        used,
+        r.frame_fallback.to_string(),
+        r.zero_normal.to_string(),
+        r.offset_clamped.to_string(),
+    ]
 }
 
 const HEADER: [&str; 14] = [
@@ -221,10 +259,14 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
     let timed = rows.iter().any(|r| r.timing_cycles.is_some());
+    let bump = bumped(rows);
     let mut head = set_names.clone();
     head.extend(HEADER.iter().map(|s| s.to_string()));
     if timed {
         head.push(TIMING_HEADER.into());
+    }
+    if bump {
+        head.push(BUMP_HEADER[0].into());
     }
     grid.push(head);
     for r in rows {
@@ -232,6 +274,10 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
         line.extend(cells(r));
         if timed {
             line.push(timing_cell(r));
+        }
+        if bump {
+            let [used, ..] = bump_cells(r);
+            line.push(used);
         }
         grid.push(line);
     }
@@ -261,12 +307,16 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 pub fn sweep_csv(rows: &[SweepRow]) -> String {
     let mut o = String::new();
     let timed = rows.iter().any(|r| r.timing_cycles.is_some());
+    let bump = bumped(rows);
     if let Some(r) = rows.first() {
         let mut head: Vec<String> = r.settings.iter().map(|(f, _)| f.clone()).collect();
         head.extend(HEADER.iter().map(|s| s.to_string()));
         head.push("ref_ms".into());
         if timed {
             head.push(TIMING_HEADER.into());
+        }
+        if bump {
+            head.extend(BUMP_HEADER.iter().map(|s| s.to_string()));
         }
         let _ = writeln!(o, "{}", head.join(","));
     }
@@ -276,6 +326,9 @@ pub fn sweep_csv(rows: &[SweepRow]) -> String {
         line.push(format!("{:.1}", r.ref_ms));
         if timed {
             line.push(timing_cell(r));
+        }
+        if bump {
+            line.extend(bump_cells(r));
         }
         let _ = writeln!(o, "{}", line.join(","));
     }

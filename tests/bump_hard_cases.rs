@@ -396,3 +396,90 @@ fn normal_map_matches_the_height_map_it_was_made_from() {
         assert!(e2.max_abs_lsb > 10, "{kind:?} flipped {e2:?}");
     }
 }
+
+/// Saturation inside the pipeline is counted per stage, never silent: one mesh of two grids
+/// whose texture densities differ 40:1, natural frame. The relative lengths (per-mesh
+/// reference = the mean `|p_u| sin`) are ~20 on the densely textured half, so `f_u len_u`
+/// leaves the s3.12 offset format there and the `perturb` stage counts it; the stage totals
+/// reach the sweep row.
+#[test]
+fn offset_format_saturation_in_the_pipeline_is_counted_per_stage() {
+    let mut m = grid(2, 1.0, 0.05);
+    for p in &mut m.positions {
+        p[0] -= 1.1;
+    }
+    let fine = grid(2, 1.0, 2.0);
+    let base = m.positions.len() as u32;
+    m.positions
+        .extend(fine.positions.iter().map(|p| [p[0] + 1.1, p[1], p[2]]));
+    m.normals.extend(fine.normals);
+    m.uvs.extend(fine.uvs);
+    m.indices
+        .extend(fine.indices.iter().map(|t| t.map(|i| i + base)));
+    let mut mat = bump_mat();
+    mat.frame = Some(FrameKind::Natural);
+    mat.bump_scale = 4.0;
+    let mut s = scene(
+        vec![m],
+        mat,
+        cam([0.0, 2.6, 1.6], [0.0, 0.0, 0.0], 0.1),
+        vec![sun([-0.5, -0.6, -0.3])],
+    );
+    (s.width, s.height) = (320, 240);
+    let r = go(&s, FrameKind::Natural);
+    let pert = &r.stats.stages[StageKind::Perturb.index()];
+    eprintln!(
+        "perturb: {} invocations, {} saturated; offsets clamped {}",
+        pert.invocations, pert.saturated, r.stats.bump.offset_clamped
+    );
+    assert!(pert.invocations > 1000);
+    assert!(pert.saturated > 0, "f len beyond s3.12 must be counted");
+    assert_eq!(r.stats.bump.nonfinite, 0);
+    assert_eq!(r.stats.bump.ref_nonfinite, 0);
+    let row = texsim::summary::SweepRow::new(Vec::new(), &r.stats);
+    assert!(row.saturated >= pert.saturated);
+    // The same scene in the unit frame (lengths 1) saturates nothing there.
+    let mut s_unit = s.clone();
+    s_unit.materials[0].frame = Some(FrameKind::Unit);
+    let u = go(&s_unit, FrameKind::Unit);
+    assert_eq!(u.stats.stages[StageKind::Perturb.index()].saturated, 0);
+}
+
+/// A normal map with normals flatter than `NORMAL_MAP_MIN_Z` (here: every 4th texel lies in
+/// the tangent plane) has those `n_z` clamped; the count reaches `Maps` and the render's
+/// `offsets clamped`, also after re-encoding for another offset range.
+#[test]
+fn normal_map_nz_clamps_are_reported() {
+    let texels: Vec<[u16; 4]> = (0..64 * 64)
+        .map(|i| {
+            if i % 4 == 0 {
+                [65535, 32768, 32768, 65535]
+            } else {
+                [32768, 32768, 65535, 65535]
+            }
+        })
+        .collect();
+    let mut s = scene(
+        vec![grid(2, 1.0, 2.0)],
+        bump_mat(),
+        cam([0.0, 1.5, 1.2], [0.0, 0.0, 0.0], 0.1),
+        vec![sun([-0.5, -0.6, -0.3])],
+    );
+    s.textures.push(texsim::scene::TextureImage {
+        name: "flat-normals".into(),
+        width: 64,
+        height: 64,
+        texels,
+        prebuilt_levels: None,
+    });
+    s.materials[0].bump = Some(1);
+    s.materials[0].bump_scale = 0.1;
+    s.materials[0].bump_normal_map = true;
+    let mut maps = Maps::new(&s, 16);
+    assert_eq!(maps.normal_nz_clamped, 64 * 64 / 4);
+    assert!(maps.bump_clamped >= maps.normal_nz_clamped);
+    let r = render(&s, &maps, &HwConfig::texram16(), &RenderOptions::default()).expect("r");
+    assert_eq!(r.stats.bump.offset_clamped, maps.bump_clamped);
+    maps.ensure_offset_bits(2);
+    assert!(maps.bump_clamped >= 64 * 64 / 4);
+}

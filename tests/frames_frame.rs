@@ -4,7 +4,7 @@
 use glam::DVec3;
 use hw_model::blinn_phong::{ShadingConfig, ShadingUnits};
 use hw_model::frame::{
-    main_direction_frame, main_frame, natural_frame, perturb_normal, unit_frame, Frame,
+    main_direction_frame, main_frame, natural_frame, perturb_normal, unit_frame, Frame, MainRole,
 };
 use hw_model::vector::Vec3x;
 use hw_model::SatCounter;
@@ -209,7 +209,7 @@ fn unit_and_natural_frames_match_twin() {
     let mut s = 31u64;
     let mut sat = SatCounter::default();
     let mut worst = 0.0f64;
-    for _ in 0..300_000 {
+    for _ in 0..1_000_000 {
         let n_i = rand_dir(&mut s) * (0.1 + unif(&mut s));
         let du = rand_dir(&mut s) * (0.1 + unif(&mut s));
         let dv = rand_dir(&mut s) * (0.1 + unif(&mut s));
@@ -244,7 +244,11 @@ fn perturbed_normal_matches_twin() {
         let n_i = rand_dir(&mut s);
         let m = rand_dir(&mut s);
         let natural = i % 2 == 1;
-        let mut fr: Frame = main_frame(&q(n_i), &q(m), &u, &mut sat);
+        let role = MainRole {
+            m_is_u: i % 4 >= 2,
+            mirrored: i % 8 >= 4,
+        };
+        let mut fr: Frame = main_frame(&q(n_i), &q(m), role, &u, &mut sat);
         if natural {
             fr.len_u = r::to_fixed(0.25 + 2.0 * unif(&mut s), lfb);
             fr.len_v = r::to_fixed(0.25 + 2.0 * unif(&mut s), lfb);
@@ -280,6 +284,95 @@ fn perturbed_normal_matches_twin() {
     assert!(worst_u <= 2.5 * ulp(), "unit {worst_u}");
     assert!(worst_n <= 8.0 * ulp(), "natural {worst_n}");
     assert_eq!(sat.saturated, 0);
+}
+
+/// One offset map gives the same bumps in every frame: on mutually perpendicular `p_u`, `p_v`,
+/// `n` (right-handed and mirrored, lengths in [0.5, 1]), the main frame with `m = p_u`, with
+/// `m = p_v` and with a constant `m` along `p_v` equals the unit frame built from the natural
+/// directions `n x p_v`, `p_u x n`, and so do the perturbed normals: in fixed point frame
+/// components within 6.5 ulp (the main frame's 4 + 2.5 ulp at sin(m, n) = 1) and perturbed
+/// normals within 9 ulp (measured 3.0 and 3.0 ulp), in float within 1e-12. With the axes of
+/// `m = p_v` applied to `m = p_u` the bumps would turn by 90 degrees.
+#[test]
+fn main_frame_roles_equal_unit_frame() {
+    let u = units();
+    let o = u.cfg.vector.offset_frac_bits;
+    let t = u.cfg.frame.frame_min_sin_bits;
+    let mut s = 53u64;
+    let mut sat = SatCounter::default();
+    let (mut worst_t, mut worst_p, mut worst_f) = (0.0f64, 0.0f64, 0.0f64);
+    for i in 0..200_000u32 {
+        let n = rand_dir(&mut s);
+        let a = rand_dir(&mut s);
+        let mirrored = i % 2 == 1;
+        let pu_dir = (a - n * n.dot(a)).normalize();
+        let pv_dir = if mirrored {
+            pu_dir.cross(n)
+        } else {
+            n.cross(pu_dir)
+        };
+        let pu = pu_dir * (0.5 + 0.5 * unif(&mut s));
+        let pv = pv_dir * (0.5 + 0.5 * unif(&mut s));
+        assert_eq!(n.dot(pu.cross(pv)) < 0.0, mirrored);
+        let (du, dv) = (n.cross(pv).normalize(), pu.cross(n).normalize());
+        let n_i = n * (0.3 + unif(&mut s));
+        let fu = r::to_fixed(2.0 * unif(&mut s) - 1.0, o);
+        let fv = r::to_fixed(2.0 * unif(&mut s) - 1.0, o);
+        let uf = unit_frame(&q(n_i), &q(du), &q(dv), &u, &mut sat);
+        let want = perturb_normal(&uf, fu, fv, &u, &mut sat);
+        let tw_unit = r::unit_frame(n_i, du, dv, t);
+        let (fu_f, fv_f) = (r::from_fixed(fu, o), r::from_fixed(fv, o));
+        let want_f = r::perturb_normal(&tw_unit, fu_f, fv_f);
+        let cases = [
+            (pu, true),
+            (pv, false),
+            (pv_dir * 0.5, false), // a constant m along p_v
+        ];
+        for (m, m_is_u) in cases {
+            let role = MainRole { m_is_u, mirrored };
+            let fr = main_frame(&q(n_i), &q(m), role, &u, &mut sat);
+            assert!(!fr.fallback);
+            let te = (d(&fr.t_u) - d(&uf.t_u))
+                .abs()
+                .max_element()
+                .max((d(&fr.t_v) - d(&uf.t_v)).abs().max_element());
+            worst_t = worst_t.max(te);
+            assert!(te <= 6.5 * ulp(), "case {i} {role:?}: frame err {te}");
+            let p = perturb_normal(&fr, fu, fv, &u, &mut sat);
+            let pe = (d(&p.v) - d(&want.v)).abs().max_element();
+            worst_p = worst_p.max(pe);
+            assert!(pe <= 9.0 * ulp(), "case {i} {role:?}: normal err {pe}");
+            let tw = r::main_frame(n_i, m, role, t);
+            let fe = (r::perturb_normal(&tw, fu_f, fv_f) - want_f)
+                .abs()
+                .max_element();
+            worst_f = worst_f.max(fe);
+            assert!(fe <= 1e-12, "case {i} {role:?}: float twin err {fe}");
+        }
+    }
+    println!(
+        "main vs unit frame: frame {:.2} ulp, perturbed normal {:.2} ulp, float twins {:.1e}",
+        worst_t / ulp(),
+        worst_p / ulp(),
+        worst_f
+    );
+    assert_eq!(sat.saturated, 0);
+    // The assignment matters: m = p_u with the axes of m = p_v turns the bumps.
+    let (n, pu) = (q(DVec3::Z), q(DVec3::X));
+    let swapped = main_frame(&n, &pu, MainRole::default(), &u, &mut sat);
+    let right = main_frame(
+        &n,
+        &pu,
+        MainRole {
+            m_is_u: true,
+            mirrored: false,
+        },
+        &u,
+        &mut sat,
+    );
+    assert_eq!(right.t_u, q(-DVec3::X));
+    assert_eq!(right.t_v, q(-DVec3::Y));
+    assert_eq!(swapped.t_u, q(DVec3::Y));
 }
 
 /// Earth-like sphere with m = the axis: finite and orthonormal everywhere; the fallback is

@@ -21,8 +21,8 @@ fn bound(cfg: &PowConfig, x: f64, n: u32) -> f64 {
     match cfg.pow_method {
         PowMethod::LogExp => {
             let el = 0.1803 * h2 + g.exp2();
-            let ee = 0.1201 * h2 + g.exp2();
-            xn * ((f64::from(n) * el).exp2() - 1.0 + ee) * 1.01 + half
+            let ee = 0.0601 * h2 + g.exp2();
+            xn * ((f64::from(n) * el).exp2() - 1.0 + ee) + half
         }
         PowMethod::Squaring => 2.0 * f64::from(n) * g.exp2() + half,
     }

@@ -45,7 +45,8 @@ fn run(method: PowMethod, cases: u32) -> f64 {
     let mut s = 77u64;
     let mut sat = SatCounter::default();
     let mut worst_ratio = 0.0f64;
-    let cu = (-f64::from(C)).exp2();
+    // Colours are unorm: raw x means x / (2^C - 1), as in the pipeline.
+    let cu = 1.0 / ((1u64 << C) - 1) as f64;
     let ulp = (-f64::from(F)).exp2();
     for i in 0..cases {
         let n = rand_dir(&mut s);
@@ -144,4 +145,66 @@ fn point_and_directional_light_vectors() {
     let u = ShadingUnits::new(&ShadingConfig::texram16());
     assert!(blinn_phong_cost(&u).cycles > 0);
     assert!(ShadingConfig::texram16().validate().is_ok());
+}
+
+/// Colours are unorm (`x / (2^C - 1)`): white light on a white diffuse surface facing it is
+/// exactly white at every colour width, half-grey light on white is half-grey within 1/2 LSB,
+/// and the fixed colour of random inputs has no systematic bias against the twin.
+#[test]
+fn unorm_products_at_every_colour_width() {
+    let mut s = 5u64;
+    for c in 4..=16u32 {
+        let mut cfg = ShadingConfig::texram16();
+        cfg.shade.shade_color_bits = c;
+        let u = ShadingUnits::new(&cfg);
+        let mut sat = SatCounter::default();
+        let max = (1u64 << c) - 1;
+        let z = r::to_vec3x(DVec3::Z, F);
+        let mut inp = BlinnPhongInput {
+            n: z,
+            l: z,
+            v: z,
+            shininess: 8,
+            kd: [max; 3],
+            ks: [0; 3],
+            light: [max; 3],
+        };
+        assert_eq!(blinn_phong(&inp, &u, &mut sat).color, [max; 3], "C = {c}");
+        inp.light = [max / 2; 3];
+        assert_eq!(
+            blinn_phong(&inp, &u, &mut sat).color,
+            [max / 2; 3],
+            "C = {c}"
+        );
+        assert_eq!(sat.saturated, 0);
+        // Mean signed error over random lit inputs, in LSBs: rounding only (|mean| < 0.05).
+        let cu = 1.0 / max as f64;
+        let (mut sum, mut k) = (0.0f64, 0u32);
+        for _ in 0..20_000 {
+            let n = rand_dir(&mut s);
+            let l = (n + 0.8 * rand_dir(&mut s)).normalize();
+            let (nq, lq) = (r::to_vec3x(n, F), r::to_vec3x(l, F));
+            let col = |s: &mut u64| [0; 3].map(|_: u64| splitmix(s) % (max + 1));
+            let (kd, light) = (col(&mut s), col(&mut s));
+            let inp = BlinnPhongInput {
+                n: nq,
+                l: lq,
+                v: lq,
+                shininess: 8,
+                kd,
+                ks: [0; 3],
+                light,
+            };
+            let out = blinn_phong(&inp, &u, &mut sat);
+            let f = |c: [u64; 3]| c.map(|x| x as f64 * cu);
+            let (nd, ld) = (r::from_vec3x(&nq, F), r::from_vec3x(&lq, F));
+            let (want, _) = r::blinn_phong(nd, ld, ld, 8, f(kd), [0.0; 3], f(light));
+            for ch in 0..3 {
+                sum += out.color[ch] as f64 - want[ch] * max as f64;
+                k += 1;
+            }
+        }
+        let bias = sum / f64::from(k);
+        assert!(bias.abs() < 0.05, "C = {c}: mean signed error {bias} LSB");
+    }
 }

@@ -1,8 +1,10 @@
 //! `hw_model::fixed`: `round_shift_right`(`_wide`) vs exact i128 floor division for every mode,
-//! shift and sign; `Format::fit`/`requantize` saturate and wrap with exact event counts.
+//! shift and sign; `round_div_wide` vs an independent half-step formula; `Format::fit`/`requantize`
+//! saturate and wrap with exact event counts.
 
 use hw_model::fixed::{
-    round_shift_right, round_shift_right_wide, Format, Overflow, Rounding, SatCounter,
+    round_div_wide, round_shift_right, round_shift_right_wide, Format, Overflow, Rounding,
+    SatCounter,
 };
 
 struct SplitMix(u64);
@@ -110,6 +112,59 @@ fn round_shift_right_wide_vs_exact() {
             if mode == Rounding::Truncate { -1 } else { 0 }
         );
     }
+}
+
+/// `round_div_wide` against `floor((2x + den) / 2den)` (round half up) with the tie fixed to
+/// even, and against the power-of-two divider `round_shift_right_wide`; exact ties, both
+/// signs, saturation to i64, and `den <= 0` giving 0.
+#[test]
+fn round_div_wide_vs_half_step_formula() {
+    let mut rng = SplitMix(0xf1_0003);
+    for k in 0..1_000_000u32 {
+        let den = match k % 4 {
+            0 => (1i128 << (rng.next() % 24)) * ((1i128 << (1 + rng.next() % 16)) - 1),
+            1 => 1i128 << (rng.next() % 60),
+            _ => 1 + i128::from(rng.next() >> (rng.next() % 63)),
+        };
+        let x = match k % 5 {
+            // Exact ties: an odd multiple of den / 2.
+            0 if den % 2 == 0 => (den / 2) * (2 * i128::from(rng.next() as i32) + 1),
+            1 => i128::from(interesting(&mut rng)) << (rng.next() % 40),
+            _ => i128::from(rng.next() as i64) * i128::from(rng.next() % 4096),
+        };
+        let mode = ROUNDINGS[(k % 3) as usize];
+        let up = (2 * x + den).div_euclid(2 * den);
+        let tie = (2 * x + den).rem_euclid(2 * den) == 0;
+        let want = match mode {
+            Rounding::Truncate => x.div_euclid(den),
+            Rounding::HalfUp => up,
+            Rounding::HalfEven if tie && up.rem_euclid(2) == 1 => up - 1,
+            Rounding::HalfEven => up,
+        }
+        .clamp(i128::from(i64::MIN), i128::from(i64::MAX));
+        assert_eq!(
+            i128::from(round_div_wide(x, den, mode)),
+            want,
+            "x={x} den={den} {mode:?}"
+        );
+        if den.count_ones() == 1 {
+            let s = den.trailing_zeros();
+            assert_eq!(
+                round_div_wide(x, den, mode),
+                round_shift_right_wide(x, s, mode)
+            );
+        }
+    }
+    for mode in ROUNDINGS {
+        assert_eq!(round_div_wide(255 * 255 * 255, 255 * 255, mode), 255);
+        assert_eq!(round_div_wide(i128::MAX, 3, mode), i64::MAX);
+        assert_eq!(round_div_wide(i128::MIN, 3, mode), i64::MIN);
+        assert_eq!(round_div_wide(7, 0, mode), 0);
+        assert_eq!(round_div_wide(7, -2, mode), 0);
+    }
+    assert_eq!(round_div_wide(-3, 2, Rounding::HalfEven), -2);
+    assert_eq!(round_div_wide(-3, 2, Rounding::HalfUp), -1);
+    assert_eq!(round_div_wide(-3, 2, Rounding::Truncate), -2);
 }
 
 #[test]

@@ -177,6 +177,28 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     }
 }
 
+/// The divide-by-constant sibling of [`round_shift_right_wide`]: `x / den` for a constant
+/// `den > 0` (e.g. the `2^n - 1` of unsigned normalized products), rounded by `mode`, exact
+/// for every `i128` input, result saturated to `i64`. Hardware multiplies by a precomputed
+/// reciprocal with enough bits, which gives the same integer. A `den <= 0` gives 0.
+#[inline]
+#[must_use]
+pub fn round_div_wide(x: i128, den: i128, mode: Rounding) -> i64 {
+    if den <= 0 {
+        return 0;
+    }
+    let q = x.div_euclid(den);
+    // Remainder r in [0, den) against the other part den - r: no overflow for any den.
+    let r = x.rem_euclid(den);
+    let rest = den - r;
+    let v = match mode {
+        Rounding::Truncate => q,
+        Rounding::HalfUp => q + i128::from(r >= rest),
+        Rounding::HalfEven => q + i128::from(r > rest || (r == rest && q & 1 == 1)),
+    };
+    v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+}
+
 /// `round_shift_right` for `i128` accumulators, result saturated to `i64`. Exact for every
 /// `i128` input and every `shift` (shifts of 128 or more behave as the exact quotient).
 #[inline]

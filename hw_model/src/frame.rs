@@ -16,9 +16,21 @@
 //!    `e1` is perpendicular to the plane of `n` and `m`, `e2` lies in it. (The converted paper
 //!    text also says the opposite in one sentence, "e2 is perpendicular to m and e1 is in the
 //!    plane of n and m"; the formula, the bullet list after it and the earth example, where
-//!    `e1` points east, agree with each other, so the formula is implemented.) For the offsets
-//!    `t_u = -e1`, `t_v = -e2`: with `m = p_v` and orthogonal `p_u, p_v` this equals frame 2
-//!    (`n x p_v = -p_u` direction), so one offset map tilts the normal downhill in every frame.
+//!    `e1` points east, agree with each other, so the formula is implemented.)
+//!
+//!    Which of `e1`, `e2` carries `f_u` and which `f_v` depends on what `m` stands for
+//!    ([`MainRole`]); the assignment makes frame 3 equal frame 2 wherever `p_u`, `p_v` and `n` are
+//!    mutually perpendicular, so one offset map gives the same bumps in every frame:
+//!    - `m = p_v`, or a constant `m` (which stands for the v direction, as the paper's earth
+//!      axis: `e1` east = u, `e2` north = v): `t_u = -e1` (`-e1 = n x p_v / |n x p_v|`, exactly
+//!      the direction of `s_u`), `t_v = -e2`;
+//!    - `m = p_u`: `t_v = e1` (`e1 = p_u x n / |p_u x n|`, exactly the direction of `s_v`),
+//!      `t_u = -e2`.
+//!
+//!    The vector along `m` (`-e2`) is `s_u` or `s_v` only when `(p_u, p_v, n)` is
+//!    right-handed; with mirrored texture coordinates (`n . (p_u x p_v) < 0`, a flag per
+//!    triangle, [`MainRole::mirrored`]) frames 1 and 2 flip that axis, so frame 3 uses `+e2`
+//!    there. A sign select: no arithmetic, no cost.
 //!
 //! Near-parallel main direction: if `|m^ x n|^2 < 2^(-2 t)` (`t = frame_min_sin_bits`, i.e.
 //! the angle between `m` and `n` is below `asin(2^-t)`, 0.9 degrees for t = 6), or `m` is zero,
@@ -31,11 +43,14 @@
 //! saturation event each by the normalizer.
 //!
 //! ERROR BOUNDS (texram16, s1.14, ulp = 2^-14; stated bound / measured max over 1M random
-//! cases in `tests/frames_frame.rs`): main frame orthonormality (| |x| - 1 | and pairwise dot
-//! products) <= 3 ulp / 1.95 ulp; main frame components against the float twin on the same
-//! quantized inputs <= 4 ulp + 2.5 ulp / sin(m, n) / 0.47 of that; unit and natural frame
-//! components <= 0.61 ulp / 0.58 ulp; perturbed normal <= 2.5 ulp / 1.07 ulp (unit lengths),
-//! <= 8 ulp / 3.4 ulp (natural lengths in [0.25, 2.25], offsets in [-2, 2]).
+//! cases each in `tests/frames_frame.rs`): main frame orthonormality (| |x| - 1 | and pairwise
+//! dot products) <= 3 ulp / 1.95 ulp; main frame components against the float twin on the
+//! same quantized inputs <= 4 ulp + 2.5 ulp / sin(m, n) / 0.47 of that; unit and natural frame
+//! components <= 0.61 ulp / 0.59 ulp; perturbed normal ([`perturb_normal`]) <= 2.5 ulp /
+//! 1.10 ulp (unit lengths), <= 8 ulp / 3.38 ulp (natural lengths in [0.25, 2.25], offsets in
+//! [-2, 2]). Main frame of every [`MainRole`] against the unit frame on mutually perpendicular
+//! `p_u`, `p_v`, `n` (200k cases): frame components <= 6.5 ulp / 3.0 ulp, perturbed normals
+//! <= 9 ulp / 3.0 ulp.
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
@@ -59,6 +74,19 @@ pub enum FrameKind {
     Unit,
     /// Orthonormal frame from the normal and a main direction `m`.
     Main,
+}
+
+/// What the main direction `m` of frame 3 stands for, and the orientation of the texture
+/// coordinates: together they select which of `e1`, `e2` (and with which sign) carries `f_u`
+/// and which `f_v` (module doc, frame 3). The default is a constant `m` (or `m = p_v`) on
+/// right-handed texture coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct MainRole {
+    /// `m` is `p_u` (interpolated per pixel). `false`: `m` is `p_v`, or a constant per object,
+    /// which stands for the v direction.
+    pub m_is_u: bool,
+    /// `(p_u, p_v, n)` is left-handed (mirrored texture coordinates), per triangle.
+    pub mirrored: bool,
 }
 
 /// Frame unit configuration.
@@ -199,16 +227,33 @@ fn neg(v: &Vec3x, fmt: &Format, sat: &mut SatCounter) -> Vec3x {
     v.map(|x| fmt.fit(-x, sat))
 }
 
-/// Frame 3 as a [`Frame`]: `t_u = -e1`, `t_v = -e2`, lengths 1.
+/// Frame 3 as a [`Frame`], lengths 1: `t_u = -e1`, `t_v = -e2` for `m = p_v` or a constant
+/// `m`; `t_u = -e2`, `t_v = e1` for `m = p_u`; `e2` instead of `-e2` when mirrored (module doc).
 #[must_use]
-pub fn main_frame(n_i: &Vec3x, m: &Vec3x, units: &ShadingUnits, sat: &mut SatCounter) -> Frame {
+pub fn main_frame(
+    n_i: &Vec3x,
+    m: &Vec3x,
+    role: MainRole,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> Frame {
     let mf = main_direction_frame(n_i, m, units, sat);
     let fmt = vector_format(&units.cfg.vector);
     let one = 1i64 << units.cfg.frame.frame_len_frac_bits;
+    let along_m = if role.mirrored {
+        mf.e2
+    } else {
+        neg(&mf.e2, &fmt, sat)
+    };
+    let (t_u, t_v) = if role.m_is_u {
+        (along_m, mf.e1)
+    } else {
+        (neg(&mf.e1, &fmt, sat), along_m)
+    };
     Frame {
         n: mf.n,
-        t_u: neg(&mf.e1, &fmt, sat),
-        t_v: neg(&mf.e2, &fmt, sat),
+        t_u,
+        t_v,
         len_u: one,
         len_v: one,
         fallback: mf.fallback,
@@ -255,7 +300,7 @@ pub fn unit_frame(
     let one = 1i64 << units.cfg.frame.frame_len_frac_bits;
     if su.zero || sv.zero {
         let axis = least_aligned_axis(&nn.v, f);
-        let mut fr = main_frame(&nn.v, &axis, units, sat);
+        let mut fr = main_frame(&nn.v, &axis, MainRole::default(), units, sat);
         fr.fallback = true;
         fr.zero_normal = nn.zero;
         return fr;
@@ -271,8 +316,8 @@ pub fn unit_frame(
     }
 }
 
-/// The frame of `units.cfg.frame.frame_kind` from all per-pixel inputs (`m` is used by the
-/// main frame only; `d_u`, `d_v`, lengths by the other two).
+/// The frame of `units.cfg.frame.frame_kind` from all per-pixel inputs (`m` and `role` are
+/// used by the main frame only; `d_u`, `d_v`, lengths by the other two).
 #[must_use]
 #[allow(clippy::too_many_arguments)]
 pub fn build_frame(
@@ -282,13 +327,14 @@ pub fn build_frame(
     len_u: i64,
     len_v: i64,
     m: &Vec3x,
+    role: MainRole,
     units: &ShadingUnits,
     sat: &mut SatCounter,
 ) -> Frame {
     match units.cfg.frame.frame_kind {
         FrameKind::Natural => natural_frame(n_i, d_u, d_v, len_u, len_v, units, sat),
         FrameKind::Unit => unit_frame(n_i, d_u, d_v, units, sat),
-        FrameKind::Main => main_frame(n_i, m, units, sat),
+        FrameKind::Main => main_frame(n_i, m, role, units, sat),
     }
 }
 
@@ -296,9 +342,12 @@ pub fn build_frame(
 /// offset format. Each `f len` is rounded once into offset format (saturating, counted), the
 /// multiply-add is exact with one rounding into wide format, then normalized (a zero result
 /// falls back to the frame normal).
-/// ERROR BOUND per component against the exact normalization of the exact `n + f s` of the
-/// given frame: 2^-F (madd rounding and length-scaled offset rounding, relative to |n'| >= the
-/// frame's normal component) plus the normalize bound; measured in `tests/frames_frame.rs`.
+/// ERROR BOUND per component against the f64 twin on the same frame and offsets (texram16,
+/// ulp = 2^-14, offsets in [-2, 2]; asserted in `tests/frames_frame.rs`, 1M cases): 2.5 ulp
+/// with lengths 1 (madd rounding, at most sqrt(3)/2 ulp relative to `|n'|`, plus the
+/// normalize bound 0.61 ulp), 8 ulp with natural lengths in [0.25, 2.25] (adds the rounding
+/// of each `f len` to the offset format, 1/2 ulp of s3.12 = 2 ulp of s1.14 per offset);
+/// measured 1.10 and 3.38 ulp.
 #[must_use]
 pub fn perturb_normal(
     fr: &Frame,
@@ -322,7 +371,10 @@ pub fn perturb_normal(
     normalize3(&w, fr.n, &units.rsqrt, vc, sat)
 }
 
-/// Cost of building one frame of `kind` (normalizer costs include the rsqrt).
+/// Cost of building one frame of `kind` (normalizer costs include the rsqrt). The natural
+/// frame includes its length scaling: the two scalar multiplies `f_u len_u`, `f_v len_v`
+/// (`frame_len_cycles`), which [`perturb_normal`] performs but only the natural frame needs
+/// (the unit and main frames have lengths 1), so they are charged here, once.
 #[must_use]
 pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
     let c = &units.cfg;
@@ -330,7 +382,7 @@ pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
     match kind {
         FrameKind::Unit => nz.times(3),
         FrameKind::Natural => nz.times(3).plus(UnitCost {
-            ops: 0,
+            ops: 2,
             cycles: c.frame.frame_len_cycles,
             texels: 0,
         }),
@@ -341,16 +393,11 @@ pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
     }
 }
 
-/// Cost of one [`perturb_normal`]: two length multiplies, the multiply-add, a normalize.
+/// Cost of one [`perturb_normal`] of any frame: the multiply-add and a normalize (the natural
+/// frame's length multiplies are in [`frame_cost`]).
 #[must_use]
 pub fn perturb_cost(units: &ShadingUnits) -> UnitCost {
     let c = &units.cfg;
     let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt));
-    UnitCost {
-        ops: 2,
-        cycles: c.frame.frame_len_cycles,
-        texels: 0,
-    }
-    .plus(madd_cost(&c.vector))
-    .plus(nz)
+    madd_cost(&c.vector).plus(nz)
 }

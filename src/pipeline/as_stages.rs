@@ -5,8 +5,11 @@
 //! An AS material runs `bary` (+ `texcoord`, `lod`, `trilinear` when textured), `normal`,
 //! (`bump-fetch` of its exponent map, when it has one), `frame` and `as-shade`: the bump
 //! stages' interpolation and Schilling's main-direction frame
-//! (frame 3: `n`, `u = e1 = m x n / |m x n|`, `v = e2 = n x e1`) supply the anisotropy axes, so
-//! one main direction gives brushed metal on any mesh. Per light `k1 = l`, with `k2` the
+//! (frame 3: `n`, `e1 = m x n / |m x n|`, `e2 = n x e1`; the axes `u = t_u`, `v = t_v` of
+//! `hw_model::frame::main_frame`: `u = -e1`, `v = -e2` for a constant `m` or `m = p_v`,
+//! `u = -e2`, `v = e1` for `m = p_u` (the axis along `m` negated on mirrored texture
+//! coordinates; only squares of `h.u`, `h.v` enter), so `u` follows the texture's u direction)
+//! supply the anisotropy axes, so one main direction gives brushed metal on any mesh. Per light `k1 = l`, with `k2` the
 //! direction to the eye:
 //!
 //! `L = pi (rho_s + kd rho_d) (n.l) E_light` per channel (`E = pi` times the light colour, so a
@@ -24,7 +27,8 @@
 //! `L` is one exact integer product, aligned with [`GUARD`] guard bits, summed over the lights
 //! and rounded once to `shade_color_bits` unorm (saturating, counted). `kd`, the light colour
 //! and the ambient are `shade_color_bits` unorms whose scale `2^bits - 1` is taken as `2^bits`
-//! in the diffuse and ambient products (as the Blinn-Phong stage does; at most 1 LSB).
+//! in the diffuse and ambient products (at most 1 LSB; the Blinn-Phong unit divides by
+//! `2^bits - 1` exactly).
 //! `l + v = 0` (`k1 = -k2`) gives no contribution and is counted in `h_zero`.
 
 use super::stages::{Counters, Machine};

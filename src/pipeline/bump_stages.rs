@@ -21,7 +21,7 @@ use crate::shading::reference as fref;
 use glam::DVec3;
 use hw_model::blinn_phong::{blinn_phong, BlinnPhongInput};
 use hw_model::fixed::{Format, SatCounter};
-use hw_model::frame::{main_frame, natural_frame, perturb_normal, unit_frame, Frame};
+use hw_model::frame::{main_frame, natural_frame, perturb_normal, unit_frame, Frame, MainRole};
 use hw_model::interpolator::interpolate;
 use hw_model::lod::lod;
 use hw_model::modulate::modulate;
@@ -47,6 +47,10 @@ pub struct BumpAttrs {
     pub eye_x: [[i64; 3]; 3],
     pub light_f: [[[f64; 3]; 3]; MAX_POINT_LIGHTS],
     pub light_x: [[[i64; 3]; 3]; MAX_POINT_LIGHTS],
+    /// The triangle's texture coordinates are mirrored (`n . (p_u x p_v) < 0`, the sign of
+    /// `(d_u x d_v) . n` at two or three of its vertices); selects the main frame's sign along
+    /// `m` (`hw_model::frame::MainRole`).
+    pub mirrored: bool,
 }
 
 /// Float per-vertex bump data of one (possibly clipped) vertex.
@@ -104,6 +108,7 @@ impl BumpAttrs {
             m_f: v.map(|x| x.m),
             len_f: v.map(|x| x.len),
             eye_f: rel(eye),
+            mirrored: mirrored(v),
             ..Default::default()
         };
         for (k, &lp) in lights.iter().take(MAX_POINT_LIGHTS).enumerate() {
@@ -117,6 +122,24 @@ impl BumpAttrs {
         b.eye_x = q3(b.eye_f, sat);
         b.len_x = b.len_f.map(|x| x.map(|c| to_raw(c, &m.len_fmt, sat)));
         b
+    }
+}
+
+/// Two or three of the vertices have left-handed `(s_u, s_v, n)`: `s_u x s_v = n (n . (p_u x
+/// p_v))` for a unit `n` (and `-T x -B = w n` for the tangent fallback), so the sign of
+/// `(d_u x d_v) . n` is the handedness of the texture coordinates.
+fn mirrored(v: &[BumpVertex; 3]) -> bool {
+    v.iter()
+        .filter(|x| d3(&x.du).cross(d3(&x.dv)).dot(d3(&x.n)) < 0.0)
+        .count()
+        >= 2
+}
+
+/// The main frame's role of `bp`'s main direction on a triangle of `ba`.
+fn main_role(bp: &BumpPlan, ba: &BumpAttrs) -> MainRole {
+    MainRole {
+        m_is_u: bp.main == MainDirection::Pu,
+        mirrored: ba.mirrored,
     }
 }
 
@@ -327,7 +350,7 @@ pub fn run_bump_stage(
                         natural_frame(&n, &du, &dv, len[0], len[1], units, &mut sat)
                     }
                     FrameKind::Unit => unit_frame(&n, &du, &dv, units, &mut sat),
-                    FrameKind::Main => main_frame(&n, &mm, units, &mut sat),
+                    FrameKind::Main => main_frame(&n, &mm, main_role(bp, ba), units, &mut sat),
                 };
                 c.frame_fallback += u64::from(fr.fallback);
                 c.zero_normal += u64::from(fr.zero_normal);
@@ -348,6 +371,7 @@ pub fn run_bump_stage(
                     bf.len[0],
                     bf.len[1],
                     d3(&bf.m),
+                    main_role(bp, ba),
                     units.cfg.frame.frame_min_sin_bits,
                 );
                 c.frame_fallback += u64::from(fr.fallback);

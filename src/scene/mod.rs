@@ -182,7 +182,8 @@ impl AsBrdf {
 /// The main direction `m` of the main-direction frame (Schilling 1997, frame 3).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MainDirection {
-    /// A constant world-space direction per object.
+    /// A constant world-space direction per object; it stands for the texture's v direction
+    /// (`hw_model::frame::MainRole`).
     Constant([f32; 3]),
     /// The surface derivative `p_u` (tangent), interpolated per pixel.
     Pu,

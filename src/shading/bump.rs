@@ -168,11 +168,14 @@ pub fn bump_image_from_height(
 /// (|offset| <= 1/0.05 = 20 before the encoding clamp) and counted.
 pub const NORMAL_MAP_MIN_Z: f32 = 0.05;
 
-/// Tangent-space normal map (`rgb = n * 0.5 + 0.5`, x along `T = dP/du`, y along `B = dP/dv`;
-/// `flip_green` for maps authored with y along `-B`, "DirectX style") -> offsets
-/// `f_u = -n_x / n_z`, `f_v = -n_y / n_z`, which reproduce the normal's direction in the
-/// unit/main frame (`t_u = -T`, `t_v = -B`). Returns the offsets and the number of texels whose
-/// `n_z` was clamped.
+/// Tangent-space normal map (`rgb = n * 0.5 + 0.5`, x along `T = dP/du`, y along `B = dP/dv`
+/// with `v` = the texture's `t`, which grows down the image) -> offsets. `flip_green`: the
+/// map's green channel points along `-B`, i.e. towards the image's top row; that is the
+/// OpenGL convention (green up), which the pipeline assumes for `bump_normal_map` (it passes
+/// `true`); maps authored green-down (DirectX convention) have y along `B` and need `false`.
+/// The offsets `f_u = -n_x / n_z`, `f_v = -n_y / n_z` (`n_y` after the flip) reproduce the
+/// normal's direction in the unit and main frames (`t_u = -T`, `t_v = -B`). Returns the
+/// offsets and the number of texels whose `n_z` was clamped.
 pub fn normal_map_to_offsets(img: &TextureImage, flip_green: bool) -> Result<(Vec<[f32; 2]>, u64)> {
     check_size(&img.name, img.width, img.height, img.texels.len())?;
     let mut clamped = 0u64;

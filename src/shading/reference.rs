@@ -11,7 +11,7 @@
 //! scales the interpolated direction, which the normalization removes (the paper's remark).
 
 use glam::DVec3;
-use hw_model::frame::FrameKind;
+use hw_model::frame::{FrameKind, MainRole};
 use hw_model::vector::Vec3x;
 
 /// A frame in float: the twin of `hw_model::frame::Frame`.
@@ -116,14 +116,22 @@ pub fn main_direction_frame(
     (n, e1, e2, fallback, zero)
 }
 
-/// Frame 3 as [`FrameF`]: `t_u = -e1`, `t_v = -e2`, lengths 1.
+/// Frame 3 as [`FrameF`], lengths 1, with the axis assignment of `hw_model::frame`
+/// (`role`): `t_u = -e1`, `t_v = -e2` for `m = p_v` or a constant `m`; `t_u = -e2`,
+/// `t_v = e1` for `m = p_u`; `e2` instead of `-e2` on mirrored texture coordinates.
 #[must_use]
-pub fn main_frame(n_i: DVec3, m: DVec3, min_sin_bits: u32) -> FrameF {
+pub fn main_frame(n_i: DVec3, m: DVec3, role: MainRole, min_sin_bits: u32) -> FrameF {
     let (n, e1, e2, fallback, zero_normal) = main_direction_frame(n_i, m, min_sin_bits);
+    let along_m = if role.mirrored { e2 } else { -e2 };
+    let (t_u, t_v) = if role.m_is_u {
+        (along_m, e1)
+    } else {
+        (-e1, along_m)
+    };
     FrameF {
         n,
-        t_u: -e1,
-        t_v: -e2,
+        t_u,
+        t_v,
         len_u: 1.0,
         len_v: 1.0,
         fallback,
@@ -139,7 +147,7 @@ pub fn unit_frame(n_i: DVec3, d_u: DVec3, d_v: DVec3, min_sin_bits: u32) -> Fram
     let (su, zu) = normalize_or(d_u, DVec3::ZERO);
     let (sv, zv) = normalize_or(d_v, DVec3::ZERO);
     if zu || zv {
-        let mut f = main_frame(n, least_aligned_axis(n), min_sin_bits);
+        let mut f = main_frame(n, least_aligned_axis(n), MainRole::default(), min_sin_bits);
         f.fallback = true;
         f.zero_normal = zero_normal;
         return f;
@@ -182,12 +190,13 @@ pub fn build_frame(
     len_u: f64,
     len_v: f64,
     m: DVec3,
+    role: MainRole,
     min_sin_bits: u32,
 ) -> FrameF {
     match kind {
         FrameKind::Natural => natural_frame(n_i, d_u, d_v, len_u, len_v, min_sin_bits),
         FrameKind::Unit => unit_frame(n_i, d_u, d_v, min_sin_bits),
-        FrameKind::Main => main_frame(n_i, m, min_sin_bits),
+        FrameKind::Main => main_frame(n_i, m, role, min_sin_bits),
     }
 }
 
@@ -305,6 +314,7 @@ pub fn bump_shade(
     d_v: DVec3,
     lens: [f64; 2],
     m: DVec3,
+    role: MainRole,
     offsets: [f64; 2],
     min_sin_bits: u32,
     l: DVec3,
@@ -312,7 +322,7 @@ pub fn bump_shade(
     shininess: u32,
     colors: [[f64; 3]; 3],
 ) -> ([f64; 3], DVec3, bool, bool) {
-    let fr = build_frame(kind, n_i, d_u, d_v, lens[0], lens[1], m, min_sin_bits);
+    let fr = build_frame(kind, n_i, d_u, d_v, lens[0], lens[1], m, role, min_sin_bits);
     let n = perturb_normal(&fr, offsets[0], offsets[1]);
     let (c, hz) = blinn_phong(n, l, v, shininess, colors[0], colors[1], colors[2]);
     (c, n, fr.fallback, hz)
