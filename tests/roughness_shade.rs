@@ -191,7 +191,8 @@ fn check(case: &Case, cfg: &RoughnessConfig, units: &ShadingUnits, sat: &mut Sat
     } else {
         1.0
     };
-    let cu = (-f64::from(C)).exp2();
+    // Unorm colours: raw x means x / (2^C - 1).
+    let cu = 1.0 / ((1u64 << C) - 1) as f64;
     let col = |c: [u64; 3]| c.map(|x| x as f64 * cu);
     let (kdf, ksf, lf) = (col(kd), col(ks), col(light));
     let (want, hz) = rough_blinn_phong_f(
@@ -538,6 +539,16 @@ fn d_raw_limit_and_q_cap_saturate_to_zero_or_clamp_and_are_counted() {
     let mut sat = SatCounter::default();
     let (o, ro) = rough_blinn_phong(&inp, &ri, &cfg, &units, &mut sat);
     assert!(ro.d_zero && o.color[0] > 60_000, "{o:?} {ro:?}");
+    // Unorm colour ending: a white light on a white surface lit head-on is white, exactly.
+    let head_on = BlinnPhongInput {
+        l: n,
+        v: n,
+        kd: [65535; 3],
+        ks: [0; 3],
+        ..inp
+    };
+    let (o, _) = rough_blinn_phong(&head_on, &ri, &cfg, &units, &mut sat);
+    assert_eq!(o.color, [65535; 3], "white x white must be white");
     // Mahalanobis with a huge shear over tiny d1, d3 and h tilted along t_v: Q far above
     // 2^40, so no specular term, and the saturation is counted.
     let cfg = RoughnessConfig {

@@ -154,7 +154,6 @@ pub fn blinn_phong(
     let vc = &units.cfg.vector;
     let f = vc.vector_frac_bits;
     let p = units.cfg.pow.pow_frac_bits.clamp(8, 24);
-    let c = units.cfg.shade.shade_color_bits;
     let one_f = 1i64 << f;
     let ndl = dot3(&inp.n, &inp.l, vc, sat).clamp(0, one_f);
     let sum = [
@@ -171,18 +170,35 @@ pub fn blinn_phong(
         let x = Format::unsigned(1, p, vc.vector_rounding).requantize(ndh, f, sat);
         units.pow.pow(x as u64, inp.shininess, sat) as i64
     };
+    let color = lit_color(inp, ndl, spec, units, sat);
+    BlinnPhongOut { color, h_zero }
+}
+
+/// The colour ending shared by the Blinn-Phong-type units: `light * (kd n.l + ks spec)` with
+/// `n.l` in `F = vector_frac_bits` and `spec` in `P` (the power unit's clamped fraction bits)
+/// fraction bits. Unorm products: colour raw `x` means `x / (2^C - 1)`, so the result in raw
+/// units is `acc light / ((2^C - 1) 2^(F + P))`, one exact rounded division; saturates at 1.0
+/// (counted).
+#[must_use]
+pub fn lit_color(
+    inp: &BlinnPhongInput,
+    ndl: i64,
+    spec: i64,
+    units: &ShadingUnits,
+    sat: &mut SatCounter,
+) -> [u64; 3] {
+    let f = units.cfg.vector.vector_frac_bits;
+    let p = units.cfg.pow.pow_frac_bits.clamp(8, 24);
+    let c = units.cfg.shade.shade_color_bits;
     let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
-    // Unorm products: colour raw x means x / (2^C - 1), so `(kd n.l + ks spec) light` in
-    // raw units is `acc light / ((2^C - 1) 2^(F + P))`, one exact rounded division.
     let den = ((1i128 << c) - 1) << (f + p);
-    let color = [0usize, 1, 2].map(|i| {
+    [0usize, 1, 2].map(|i| {
         let acc = i128::from(inp.kd[i]) * i128::from(ndl) * (1i128 << p)
             + i128::from(inp.ks[i]) * i128::from(spec) * (1i128 << f);
         let lit = acc * i128::from(inp.light[i]);
         let r = round_div_wide(lit, den, units.cfg.shade.shade_rounding);
         out_fmt.fit(r, sat) as u64
-    });
-    BlinnPhongOut { color, h_zero }
+    })
 }
 
 /// Cost of one evaluation: two dots, the half-vector add and normalize, the power, and the

@@ -34,10 +34,12 @@
 //! (divider `2^-B` relative twice, half of it through the square root; square root `2^-B`;
 //! output rounding; the `Q` cap). Measured in `tests/roughness_unit.rs` (docs/ROUGHNESS.md).
 
-use crate::blinn_phong::{blinn_phong_cost, BlinnPhongInput, BlinnPhongOut, ShadingUnits};
+use crate::blinn_phong::{
+    blinn_phong_cost, lit_color, BlinnPhongInput, BlinnPhongOut, ShadingUnits,
+};
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
-use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
+use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
 use crate::pow::{pow_cost, Pow, PowConfig};
 use crate::rsqrt::{isqrt_u128, range};
 use crate::vector::{dot3, dot_cost, normalize3, Vec3x};
@@ -604,13 +606,15 @@ pub struct RoughShadeInput {
 /// Blinn-Phong with the modified specular term (Appendix A): as
 /// [`crate::blinn_phong::blinn_phong`], with `n.h` replaced by `cos a'` of [`rough_cos_d`]
 /// (`d = (h_t . t_u, h_t . t_v)`, `h_t = h - (n.h) n` the tangent-plane projection of `h`)
-/// and the exponent of the configured mode (`inp.shininess` is the material's).
+/// and the exponent of the configured mode (`inp.shininess` is the material's). The colour
+/// ending is Blinn-Phong's ([`crate::blinn_phong::lit_color`]: unorm colours, raw `x` means
+/// `x / (2^C - 1)`).
 ///
 /// ERROR BOUND (absolute, per colour channel, against the float twin
 /// `texsim::shading::roughness::rough_blinn_phong_f` on the same quantized `n`, `l`, `v`,
 /// `t_u`, `t_v` and colours, with D the same texels decoded and scaled in float; `F`, `P`,
 /// `C` the vector, power and colour fraction bits, `e` the mode's exponent, `x` the twin's
-/// `cos a'`): `light (ks S + kd 2^-(F+1)) + 2^-C`, with the specular error
+/// `cos a'`): `light (ks S + kd 2^-(F+1)) + 1/(2^C - 1)`, with the specular error
 /// `S = E_pow(x_hi) + e x_hi^(e-1) Dx`, `x_hi = min(1, x + Dx)`, `E_pow` the power unit's
 /// bound (`crate::pow` module doc) and `Dx = E_cos + E_in`:
 /// - `E_cos`: the [`rough_cos`] bound (module doc); `none`: `2^-(P+1)`;
@@ -643,7 +647,6 @@ pub fn rough_blinn_phong(
     let vc = &units.cfg.vector;
     let f = vc.vector_frac_bits;
     let p = units.cfg.pow.pow_frac_bits.clamp(8, 24);
-    let c = units.cfg.shade.shade_color_bits;
     let one_f = 1i64 << f;
     let ndl = dot3(&inp.n, &inp.l, vc, sat).clamp(0, one_f);
     let sum = [
@@ -677,14 +680,7 @@ pub fn rough_blinn_phong(
             sp as i64
         }
     };
-    let out_fmt = Format::unsigned(0, c, units.cfg.shade.shade_rounding);
-    let color = [0usize, 1, 2].map(|i| {
-        let acc = i128::from(inp.kd[i]) * i128::from(ndl) * (1i128 << p)
-            + i128::from(inp.ks[i]) * i128::from(spec) * (1i128 << f);
-        let lit = acc * i128::from(inp.light[i]);
-        let r = round_shift_right_wide(lit, c + f + p, units.cfg.shade.shade_rounding);
-        out_fmt.fit(r, sat) as u64
-    });
+    let color = lit_color(inp, ndl, spec, units, sat);
     (BlinnPhongOut { color, h_zero }, ro)
 }
 
