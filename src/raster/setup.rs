@@ -1,6 +1,12 @@
 //! Triangle setup: homogeneous clipping (Sutherland-Hodgman against the near/far planes and a
 //! guard band), perspective divide, viewport transform, snapping to the sub-pixel grid,
 //! orientation and back-face culling. Conventions are in the parent module header.
+//!
+//! Setup is the host/geometry side of the machine and runs in f64: the per-vertex `1/w` of
+//! the perspective divide is computed here and then quantized into the interpolator's
+//! `inv_w_bits` format. The hardware reciprocal unit (`hw_model::reciprocal`) models the
+//! per-pixel divide `1 / sum(E_i invw_i)` of perspective-correct interpolation, the one a
+//! texture pipeline pays for every fragment.
 
 use hw_model::config::RasterConfig;
 use rayon::prelude::*;
