@@ -706,6 +706,15 @@ fn brdf_model(p: &BrdfParams) -> Result<crate::brdf::ashikhmin_shirley::Ashikhmi
     crate::brdf::ashikhmin_shirley::AshikhminShirley::new(p.nu, p.nv, p.rs, p.rd)
 }
 
+/// The Ashikhmin-Shirley unit config of `hw` when `--fixed` is given.
+fn fixed_unit(fixed: bool, hw: &str) -> Result<Option<hw_model::aniso_phong::AnisoPhongConfig>> {
+    Ok(if fixed {
+        Some(hwconfig::resolve(hw)?.aniso_phong)
+    } else {
+        None
+    })
+}
+
 fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
     use crate::brdf::ashikhmin_shirley::dir_from_angles;
     use crate::brdf::report::{albedo_report, eval_report, sample_report};
@@ -716,11 +725,7 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
             fixed,
             hw,
         } => {
-            let cfg = if *fixed {
-                Some(hwconfig::resolve(hw)?.aniso_phong)
-            } else {
-                None
-            };
+            let cfg = fixed_unit(*fixed, hw)?;
             albedo_report(&brdf_model(p)?, *theta, cfg.as_ref())?
         }
         BrdfCmd::Eval {
@@ -732,11 +737,7 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
             fixed,
             hw,
         } => {
-            let cfg = if *fixed {
-                Some(hwconfig::resolve(hw)?.aniso_phong)
-            } else {
-                None
-            };
+            let cfg = fixed_unit(*fixed, hw)?;
             eval_report(
                 &brdf_model(p)?,
                 dir_from_angles(*theta1, *phi1),

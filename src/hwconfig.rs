@@ -238,23 +238,15 @@ pub fn to_toml(c: &HwConfig) -> String {
 
 /// Every leaf field as (dotted path, value).
 pub fn fields(c: &HwConfig) -> Vec<(String, String)> {
-    let mut out = Vec::new();
-    fn walk(t: &toml::Table, prefix: &str, out: &mut Vec<(String, String)>) {
-        for (k, v) in t {
-            let path = if prefix.is_empty() {
-                k.clone()
-            } else {
-                format!("{prefix}.{k}")
-            };
-            match v {
-                toml::Value::Table(s) => walk(s, &path, out),
-                toml::Value::String(s) => out.push((path, s.clone())),
-                other => out.push((path, other.to_string())),
-            }
-        }
-    }
-    walk(&to_table(c), "", &mut out);
-    out
+    let mut leaves = Vec::new();
+    leaf_values(&to_table(c), "", &mut leaves);
+    leaves
+        .into_iter()
+        .map(|(path, v)| match v {
+            toml::Value::String(s) => (path, s),
+            other => (path, other.to_string()),
+        })
+        .collect()
 }
 
 /// Returns `c` with the field `name` (a unique leaf name like `weight_bits`, or a dotted path
