@@ -398,7 +398,7 @@ fn interp(a: i64, b: i64, frac: i64, fb: u32, rnd: Rounding) -> i64 {
 /// configuration).
 ///
 /// Declared precision (derived here, checked by `tests/as_power.rs` against `(1 - s)^(E/2)` in
-/// f64). Let `f = aniso_pow_frac_bits`, `b = aniso_pow_lut_bits`, `r = aniso_ratio_bits`,
+/// double precision). Let `f = aniso_pow_frac_bits`, `b = aniso_pow_lut_bits`, `r = aniso_ratio_bits`,
 /// `u = 1/2` for the round-to-nearest modes and `u = 1` for `Truncate`, `L = -log2(1 - s)`
 /// and `X = E L / 2`, so the exact power is `P = 2^-X`.
 /// - Every ROM entry is its function computed to ~2^-55 and rounded once: within

@@ -342,7 +342,7 @@ pub fn build_frame(
 /// offset format. Each `f len` is rounded once into offset format (saturating, counted), the
 /// multiply-add is exact with one rounding into wide format, then normalized (a zero result
 /// falls back to the frame normal).
-/// ERROR BOUND per component against the f64 twin on the same frame and offsets (texram16,
+/// ERROR BOUND per component against the float twin on the same frame and offsets (texram16,
 /// ulp = 2^-14, offsets in [-2, 2]; asserted in `tests/frames_frame.rs`, 1M cases): 2.5 ulp
 /// with lengths 1 (madd rounding, at most sqrt(3)/2 ulp relative to `|n'|`, plus the
 /// normalize bound 0.61 ulp), 8 ulp with natural lengths in [0.25, 2.25] (adds the rounding
