@@ -207,9 +207,16 @@ impl AddressMap {
         }
     }
 
-    /// The address record of a level (a dummy 1-texel level if out of range).
+    /// The address record of a level (a dummy 1-texel level if out of range, which a
+    /// render's event stream never produces: checked in debug builds).
     #[inline]
     fn level(&self, tex: u16, level: u8) -> LevelAddr {
+        debug_assert!(
+            self.levels
+                .get(tex as usize)
+                .is_some_and(|l| (level as usize) < l.len()),
+            "footprint of texture {tex} level {level} outside the frame's textures"
+        );
         self.levels
             .get(tex as usize)
             .and_then(|l| l.get(level as usize))
