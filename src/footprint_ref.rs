@@ -14,17 +14,27 @@ pub struct FootprintF {
 }
 
 /// Float twin of `hw_model::footprint::footprint`: `uv` at the sample and helper samples
-/// (normalized), level-0 size, `probes` (a power of two). The LOD is
+/// (normalized), level-0 size, `probes` (a power of two), `adaptive` (the smallest power of
+/// two `N <= probes` with `|major|^2 <= N^2 |minor|^2`). The LOD is
 /// `log2(max(minor, major / N))` (`N = 1`: `log2(major)`), clamped below at -32.
 #[must_use]
-pub fn footprint_f64(uv: &[[f64; 2]; 3], size: (u32, u32), probes: u32) -> FootprintF {
-    let n = probes.clamp(1, 16);
+pub fn footprint_f64(
+    uv: &[[f64; 2]; 3],
+    size: (u32, u32),
+    probes: u32,
+    adaptive: bool,
+) -> FootprintF {
+    let cap = probes.clamp(1, 16);
     let (w, h) = (f64::from(size.0), f64::from(size.1));
     let dx = [uv[1][0] - uv[0][0], uv[1][1] - uv[0][1]];
     let dy = [uv[2][0] - uv[0][0], uv[2][1] - uv[0][1]];
     let l2 = |d: [f64; 2]| (d[0] * w).powi(2) + (d[1] * h).powi(2);
     let (lx, ly) = (l2(dx), l2(dy));
     let (maj, lmaj, lmin) = if lx >= ly { (dx, lx, ly) } else { (dy, ly, lx) };
+    let mut n = if adaptive { 1 } else { cap };
+    while n < cap && lmaj > lmin * f64::from(n * n) {
+        n *= 2;
+    }
     let nf = f64::from(n);
     let l = if n == 1 {
         lmaj

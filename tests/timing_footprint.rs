@@ -1,7 +1,7 @@
 //! Footprint assembly (Texram's anisotropic filter): the fixed unit against its f64 twin, the
 //! N = 1 identity with plain trilinear, the one-rounding average, and whole-frame behaviour
 //! (renders, N x texels, deterministic, less blur than plain trilinear on the receding plane
-//! against a supersampled image).
+//! against a supersampled image), and the adaptive probe count (`aniso_adaptive`).
 
 use hw_model::config::LodConfig;
 use hw_model::fixed::{round_shift_right, SatCounter};
@@ -56,12 +56,29 @@ fn lod_and_offsets_match_the_f64_twin() {
                 1u32 << (splitmix(&mut s) % 12),
                 1u32 << (splitmix(&mut s) % 12),
             );
-            let n = 1u32 << (splitmix(&mut s) % 5);
+            let cap = 1u32 << (splitmix(&mut s) % 5);
+            let adaptive = splitmix(&mut s) & 1 == 0;
             let mut sat = SatCounter::default();
-            let fx = footprint(&uv, size, FRAC, n, &cfg, &mut sat);
+            let fx = footprint(&uv, size, FRAC, cap, adaptive, &cfg, &mut sat);
             let uvf = uv.map(|p| p.map(|x| x as f64 / f64::from(1u32 << FRAC) / 1.0));
-            let ff = footprint_f64(&uvf, size, n);
-            assert_eq!(fx.probes, n);
+            let ff = footprint_f64(&uvf, size, cap, adaptive);
+            let n = fx.probes;
+            assert_eq!(n, ff.probes, "same probe count as the twin");
+            if adaptive {
+                // The anisotropy rounded up to a power of two, capped.
+                let (w, h) = (f64::from(size.0), f64::from(size.1));
+                let l2 = |p: [f64; 2]| {
+                    ((p[0] - uvf[0][0]) * w).powi(2) + ((p[1] - uvf[0][1]) * h).powi(2)
+                };
+                let (a, b) = (l2(uvf[1]), l2(uvf[2]));
+                let (lmaj, lmin) = (a.max(b), a.min(b));
+                let nf = f64::from(n);
+                assert!(n.is_power_of_two() && n <= cap);
+                assert!(n == cap || lmaj <= nf * nf * lmin, "N={n} too small");
+                assert!(n == 1 || lmaj > nf * nf / 4.0 * lmin, "N={n} too large");
+            } else {
+                assert_eq!(n, cap);
+            }
             let scale = (1u64 << FRAC) as f64;
             assert_eq!(fx.axis.map(|a| a as f64 / scale), ff.axis);
             let exact = ff.lod * f64::from(1u32 << f);
@@ -128,7 +145,7 @@ fn one_probe_is_plain_trilinear_and_the_average_rounds_once() {
         ];
         let mut sat = SatCounter::default();
         // N = 1: the LOD unit's LOD and the trilinear unit's result, bit for bit.
-        let f1 = footprint(&uv, (32, 32), FRAC, 1, &hw.lod, &mut sat);
+        let f1 = footprint(&uv, (32, 32), FRAC, 1, false, &hw.lod, &mut sat);
         let d = [
             (uv[1][0] - uv[0][0]) * 32,
             (uv[1][1] - uv[0][1]) * 32,
@@ -161,7 +178,7 @@ fn one_probe_is_plain_trilinear_and_the_average_rounds_once() {
         );
         assert_eq!(a, b);
         // N = 8: the exact sum of the probes, rounded once.
-        let f8 = footprint(&uv, (32, 32), FRAC, 8, &hw.lod, &mut sat);
+        let f8 = footprint(&uv, (32, 32), FRAC, 8, false, &hw.lod, &mut sat);
         let got = footprint_filter(
             &levels,
             base[0],
@@ -294,4 +311,66 @@ fn aniso_reduces_blur_on_the_receding_plane() {
         errs[2],
         errs[0]
     );
+}
+
+#[test]
+fn adaptive_probes_follow_the_anisotropy_and_cost_what_they_take() {
+    let s = plane(96);
+    let big = plane(384);
+    let maps = Maps::new(&s, HwConfig::texram16().trilinear.texel_bits);
+    let float = RenderOptions {
+        hw_impls: StageImpls::FLOAT,
+        reference: false,
+        ..Default::default()
+    };
+    let ss = render(&big, &maps, &with_probes(1), &float).expect("supersampled");
+    let timed = RenderOptions {
+        timing: true,
+        ..Default::default()
+    };
+    let fixed16 = with_probes(16);
+    let adaptive16 = HwConfig {
+        trilinear: hw_model::config::TrilinearConfig {
+            aniso_adaptive: true,
+            ..fixed16.trilinear.clone()
+        },
+        ..fixed16.clone()
+    };
+    let run = |hw: &HwConfig| {
+        let r = render(&s, &maps, hw, &timed).expect("render");
+        let st = &r.stats.stages[StageKind::Trilinear.index()];
+        let ev = r.events.as_ref().expect("events");
+        let fps = ev.footprints.len() as u64;
+        // The first estimate counts the probes each pixel took: 4 texels per footprint (8 on
+        // two levels), as the timing model's event stream has them.
+        assert!(
+            4 * fps <= st.texels && st.texels <= 8 * fps,
+            "{} vs {fps}",
+            st.texels
+        );
+        let cycles = texsim::timing::simulate(ev, hw, "w1-plane").total_cycles;
+        (
+            blur_error(&r.hw_image, &ss.hw_image, &r.mask),
+            st.texels,
+            st.cycles,
+            cycles,
+        )
+    };
+    let one = run(&with_probes(1));
+    let f = run(&fixed16);
+    let a = run(&adaptive16);
+    eprintln!(
+        "w1-plane 96x96 vs 4x4 supersampled, mean 8-bit LSB / trilinear texels / stage cycles / \
+         timing cycles: N=1 {one:?}, fixed 16 {f:?}, adaptive <= 16 {a:?}"
+    );
+    assert!(
+        a.1 < f.1 && a.1 > one.1,
+        "texels between plain and fixed 16"
+    );
+    assert!(
+        a.2 < f.2 && a.3 < f.3,
+        "cheaper than fixed 16 in both cost models"
+    );
+    assert!(a.0 < one.0, "adaptive {} vs trilinear {}", a.0, one.0);
+    assert!(a.0 <= f.0 * 1.1, "adaptive {} vs fixed 16 {}", a.0, f.0);
 }

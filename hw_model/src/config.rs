@@ -135,6 +135,10 @@ pub struct TrilinearConfig {
     /// Anisotropic footprint assembly (Texram): trilinear probes along the footprint's major
     /// axis, averaged; 1 = plain trilinear. A power of two, at most 16.
     pub aniso_probes: u32,
+    /// Footprint assembly picks the probe count per pixel: the anisotropy of the footprint
+    /// rounded up to a power of two, at most `aniso_probes` (false: always `aniso_probes`).
+    #[serde(default)]
+    pub aniso_adaptive: bool,
 }
 
 /// Colour datapath: vertex colour and the modulate (colour x texel) unit.
@@ -225,6 +229,7 @@ impl HwConfig {
                 bilinear_cycles: 1,
                 level_lerp_cycles: 1,
                 aniso_probes: 1,
+                aniso_adaptive: false,
             },
             color: ColorConfig {
                 color_bits: 16,

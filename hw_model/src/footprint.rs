@@ -8,7 +8,10 @@
 //! - Major axis: the derivative vector with the larger squared texel-space length (`x` on a
 //!   tie), exact in `u128`; the minor length is that of the other vector.
 //! - Probes: `N` = `aniso_probes` (a power of two <= 16; every pixel takes all `N`, so a
-//!   lookup's cost is fixed). Probe `i` (0-based) is at `uv + axis * (2i + 1 - N) / (2N)`: the
+//!   lookup's cost is fixed), or with `aniso_adaptive` the smallest power of two `N <=
+//!   aniso_probes` with `|major|^2 <= N^2 |minor|^2`: the anisotropy rounded up to a power of
+//!   two, as Texram picks it (an isotropic footprint takes one probe, plain trilinear; the
+//!   cost then varies per pixel and is counted per pixel). Probe `i` (0-based) is at `uv + axis * (2i + 1 - N) / (2N)`: the
 //!   centres of `N` equal segments of the major axis, centred on the pixel. Each offset is the
 //!   exact product rounded once (half-even) to the texture-coordinate format.
 //! - Per-probe LOD: `log2(max(minor, major / N))`, the practice of
@@ -60,7 +63,9 @@ fn len2(du: i64, dv: i64, w: u32, h: u32) -> u128 {
 
 /// Assembles the footprint of a pixel from its texture coordinates `uv` at the sample and the
 /// helper samples (x+1, y) and (x, y+1) (`frac` fraction bits, normalized), the level-0 size
-/// `(w, h)` and `probes` (clamped to a power of two in 1..=16).
+/// `(w, h)` and `probes` (clamped to a power of two in 1..=16). With `adaptive` the probe
+/// count is the smallest power of two `N <= probes` with `|major|^2 <= N^2 |minor|^2` (the
+/// anisotropy rounded up to a power of two, as Texram chooses it), else `probes`.
 #[inline]
 #[must_use]
 pub fn footprint(
@@ -68,14 +73,15 @@ pub fn footprint(
     size: (u32, u32),
     frac: u32,
     probes: u32,
+    adaptive: bool,
     cfg: &LodConfig,
     sat: &mut SatCounter,
 ) -> Footprint {
-    let n = probes.clamp(1, MAX_PROBES as u32);
-    let n = if n.is_power_of_two() {
-        n
+    let cap = probes.clamp(1, MAX_PROBES as u32);
+    let cap = if cap.is_power_of_two() {
+        cap
     } else {
-        n.next_power_of_two() >> 1
+        cap.next_power_of_two() >> 1
     };
     let (w, h) = size;
     let dx = [uv[1][0] - uv[0][0], uv[1][1] - uv[0][1]];
@@ -87,6 +93,10 @@ pub fn footprint(
     } else {
         (dy, dx, ly, lx)
     };
+    let mut n = if adaptive { 1 } else { cap };
+    while n < cap && lmaj > lmin.saturating_mul(u128::from(n) * u128::from(n)) {
+        n *= 2;
+    }
     let texel = |d: [i64; 2]| [d[0] * i64::from(w), d[1] * i64::from(h), 0, 0];
     let f = cfg.lod_frac_bits.min(16);
     let log2n = n.trailing_zeros();

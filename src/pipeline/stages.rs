@@ -368,6 +368,17 @@ fn unorm(raw: u32, bits: u32) -> f64 {
     f64::from(raw) / f64::from(max_unorm(bits))
 }
 
+/// A stage's accumulated `[ops, cycles, texels]` with this pixel's planned footprint-assembly
+/// cost (`aniso_probes` probes) replaced by that of the `probes` it took (`aniso_adaptive`).
+fn per_pixel_probes(acc: [u64; 3], planned: &UnitCost, m: &Machine, probes: u32) -> [u64; 3] {
+    let took = footprint_cost(&m.hw.trilinear, &m.hw.lod, probes);
+    [
+        acc[0] - u64::from(planned.ops) + u64::from(took.ops),
+        acc[1] - u64::from(planned.cycles) + u64::from(took.cycles),
+        acc[2] - u64::from(planned.texels) + u64::from(took.texels),
+    ]
+}
+
 /// Runs `plan` on one fragment at pixel (`px`, `py`) of `tri`, each stage by its twin in
 /// `impls`; the result is in `frag.out` (and `frag.out_x` when the last stage was Fixed).
 /// A Fixed stage reads the raw value of a Fixed producer and quantizes the carrier of a Float
@@ -504,6 +515,7 @@ pub fn run(
             StageKind::Trilinear => {
                 let Some(t) = plan.texture else { continue };
                 let probes = hw.trilinear.aniso_probes;
+                let adaptive = hw.trilinear.aniso_adaptive;
                 let aniso = probes > 1 && plan.derivatives;
                 if fixed {
                     if !fixed_in(StageKind::Texcoord) && !fixed_in(StageKind::Lod) {
@@ -518,7 +530,10 @@ pub fn run(
                     let r = if aniso {
                         let levels = &m.tex_fixed[t];
                         let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
-                        let fp = footprint(&frag.uv_x, size, fb, probes, &hw.lod, sat);
+                        let fp = footprint(&frag.uv_x, size, fb, probes, adaptive, &hw.lod, sat);
+                        if fp.probes != probes {
+                            c.cost[k] = per_pixel_probes(c.cost[k], cost, m, fp.probes);
+                        }
                         footprint_filter(levels, u, v, fb, &fp, lfb, plan.wrap, &hw.trilinear, None)
                     } else {
                         trilinear(
@@ -542,7 +557,10 @@ pub fn run(
                     frag.texel = if aniso {
                         let levels = &m.tex_float[t];
                         let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
-                        let fp = footprint_f64(&frag.uv, size, probes);
+                        let fp = footprint_f64(&frag.uv, size, probes, adaptive);
+                        if fp.probes != probes {
+                            c.cost[k] = per_pixel_probes(c.cost[k], cost, m, fp.probes);
+                        }
                         footprint_filter_f64(levels, u, v, &fp, plan.wrap)
                     } else {
                         trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap)

@@ -188,7 +188,15 @@ pub fn record_pixel(
         let size = levels.first().map_or((1, 1), |l| (l.width, l.height));
         let probes = lookups(kind, hw);
         if kind == StageKind::Trilinear && probes > 1 && plan.derivatives {
-            let fp = footprint(&uv, size, fb, probes, &hw.lod, &mut sat);
+            let fp = footprint(
+                &uv,
+                size,
+                fb,
+                probes,
+                hw.trilinear.aniso_adaptive,
+                &hw.lod,
+                &mut sat,
+            );
             let mut traces = [TrilinearTrace::default(); MAX_PROBES];
             let _ = footprint_filter(
                 levels,
