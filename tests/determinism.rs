@@ -1,5 +1,5 @@
 //! Every built-in scene, with every effect it uses (bumps, roughness, NDF, Ashikhmin-Shirley,
-//! footprint assembly), the ground truth and the timing model, renders bit-identically on 1
+//! adaptive footprint assembly), the ground truth and the timing model, renders bit-identically on 1
 //! and on 3 threads, and with the timing model off.
 
 use texsim::render::{render, Maps, RenderOptions, Rendered};
@@ -30,7 +30,8 @@ fn stats_json(r: &Rendered) -> serde_json::Value {
 #[test]
 fn every_builtin_scene_is_identical_on_1_and_3_threads() {
     let mut hw = hw_model::HwConfig::texram16();
-    hw.trilinear.aniso_probes = 2;
+    hw.trilinear.aniso_probes = 4;
+    hw.trilinear.aniso_adaptive = true;
     for &(name, _) in BUILTIN {
         let mut s = scene::builtin(name).expect("builtin");
         s.width = 96;
