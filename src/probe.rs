@@ -5,11 +5,11 @@
 use crate::cli::ProbeArgs;
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::maps::{build_mip_chain, quantize_chain};
-use crate::reference::{trilinear_f64, LevelF};
+use crate::reference::trilinear_f64;
 use crate::scene::{decode_texture, WrapMode};
 use crate::{hwconfig, Error, Result};
 use hw_model::fixed::{Format, Rounding, SatCounter};
-use hw_model::trilinear::{trilinear, Level, TrilinearTrace};
+use hw_model::trilinear::{trilinear, TrilinearTrace};
 use std::fmt::Write;
 
 /// Runs the probe and prints the report.
@@ -39,24 +39,8 @@ pub fn probe_report(
     let chain = build_mip_chain(tex);
     let tb = hw.trilinear.texel_bits;
     let fixed = quantize_chain(&chain, tb);
-    let levels: Vec<Level> = fixed
-        .levels
-        .iter()
-        .map(|l| Level {
-            width: l.width,
-            height: l.height,
-            texels: &l.texels,
-        })
-        .collect();
-    let levels_f: Vec<LevelF> = chain
-        .levels
-        .iter()
-        .map(|l| LevelF {
-            width: l.width,
-            height: l.height,
-            texels: &l.texels,
-        })
-        .collect();
+    let levels = fixed.views();
+    let levels_f = chain.views();
     let i = &hw.interp;
     let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
         .with_overflow(i.texcoord_overflow);

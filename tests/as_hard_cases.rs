@@ -28,6 +28,20 @@ struct Case {
     brdf: AsBrdf,
 }
 
+impl Case {
+    /// The BRDF's dot products for the halfway vector `h`.
+    fn dots(&self, h: DVec3) -> Dots {
+        Dots {
+            hn: h.dot(self.n),
+            hu: h.dot(self.u),
+            hv: h.dot(self.v),
+            kh: self.light.dot(h),
+            nk1: self.n.dot(self.light),
+            nk2: self.n.dot(self.eye),
+        }
+    }
+}
+
 /// (fixed rgb, float rgb, counters of both runs) on machine `m` (lights replaced).
 fn shade<'a>(m: Machine<'a>, c: &Case) -> (Machine<'a>, [f64; 3], [f64; 3], Counters) {
     let f = m.hw.shading.vector.vector_frac_bits;
@@ -79,14 +93,7 @@ fn unclamped_float(c: &Case) -> [f64; 3] {
     let sum = c.light + c.eye;
     if sum != DVec3::ZERO {
         let h = sum.normalize();
-        let d = Dots {
-            hn: h.dot(c.n),
-            hu: h.dot(c.u),
-            hv: h.dot(c.v),
-            kh: c.light.dot(h),
-            nk1: c.n.dot(c.light),
-            nk2: c.n.dot(c.eye),
-        };
+        let d = c.dots(h);
         let (sp, df) = p.eval_from_dots(&d);
         for ch in 0..3 {
             out[ch] += PI * (sp + df * kd[ch]) * d.nk1.max(0.0);
@@ -108,14 +115,7 @@ fn unit_within_declared_range(c: &Case, roms: &AnisoPhongRoms) -> bool {
         return false;
     }
     let h = sum.normalize();
-    let d = Dots {
-        hn: h.dot(c.n),
-        hu: h.dot(c.u),
-        hv: h.dot(c.v),
-        kh: c.light.dot(h),
-        nk1: c.n.dot(c.light),
-        nk2: c.n.dot(c.eye),
-    };
+    let d = c.dots(h);
     let p = AshikhminShirley {
         nu: c.brdf.nu,
         nv: c.brdf.nv,

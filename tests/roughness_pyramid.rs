@@ -4,25 +4,14 @@
 
 #![allow(clippy::needless_range_loop)]
 
+mod rough_common;
+
 use hw_model::roughness::{decode_d, RoughnessConfig, D2_CHANNEL};
+use rough_common::Rng;
 use texsim::shading::roughness::{
     build_rough_pyramid, d_factor, d_product, decode_d_texels, lambda1, quantize_d_channel,
     quantize_rough_chain, rough_mip_chain, RoughParams, RoughnessEncoding, UNIFORM_CORRECTION,
 };
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// Direct mean and covariance (population, 1/n) of the finest offsets in the block of texel
 /// `(x, y)` at level `l` of a power-of-two map.
@@ -503,9 +492,9 @@ fn lod_past_the_last_level_reads_the_last_texel_through_the_real_path() {
     use hw_model::fixed::SatCounter;
     use hw_model::lod::lod;
     use hw_model::roughness::{rough_cos, RoughInput, RoughVariant};
-    use hw_model::trilinear::{trilinear, Level};
+    use hw_model::trilinear::trilinear;
     use hw_model::wrap::WrapMode;
-    use texsim::reference::{trilinear_f64, LevelF};
+    use texsim::reference::trilinear_f64;
     use texsim::shading::roughness::rough_cos_twin;
     let mut r = Rng(10);
     let (w, h) = (12u32, 6u32);
@@ -538,24 +527,8 @@ fn lod_past_the_last_level_reads_the_last_texel_through_the_real_path() {
             let (chain, clamped) = rough_mip_chain(&pyr, &params, &enc, iso);
             assert_eq!(clamped, 0);
             let q = quantize_rough_chain(&chain, d_bits, tb);
-            let fixed: Vec<Level> = q
-                .levels
-                .iter()
-                .map(|l| Level {
-                    width: l.width,
-                    height: l.height,
-                    texels: &l.texels,
-                })
-                .collect();
-            let float: Vec<LevelF> = chain
-                .levels
-                .iter()
-                .map(|l| LevelF {
-                    width: l.width,
-                    height: l.height,
-                    texels: &l.texels,
-                })
-                .collect();
+            let fixed = q.views();
+            let float = chain.views();
             let last = fixed.len() as i64 - 1;
             let (last_x, last_f) = (
                 q.levels[last as usize].texels[0],

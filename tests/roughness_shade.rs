@@ -5,6 +5,8 @@
 //! and the energy normalization; the D scaling unit `scale_d` against its twin; and the
 //! saturations (`D_RAW_LIMIT`, `Q >= 2^Q_CAP_BITS`) counted.
 
+mod rough_common;
+
 use glam::DVec3;
 use hw_model::blinn_phong::{BlinnPhongInput, ShadingConfig, ShadingUnits};
 use hw_model::fixed::SatCounter;
@@ -13,40 +15,11 @@ use hw_model::roughness::{
     RoughVariant, RoughnessConfig, D_RAW_LIMIT, Q_CAP_BITS,
 };
 use hw_model::rsqrt::RsqrtConfig;
+use rough_common::Rng;
 use texsim::shading::reference as r;
 use texsim::shading::roughness::{
     d_and_cos, decode_d_texels, normalize_factor, rough_blinn_phong_f, rough_cos_twin, scale_d_f,
 };
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    fn dir(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-            );
-            let l = v.length();
-            if l > 0.1 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-}
 
 /// `(1 + u^2)^(-1/2)`, the twin's `cos a'` as a function of `u = tan a'` (0 at infinity).
 fn cos_of_u(u: f64) -> f64 {

@@ -6,27 +6,16 @@
 
 #![allow(clippy::needless_range_loop)]
 
+mod rough_common;
+
 use hw_model::fixed::SatCounter;
 use hw_model::pow::{Pow, PowConfig};
 use hw_model::roughness::{
     decode_d, div_round, rough_cos, rough_cost, rough_specular, sqrt_round, RoughExponentMode,
     RoughInput, RoughVariant, RoughnessConfig,
 };
+use rough_common::Rng;
 use texsim::shading::roughness::{d_factor, decode_d_texels, rough_cos_twin};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 const VARIANTS: [RoughVariant; 4] = [
     RoughVariant::Published,

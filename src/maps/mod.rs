@@ -43,6 +43,36 @@ pub struct FixedMipChain {
     pub levels: Vec<FixedLevel>,
 }
 
+impl MipChain {
+    /// The levels as the float trilinear twin reads them.
+    #[must_use]
+    pub fn views(&self) -> Vec<crate::reference::LevelF<'_>> {
+        self.levels
+            .iter()
+            .map(|l| crate::reference::LevelF {
+                width: l.width,
+                height: l.height,
+                texels: &l.texels,
+            })
+            .collect()
+    }
+}
+
+impl FixedMipChain {
+    /// The levels as the fixed trilinear unit reads them.
+    #[must_use]
+    pub fn views(&self) -> Vec<hw_model::trilinear::Level<'_>> {
+        self.levels
+            .iter()
+            .map(|l| hw_model::trilinear::Level {
+                width: l.width,
+                height: l.height,
+                texels: &l.texels,
+            })
+            .collect()
+    }
+}
+
 /// Size of the level after one of size `n` (see the module doc).
 #[must_use]
 pub fn next_level_size(n: u32) -> u32 {

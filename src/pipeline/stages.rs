@@ -132,32 +132,8 @@ impl<'a> Machine<'a> {
                 .with_overflow(hw.color.color_overflow),
             lod_fmt: Format::signed(8, hw.lod.lod_frac_bits, Rounding::Truncate),
             bary_fmt: Format::signed(16, i.bary_bits, i.interp_rounding),
-            tex_fixed: fixed
-                .iter()
-                .map(|c| {
-                    c.levels
-                        .iter()
-                        .map(|l| Level {
-                            width: l.width,
-                            height: l.height,
-                            texels: &l.texels,
-                        })
-                        .collect()
-                })
-                .collect(),
-            tex_float: float
-                .iter()
-                .map(|c| {
-                    c.levels
-                        .iter()
-                        .map(|l| LevelF {
-                            width: l.width,
-                            height: l.height,
-                            texels: &l.texels,
-                        })
-                        .collect()
-                })
-                .collect(),
+            tex_fixed: fixed.iter().map(FixedMipChain::views).collect(),
+            tex_float: float.iter().map(MipChain::views).collect(),
             units: ShadingUnits::new(&hw.shading),
             vec_fmt: vector_format(&hw.shading.vector),
             len_fmt: len_format(&hw.shading.frame, hw.shading.vector.vector_rounding),
