@@ -4,10 +4,10 @@
 
 #![allow(clippy::needless_range_loop)]
 
-mod rough_common;
+mod rng_common;
 
 use hw_model::roughness::{decode_d, RoughnessConfig, D2_CHANNEL};
-use rough_common::Rng;
+use rng_common::Rng;
 use texsim::shading::roughness::{
     build_rough_pyramid, d_factor, d_product, decode_d_texels, lambda1, quantize_d_channel,
     quantize_rough_chain, rough_mip_chain, RoughParams, RoughnessEncoding, UNIFORM_CORRECTION,

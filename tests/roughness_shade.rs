@@ -5,7 +5,7 @@
 //! and the energy normalization; the D scaling unit `scale_d` against its twin; and the
 //! saturations (`D_RAW_LIMIT`, `Q >= 2^Q_CAP_BITS`) counted.
 
-mod rough_common;
+mod rng_common;
 
 use glam::DVec3;
 use hw_model::blinn_phong::{BlinnPhongInput, ShadingConfig, ShadingUnits};
@@ -15,7 +15,7 @@ use hw_model::roughness::{
     RoughVariant, RoughnessConfig, D_RAW_LIMIT, Q_CAP_BITS,
 };
 use hw_model::rsqrt::RsqrtConfig;
-use rough_common::Rng;
+use rng_common::Rng;
 use texsim::shading::reference as r;
 use texsim::shading::roughness::{
     d_and_cos, decode_d_texels, normalize_factor, rough_blinn_phong_f, rough_cos_twin, scale_d_f,

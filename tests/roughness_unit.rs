@@ -6,7 +6,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-mod rough_common;
+mod rng_common;
 
 use hw_model::fixed::SatCounter;
 use hw_model::pow::{Pow, PowConfig};
@@ -14,7 +14,7 @@ use hw_model::roughness::{
     decode_d, div_round, rough_cos, rough_cost, rough_specular, sqrt_round, RoughExponentMode,
     RoughInput, RoughVariant, RoughnessConfig,
 };
-use rough_common::Rng;
+use rng_common::Rng;
 use texsim::shading::roughness::{d_factor, decode_d_texels, rough_cos_twin};
 
 const VARIANTS: [RoughVariant; 4] = [

@@ -1,38 +1,14 @@
 //! Shared helpers of the NDF tests: a seeded PRNG and random moment texels.
 #![allow(dead_code)]
 
-use glam::DVec3;
 use hw_model::config::HwConfig;
 use hw_model::ndf::{NdfConfig, NdfTexels, NdfUnit};
 use hw_model::rsqrt::RsqrtConfig;
 use texsim::shading::ndf::{quantize_texel, Moments};
 
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    pub fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn normal(&mut self) -> f64 {
-        let u = self.unit().max(1e-300);
-        let v = self.unit();
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-    }
-    /// A unit vector within `max_tilt` radians of +z.
-    pub fn tilted(&mut self, max_tilt: f64) -> DVec3 {
-        let c = 1.0 - self.unit() * (1.0 - max_tilt.cos());
-        let s = (1.0 - c * c).max(0.0).sqrt();
-        let p = 2.0 * std::f64::consts::PI * self.unit();
-        DVec3::new(s * p.cos(), s * p.sin(), c)
-    }
-}
+#[path = "../rng_common/mod.rs"]
+mod rng_common;
+pub use rng_common::Rng;
 
 pub fn unit(cfg: &NdfConfig) -> NdfUnit {
     NdfUnit::new(

@@ -1,9 +1,9 @@
-//! Shared helper of the roughness tests: a seeded splitmix64 generator.
+//! The tests' one seeded generator (splitmix64): reproducible on every machine.
 #![allow(dead_code)]
 
 use glam::DVec3;
 
-/// Splitmix64: seeded, reproducible on every machine.
+/// splitmix64.
 pub struct Rng(pub u64);
 
 impl Rng {
@@ -18,9 +18,26 @@ impl Rng {
     pub fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
-    /// Uniform in 0..n.
+    /// Uniform in [a, b).
+    pub fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.unit()
+    }
+    /// Uniform integer in [0, n).
     pub fn below(&mut self, n: u64) -> u64 {
         self.next() % n
+    }
+    /// Standard normal (Box-Muller).
+    pub fn normal(&mut self) -> f64 {
+        let u = self.unit().max(1e-300);
+        let v = self.unit();
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+    }
+    /// A unit vector within `max_tilt` radians of +z.
+    pub fn tilted(&mut self, max_tilt: f64) -> DVec3 {
+        let c = 1.0 - self.unit() * (1.0 - max_tilt.cos());
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        let p = 2.0 * std::f64::consts::PI * self.unit();
+        DVec3::new(s * p.cos(), s * p.sin(), c)
     }
     /// A uniformly distributed unit vector (rejection sampling in the unit ball).
     pub fn dir(&mut self) -> DVec3 {
