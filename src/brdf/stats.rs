@@ -78,6 +78,26 @@ fn result(statistic: f64, groups: usize, total_probability: f64, lost: usize) ->
     }
 }
 
+/// The chi-square result of `samples` binned into `observed` against the bin probabilities
+/// `expected` (bins expecting fewer than 5 merged); `lost` samples make it infinite.
+fn binned_result(
+    observed: &[f64],
+    expected: &[f64],
+    samples: usize,
+    total_probability: f64,
+    lost: usize,
+) -> Chi2Result {
+    let n = samples as f64;
+    let pairs: Vec<(f64, f64)> = observed
+        .iter()
+        .zip(expected)
+        .map(|(&o, &e)| (o, e * n))
+        .collect();
+    let (statistic, groups) = chi2_merged(&pairs, 5.0);
+    let statistic = if lost > 0 { f64::INFINITY } else { statistic };
+    result(statistic, groups, total_probability, lost)
+}
+
 /// Wilson-Hilferty approximation of the chi-square quantile for `dof` degrees of freedom and
 /// standard normal quantile `z`.
 #[must_use]
@@ -233,15 +253,7 @@ pub fn chi2_k2_of(
             None => lost += 1,
         }
     }
-    let n = samples as f64;
-    let pairs: Vec<(f64, f64)> = observed
-        .iter()
-        .zip(&expected)
-        .map(|(&o, &e)| (o, e * n))
-        .collect();
-    let (statistic, groups) = chi2_merged(&pairs, 5.0);
-    let statistic = if lost > 0 { f64::INFINITY } else { statistic };
-    result(statistic, groups, total_probability, lost)
+    binned_result(&observed, &expected, samples, total_probability, lost)
 }
 
 /// Chi-square test of the half-vector sampler [`AshikhminShirley::sample_h`] (eqs. 21-22)
@@ -294,7 +306,6 @@ pub fn chi2_h_of(
         .collect();
     let mu_edge = |j: usize, k: usize| (k as f64 / NC as f64).powf(1.0 / (ej[j] + 1.0));
     let norm = ((nu + 1.0) * (nv + 1.0)).sqrt() / (2.0 * PI);
-    let n = samples as f64;
     let mut expected = vec![0.0; NP * NC];
     for j in 0..NP {
         // Integrate in psi: a smooth change of variables that follows the lobe.
@@ -332,11 +343,5 @@ pub fn chi2_h_of(
         let k = ((t * NC as f64) as usize).min(NC - 1);
         observed[j * NC + k] += 1.0;
     }
-    let pairs: Vec<(f64, f64)> = observed
-        .iter()
-        .zip(&expected)
-        .map(|(&o, &e)| (o, e * n))
-        .collect();
-    let (statistic, groups) = chi2_merged(&pairs, 5.0);
-    result(statistic, groups, total_probability, 0)
+    binned_result(&observed, &expected, samples, total_probability, 0)
 }
