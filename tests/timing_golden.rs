@@ -335,24 +335,38 @@ fn modern_preset_is_faster_and_cached() {
     }
 }
 
-fn row(name: &'static str, preset: &'static str, r: &TimingReport) -> String {
-    format!(
-        "    (\"{name}\", \"{preset}\", {}, {}, {}, {}, \"{}\", {}, {}, {}),",
+/// A report's row of [`EVERY_SCENE`] (the bottleneck owned).
+fn row(name: &'static str, preset: &'static str, r: &TimingReport) -> OwnedRow {
+    (
+        name,
+        preset,
         r.total_cycles,
         r.visibility_pass_cycles,
         r.shading_pass_cycles,
         r.stalls.iter().map(|s| s.cycles).sum::<u64>(),
-        r.bottleneck,
+        r.bottleneck.clone(),
         r.bottleneck_cycles,
         r.memory.texel_accesses,
         r.memory.dram_page_misses,
     )
 }
 
+type OwnedRow = (
+    &'static str,
+    &'static str,
+    u64,
+    u64,
+    u64,
+    u64,
+    String,
+    u64,
+    u64,
+    u64,
+);
+
 #[test]
 fn every_builtin_scene_on_two_presets() {
     let mut got = Vec::new();
-    let mut want = Vec::new();
     for &(name, _) in BUILTIN {
         for preset in ["texram16", "d3d11"] {
             let mut s = scene::builtin(name).expect("builtin scene");
@@ -364,15 +378,15 @@ fn every_builtin_scene_on_two_presets() {
             got.push(row(name, preset, &r));
         }
     }
-    for &(n, p, t, v, sh, st, b, bc, ta, pm) in EVERY_SCENE {
-        want.push(format!(
-            "    (\"{n}\", \"{p}\", {t}, {v}, {sh}, {st}, \"{b}\", {bc}, {ta}, {pm}),"
-        ));
-    }
+    let want: Vec<OwnedRow> = EVERY_SCENE
+        .iter()
+        .map(|&(n, p, t, v, sh, st, b, bc, ta, pm)| (n, p, t, v, sh, st, b.to_string(), bc, ta, pm))
+        .collect();
+    let listing: Vec<String> = got.iter().map(|r| format!("    {r:?},")).collect();
     assert!(
         got == want,
         "golden cycle counts of the scene suite changed; got:\n{}",
-        got.join("\n")
+        listing.join("\n")
     );
 }
 
