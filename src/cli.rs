@@ -661,11 +661,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         let varies_frame = set
             .iter()
             .any(|(f, _)| f == "frame" || f == "frame_kind" || f.ends_with(".frame_kind"));
-        let kind = match cfg.shading.frame.frame_kind {
-            hw_model::frame::FrameKind::Natural => "natural",
-            hw_model::frame::FrameKind::Unit => "unit",
-            hw_model::frame::FrameKind::Main => "main",
-        };
+        let kind = cfg.shading.frame.frame_kind.name();
         let used = &row.frame_used;
         if varies_frame && !used.is_empty() && !used.split('+').any(|u| u == kind) {
             eprintln!(

@@ -17,8 +17,8 @@ use crate::pipeline::{
 };
 use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
 use crate::report::{compare, ErrorMetrics, Image};
-use crate::scene::{FrameKind, MainDirection, Mesh, TextureImage};
 use crate::scene::{Light, Scene};
+use crate::scene::{MainDirection, Mesh, TextureImage};
 use crate::shading::bump::{
     height_to_offsets, heights_from_texture, normal_map_to_offsets, offsets_to_image, BumpParams,
     OffsetEncoding,
@@ -574,11 +574,7 @@ fn bump_frames(geo: &Geometry, hw: &HwConfig) -> String {
         .plans
         .iter()
         .filter_map(|p| p.bump.as_ref())
-        .map(|b| match b.frame.unwrap_or(hw.shading.frame.frame_kind) {
-            FrameKind::Natural => "natural",
-            FrameKind::Unit => "unit",
-            FrameKind::Main => "main",
-        })
+        .map(|b| b.frame.unwrap_or(hw.shading.frame.frame_kind).name())
         .collect();
     kinds.sort_unstable();
     kinds.dedup();

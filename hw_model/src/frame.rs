@@ -76,6 +76,18 @@ pub enum FrameKind {
     Main,
 }
 
+impl FrameKind {
+    /// The name used in configs, scenes and reports.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            FrameKind::Natural => "natural",
+            FrameKind::Unit => "unit",
+            FrameKind::Main => "main",
+        }
+    }
+}
+
 /// What the main direction `m` of frame 3 stands for, and the orientation of the texture
 /// coordinates: together they select which of `e1`, `e2` (and with which sign) carries `f_u`
 /// and which `f_v` (module doc, frame 3). The default is a constant `m` (or `m = p_v`) on
