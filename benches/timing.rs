@@ -25,22 +25,24 @@ fn model(c: &mut Criterion) {
 }
 
 fn render_cost(c: &mut Criterion) {
-    let s = texsim::scene::builtin("demo").expect("builtin");
     let hw = hw_model::HwConfig::texram16();
-    let maps = Maps::new(&s, hw.trilinear.texel_bits);
-    let mut g = c.benchmark_group("render-timing-cost/demo");
-    g.sample_size(10);
-    for (label, timing) in [("timing-off", false), ("timing-on", true)] {
-        let opts = RenderOptions {
-            reference: false,
-            timing,
-            ..Default::default()
-        };
-        g.bench_function(label, |b| {
-            b.iter(|| render(&s, &maps, &hw, &opts).expect("render"))
-        });
+    for name in ["demo", "w1-plane"] {
+        let s = texsim::scene::builtin(name).expect("builtin");
+        let maps = Maps::new(&s, hw.trilinear.texel_bits);
+        let mut g = c.benchmark_group(format!("render-timing-cost/{name}"));
+        g.sample_size(10);
+        for (label, timing) in [("timing-off", false), ("timing-on", true)] {
+            let opts = RenderOptions {
+                reference: false,
+                timing,
+                ..Default::default()
+            };
+            g.bench_function(label, |b| {
+                b.iter(|| render(&s, &maps, &hw, &opts).expect("render"))
+            });
+        }
+        g.finish();
     }
-    g.finish();
 }
 
 criterion_group!(benches, model, render_cost);

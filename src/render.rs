@@ -781,19 +781,22 @@ struct ShadeInput<'a> {
     costs: &'a [[UnitCost; StageKind::COUNT]],
 }
 
-/// Shades row `y` into `row`, adding to `c`; `on_pixel(plan, plan index, triangle, frag)`
-/// sees every shaded fragment (a no-op closure compiles to the plain loop; the timing model
-/// records its events through it).
+/// Shades row `y` into `row`, adding to `c`; `on_pixel(plan index, triangle, frag)` sees every
+/// shaded fragment (a no-op closure compiles to the plain loop; the timing model records its
+/// events through it, from the footprints the stages traced when `trace`).
+#[allow(clippy::too_many_arguments)]
 fn shade_row(
     inp: &ShadeInput,
     impls: &StageImpls,
     y: usize,
     row: &mut [[u16; 4]],
     c: &mut Counters,
-    mut on_pixel: impl FnMut(&Plan, u32, u32, &Frag),
+    trace: bool,
+    mut on_pixel: impl FnMut(u32, u32, &Frag),
 ) {
     let w = inp.vis.width as usize;
     let mut frag = Frag::default();
+    frag.trace.on = trace;
     let tris = &inp.vis.tri[y * w..(y + 1) * w];
     for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
         if t == NO_TRI {
@@ -816,7 +819,7 @@ fn shade_row(
             c,
         );
         *out = output16(&frag);
-        on_pixel(plan, a.plan, t, &frag);
+        on_pixel(a.plan, t, &frag);
     }
 }
 
@@ -838,7 +841,7 @@ fn shade(
             .enumerate()
             .map(|(y, row)| {
                 let mut c = Counters::default();
-                shade_row(inp, impls, y, row, &mut c, |_, _, _, _| {});
+                shade_row(inp, impls, y, row, &mut c, false, |_, _, _| {});
                 c
             })
             .reduce(Counters::default, |mut a, b| {
@@ -858,8 +861,8 @@ fn shade(
         .map(|(y, row)| {
             let mut c = Counters::default();
             let mut ev = RowEvents::with_capacity(w, lookups);
-            shade_row(inp, impls, y, row, &mut c, |plan, pi, t, frag| {
-                record_pixel(plan, pi, t, impls, inp.m, frag, &mut ev);
+            shade_row(inp, impls, y, row, &mut c, true, |pi, t, frag| {
+                record_pixel(pi, t, frag, &mut ev);
             });
             (c, ev)
         })

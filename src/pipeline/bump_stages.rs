@@ -13,6 +13,7 @@
 //! fit the vector format with full precision.
 
 use super::stages::{column, column_f, Counters, Machine, TriAttrs};
+use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
 use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::reference::{interpolate_f64, lod_f64, trilinear_f64};
@@ -25,7 +26,6 @@ use hw_model::frame::{main_frame, natural_frame, perturb_normal, unit_frame, Fra
 use hw_model::interpolator::interpolate;
 use hw_model::lod::lod;
 use hw_model::modulate::modulate;
-use hw_model::trilinear::trilinear;
 use hw_model::vector::{normalize3, offset_from_texel, Vec3x};
 
 /// One screen triangle's bump vertex data, in float and in the machine's formats.
@@ -304,7 +304,12 @@ pub fn run_bump_stage(
                 let d = super::stages::texel_derivs(&frag.uv_x, w, h);
                 let l = lod(d, fb, &hw.lod, &mut sat);
                 let [u, v] = frag.uv_x[0];
-                let r = trilinear(
+                let at = Lookup {
+                    stage: kind,
+                    lookup: 0,
+                    tex: t,
+                };
+                let r = trilinear_traced(
                     &m.tex_fixed[t],
                     u,
                     v,
@@ -313,7 +318,8 @@ pub fn run_bump_stage(
                     lfb_lod,
                     plan.wrap,
                     &hw.trilinear,
-                    None,
+                    &mut frag.trace,
+                    at,
                 );
                 let tb = hw.trilinear.texel_bits;
                 bf.texel_x = [u32::from(r[0]), u32::from(r[1])];
@@ -324,6 +330,12 @@ pub fn run_bump_stage(
                 let [u, v] = uv[0];
                 let r = trilinear_f64(&m.tex_float[t], u, v, l, plan.wrap);
                 bf.texel = [r[0], r[1]];
+                let at = Lookup {
+                    stage: kind,
+                    lookup: 0,
+                    tex: t,
+                };
+                trace_float_fetch(m, frag, fixed_in(StageKind::Texcoord), plan.wrap, at, 1);
             }
         }
         StageKind::Frame => {

@@ -16,6 +16,7 @@ pub mod bump_stages;
 pub mod ndf_stages;
 pub mod rough_stages;
 pub mod stages;
+pub mod trace;
 
 use crate::scene::{FrameKind, MainDirection, Material, WrapMode};
 use serde::Serialize;
@@ -335,6 +336,8 @@ pub struct Frag {
     pub rough_x: [u32; 3],
     /// NDF stages.
     pub ndf: ndf_stages::NdfFrag,
+    /// The texel footprints the stages fetched (recorded only when `trace.on`).
+    pub trace: trace::Trace,
 }
 
 /// Most point lights shaded per pixel by a bump material (their vectors are interpolated).

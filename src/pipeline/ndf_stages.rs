@@ -19,6 +19,7 @@
 //! runs `ndf-shade` in float and says so.
 
 use super::stages::{Counters, Machine};
+use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
 use super::{Frag, Impl, Plan, StageImpls, StageKind};
 use crate::fixedpoint::{from_unorm, to_raw, to_unorm};
 use crate::reference::{lod_f64, trilinear_f64};
@@ -31,7 +32,7 @@ use hw_model::lod::{lod, lod_cost};
 use hw_model::modulate::modulate;
 use hw_model::ndf::{ndf_cost, ndf_lookups, NdfNorm, NdfTexels, NdfUnit, NDF_FRAC};
 use hw_model::rsqrt::rsqrt_cost;
-use hw_model::trilinear::{trilinear, trilinear_cost};
+use hw_model::trilinear::trilinear_cost;
 use hw_model::vector::{dot3, normalize3, normalize_cost, Vec3x};
 use hw_model::UnitCost;
 
@@ -270,7 +271,12 @@ pub fn run_ndf_stage(
                     let Some(levels) = m.tex_fixed.get(np.maps + i) else {
                         continue;
                     };
-                    let r = trilinear(
+                    let at = Lookup {
+                        stage: kind,
+                        lookup: i as u32,
+                        tex: np.maps + i,
+                    };
+                    let r = trilinear_traced(
                         levels,
                         u,
                         v,
@@ -279,7 +285,8 @@ pub fn run_ndf_stage(
                         hw.lod.lod_frac_bits,
                         plan.wrap,
                         &hw.trilinear,
-                        None,
+                        &mut frag.trace,
+                        at,
                     );
                     frag.ndf.texel_x[i] = r;
                     frag.ndf.texel[i] = r.map(|x| from_unorm(u32::from(x), mb));
@@ -293,6 +300,13 @@ pub fn run_ndf_stage(
                     };
                     frag.ndf.texel[i] = trilinear_f64(levels, u, v, frag.lod, plan.wrap);
                 }
+                let at = Lookup {
+                    stage: kind,
+                    lookup: 0,
+                    tex: np.maps,
+                };
+                let raw_uv = fixed_in(StageKind::Texcoord);
+                trace_float_fetch(m, frag, raw_uv, plan.wrap, at, n_maps as u32);
             }
         }
         StageKind::NdfShade => {

@@ -18,6 +18,7 @@
 
 use super::bump_stages::point_lights;
 use super::stages::{Counters, Machine};
+use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
 use super::{Frag, Impl, Plan, StageImpls, StageKind};
 use crate::fixedpoint::{from_unorm, to_raw, to_unorm};
 use crate::maps::MipChain;
@@ -38,7 +39,7 @@ use hw_model::roughness::{
     decode_d, rough_blinn_phong, rough_blinn_phong_cost, scale_d, RoughShadeInput, RoughVariant,
 };
 use hw_model::rsqrt::rsqrt_cost;
-use hw_model::trilinear::{trilinear, trilinear_cost};
+use hw_model::trilinear::trilinear_cost;
 use hw_model::vector::{normalize3, normalize_cost, Vec3x};
 use hw_model::UnitCost;
 
@@ -311,7 +312,12 @@ pub fn run_rough_stage(
                 ];
                 let l = lod(d, fb, &hw.lod, &mut sat);
                 let [u, v] = uv[0];
-                let r = trilinear(
+                let at = Lookup {
+                    stage: kind,
+                    lookup: 0,
+                    tex: t,
+                };
+                let r = trilinear_traced(
                     &m.tex_fixed[t],
                     u,
                     v,
@@ -320,7 +326,8 @@ pub fn run_rough_stage(
                     hw.lod.lod_frac_bits,
                     plan.wrap,
                     &hw.trilinear,
-                    None,
+                    &mut frag.trace,
+                    at,
                 );
                 frag.rough_x = [0, 1, 2].map(|i| u32::from(r[i]));
                 frag.rough = frag.rough_x.map(|x| from_unorm(x, tb));
@@ -335,6 +342,12 @@ pub fn run_rough_stage(
                 ]);
                 let r = trilinear_f64(&m.tex_float[t], uv[0][0], uv[0][1], l, plan.wrap);
                 frag.rough = [r[0], r[1], r[2]];
+                let at = Lookup {
+                    stage: kind,
+                    lookup: 0,
+                    tex: t,
+                };
+                trace_float_fetch(m, frag, fixed_in(StageKind::Texcoord), plan.wrap, at, 1);
             }
         }
         StageKind::RoughShade => {

@@ -4,6 +4,7 @@
 //! hardware's input formats, so the per-pixel loop allocates nothing.
 
 use super::bump_stages::{self, run_bump_stage, BumpAttrs};
+use super::trace::{trilinear_traced, Lookup, Trace};
 use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
@@ -19,7 +20,7 @@ use glam::DVec3;
 use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
-use hw_model::footprint::{footprint, footprint_cost, footprint_filter};
+use hw_model::footprint::{footprint, footprint_cost, footprint_filter, MAX_PROBES};
 use hw_model::frame::{frame_cost, len_format, perturb_cost};
 use hw_model::interpolator::{
     interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
@@ -29,7 +30,7 @@ use hw_model::lod::{lod, lod_cost};
 use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
 use hw_model::reciprocal::Reciprocal;
 use hw_model::rsqrt::rsqrt_cost;
-use hw_model::trilinear::{trilinear, trilinear_cost, Level};
+use hw_model::trilinear::{trilinear_cost, Level, TrilinearTrace};
 use hw_model::vector::{normalize_cost, vector_format};
 use hw_model::UnitCost;
 
@@ -384,6 +385,7 @@ pub fn run(
     frag.color = plan.const_color;
     frag.out = plan.const_color;
     frag.out_bits = 0;
+    frag.trace.clear();
     let mut color_from_stage = false;
     for &kind in &plan.stages {
         let k = kind.index();
@@ -502,28 +504,12 @@ pub fn run(
                     } else {
                         to_raw(frag.lod, &m.lod_fmt, sat)
                     };
-                    let [u, v] = frag.uv_x[0];
-                    let r = if aniso {
-                        let levels = &m.tex_fixed[t];
-                        let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
-                        let fp = footprint(&frag.uv_x, size, fb, probes, adaptive, &hw.lod, sat);
-                        if fp.probes != probes {
-                            c.cost[k] = per_pixel_probes(c.cost[k], cost, m, fp.probes);
-                        }
-                        footprint_filter(levels, u, v, fb, &fp, lfb, plan.wrap, &hw.trilinear, None)
-                    } else {
-                        trilinear(
-                            &m.tex_fixed[t],
-                            u,
-                            v,
-                            fb,
-                            l,
-                            lfb,
-                            plan.wrap,
-                            &hw.trilinear,
-                            None,
-                        )
-                    };
+                    let uv = frag.uv_x;
+                    let (r, took) =
+                        trilinear_fixed(m, plan, t, &uv, l, aniso, &mut frag.trace, sat);
+                    if took != probes {
+                        c.cost[k] = per_pixel_probes(c.cost[k], cost, m, took);
+                    }
                     frag.texel_x = r.map(u32::from);
                     frag.texel = frag.texel_x.map(|x| unorm(x, tb));
                     frag.out_x = frag.texel_x;
@@ -542,6 +528,31 @@ pub fn run(
                         trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap)
                     };
                     frag.out_bits = 0;
+                    if frag.trace.on {
+                        // The footprints the hardware unit fetches for these inputs.
+                        let mut scratch = SatCounter::default();
+                        let uv = if fixed_in(StageKind::Texcoord) {
+                            frag.uv_x
+                        } else {
+                            frag.uv
+                                .map(|s| s.map(|x| to_raw(x, &m.uv_fmt, &mut scratch)))
+                        };
+                        let l = if fixed_in(StageKind::Lod) {
+                            frag.lod_x
+                        } else {
+                            to_raw(frag.lod, &m.lod_fmt, &mut scratch)
+                        };
+                        let _ = trilinear_fixed(
+                            m,
+                            plan,
+                            t,
+                            &uv,
+                            l,
+                            aniso,
+                            &mut frag.trace,
+                            &mut scratch,
+                        );
+                    }
                 }
                 frag.out = frag.texel;
             }
@@ -584,6 +595,72 @@ pub fn run(
             }
         }
     }
+}
+
+/// The fixed trilinear stage of texture `t` at raw coordinates `uv` (sample and helper
+/// samples) and raw LOD `l`: footprint assembly when `aniso`, else one trilinear lookup; its
+/// footprints go into `trace`. Returns the filtered texel and the probes it took.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn trilinear_fixed(
+    m: &Machine,
+    plan: &Plan,
+    t: usize,
+    uv: &[[i64; 2]; 3],
+    l: i64,
+    aniso: bool,
+    trace: &mut Trace,
+    sat: &mut SatCounter,
+) -> ([u16; 4], u32) {
+    let hw = m.hw;
+    let fb = m.uv_fmt.frac_bits;
+    let lfb = hw.lod.lod_frac_bits;
+    let levels = &m.tex_fixed[t];
+    let [u, v] = uv[0];
+    let kind = StageKind::Trilinear;
+    if !aniso {
+        let at = Lookup {
+            stage: kind,
+            lookup: 0,
+            tex: t,
+        };
+        let r = trilinear_traced(
+            levels,
+            u,
+            v,
+            fb,
+            l,
+            lfb,
+            plan.wrap,
+            &hw.trilinear,
+            trace,
+            at,
+        );
+        return (r, hw.trilinear.aniso_probes);
+    }
+    let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
+    let (probes, adaptive) = (hw.trilinear.aniso_probes, hw.trilinear.aniso_adaptive);
+    let fp = footprint(uv, size, fb, probes, adaptive, &hw.lod, sat);
+    if !trace.on {
+        let r = footprint_filter(levels, u, v, fb, &fp, lfb, plan.wrap, &hw.trilinear, None);
+        return (r, fp.probes);
+    }
+    let mut traces = [TrilinearTrace::default(); MAX_PROBES];
+    let r = footprint_filter(
+        levels,
+        u,
+        v,
+        fb,
+        &fp,
+        lfb,
+        plan.wrap,
+        &hw.trilinear,
+        Some(&mut traces),
+    );
+    for (i, tr) in traces.iter().take(fp.probes as usize).enumerate() {
+        trace.record(kind, i as u32, t, tr);
+    }
+    (r, fp.probes)
 }
 
 /// Quantizes the float texture coordinates of the first `samples` samples into the machine's

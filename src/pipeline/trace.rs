@@ -1,0 +1,180 @@
+//! Texture-access traces: the texel footprints a fragment's stages fetch, recorded by the
+//! functional pass itself (the timing model's events, never a replay).
+//!
+//! A stage makes every trilinear lookup through [`trilinear_traced`] (or records its
+//! footprint-assembly probes with [`Trace::record`]). When the shading pass collects events
+//! ([`Trace::on`]), the unit is called with its trace and the footprints it read are appended
+//! to the fragment's [`Trace`]; when it does not, the plain unit runs and nothing is paid but
+//! one predictable branch per lookup. A float twin under timing records the footprints that
+//! the hardware unit fetches for its inputs rounded into the machine's formats (the float
+//! arithmetic has no addresses of its own).
+
+use super::StageKind;
+use hw_model::config::TrilinearConfig;
+use hw_model::trilinear::{trilinear, Level, TrilinearTrace};
+use hw_model::wrap::WrapMode;
+use serde::Serialize;
+
+/// One bilinear footprint (2x2 texels) read from texture memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct TexelFootprint {
+    /// Stage kind index (`StageKind::index`) of the lookup.
+    pub stage: u8,
+    /// Lookup number within the stage (probe of footprint assembly, or the n-th map of a
+    /// multi-lookup stage); the footprints of one lookup are consecutive.
+    pub lookup: u8,
+    /// MIP level.
+    pub level: u8,
+    /// Texture index (into the prepared maps).
+    pub tex: u16,
+    /// Texel columns x0, x1 and rows y0, y1 (after wrapping); texels (x0,y0), (x1,y0),
+    /// (x0,y1), (x1,y1).
+    pub x: [u32; 2],
+    pub y: [u32; 2],
+}
+
+/// Most footprints one fragment can fetch: footprint assembly's 16 probes of two levels, the
+/// offset and roughness maps (two levels each) and four NDF maps (two levels each).
+pub const MAX_FOOTPRINTS: usize = 2 * hw_model::footprint::MAX_PROBES + 2 * 2 + 2 * 4;
+
+/// The footprints of one fragment, in the order its stages fetched them.
+#[derive(Clone, Copy, Debug)]
+pub struct Trace {
+    /// Record footprints (set by the shading pass when it collects timing events).
+    pub on: bool,
+    len: u32,
+    fps: [TexelFootprint; MAX_FOOTPRINTS],
+}
+
+impl Default for Trace {
+    fn default() -> Self {
+        Self {
+            on: false,
+            len: 0,
+            fps: [TexelFootprint::default(); MAX_FOOTPRINTS],
+        }
+    }
+}
+
+impl Trace {
+    /// Forgets the previous fragment's footprints.
+    #[inline]
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// The footprints recorded since [`Trace::clear`].
+    #[must_use]
+    pub fn footprints(&self) -> &[TexelFootprint] {
+        &self.fps[..self.len as usize]
+    }
+
+    /// Appends the footprints of one trilinear lookup (one per level it used).
+    pub fn record(&mut self, stage: StageKind, lookup: u32, tex: usize, t: &TrilinearTrace) {
+        for b in t.level.iter().take(t.levels_used as usize) {
+            let Some(slot) = self.fps.get_mut(self.len as usize) else {
+                debug_assert!(
+                    false,
+                    "more than {MAX_FOOTPRINTS} footprints in one fragment"
+                );
+                return;
+            };
+            *slot = TexelFootprint {
+                stage: stage.index() as u8,
+                lookup: lookup as u8,
+                level: b.level as u8,
+                tex: tex as u16,
+                x: [b.coords[0].0, b.coords[1].0],
+                y: [b.coords[0].1, b.coords[2].1],
+            };
+            self.len += 1;
+        }
+    }
+}
+
+/// Where a traced lookup comes from: the stage, its lookup number and the map it reads.
+#[derive(Clone, Copy, Debug)]
+pub struct Lookup {
+    pub stage: StageKind,
+    pub lookup: u32,
+    pub tex: usize,
+}
+
+/// [`hw_model::trilinear::trilinear`] of a stage's lookup, its footprints recorded into `trace`
+/// when tracing is on.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn trilinear_traced(
+    levels: &[Level],
+    u: i64,
+    v: i64,
+    frac: u32,
+    lod: i64,
+    lod_frac_bits: u32,
+    wrap: [WrapMode; 2],
+    cfg: &TrilinearConfig,
+    trace: &mut Trace,
+    at: Lookup,
+) -> [u16; 4] {
+    if !trace.on {
+        return trilinear(levels, u, v, frac, lod, lod_frac_bits, wrap, cfg, None);
+    }
+    let mut t = TrilinearTrace::default();
+    let r = trilinear(
+        levels,
+        u,
+        v,
+        frac,
+        lod,
+        lod_frac_bits,
+        wrap,
+        cfg,
+        Some(&mut t),
+    );
+    trace.record(at.stage, at.lookup, at.tex, &t);
+    r
+}
+
+/// For a float twin under timing: records the footprints of the hardware lookups the fixed
+/// twin makes, `maps` maps from `at.tex` on (lookups `at.lookup..`), at the fragment's raw
+/// coordinates (its float carriers rounded into the machine's format unless `raw_uv`) with the
+/// LOD of their derivatives against level 0 of `at.tex`, as the fixed fetch stages compute it.
+pub fn trace_float_fetch(
+    m: &super::stages::Machine,
+    frag: &mut super::Frag,
+    raw_uv: bool,
+    wrap: [WrapMode; 2],
+    at: Lookup,
+    maps: u32,
+) {
+    if !frag.trace.on {
+        return;
+    }
+    let Some(l0) = m.tex_fixed.get(at.tex).and_then(|l| l.first()) else {
+        return;
+    };
+    let mut scratch = hw_model::fixed::SatCounter::default();
+    let uv = if raw_uv {
+        frag.uv_x
+    } else {
+        frag.uv
+            .map(|s| s.map(|x| crate::fixedpoint::to_raw(x, &m.uv_fmt, &mut scratch)))
+    };
+    let fb = m.uv_fmt.frac_bits;
+    let d = super::stages::texel_derivs(&uv, l0.width, l0.height);
+    let l = hw_model::lod::lod(d, fb, &m.hw.lod, &mut scratch);
+    let [u, v] = uv[0];
+    for i in 0..maps {
+        let Some(levels) = m.tex_fixed.get(at.tex + i as usize) else {
+            continue;
+        };
+        let at = Lookup {
+            lookup: at.lookup + i,
+            tex: at.tex + i as usize,
+            ..at
+        };
+        let lfb = m.hw.lod.lod_frac_bits;
+        let hw = &m.hw.trilinear;
+        let _ = trilinear_traced(levels, u, v, fb, l, lfb, wrap, hw, &mut frag.trace, at);
+    }
+}
