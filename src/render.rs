@@ -13,7 +13,7 @@ use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
 use crate::pipeline::bump_stages::{BumpAttrs, BumpVertex};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{
-    plan_with_bump, BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS,
+    plan_with_bump, BumpPlan, Frag, Impl, Plan, Program, StageImpls, StageKind, MAX_POINT_LIGHTS,
 };
 use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
 use crate::report::{compare, ErrorMetrics, Image};
@@ -777,17 +777,15 @@ struct ShadeInput<'a> {
     attrs: &'a [TriAttrs],
     geo: &'a Geometry,
     m: &'a Machine<'a>,
-    /// Cost of each stage kind, per plan.
-    costs: &'a [[UnitCost; StageKind::COUNT]],
 }
 
-/// Shades row `y` into `row`, adding to `c`; `on_pixel(plan index, triangle, frag)` sees every
+/// Shades row `y` into `row` with the plans compiled as `progs`, adding to `c`; `on_pixel(plan index, triangle, frag)` sees every
 /// shaded fragment (a no-op closure compiles to the plain loop; the timing model records its
 /// events through it, from the footprints the stages traced when `trace`).
 #[allow(clippy::too_many_arguments)]
 fn shade_row(
     inp: &ShadeInput,
-    impls: &StageImpls,
+    progs: &[Program],
     y: usize,
     row: &mut [[u16; 4]],
     c: &mut Counters,
@@ -807,16 +805,7 @@ fn shade_row(
         let tri = &inp.setup.tris[t as usize];
         let plan = &inp.geo.plans[pi];
         run(
-            plan,
-            &inp.costs[pi],
-            impls,
-            inp.m,
-            tri,
-            a,
-            x as i64,
-            y as i64,
-            &mut frag,
-            c,
+            &progs[pi], plan, inp.m, tri, a, x as i64, y as i64, &mut frag, c,
         );
         *out = output16(&frag);
         on_pixel(a.plan, t, &frag);
@@ -834,6 +823,13 @@ fn shade(
     let vis = inp.vis;
     let w = vis.width as usize;
     let mut img = Image::new(vis.width, vis.height, background);
+    let progs: Vec<Program> = inp
+        .geo
+        .plans
+        .iter()
+        .map(|p| Program::new(p, impls, inp.m))
+        .collect();
+    let progs = &progs[..];
     if !timing {
         let counters = img
             .px
@@ -841,7 +837,7 @@ fn shade(
             .enumerate()
             .map(|(y, row)| {
                 let mut c = Counters::default();
-                shade_row(inp, impls, y, row, &mut c, false, |_, _, _| {});
+                shade_row(inp, progs, y, row, &mut c, false, |_, _, _| {});
                 c
             })
             .reduce(Counters::default, |mut a, b| {
@@ -861,7 +857,7 @@ fn shade(
         .map(|(y, row)| {
             let mut c = Counters::default();
             let mut ev = RowEvents::with_capacity(w, lookups);
-            shade_row(inp, impls, y, row, &mut c, true, |pi, t, frag| {
+            shade_row(inp, progs, y, row, &mut c, true, |pi, t, frag| {
                 record_pixel(pi, t, frag, &mut ev);
             });
             (c, ev)
@@ -974,7 +970,6 @@ pub fn render(
         attrs: &attrs,
         geo: &geo,
         m: &m,
-        costs: &costs,
     };
     let (hw_image, counters, mut events) = shade(&inp, &opts.hw_impls, bg, opts.timing);
     if let Some(fe) = events.as_mut() {
@@ -1051,15 +1046,12 @@ pub fn render(
             .with_lights(&scene.lights, scene.ambient)
             .with_bump_attrs(&battrs)
             .with_ndf_truth(&ndf_truth);
-        let tcosts: Vec<[UnitCost; StageKind::COUNT]> =
-            geo.plans.iter().map(|p| mt.plan_costs(p)).collect();
         let tin = ShadeInput {
             vis: &vis,
             setup: &setup,
             attrs: &attrs,
             geo: &geo,
             m: &mt,
-            costs: &tcosts,
         };
         let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, false);
         geo.plans = saved;

@@ -32,7 +32,7 @@
 //! `l + v = 0` (`k1 = -k2`) gives no contribution and is counted in `h_zero`.
 
 use super::stages::{Counters, Machine};
-use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind};
+use super::{BumpPlan, Frag, Impl, Plan, Px, StageImpls, StageKind};
 use crate::brdf::{AshikhminShirley, Dots};
 use crate::fixedpoint::{to_raw, to_unorm};
 use crate::scene::{FrameKind, Material};
@@ -377,4 +377,9 @@ pub fn run_as_shade(
         super::bump_stages::float_output(acc, frag, c);
     }
     c.sat[k] = sat;
+}
+
+/// Stage-table entry of `as-shade`; it runs the twin `px.impls` names for it.
+pub fn row(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    run_as_shade(px.plan, px.impls, px.m, frag, c);
 }

@@ -14,19 +14,25 @@
 
 use super::stages::{column, column_f, Counters, Machine, TriAttrs};
 use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
-use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
+use super::{BumpPlan, Frag, Impl, Plan, Px, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::reference::{interpolate_f64, lod_f64, trilinear_f64};
 use crate::scene::{FrameKind, MainDirection};
 use crate::shading::reference as fref;
 use glam::DVec3;
-use hw_model::blinn_phong::{blinn_phong, BlinnPhongInput};
+use hw_model::blinn_phong::{blinn_phong, blinn_phong_cost, BlinnPhongInput};
 use hw_model::fixed::{Format, SatCounter};
-use hw_model::frame::{main_frame, natural_frame, perturb_normal, unit_frame, Frame, MainRole};
-use hw_model::interpolator::interpolate;
-use hw_model::lod::lod;
+use hw_model::frame::{
+    frame_cost, main_frame, natural_frame, perturb_cost, perturb_normal, unit_frame, Frame,
+    MainRole,
+};
+use hw_model::interpolator::{interpolate, interpolate_cost};
+use hw_model::lod::{lod, lod_cost};
 use hw_model::modulate::modulate;
-use hw_model::vector::{normalize3, offset_from_texel, Vec3x};
+use hw_model::rsqrt::rsqrt_cost;
+use hw_model::trilinear::trilinear_cost;
+use hw_model::vector::{normalize3, normalize_cost, offset_from_texel, Vec3x};
+use hw_model::UnitCost;
 
 /// One screen triangle's bump vertex data, in float and in the machine's formats.
 #[derive(Clone, Copy, Debug, Default)]
@@ -598,4 +604,50 @@ pub(super) fn fixed_output(acc: [u64; 3], frag: &mut Frag, sat: &mut SatCounter,
     frag.out_x[3] = max as u32;
     frag.out[3] = 1.0;
     frag.out_bits = cb;
+}
+
+/// Cost of one invocation of a bump stage of `plan` (zero without a bump plan).
+pub fn bump_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
+    let Some(bp) = &plan.bump else {
+        return UnitCost::default();
+    };
+    let u = &m.units;
+    let fk = m.frame_of(bp);
+    let np = point_lights(m) as u32;
+    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
+    let mac = UnitCost {
+        ops: 3,
+        cycles: u.cfg.shade.shade_cycles,
+        texels: 0,
+    };
+    match kind {
+        StageKind::Normal => interpolate_cost(&m.hw.interp).times(normal_attr_count(m, bp, fk)),
+        StageKind::BumpFetch => lod_cost(&m.hw.lod).plus(trilinear_cost(&m.hw.trilinear, 2)),
+        StageKind::Frame => frame_cost(fk, u),
+        StageKind::Perturb => perturb_cost(u),
+        StageKind::Phong => {
+            let lights = m.lights.len() as u32;
+            let mut c = blinn_phong_cost(u)
+                .times(lights)
+                .plus(nz.times(1 + np))
+                .plus(mac.times(1 + lights));
+            if plan.texture.is_some() {
+                c = c.plus(mac);
+            }
+            c
+        }
+        _ => UnitCost::default(),
+    }
+}
+
+/// Stage-table entry of bump stage `K` (`StageKind::index`); it runs the twin `px.impls`
+/// names for it.
+pub fn row<const K: usize>(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    run_bump_stage(StageKind::ALL[K], px.plan, px.impls, px.m, px.a, frag, c);
+}
+
+/// Stage-table cost of bump stage `K`.
+#[must_use]
+pub fn row_cost<const K: usize>(m: &Machine, plan: &Plan) -> UnitCost {
+    bump_stage_cost(m, StageKind::ALL[K], plan)
 }

@@ -12,127 +12,23 @@
 //! rounded into its input format (how a mixed run isolates one stage's error).
 
 pub mod as_stages;
+pub mod bary;
 pub mod bump_stages;
+pub mod color;
+pub mod lod;
+pub mod modulate;
 pub mod ndf_stages;
 pub mod rough_stages;
 pub mod stages;
+pub mod table;
+pub mod texcoord;
 pub mod trace;
+pub mod trilinear;
+
+pub use table::{Program, Px, StageKind, StageRow, STAGES};
 
 use crate::scene::{FrameKind, MainDirection, Material, WrapMode};
 use serde::Serialize;
-use std::fmt;
-
-/// The kinds of stage, in pipeline order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum StageKind {
-    /// Perspective-correct barycentrics (reciprocal unit + interpolator setup).
-    Bary,
-    /// Vertex colour interpolation (Gouraud lighting result).
-    Color,
-    /// Texture-coordinate interpolation, with the helper samples for derivatives.
-    Texcoord,
-    /// LOD from the texture-coordinate derivatives.
-    Lod,
-    /// Wrap + trilinear MIP filtering.
-    Trilinear,
-    /// Colour x texel.
-    Modulate,
-    /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
-    Normal,
-    /// Bump materials: LOD + trilinear fetch of the offset map `(f_u, f_v)`.
-    BumpFetch,
-    /// Bump materials: the local frame (natural, unit or main direction).
-    Frame,
-    /// Bump materials: `n' = normalize(n + f_u s_u + f_v s_v)`.
-    Perturb,
-    /// Bump materials: per-pixel Blinn-Phong over every scene light (+ ambient).
-    Phong,
-    /// Ashikhmin-Shirley materials: the anisotropic Phong BRDF per pixel over every light.
-    AsShade,
-    /// Roughness materials: trilinear fetch of the D map at the bump fetch's LOD.
-    RoughFetch,
-    /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
-    RoughShade,
-    /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).
-    NdfFetch,
-    /// NDF materials: Sigma, its inverse, Mahalanobis distance, density, normalization, lights.
-    NdfShade,
-}
-
-impl StageKind {
-    /// Number of stage kinds.
-    pub const COUNT: usize = 16;
-
-    /// Every stage kind, in pipeline order (the bump stages follow the texture stages).
-    pub const ALL: [StageKind; StageKind::COUNT] = [
-        StageKind::Bary,
-        StageKind::Color,
-        StageKind::Texcoord,
-        StageKind::Lod,
-        StageKind::Trilinear,
-        StageKind::Modulate,
-        StageKind::Normal,
-        StageKind::BumpFetch,
-        StageKind::Frame,
-        StageKind::Perturb,
-        StageKind::Phong,
-        StageKind::AsShade,
-        StageKind::RoughFetch,
-        StageKind::RoughShade,
-        StageKind::NdfFetch,
-        StageKind::NdfShade,
-    ];
-
-    /// The name used on the command line and in reports.
-    #[must_use]
-    pub const fn name(self) -> &'static str {
-        match self {
-            StageKind::Bary => "bary",
-            StageKind::Color => "color",
-            StageKind::Texcoord => "texcoord",
-            StageKind::Lod => "lod",
-            StageKind::Trilinear => "trilinear",
-            StageKind::Modulate => "modulate",
-            StageKind::Normal => "normal",
-            StageKind::BumpFetch => "bump-fetch",
-            StageKind::Frame => "frame",
-            StageKind::Perturb => "perturb",
-            StageKind::Phong => "phong",
-            StageKind::AsShade => "as-shade",
-            StageKind::RoughFetch => "rough-fetch",
-            StageKind::RoughShade => "rough-shade",
-            StageKind::NdfFetch => "ndf-fetch",
-            StageKind::NdfShade => "ndf-shade",
-        }
-    }
-
-    /// Parses a stage name.
-    pub fn parse(s: &str) -> crate::Result<StageKind> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
-                crate::Error::msg(format!(
-                    "unknown stage '{s}' (stages: {})",
-                    names.join(", ")
-                ))
-            })
-    }
-
-    /// Position in [`StageKind::ALL`].
-    #[must_use]
-    pub const fn index(self) -> usize {
-        self as usize
-    }
-}
-
-impl fmt::Display for StageKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// Which twin of a stage runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]

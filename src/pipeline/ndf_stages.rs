@@ -20,7 +20,7 @@
 
 use super::stages::{Counters, Machine};
 use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
-use super::{Frag, Impl, Plan, StageImpls, StageKind};
+use super::{Frag, Impl, Plan, Px, StageImpls, StageKind};
 use crate::fixedpoint::{from_unorm, to_raw, to_unorm};
 use crate::reference::{lod_f64, trilinear_f64};
 use crate::shading::ndf::{eval_float, ground_truth, Moments};
@@ -472,3 +472,15 @@ pub fn shade_is_float_only(hw: &HwConfig) -> bool {
 /// Why a render with `ndf_norm = exact` has no cycle count (`CycleEstimate::not_modelled`).
 pub const EXACT_NOT_MODELLED: &str =
     "ndf-shade with ndf_norm = exact is float only: no hardware cost model";
+
+/// Stage-table entry of ndf stage `K` (`StageKind::index`); it runs the twin `px.impls`
+/// names for it.
+pub fn row<const K: usize>(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    run_ndf_stage(StageKind::ALL[K], px.plan, px.impls, px.m, frag, c);
+}
+
+/// Stage-table cost of ndf stage `K`.
+#[must_use]
+pub fn row_cost<const K: usize>(m: &Machine, plan: &Plan) -> UnitCost {
+    ndf_stage_cost(m, StageKind::ALL[K], plan)
+}

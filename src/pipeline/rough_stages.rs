@@ -19,7 +19,7 @@
 use super::bump_stages::point_lights;
 use super::stages::{Counters, Machine};
 use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
-use super::{Frag, Impl, Plan, StageImpls, StageKind};
+use super::{Frag, Impl, Plan, Px, StageImpls, StageKind};
 use crate::fixedpoint::{from_unorm, to_raw, to_unorm};
 use crate::maps::MipChain;
 use crate::reference::{lod_f64, trilinear_f64};
@@ -520,4 +520,16 @@ pub fn run_rough_stage(
         _ => {}
     }
     c.sat[k] = sat;
+}
+
+/// Stage-table entry of rough stage `K` (`StageKind::index`); it runs the twin `px.impls`
+/// names for it.
+pub fn row<const K: usize>(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    run_rough_stage(StageKind::ALL[K], px.plan, px.impls, px.m, frag, c);
+}
+
+/// Stage-table cost of rough stage `K`.
+#[must_use]
+pub fn row_cost<const K: usize>(m: &Machine, plan: &Plan) -> UnitCost {
+    rough_stage_cost(m, StageKind::ALL[K], plan)
 }

@@ -1,37 +1,26 @@
-//! The stage twins: for each [`StageKind`], a Fixed implementation (hw_model units, declared
-//! formats) and a Float implementation (`crate::reference`, exact math), behind one entry point
-//! [`run`]. Per-triangle vertex data is prepared once ([`TriAttrs`]), in float and in the
-//! hardware's input formats, so the per-pixel loop allocates nothing.
+//! What every stage shares: the [`Machine`] (the units and formats of one hardware
+//! configuration, built once per render), the per-triangle vertex data ([`TriAttrs`], in float
+//! and in the hardware's input formats, so the per-pixel loop allocates nothing), the run's
+//! [`Counters`], and [`run`], which runs a compiled [`Program`] on one fragment. The stages
+//! themselves are one file each, registered in [`super::table`].
 
-use super::bump_stages::{self, run_bump_stage, BumpAttrs};
-use super::trace::{trilinear_traced, Lookup, Trace};
-use super::{BumpPlan, Frag, Impl, Plan, StageImpls, StageKind, MAX_POINT_LIGHTS};
-use crate::fixedpoint::{from_raw, to_raw, to_unorm};
-use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
+use super::bump_stages::BumpAttrs;
+use super::{BumpPlan, Frag, Plan, Program, Px, StageKind, MAX_POINT_LIGHTS};
+use crate::fixedpoint::{to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
-use crate::reference::{
-    interpolate_f64, lod_f64, perspective_bary_derivs_f64, perspective_bary_f64, trilinear_f64,
-    LevelF,
-};
+use crate::reference::LevelF;
 use crate::scene::{FrameKind, Light};
 use crate::shading::reference as fref;
 use glam::DVec3;
-use hw_model::blinn_phong::{blinn_phong_cost, ShadingUnits};
+use hw_model::blinn_phong::ShadingUnits;
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Rounding, SatCounter};
-use hw_model::footprint::{footprint, footprint_cost, footprint_filter, MAX_PROBES};
-use hw_model::frame::{frame_cost, len_format, perturb_cost};
-use hw_model::interpolator::{
-    interpolate, interpolate_cost, perspective_bary, perspective_bary_cost,
-    perspective_bary_derivs, perspective_bary_derivs_cost,
-};
-use hw_model::lod::{lod, lod_cost};
-use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
+use hw_model::frame::len_format;
+use hw_model::modulate::unorm_convert;
 use hw_model::reciprocal::Reciprocal;
-use hw_model::rsqrt::rsqrt_cost;
-use hw_model::trilinear::{trilinear_cost, Level, TrilinearTrace};
-use hw_model::vector::{normalize_cost, vector_format};
+use hw_model::trilinear::Level;
+use hw_model::vector::vector_format;
 use hw_model::UnitCost;
 
 /// Per-stage counters of one run (summed over fragments; order-independent integer sums).
@@ -220,67 +209,7 @@ impl<'a> Machine<'a> {
     /// Cost of one invocation of `kind` in `plan` (fixed units' op and cycle counts).
     #[must_use]
     pub fn stage_cost(&self, kind: StageKind, plan: &Plan) -> UnitCost {
-        let samples = if plan.derivatives { 3 } else { 1 };
-        let i = &self.hw.interp;
-        match kind {
-            StageKind::Bary if plan.derivatives => perspective_bary_derivs_cost(i, &self.recip),
-            StageKind::Bary => perspective_bary_cost(i, &self.recip),
-            StageKind::Color => interpolate_cost(i).times(3),
-            StageKind::Texcoord => interpolate_cost(i).times(2 * samples),
-            StageKind::Lod => lod_cost(&self.hw.lod),
-            StageKind::Trilinear if plan.derivatives => footprint_cost(
-                &self.hw.trilinear,
-                &self.hw.lod,
-                self.hw.trilinear.aniso_probes,
-            ),
-            StageKind::Trilinear => trilinear_cost(&self.hw.trilinear, 2),
-            StageKind::Modulate => modulate_cost(&self.hw.color),
-            StageKind::AsShade => super::as_stages::as_shade_cost(self, plan),
-            StageKind::RoughFetch | StageKind::RoughShade => {
-                super::rough_stages::rough_stage_cost(self, kind, plan)
-            }
-            StageKind::NdfFetch | StageKind::NdfShade => {
-                super::ndf_stages::ndf_stage_cost(self, kind, plan)
-            }
-            _ => self.bump_stage_cost(kind, plan),
-        }
-    }
-
-    /// Cost of one invocation of a bump stage of `plan` (zero without a bump plan).
-    fn bump_stage_cost(&self, kind: StageKind, plan: &Plan) -> UnitCost {
-        let Some(bp) = &plan.bump else {
-            return UnitCost::default();
-        };
-        let u = &self.units;
-        let fk = self.frame_of(bp);
-        let np = bump_stages::point_lights(self) as u32;
-        let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
-        let mac = UnitCost {
-            ops: 3,
-            cycles: u.cfg.shade.shade_cycles,
-            texels: 0,
-        };
-        match kind {
-            StageKind::Normal => interpolate_cost(&self.hw.interp)
-                .times(bump_stages::normal_attr_count(self, bp, fk)),
-            StageKind::BumpFetch => {
-                lod_cost(&self.hw.lod).plus(trilinear_cost(&self.hw.trilinear, 2))
-            }
-            StageKind::Frame => frame_cost(fk, u),
-            StageKind::Perturb => perturb_cost(u),
-            StageKind::Phong => {
-                let lights = self.lights.len() as u32;
-                let mut c = blinn_phong_cost(u)
-                    .times(lights)
-                    .plus(nz.times(1 + np))
-                    .plus(mac.times(1 + lights));
-                if plan.texture.is_some() {
-                    c = c.plus(mac);
-                }
-                c
-            }
-            _ => UnitCost::default(),
-        }
+        (kind.row().cost)(self, plan)
     }
 }
 
@@ -340,336 +269,48 @@ pub(crate) fn column_f<const N: usize>(v: &[[f64; N]; 3], c: usize) -> [f64; 3] 
     [v[0][c], v[1][c], v[2][c]]
 }
 
+/// A raw unorm value of `bits` bits as its exact float carrier.
 #[inline]
-fn unorm(raw: u32, bits: u32) -> f64 {
+pub(crate) fn unorm(raw: u32, bits: u32) -> f64 {
     f64::from(raw) / f64::from(max_unorm(bits))
 }
 
-/// A stage's accumulated `[ops, cycles, texels]` with this pixel's planned footprint-assembly
-/// cost (`aniso_probes` probes) replaced by that of the `probes` it took (`aniso_adaptive`).
-fn per_pixel_probes(acc: [u64; 3], planned: &UnitCost, m: &Machine, probes: u32) -> [u64; 3] {
-    let took = footprint_cost(&m.hw.trilinear, &m.hw.lod, probes);
-    [
-        acc[0] - u64::from(planned.ops) + u64::from(took.ops),
-        acc[1] - u64::from(planned.cycles) + u64::from(took.cycles),
-        acc[2] - u64::from(planned.texels) + u64::from(took.texels),
-    ]
-}
-
-/// Runs `plan` on one fragment at pixel (`px`, `py`) of `tri`, each stage by its twin in
-/// `impls`; the result is in `frag.out` (and `frag.out_x` when the last stage was Fixed).
-/// A Fixed stage reads the raw value of a Fixed producer and quantizes the carrier of a Float
-/// one; `costs` holds the plan's cost per stage kind.
+/// Runs the compiled plan `prog` of `plan` on one fragment at pixel (`x`, `y`) of `tri`; the
+/// result is in `frag.out` (and `frag.out_x` when the last stage was Fixed).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn run(
+    prog: &Program,
     plan: &Plan,
-    costs: &[UnitCost; StageKind::COUNT],
-    impls: &StageImpls,
     m: &Machine,
     tri: &ScreenTri,
     a: &TriAttrs,
-    px: i64,
-    py: i64,
+    x: i64,
+    y: i64,
     frag: &mut Frag,
     c: &mut Counters,
 ) {
-    let samples = if plan.derivatives { 3 } else { 1 };
-    let hw = m.hw;
-    let cb = hw.color.color_bits;
-    let tb = hw.trilinear.texel_bits;
-    let bb = hw.interp.bary_bits;
-    let fb = m.uv_fmt.frac_bits;
-    let lfb = hw.lod.lod_frac_bits;
-    let fixed_in = |k: StageKind| impls.of(k) == Impl::Fixed;
     frag.color = plan.const_color;
     frag.out = plan.const_color;
     frag.out_bits = 0;
     frag.trace.clear();
-    let mut color_from_stage = false;
-    for &kind in &plan.stages {
-        let k = kind.index();
+    let px = Px {
+        plan,
+        impls: &prog.impls,
+        m,
+        tri,
+        a,
+        x,
+        y,
+        color_raw: prog.color_raw,
+    };
+    for op in &prog.ops {
+        let k = op.kind.index();
         c.invocations[k] += 1;
-        let cost = &costs[k];
-        c.cost[k][0] += u64::from(cost.ops);
-        c.cost[k][1] += u64::from(cost.cycles);
-        c.cost[k][2] += u64::from(cost.texels);
-        let fixed = impls.of(kind) == Impl::Fixed;
-        let sat = &mut c.sat[k];
-        match kind {
-            StageKind::Bary => {
-                let sub = hw.raster.subpixel_bits;
-                if fixed {
-                    if plan.derivatives {
-                        let (e, dx, dy) = tri.edges_fixed_with_steps(px, py, sub);
-                        frag.bary_x = perspective_bary_derivs(
-                            e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat,
-                        );
-                    } else {
-                        let e = tri.edges_fixed(px, py, sub);
-                        frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
-                    }
-                    for s in 0..samples {
-                        frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
-                    }
-                } else {
-                    let (x, y) = (px as f64, py as f64);
-                    let e = tri.edges_float(x, y);
-                    if plan.derivatives {
-                        let ex = tri.edges_float(x + 1.0, y);
-                        let ey = tri.edges_float(x, y + 1.0);
-                        let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
-                        let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
-                        frag.bary = perspective_bary_derivs_f64(e, dx, dy, a.inv_w_f);
-                    } else {
-                        frag.bary[0] = perspective_bary_f64(e, a.inv_w_f);
-                    }
-                }
-            }
-            StageKind::Color => {
-                color_from_stage = true;
-                if fixed {
-                    let b = if fixed_in(StageKind::Bary) {
-                        frag.bary_x[0]
-                    } else {
-                        frag.bary[0].map(|x| to_raw(x, &m.bary_fmt, sat))
-                    };
-                    for ch in 0..3 {
-                        let r =
-                            interpolate(b, bb, column(&a.color_x, ch), &m.color_fmt, sat) as u32;
-                        frag.color_x[ch] = r;
-                        frag.color[ch] = unorm(r, cb);
-                    }
-                    frag.color_x[3] = max_unorm(cb);
-                    frag.out_x = frag.color_x;
-                    frag.out_bits = cb;
-                } else {
-                    for ch in 0..3 {
-                        frag.color[ch] = interpolate_f64(frag.bary[0], column_f(&a.color_f, ch));
-                    }
-                    frag.out_bits = 0;
-                }
-                frag.color[3] = 1.0;
-                frag.out = frag.color;
-            }
-            StageKind::Texcoord => {
-                let raw_bary = fixed_in(StageKind::Bary);
-                for s in 0..samples {
-                    if fixed {
-                        let b = if raw_bary {
-                            frag.bary_x[s]
-                        } else {
-                            frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat))
-                        };
-                        for ax in 0..2 {
-                            let r = interpolate(b, bb, column(&a.uv_x, ax), &m.uv_fmt, sat);
-                            frag.uv_x[s][ax] = r;
-                            frag.uv[s][ax] = from_raw(r, fb);
-                        }
-                    } else {
-                        for ax in 0..2 {
-                            frag.uv[s][ax] = interpolate_f64(frag.bary[s], column_f(&a.uv_f, ax));
-                        }
-                    }
-                }
-            }
-            StageKind::Lod => {
-                let Some(t) = plan.texture else { continue };
-                let Some(l0) = m.tex_float[t].first() else {
-                    continue;
-                };
-                let (w, h) = (l0.width, l0.height);
-                if fixed {
-                    if !fixed_in(StageKind::Texcoord) {
-                        quantize_uv(frag, m, samples, sat);
-                    }
-                    let d = texel_derivs(&frag.uv_x, w, h);
-                    frag.lod_x = lod(d, fb, &hw.lod, sat);
-                    frag.lod = from_raw(frag.lod_x, lfb);
-                } else {
-                    frag.lod = lod_f64(texel_derivs_f64(&frag.uv, w, h));
-                }
-            }
-            StageKind::Trilinear => {
-                let Some(t) = plan.texture else { continue };
-                let probes = hw.trilinear.aniso_probes;
-                let adaptive = hw.trilinear.aniso_adaptive;
-                let aniso = probes > 1 && plan.derivatives;
-                if fixed {
-                    if !fixed_in(StageKind::Texcoord) && !fixed_in(StageKind::Lod) {
-                        quantize_uv(frag, m, if aniso { samples } else { 1 }, sat);
-                    }
-                    let l = if fixed_in(StageKind::Lod) {
-                        frag.lod_x
-                    } else {
-                        to_raw(frag.lod, &m.lod_fmt, sat)
-                    };
-                    let uv = frag.uv_x;
-                    let (r, took) =
-                        trilinear_fixed(m, plan, t, &uv, l, aniso, &mut frag.trace, sat);
-                    if took != probes {
-                        c.cost[k] = per_pixel_probes(c.cost[k], cost, m, took);
-                    }
-                    frag.texel_x = r.map(u32::from);
-                    frag.texel = frag.texel_x.map(|x| unorm(x, tb));
-                    frag.out_x = frag.texel_x;
-                    frag.out_bits = tb;
-                } else {
-                    let [u, v] = frag.uv[0];
-                    frag.texel = if aniso {
-                        let levels = &m.tex_float[t];
-                        let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
-                        let fp = footprint_f64(&frag.uv, size, probes, adaptive);
-                        if fp.probes != probes {
-                            c.cost[k] = per_pixel_probes(c.cost[k], cost, m, fp.probes);
-                        }
-                        footprint_filter_f64(levels, u, v, &fp, plan.wrap)
-                    } else {
-                        trilinear_f64(&m.tex_float[t], u, v, frag.lod, plan.wrap)
-                    };
-                    frag.out_bits = 0;
-                    if frag.trace.on {
-                        // The footprints the hardware unit fetches for these inputs.
-                        let mut scratch = SatCounter::default();
-                        let uv = if fixed_in(StageKind::Texcoord) {
-                            frag.uv_x
-                        } else {
-                            frag.uv
-                                .map(|s| s.map(|x| to_raw(x, &m.uv_fmt, &mut scratch)))
-                        };
-                        let l = if fixed_in(StageKind::Lod) {
-                            frag.lod_x
-                        } else {
-                            to_raw(frag.lod, &m.lod_fmt, &mut scratch)
-                        };
-                        let _ = trilinear_fixed(
-                            m,
-                            plan,
-                            t,
-                            &uv,
-                            l,
-                            aniso,
-                            &mut frag.trace,
-                            &mut scratch,
-                        );
-                    }
-                }
-                frag.out = frag.texel;
-            }
-            StageKind::Modulate => {
-                if fixed {
-                    let rnd = hw.color.color_rounding;
-                    let col = if color_from_stage && fixed_in(StageKind::Color) {
-                        frag.color_x
-                    } else {
-                        frag.color.map(|x| to_unorm(x, cb))
-                    };
-                    let tex = if fixed_in(StageKind::Trilinear) {
-                        frag.texel_x
-                    } else {
-                        frag.texel.map(|x| to_unorm(x, tb))
-                    };
-                    for ch in 0..4 {
-                        frag.out_x[ch] = modulate(col[ch], cb, tex[ch], tb, cb, rnd);
-                        frag.out[ch] = unorm(frag.out_x[ch], cb);
-                    }
-                    frag.out_bits = cb;
-                } else {
-                    for ch in 0..4 {
-                        frag.out[ch] = frag.color[ch] * frag.texel[ch];
-                    }
-                    frag.out_bits = 0;
-                }
-            }
-            StageKind::Normal
-            | StageKind::BumpFetch
-            | StageKind::Frame
-            | StageKind::Perturb
-            | StageKind::Phong => run_bump_stage(kind, plan, impls, m, a, frag, c),
-            StageKind::AsShade => super::as_stages::run_as_shade(plan, impls, m, frag, c),
-            StageKind::RoughFetch | StageKind::RoughShade => {
-                super::rough_stages::run_rough_stage(kind, plan, impls, m, frag, c);
-            }
-            StageKind::NdfFetch | StageKind::NdfShade => {
-                super::ndf_stages::run_ndf_stage(kind, plan, impls, m, frag, c);
-            }
-        }
-    }
-}
-
-/// The fixed trilinear stage of texture `t` at raw coordinates `uv` (sample and helper
-/// samples) and raw LOD `l`: footprint assembly when `aniso`, else one trilinear lookup; its
-/// footprints go into `trace`. Returns the filtered texel and the probes it took.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn trilinear_fixed(
-    m: &Machine,
-    plan: &Plan,
-    t: usize,
-    uv: &[[i64; 2]; 3],
-    l: i64,
-    aniso: bool,
-    trace: &mut Trace,
-    sat: &mut SatCounter,
-) -> ([u16; 4], u32) {
-    let hw = m.hw;
-    let fb = m.uv_fmt.frac_bits;
-    let lfb = hw.lod.lod_frac_bits;
-    let levels = &m.tex_fixed[t];
-    let [u, v] = uv[0];
-    let kind = StageKind::Trilinear;
-    if !aniso {
-        let at = Lookup {
-            stage: kind,
-            lookup: 0,
-            tex: t,
-        };
-        let r = trilinear_traced(
-            levels,
-            u,
-            v,
-            fb,
-            l,
-            lfb,
-            plan.wrap,
-            &hw.trilinear,
-            trace,
-            at,
-        );
-        return (r, hw.trilinear.aniso_probes);
-    }
-    let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
-    let (probes, adaptive) = (hw.trilinear.aniso_probes, hw.trilinear.aniso_adaptive);
-    let fp = footprint(uv, size, fb, probes, adaptive, &hw.lod, sat);
-    if !trace.on {
-        let r = footprint_filter(levels, u, v, fb, &fp, lfb, plan.wrap, &hw.trilinear, None);
-        return (r, fp.probes);
-    }
-    let mut traces = [TrilinearTrace::default(); MAX_PROBES];
-    let r = footprint_filter(
-        levels,
-        u,
-        v,
-        fb,
-        &fp,
-        lfb,
-        plan.wrap,
-        &hw.trilinear,
-        Some(&mut traces),
-    );
-    for (i, tr) in traces.iter().take(fp.probes as usize).enumerate() {
-        trace.record(kind, i as u32, t, tr);
-    }
-    (r, fp.probes)
-}
-
-/// Quantizes the float texture coordinates of the first `samples` samples into the machine's
-/// format (a Fixed consumer after a Float texcoord stage).
-fn quantize_uv(frag: &mut Frag, m: &Machine, samples: usize, sat: &mut SatCounter) {
-    for s in 0..samples {
-        for ax in 0..2 {
-            frag.uv_x[s][ax] = to_raw(frag.uv[s][ax], &m.uv_fmt, sat);
-        }
+        c.cost[k][0] += u64::from(op.cost.ops);
+        c.cost[k][1] += u64::from(op.cost.cycles);
+        c.cost[k][2] += u64::from(op.cost.texels);
+        (op.run)(&px, frag, c);
     }
 }
 

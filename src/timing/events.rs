@@ -92,17 +92,12 @@ impl FrameEvents {
     }
 }
 
-/// Texture lookups one invocation of `kind` makes. Data-driven so that multi-lookup stages
-/// plug in: trilinear makes `aniso_probes` (footprint assembly; 1 = plain trilinear); an NDF
-/// stage would make 3 (4 with the normalization map), a roughness stage 2 (bump + roughness).
+/// Texture lookups one invocation of `kind` makes (the stage table's `lookups` column):
+/// trilinear makes `aniso_probes` (footprint assembly; 1 = plain trilinear), the bump and
+/// roughness fetches one each, the NDF fetch 3 (4 with the normalization map).
 #[must_use]
 pub fn lookups(kind: StageKind, hw: &HwConfig) -> u32 {
-    match kind {
-        StageKind::Trilinear => hw.trilinear.aniso_probes.max(1),
-        StageKind::BumpFetch | StageKind::RoughFetch => 1,
-        StageKind::NdfFetch => hw_model::ndf::ndf_lookups(&hw.ndf),
-        _ => 0,
-    }
+    (kind.row().lookups)(hw)
 }
 
 /// Records the events of one shaded pixel (after `run` has filled `frag` with its trace on):

@@ -1,0 +1,56 @@
+//! `bary`: perspective-correct barycentrics at the pixel and, when the plan needs derivatives,
+//! at its two first-order neighbours (Heckbert & Moreton 1991; `hw_model::interpolator`).
+
+use super::stages::{Counters, Machine};
+use super::{Frag, Plan, Px, StageKind};
+use crate::fixedpoint::from_raw;
+use crate::reference::{perspective_bary_derivs_f64, perspective_bary_f64};
+use hw_model::interpolator::{
+    perspective_bary, perspective_bary_cost, perspective_bary_derivs, perspective_bary_derivs_cost,
+};
+use hw_model::UnitCost;
+
+/// Fixed twin: exact integer edge functions, one reciprocal, analytic derivatives.
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let hw = px.m.hw;
+    let sat = &mut c.sat[StageKind::Bary.index()];
+    let sub = hw.raster.subpixel_bits;
+    let bb = hw.interp.bary_bits;
+    let (tri, a, m) = (px.tri, px.a, px.m);
+    if px.plan.derivatives {
+        let (e, dx, dy) = tri.edges_fixed_with_steps(px.x, px.y, sub);
+        frag.bary_x = perspective_bary_derivs(e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat);
+    } else {
+        let e = tri.edges_fixed(px.x, px.y, sub);
+        frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
+    }
+    for s in 0..px.samples() {
+        frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+    }
+}
+
+/// Float twin: the same algorithm on float edge functions.
+pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
+    let (x, y) = (px.x as f64, px.y as f64);
+    let (tri, a) = (px.tri, px.a);
+    let e = tri.edges_float(x, y);
+    if px.plan.derivatives {
+        let ex = tri.edges_float(x + 1.0, y);
+        let ey = tri.edges_float(x, y + 1.0);
+        let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
+        let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
+        frag.bary = perspective_bary_derivs_f64(e, dx, dy, a.inv_w_f);
+    } else {
+        frag.bary[0] = perspective_bary_f64(e, a.inv_w_f);
+    }
+}
+
+/// One invocation: the barycentrics, plus their derivatives when the plan needs them.
+#[must_use]
+pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
+    if plan.derivatives {
+        perspective_bary_derivs_cost(&m.hw.interp, &m.recip)
+    } else {
+        perspective_bary_cost(&m.hw.interp, &m.recip)
+    }
+}

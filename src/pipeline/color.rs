@@ -1,0 +1,48 @@
+//! `color`: interpolation of the vertex colour (the Gouraud lighting result) at the pixel
+//! (`hw_model::interpolator::interpolate`, unorm `color_bits`).
+
+use super::stages::{column, column_f, unorm, Counters, Machine};
+use super::{Frag, Plan, Px, StageKind};
+use crate::fixedpoint::to_raw;
+use crate::reference::interpolate_f64;
+use hw_model::interpolator::{interpolate, interpolate_cost};
+use hw_model::UnitCost;
+
+/// Fixed twin: three channels through the interpolator, alpha one.
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let m = px.m;
+    let cb = m.hw.color.color_bits;
+    let bb = m.hw.interp.bary_bits;
+    let sat = &mut c.sat[StageKind::Color.index()];
+    let b = if px.fixed(StageKind::Bary) {
+        frag.bary_x[0]
+    } else {
+        frag.bary[0].map(|x| to_raw(x, &m.bary_fmt, sat))
+    };
+    for ch in 0..3 {
+        let r = interpolate(b, bb, column(&px.a.color_x, ch), &m.color_fmt, sat) as u32;
+        frag.color_x[ch] = r;
+        frag.color[ch] = unorm(r, cb);
+    }
+    frag.color_x[3] = ((1u64 << cb) - 1) as u32;
+    frag.out_x = frag.color_x;
+    frag.out_bits = cb;
+    frag.color[3] = 1.0;
+    frag.out = frag.color;
+}
+
+/// Float twin.
+pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
+    for ch in 0..3 {
+        frag.color[ch] = interpolate_f64(frag.bary[0], column_f(&px.a.color_f, ch));
+    }
+    frag.out_bits = 0;
+    frag.color[3] = 1.0;
+    frag.out = frag.color;
+}
+
+/// One invocation: three interpolations.
+#[must_use]
+pub fn cost(m: &Machine, _: &Plan) -> UnitCost {
+    interpolate_cost(&m.hw.interp).times(3)
+}

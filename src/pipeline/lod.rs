@@ -1,0 +1,40 @@
+//! `lod`: the level of detail of the material texture from the texture-coordinate derivatives
+//! (the OpenGL isotropic rule; `hw_model::lod`).
+
+use super::stages::{texel_derivs, texel_derivs_f64, Counters, Machine};
+use super::texcoord::quantize_uv;
+use super::{Frag, Plan, Px, StageKind};
+use crate::fixedpoint::from_raw;
+use crate::reference::lod_f64;
+use hw_model::lod::lod_cost;
+use hw_model::UnitCost;
+
+/// Fixed twin: squared lengths, bit-serial log2.
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let m = px.m;
+    let Some(l0) = px.plan.texture.and_then(|t| m.tex_float[t].first()) else {
+        return;
+    };
+    let sat = &mut c.sat[StageKind::Lod.index()];
+    if !px.fixed(StageKind::Texcoord) {
+        quantize_uv(frag, m, px.samples(), sat);
+    }
+    let d = texel_derivs(&frag.uv_x, l0.width, l0.height);
+    let fb = m.uv_fmt.frac_bits;
+    frag.lod_x = hw_model::lod::lod(d, fb, &m.hw.lod, sat);
+    frag.lod = from_raw(frag.lod_x, m.hw.lod.lod_frac_bits);
+}
+
+/// Float twin.
+pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
+    let Some(l0) = px.plan.texture.and_then(|t| px.m.tex_float[t].first()) else {
+        return;
+    };
+    frag.lod = lod_f64(texel_derivs_f64(&frag.uv, l0.width, l0.height));
+}
+
+/// One invocation of the LOD unit.
+#[must_use]
+pub fn cost(m: &Machine, _: &Plan) -> UnitCost {
+    lod_cost(&m.hw.lod)
+}

@@ -1,0 +1,298 @@
+//! The stage table: one row per stage kind, from which the kind, its name, the count and the
+//! dispatch are generated (as tiny-skia's `Stage` list and its function tables), and the
+//! [`Program`] a material's plan is compiled into once per render: its stages' twins and
+//! costs resolved, so the pixel loop only calls what is in the program.
+//!
+//! A row names the stage's fixed twin, its float twin, its cost per invocation and its texture
+//! lookups per invocation (what the timing model budgets events for). Adding a stage is a file
+//! with those four functions and a row here (see `docs/ARCHITECTURE.md`).
+
+use super::stages::{Counters, Machine, TriAttrs};
+use super::{
+    as_stages, bary, bump_stages, color, lod, modulate, ndf_stages, rough_stages, texcoord,
+    trilinear,
+};
+use super::{Frag, Impl, Plan, StageImpls};
+use crate::raster::ScreenTri;
+use hw_model::{HwConfig, UnitCost};
+use serde::Serialize;
+use std::fmt;
+
+/// What a stage twin sees of the pixel it shades.
+pub struct Px<'a> {
+    /// The material's plan (maps, frame, lights and options of its stages).
+    pub plan: &'a Plan,
+    /// The twin of every stage kind in this run (a Fixed stage reads a Fixed producer's raw
+    /// value and rounds a Float producer's carrier into its input format).
+    pub impls: &'a StageImpls,
+    pub m: &'a Machine<'a>,
+    pub tri: &'a ScreenTri,
+    pub a: &'a TriAttrs,
+    /// The pixel.
+    pub x: i64,
+    pub y: i64,
+    /// The plan's colour comes from a Fixed `color` stage (its raw value is in `Frag::color_x`).
+    pub color_raw: bool,
+}
+
+impl Px<'_> {
+    /// True when stage `kind` runs its fixed twin in this run.
+    #[inline]
+    #[must_use]
+    pub fn fixed(&self, kind: StageKind) -> bool {
+        self.impls.of(kind) == Impl::Fixed
+    }
+
+    /// Samples per pixel: the pixel and, when the plan needs derivatives, its two helpers.
+    #[inline]
+    #[must_use]
+    pub fn samples(&self) -> usize {
+        if self.plan.derivatives {
+            3
+        } else {
+            1
+        }
+    }
+}
+
+/// A stage twin: shades one fragment, counting into the run's counters.
+pub type RunFn = fn(&Px, &mut Frag, &mut Counters);
+/// A stage's cost per invocation in a plan on a machine (fixed units' ops, cycles, texels).
+pub type CostFn = fn(&Machine, &Plan) -> UnitCost;
+/// Texture lookups per invocation on a hardware configuration.
+pub type LookupsFn = fn(&HwConfig) -> u32;
+
+/// One row of the stage table.
+#[derive(Clone, Copy)]
+pub struct StageRow {
+    pub kind: StageKind,
+    pub name: &'static str,
+    pub fixed: RunFn,
+    pub float: RunFn,
+    pub cost: CostFn,
+    pub lookups: LookupsFn,
+}
+
+/// A stage that reads no texture.
+fn no_lookups(_: &HwConfig) -> u32 {
+    0
+}
+
+/// A stage that makes one trilinear lookup.
+fn one_lookup(_: &HwConfig) -> u32 {
+    1
+}
+
+macro_rules! stage_table {
+    ($( $(#[doc = $doc:literal])* $kind:ident $name:literal {
+        fixed: $fixed:expr, float: $float:expr, cost: $cost:expr, lookups: $lookups:expr $(,)?
+    } )*) => {
+        /// The kinds of stage, in pipeline order (generated from the stage table).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+        #[serde(rename_all = "kebab-case")]
+        pub enum StageKind {
+            $( $(#[doc = $doc])* $kind, )*
+        }
+
+        impl StageKind {
+            /// Number of stage kinds.
+            pub const COUNT: usize = [$($name),*].len();
+
+            /// Every stage kind, in pipeline order.
+            pub const ALL: [StageKind; StageKind::COUNT] = [$(StageKind::$kind,)*];
+        }
+
+        /// The stage table, indexed by [`StageKind::index`].
+        pub const STAGES: [StageRow; StageKind::COUNT] = [$(
+            StageRow {
+                kind: StageKind::$kind,
+                name: $name,
+                fixed: $fixed,
+                float: $float,
+                cost: $cost,
+                lookups: $lookups,
+            },
+        )*];
+    };
+}
+
+stage_table! {
+    /// Perspective-correct barycentrics (reciprocal unit + interpolator setup).
+    Bary "bary" {
+        fixed: bary::fixed, float: bary::float, cost: bary::cost, lookups: no_lookups
+    }
+    /// Vertex colour interpolation (Gouraud lighting result).
+    Color "color" {
+        fixed: color::fixed, float: color::float, cost: color::cost, lookups: no_lookups
+    }
+    /// Texture-coordinate interpolation, with the helper samples for derivatives.
+    Texcoord "texcoord" {
+        fixed: texcoord::fixed, float: texcoord::float, cost: texcoord::cost,
+        lookups: no_lookups,
+    }
+    /// LOD from the texture-coordinate derivatives.
+    Lod "lod" {
+        fixed: lod::fixed, float: lod::float, cost: lod::cost, lookups: no_lookups
+    }
+    /// Wrap + trilinear MIP filtering (footprint assembly with `aniso_probes` > 1).
+    Trilinear "trilinear" {
+        fixed: trilinear::fixed, float: trilinear::float, cost: trilinear::cost,
+        lookups: trilinear::lookups,
+    }
+    /// Colour x texel.
+    Modulate "modulate" {
+        fixed: modulate::fixed, float: modulate::float, cost: modulate::cost,
+        lookups: no_lookups,
+    }
+    /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
+    Normal "normal" {
+        fixed: bump_stages::row::<{ StageKind::Normal as usize }>,
+        float: bump_stages::row::<{ StageKind::Normal as usize }>,
+        cost: bump_stages::row_cost::<{ StageKind::Normal as usize }>,
+        lookups: no_lookups,
+    }
+    /// Bump materials: LOD + trilinear fetch of the offset map `(f_u, f_v)`.
+    BumpFetch "bump-fetch" {
+        fixed: bump_stages::row::<{ StageKind::BumpFetch as usize }>,
+        float: bump_stages::row::<{ StageKind::BumpFetch as usize }>,
+        cost: bump_stages::row_cost::<{ StageKind::BumpFetch as usize }>,
+        lookups: one_lookup,
+    }
+    /// Bump materials: the local frame (natural, unit or main direction).
+    Frame "frame" {
+        fixed: bump_stages::row::<{ StageKind::Frame as usize }>,
+        float: bump_stages::row::<{ StageKind::Frame as usize }>,
+        cost: bump_stages::row_cost::<{ StageKind::Frame as usize }>,
+        lookups: no_lookups,
+    }
+    /// Bump materials: `n' = normalize(n + f_u s_u + f_v s_v)`.
+    Perturb "perturb" {
+        fixed: bump_stages::row::<{ StageKind::Perturb as usize }>,
+        float: bump_stages::row::<{ StageKind::Perturb as usize }>,
+        cost: bump_stages::row_cost::<{ StageKind::Perturb as usize }>,
+        lookups: no_lookups,
+    }
+    /// Bump materials: per-pixel Blinn-Phong over every scene light (+ ambient).
+    Phong "phong" {
+        fixed: bump_stages::row::<{ StageKind::Phong as usize }>,
+        float: bump_stages::row::<{ StageKind::Phong as usize }>,
+        cost: bump_stages::row_cost::<{ StageKind::Phong as usize }>,
+        lookups: no_lookups,
+    }
+    /// Ashikhmin-Shirley materials: the anisotropic Phong BRDF per pixel over every light.
+    AsShade "as-shade" {
+        fixed: as_stages::row, float: as_stages::row, cost: as_stages::as_shade_cost,
+        lookups: no_lookups,
+    }
+    /// Roughness materials: trilinear fetch of the D map at the bump fetch's LOD.
+    RoughFetch "rough-fetch" {
+        fixed: rough_stages::row::<{ StageKind::RoughFetch as usize }>,
+        float: rough_stages::row::<{ StageKind::RoughFetch as usize }>,
+        cost: rough_stages::row_cost::<{ StageKind::RoughFetch as usize }>,
+        lookups: one_lookup,
+    }
+    /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
+    RoughShade "rough-shade" {
+        fixed: rough_stages::row::<{ StageKind::RoughShade as usize }>,
+        float: rough_stages::row::<{ StageKind::RoughShade as usize }>,
+        cost: rough_stages::row_cost::<{ StageKind::RoughShade as usize }>,
+        lookups: no_lookups,
+    }
+    /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).
+    NdfFetch "ndf-fetch" {
+        fixed: ndf_stages::row::<{ StageKind::NdfFetch as usize }>,
+        float: ndf_stages::row::<{ StageKind::NdfFetch as usize }>,
+        cost: ndf_stages::row_cost::<{ StageKind::NdfFetch as usize }>,
+        lookups: ndf_stages::fetch_lookups,
+    }
+    /// NDF materials: Sigma, its inverse, Mahalanobis distance, density, normalization, lights.
+    NdfShade "ndf-shade" {
+        fixed: ndf_stages::row::<{ StageKind::NdfShade as usize }>,
+        float: ndf_stages::row::<{ StageKind::NdfShade as usize }>,
+        cost: ndf_stages::row_cost::<{ StageKind::NdfShade as usize }>,
+        lookups: no_lookups,
+    }
+}
+
+impl StageKind {
+    /// The name used on the command line and in reports.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        STAGES[self as usize].name
+    }
+
+    /// The table row of this kind.
+    #[must_use]
+    pub const fn row(self) -> &'static StageRow {
+        &STAGES[self as usize]
+    }
+
+    /// Parses a stage name.
+    pub fn parse(s: &str) -> crate::Result<StageKind> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
+                crate::Error::msg(format!(
+                    "unknown stage '{s}' (stages: {})",
+                    names.join(", ")
+                ))
+            })
+    }
+
+    /// Position in [`StageKind::ALL`].
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl fmt::Display for StageKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One compiled stage: its kind, the twin that runs and its cost per invocation.
+#[derive(Clone, Copy)]
+pub struct Op {
+    pub kind: StageKind,
+    pub run: RunFn,
+    pub cost: UnitCost,
+}
+
+/// A plan compiled for one run: the stages in order with their twins and costs resolved.
+pub struct Program {
+    pub ops: Vec<Op>,
+    pub impls: StageImpls,
+    /// The plan's colour comes from a Fixed `color` stage.
+    pub color_raw: bool,
+}
+
+impl Program {
+    /// Compiles `plan` with the twins `impls` on the machine `m`.
+    #[must_use]
+    pub fn new(plan: &Plan, impls: &StageImpls, m: &Machine) -> Self {
+        let ops = plan
+            .stages
+            .iter()
+            .map(|&kind| {
+                let row = kind.row();
+                Op {
+                    kind,
+                    run: match impls.of(kind) {
+                        Impl::Fixed => row.fixed,
+                        Impl::Float => row.float,
+                    },
+                    cost: (row.cost)(m, plan),
+                }
+            })
+            .collect();
+        Self {
+            ops,
+            impls: *impls,
+            color_raw: plan.has(StageKind::Color) && impls.of(StageKind::Color) == Impl::Fixed,
+        }
+    }
+}

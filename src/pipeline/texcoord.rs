@@ -1,0 +1,57 @@
+//! `texcoord`: interpolation of the texture coordinates at the pixel and its helper samples
+//! (`hw_model::interpolator::interpolate`, signed `texcoord_int_bits.texcoord_frac_bits`).
+
+use super::stages::{column, column_f, Counters, Machine};
+use super::{Frag, Plan, Px, StageKind};
+use crate::fixedpoint::{from_raw, to_raw};
+use crate::reference::interpolate_f64;
+use hw_model::fixed::SatCounter;
+use hw_model::interpolator::{interpolate, interpolate_cost};
+use hw_model::UnitCost;
+
+/// Fixed twin: two interpolations per sample.
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let m = px.m;
+    let bb = m.hw.interp.bary_bits;
+    let fb = m.uv_fmt.frac_bits;
+    let raw_bary = px.fixed(StageKind::Bary);
+    let sat = &mut c.sat[StageKind::Texcoord.index()];
+    for s in 0..px.samples() {
+        let b = if raw_bary {
+            frag.bary_x[s]
+        } else {
+            frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat))
+        };
+        for ax in 0..2 {
+            let r = interpolate(b, bb, column(&px.a.uv_x, ax), &m.uv_fmt, sat);
+            frag.uv_x[s][ax] = r;
+            frag.uv[s][ax] = from_raw(r, fb);
+        }
+    }
+}
+
+/// Float twin.
+pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
+    for s in 0..px.samples() {
+        for ax in 0..2 {
+            frag.uv[s][ax] = interpolate_f64(frag.bary[s], column_f(&px.a.uv_f, ax));
+        }
+    }
+}
+
+/// One invocation: two interpolations per sample.
+#[must_use]
+pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
+    let samples = if plan.derivatives { 3 } else { 1 };
+    interpolate_cost(&m.hw.interp).times(2 * samples)
+}
+
+/// Rounds the float texture coordinates of the first `samples` samples into the machine's
+/// format (a Fixed consumer after a Float `texcoord`).
+pub fn quantize_uv(frag: &mut Frag, m: &Machine, samples: usize, sat: &mut SatCounter) {
+    for s in 0..samples {
+        for ax in 0..2 {
+            frag.uv_x[s][ax] = to_raw(frag.uv[s][ax], &m.uv_fmt, sat);
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! `trilinear`: wrap + trilinear MIP filtering of the material texture (Williams 1983;
+//! `hw_model::trilinear`), or footprint assembly over `aniso_probes` probes along the major
+//! axis (`hw_model::footprint`) when the plan has derivatives.
+
+use super::stages::{unorm, Counters, Machine};
+use super::texcoord::quantize_uv;
+use super::trace::{trilinear_traced, Lookup, Trace};
+use super::{Frag, Plan, Px, StageKind};
+use crate::fixedpoint::to_raw;
+use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
+use crate::reference::trilinear_f64;
+use hw_model::fixed::SatCounter;
+use hw_model::footprint::{footprint, footprint_cost, footprint_filter, MAX_PROBES};
+use hw_model::trilinear::{trilinear_cost, TrilinearTrace};
+use hw_model::{HwConfig, UnitCost};
+
+const KIND: StageKind = StageKind::Trilinear;
+
+/// Footprint assembly runs: more than one probe and the derivatives it needs.
+#[inline]
+fn aniso(px: &Px) -> bool {
+    px.m.hw.trilinear.aniso_probes > 1 && px.plan.derivatives
+}
+
+/// Fixed twin.
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let Some(t) = px.plan.texture else { return };
+    let m = px.m;
+    let k = KIND.index();
+    let sat = &mut c.sat[k];
+    let aniso = aniso(px);
+    if !px.fixed(StageKind::Texcoord) && !px.fixed(StageKind::Lod) {
+        quantize_uv(frag, m, if aniso { px.samples() } else { 1 }, sat);
+    }
+    let l = if px.fixed(StageKind::Lod) {
+        frag.lod_x
+    } else {
+        to_raw(frag.lod, &m.lod_fmt, sat)
+    };
+    let uv = frag.uv_x;
+    let (r, took) = lookup(m, px.plan, t, &uv, l, aniso, &mut frag.trace, sat);
+    if took != m.hw.trilinear.aniso_probes {
+        c.cost[k] = per_pixel_probes(c.cost[k], m, took);
+    }
+    let tb = m.hw.trilinear.texel_bits;
+    frag.texel_x = r.map(u32::from);
+    frag.texel = frag.texel_x.map(|x| unorm(x, tb));
+    frag.out_x = frag.texel_x;
+    frag.out_bits = tb;
+    frag.out = frag.texel;
+}
+
+/// Float twin. Under timing it records the footprints the hardware unit fetches for its
+/// inputs rounded into the machine's formats.
+pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let Some(t) = px.plan.texture else { return };
+    let m = px.m;
+    let (probes, adaptive) = (m.hw.trilinear.aniso_probes, m.hw.trilinear.aniso_adaptive);
+    let [u, v] = frag.uv[0];
+    let aniso = aniso(px);
+    frag.texel = if aniso {
+        let levels = &m.tex_float[t];
+        let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
+        let fp = footprint_f64(&frag.uv, size, probes, adaptive);
+        if fp.probes != probes {
+            let k = KIND.index();
+            c.cost[k] = per_pixel_probes(c.cost[k], m, fp.probes);
+        }
+        footprint_filter_f64(levels, u, v, &fp, px.plan.wrap)
+    } else {
+        trilinear_f64(&m.tex_float[t], u, v, frag.lod, px.plan.wrap)
+    };
+    frag.out_bits = 0;
+    frag.out = frag.texel;
+    if frag.trace.on {
+        let mut scratch = SatCounter::default();
+        let uv = if px.fixed(StageKind::Texcoord) {
+            frag.uv_x
+        } else {
+            frag.uv
+                .map(|s| s.map(|x| to_raw(x, &m.uv_fmt, &mut scratch)))
+        };
+        let l = if px.fixed(StageKind::Lod) {
+            frag.lod_x
+        } else {
+            to_raw(frag.lod, &m.lod_fmt, &mut scratch)
+        };
+        let _ = lookup(m, px.plan, t, &uv, l, aniso, &mut frag.trace, &mut scratch);
+    }
+}
+
+/// One invocation: footprint assembly over `aniso_probes` probes when the plan has
+/// derivatives, else one trilinear lookup (two levels).
+#[must_use]
+pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
+    if plan.derivatives {
+        footprint_cost(&m.hw.trilinear, &m.hw.lod, m.hw.trilinear.aniso_probes)
+    } else {
+        trilinear_cost(&m.hw.trilinear, 2)
+    }
+}
+
+/// Lookups per invocation: one per probe.
+#[must_use]
+pub fn lookups(hw: &HwConfig) -> u32 {
+    hw.trilinear.aniso_probes.max(1)
+}
+
+/// A stage's accumulated `[ops, cycles, texels]` with this pixel's planned footprint-assembly
+/// cost (`aniso_probes` probes) replaced by that of the `probes` it took (`aniso_adaptive`).
+fn per_pixel_probes(acc: [u64; 3], m: &Machine, probes: u32) -> [u64; 3] {
+    let (tc, lc) = (&m.hw.trilinear, &m.hw.lod);
+    let planned = footprint_cost(tc, lc, tc.aniso_probes);
+    let took = footprint_cost(tc, lc, probes);
+    [
+        acc[0] - u64::from(planned.ops) + u64::from(took.ops),
+        acc[1] - u64::from(planned.cycles) + u64::from(took.cycles),
+        acc[2] - u64::from(planned.texels) + u64::from(took.texels),
+    ]
+}
+
+/// The fixed lookup of texture `t` at raw coordinates `uv` (sample and helper samples) and raw
+/// LOD `l`: footprint assembly when `aniso`, else one trilinear lookup; its footprints go into
+/// `trace`. Returns the filtered texel and the probes it took.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn lookup(
+    m: &Machine,
+    plan: &Plan,
+    t: usize,
+    uv: &[[i64; 2]; 3],
+    l: i64,
+    aniso: bool,
+    trace: &mut Trace,
+    sat: &mut SatCounter,
+) -> ([u16; 4], u32) {
+    let hw = m.hw;
+    let fb = m.uv_fmt.frac_bits;
+    let lfb = hw.lod.lod_frac_bits;
+    let levels = &m.tex_fixed[t];
+    let [u, v] = uv[0];
+    if !aniso {
+        let at = Lookup {
+            stage: KIND,
+            lookup: 0,
+            tex: t,
+        };
+        let r = trilinear_traced(
+            levels,
+            u,
+            v,
+            fb,
+            l,
+            lfb,
+            plan.wrap,
+            &hw.trilinear,
+            trace,
+            at,
+        );
+        return (r, hw.trilinear.aniso_probes);
+    }
+    let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
+    let (probes, adaptive) = (hw.trilinear.aniso_probes, hw.trilinear.aniso_adaptive);
+    let fp = footprint(uv, size, fb, probes, adaptive, &hw.lod, sat);
+    if !trace.on {
+        let r = footprint_filter(levels, u, v, fb, &fp, lfb, plan.wrap, &hw.trilinear, None);
+        return (r, fp.probes);
+    }
+    let mut traces = [TrilinearTrace::default(); MAX_PROBES];
+    let r = footprint_filter(
+        levels,
+        u,
+        v,
+        fb,
+        &fp,
+        lfb,
+        plan.wrap,
+        &hw.trilinear,
+        Some(&mut traces),
+    );
+    for (i, tr) in traces.iter().take(fp.probes as usize).enumerate() {
+        trace.record(KIND, i as u32, t, tr);
+    }
+    (r, fp.probes)
+}
