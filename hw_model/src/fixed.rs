@@ -184,19 +184,55 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
 #[inline]
 #[must_use]
 pub fn round_div_wide(x: i128, den: i128, mode: Rounding) -> i64 {
+    round_div_i128(x, den, mode).clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+}
+
+/// [`round_div_wide`] without the saturation: `x / den` rounded by `mode`, exact for every
+/// `i128` input and `den > 0` (a `den <= 0` gives 0).
+#[inline]
+#[must_use]
+pub fn round_div_i128(x: i128, den: i128, mode: Rounding) -> i128 {
     if den <= 0 {
         return 0;
+    }
+    // The same quotient and remainder in 64-bit arithmetic when both fit (the common case).
+    if let (Ok(x64), Ok(d64)) = (i64::try_from(x), i64::try_from(den)) {
+        let (q, r) = (x64.div_euclid(d64), x64.rem_euclid(d64));
+        return i128::from(q + i64::from(round_up(r > d64 - r, r == d64 - r, q & 1 == 1, mode)));
     }
     let q = x.div_euclid(den);
     // Remainder r in [0, den) against the other part den - r: no overflow for any den.
     let r = x.rem_euclid(den);
     let rest = den - r;
-    let v = match mode {
-        Rounding::Truncate => q,
-        Rounding::HalfUp => q + i128::from(r >= rest),
-        Rounding::HalfEven => q + i128::from(r > rest || (r == rest && q & 1 == 1)),
-    };
-    v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+    q + i128::from(round_up(r > rest, r == rest, q & 1 == 1, mode))
+}
+
+/// Rounds the magnitude `x + f` to a multiple of `2^shift` (returned divided by it), where
+/// `f` in [0, 1) is what an earlier truncating division or root dropped (`f > 0` iff
+/// `sticky`): the rounding of a correctly rounded divider or square root. Unsaturated, exact
+/// for every `x` and `shift` in 1..=127.
+#[inline]
+#[must_use]
+pub fn round_shift_right_sticky(x: u128, shift: u32, sticky: bool, mode: Rounding) -> u128 {
+    let shift = shift.clamp(1, 127);
+    let floor = x >> shift;
+    let rem = x & ((1u128 << shift) - 1);
+    let half = 1u128 << (shift - 1);
+    // Above half: a larger remainder, or exactly half plus the dropped fraction.
+    let above = rem > half || (rem == half && sticky);
+    let tie = rem == half && !sticky;
+    floor + u128::from(round_up(above, tie, floor & 1 == 1, mode))
+}
+
+/// The rounding decision shared by every routine here: whether to add one to the floor,
+/// given whether the dropped part is above one half, exactly one half, and the floor's parity.
+#[inline]
+const fn round_up(above_half: bool, half: bool, odd: bool, mode: Rounding) -> bool {
+    match mode {
+        Rounding::Truncate => false,
+        Rounding::HalfUp => above_half || half,
+        Rounding::HalfEven => above_half || (half && odd),
+    }
 }
 
 /// `round_shift_right` for `i128` accumulators, result saturated to `i64`. Exact for every
@@ -233,4 +269,84 @@ pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
 #[must_use]
 pub const fn clz64(x: u64) -> u32 {
     x.leading_zeros()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+    /// Splitmix64: the seeded generator of these tests.
+    fn next(s: &mut u64) -> u64 {
+        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Rounds `num / den` (den > 0) by comparing twice the remainder with the divisor in
+    /// `i128` (independent of the routines under test; operands below 2^100).
+    fn reference_div(num: i128, den: i128, mode: Rounding) -> i128 {
+        let q = num.div_euclid(den);
+        let twice = 2 * num.rem_euclid(den);
+        q + i128::from(match mode {
+            Rounding::Truncate => false,
+            Rounding::HalfUp => twice >= den,
+            Rounding::HalfEven => twice > den || (twice == den && q & 1 == 1),
+        })
+    }
+
+    /// 2M seeded cases over the 64-bit fast path and the 128-bit path, every mode, with
+    /// exact ties forced on a quarter of them.
+    #[test]
+    fn round_div_i128_matches_the_reference() {
+        let mut s = 0x5eed_0001;
+        for i in 0..2_000_000u32 {
+            let wide = i % 2 == 1;
+            let bits = if wide { 99 } else { 62 };
+            let den = i128::from(next(&mut s) >> (64 - (next(&mut s) % 40 + 1))) + 1;
+            let mut num = i128::from(next(&mut s)) << 36 | i128::from(next(&mut s) >> 28);
+            num &= (1i128 << bits) - 1;
+            if i % 4 == 2 {
+                num = (num / den) * den + den / 2;
+            }
+            if next(&mut s) & 1 == 1 {
+                num = -num;
+            }
+            for mode in MODES {
+                assert_eq!(
+                    round_div_i128(num, den, mode),
+                    reference_div(num, den, mode),
+                    "{num} / {den} {mode:?}"
+                );
+            }
+        }
+        assert_eq!(round_div_i128(7, 0, Rounding::HalfEven), 0);
+    }
+
+    /// `round_shift_right_sticky(x, s, sticky)` rounds `x + f` with `0 < f < 1` iff sticky:
+    /// the same as rounding `2x + sticky` over `2^(s+1)` exactly (2M seeded cases, ties forced).
+    #[test]
+    fn round_shift_right_sticky_rounds_the_exact_value() {
+        let mut s = 0x5eed_0002;
+        for i in 0..2_000_000u32 {
+            let shift = (next(&mut s) % 90) as u32 + 1;
+            let mut x = u128::from(next(&mut s)) << 32 | u128::from(next(&mut s) >> 32);
+            if i % 3 == 0 {
+                x = (x >> shift << shift) | (1u128 << (shift - 1));
+            }
+            let sticky = next(&mut s) & 1 == 1;
+            let num = 2 * x as i128 + i128::from(sticky);
+            for mode in MODES {
+                let want = reference_div(num, 1i128 << (shift + 1), mode);
+                assert_eq!(
+                    round_shift_right_sticky(x, shift, sticky, mode) as i128,
+                    want,
+                    "{x} >> {shift} sticky {sticky} {mode:?}"
+                );
+            }
+        }
+    }
 }

@@ -8,20 +8,7 @@
 
 use crate::config::ColorConfig;
 use crate::cost::UnitCost;
-use crate::fixed::Rounding;
-
-/// `num / den` rounded by `mode` (`den > 0`).
-#[inline]
-#[must_use]
-fn div_round(num: u64, den: u64, mode: Rounding) -> u64 {
-    let q = num / den;
-    let r = num - q * den;
-    match mode {
-        Rounding::Truncate => q,
-        Rounding::HalfUp => q + u64::from(2 * r >= den),
-        Rounding::HalfEven => q + u64::from(2 * r > den || (2 * r == den && q & 1 == 1)),
-    }
-}
+use crate::fixed::{round_div_wide, Rounding};
 
 #[inline]
 fn unorm_max(bits: u32) -> u64 {
@@ -50,7 +37,7 @@ pub fn modulate(
         unorm_max(out_bits.min(16)),
     );
     let num = u64::from(a).min(ma) * u64::from(b).min(mb) * mo;
-    div_round(num, ma * mb, rounding) as u32
+    round_div_wide(i128::from(num), i128::from(ma * mb), rounding) as u32
 }
 
 /// Unorm width conversion `round(x (2^to - 1) / (2^from - 1))`; widths 1..=32 (a zero width
@@ -65,7 +52,11 @@ pub fn unorm_convert(x: u32, from_bits: u32, to_bits: u32, rounding: Rounding) -
     if mf == mt {
         return u64::from(x).min(mf) as u32;
     }
-    div_round(u64::from(x).min(mf) * mt, mf, rounding) as u32
+    round_div_wide(
+        i128::from(u64::from(x).min(mf) * mt),
+        i128::from(mf),
+        rounding,
+    ) as u32
 }
 
 /// Cost of one modulate (4 channels in parallel): per channel a multiply and a

@@ -58,7 +58,7 @@
 
 use crate::config::{ConfigError, ReciprocalConfig};
 use crate::cost::UnitCost;
-use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
+use crate::fixed::{round_div_i128, round_shift_right_wide, Rounding, SatCounter};
 use crate::reciprocal::Reciprocal;
 use crate::rsqrt::{isqrt_u128, range, rsqrt_cost, Rsqrt, RsqrtConfig};
 use serde::{Deserialize, Serialize};
@@ -249,18 +249,6 @@ pub struct NdfUnit {
     exp_t: Vec<i64>,
 }
 
-/// Exact rounded quotient `n / den` for `den > 0` (a constant divider).
-fn div_round(n: i128, den: i128, mode: Rounding) -> i128 {
-    let q = n.div_euclid(den);
-    let r = n.rem_euclid(den);
-    let twice = 2 * r;
-    match mode {
-        Rounding::Truncate => q,
-        Rounding::HalfUp => q + i128::from(twice >= den),
-        Rounding::HalfEven => q + i128::from(twice > den || (twice == den && q & 1 == 1)),
-    }
-}
-
 fn bitlen(x: u128) -> u32 {
     128 - x.leading_zeros()
 }
@@ -326,9 +314,9 @@ impl NdfUnit {
         let mut mu = [0i64; 3];
         let mut e = [0i64; 6];
         for i in 0..3 {
-            mu[i] = (div_round(unorm(t.mean[i], 1), den, rnd) - one) as i64;
-            e[i] = div_round(unorm(t.diag[i], k), den, rnd) as i64;
-            e[3 + i] = (div_round(unorm(t.off[i], k), den, rnd) - (one << k >> 1)) as i64;
+            mu[i] = (round_div_i128(unorm(t.mean[i], 1), den, rnd) - one) as i64;
+            e[i] = round_div_i128(unorm(t.diag[i], k), den, rnd) as i64;
+            e[3 + i] = (round_div_i128(unorm(t.off[i], k), den, rnd) - (one << k >> 1)) as i64;
         }
         (mu, e)
     }
@@ -442,7 +430,7 @@ impl NdfUnit {
         match self.cfg.ndf_density {
             NdfDensity::Pearson => {
                 let m = self.cfg.pearson_m;
-                let t = one - div_round(i128::from(dist), 2 * i128::from(m), rnd) as i64;
+                let t = one - round_div_i128(i128::from(dist), 2 * i128::from(m), rnd) as i64;
                 if t <= 0 {
                     return 0;
                 }
@@ -547,7 +535,7 @@ impl NdfUnit {
                     let b = self.cfg.moment_bits;
                     let den = (1i128 << b) - 1;
                     let q = i128::from(t.norm[0] & den as u16);
-                    let n = div_round((i128::from(g) * q) << t.norm_exp.min(40), den, rnd);
+                    let n = round_div_i128((i128::from(g) * q) << t.norm_exp.min(40), den, rnd);
                     if n >= i128::from(D_MAX_RAW) {
                         sat.saturated += 1;
                         D_MAX_RAW
@@ -587,7 +575,7 @@ impl NdfUnit {
                     NdfDensity::Gauss => INV_2PI_Q30,
                     NdfDensity::Pearson => {
                         let m = i64::from(self.cfg.pearson_m);
-                        div_round(
+                        round_div_i128(
                             i128::from(INV_2PI_Q30) * i128::from(m + 1),
                             i128::from(m),
                             rnd,

@@ -39,7 +39,7 @@ use crate::blinn_phong::{
 };
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
-use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
+use crate::fixed::{round_shift_right_sticky, round_shift_right_wide, Rounding, SatCounter};
 use crate::pow::{pow_cost, Pow, PowConfig};
 use crate::rsqrt::{isqrt_u128, range};
 use crate::vector::{dot3, dot_cost, normalize3, Vec3x};
@@ -301,15 +301,6 @@ fn bitlen(x: u128) -> u32 {
     128 - x.leading_zeros()
 }
 
-/// Drops `drop >= 1` low bits of `q` rounding half even, with `sticky` = nonzero bits below.
-fn round_drop(q: u128, drop: u32, sticky: bool) -> u128 {
-    let floor = q >> drop;
-    let rem = q & ((1u128 << drop) - 1);
-    let half = 1u128 << (drop - 1);
-    let up = rem > half || (rem == half && (sticky || floor & 1 == 1));
-    floor + u128::from(up)
-}
-
 /// The divider: `n / m ~= mant * 2^exp`, `mant` in `[2^(b-1), 2^b)`, correctly rounded (half
 /// even) to `b` significant bits. `n, m > 0` and below 2^95; `b` in 2..=30.
 #[must_use]
@@ -326,7 +317,7 @@ pub fn div_round(n: u128, m: u128, b: u32) -> (u64, i32) {
     let q0 = nn / mm;
     let sticky = nn % mm != 0;
     let drop = bitlen(q0) - b;
-    let mut mant = round_drop(q0, drop, sticky);
+    let mut mant = round_shift_right_sticky(q0, drop, sticky, Rounding::HalfEven);
     let mut e = drop as i32 - k;
     if mant >> b != 0 {
         mant >>= 1;
@@ -351,7 +342,7 @@ pub fn sqrt_round(s: u128, b: u32) -> (u64, i32) {
     };
     let r = isqrt_u128(sp);
     let sticky = lost || r * r != sp;
-    let mut mant = round_drop(r, 1, sticky);
+    let mut mant = round_shift_right_sticky(r, 1, sticky, Rounding::HalfEven);
     let mut e = 1 - j;
     if mant >> b != 0 {
         mant >>= 1;
@@ -372,7 +363,7 @@ fn scale_round(mant: u128, sh: i32, cap: u128) -> u128 {
         if s >= 127 {
             return 0;
         }
-        round_drop(mant, s, false).min(cap)
+        round_shift_right_sticky(mant, s, false, Rounding::HalfEven).min(cap)
     }
 }
 
