@@ -170,11 +170,7 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     // Remainder and half as unsigned so that shift = 63 does not overflow.
     let rem = (x as u64) & ((1u64 << shift) - 1);
     let half = 1u64 << (shift - 1);
-    match mode {
-        Rounding::Truncate => floor,
-        Rounding::HalfUp => floor + i64::from(rem >= half),
-        Rounding::HalfEven => floor + i64::from(rem > half || (rem == half && (floor & 1) == 1)),
-    }
+    floor + i64::from(round_up(rem > half, rem == half, floor & 1 == 1, mode))
 }
 
 /// The divide-by-constant sibling of [`round_shift_right_wide`]: `x / den` for a constant
@@ -253,13 +249,7 @@ pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
         let floor = x >> shift;
         let rem = (x as u128) & ((1u128 << shift) - 1);
         let half = 1u128 << (shift - 1);
-        match mode {
-            Rounding::Truncate => floor,
-            Rounding::HalfUp => floor + i128::from(rem >= half),
-            Rounding::HalfEven => {
-                floor + i128::from(rem > half || (rem == half && (floor & 1) == 1))
-            }
-        }
+        floor + i128::from(round_up(rem > half, rem == half, floor & 1 == 1, mode))
     };
     v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
 }
