@@ -23,7 +23,7 @@ fn main() -> texsim::Result<()> {
     ];
     for (label, hw) in &machines {
         // The budget check `texsim` does before it allocates (`render` checks again).
-        texsim::budget::check_run(&sc, hw, false)?;
+        texsim::budget::check_run(&sc, hw, true, false)?;
         let maps = Maps::new(&sc, hw.trilinear.texel_bits);
         let r = render(&sc, &maps, hw, &RenderOptions::default())?;
         let e = r

@@ -37,10 +37,13 @@ pub const BYTES_PER_TRIANGLE: u64 = 256;
 /// quantized (8 B) MIP chains (4/3 of level 0 each) and the working copies while they are
 /// built.
 pub const BYTES_PER_TEXEL: u64 = 48;
-/// Bytes per pixel of a render: visibility buffer and depth, hardware, reference and truth
-/// images, coverage mask, error heat map, the side-by-side sheet and the encoded PNGs
-/// (measured: about 45 B on w2-mesh at 2048x2048).
-pub const BYTES_PER_PIXEL: u64 = 64;
+/// Bytes per pixel of a render: visibility buffer and depth, the hardware image, coverage
+/// mask, its PNG...
+pub const BYTES_PER_PIXEL: u64 = 32;
+/// ...and with the float reference: the reference (and truth) image, the error heat map, the
+/// side-by-side sheet and their PNGs (measured in all: about 45 B per pixel on w2-mesh at
+/// 2048x2048).
+pub const BYTES_PER_REFERENCE_PIXEL: u64 = 32;
 /// Bytes per pixel of the timing model's event stream: the pixel event and its bookkeeping...
 pub const BYTES_PER_EVENT_PIXEL: u64 = 16;
 /// ...and per texture lookup of the most demanding material, two bilinear footprints (24 B
@@ -183,10 +186,10 @@ impl RunNeed {
             .saturating_add(self.events)
     }
 
-    /// The estimate of a render of `scene` on `hw` (with the timing event stream when
-    /// `timing`).
+    /// The estimate of a render of `scene` on `hw` (with the float reference when
+    /// `reference`, the timing event stream when `timing`).
     #[must_use]
-    pub fn of(scene: &Scene, hw: &HwConfig, timing: bool) -> Self {
+    pub fn of(scene: &Scene, hw: &HwConfig, reference: bool, timing: bool) -> Self {
         let pixels = u64::from(scene.width) * u64::from(scene.height);
         let texels = scene
             .textures
@@ -196,7 +199,15 @@ impl RunNeed {
         Self {
             triangles: mul(scene.triangle_count() as u64, BYTES_PER_TRIANGLE),
             texels: mul(texels, BYTES_PER_TEXEL),
-            framebuffer: mul(pixels, BYTES_PER_PIXEL),
+            framebuffer: mul(
+                pixels,
+                BYTES_PER_PIXEL
+                    + if reference {
+                        BYTES_PER_REFERENCE_PIXEL
+                    } else {
+                        0
+                    },
+            ),
             events: if timing {
                 let per_pixel = BYTES_PER_EVENT_PIXEL
                     + BYTES_PER_EVENT_LOOKUP * u64::from(max_lookups(scene, hw));
@@ -287,10 +298,10 @@ pub fn max_lookups(scene: &Scene, hw: &HwConfig) -> u32 {
         .max(1)
 }
 
-/// Checks the whole run of `scene` on `hw` against the limit before anything of it is
-/// allocated.
-pub fn check_run(scene: &Scene, hw: &HwConfig, timing: bool) -> Result<()> {
-    RunNeed::of(scene, hw, timing).check(scene)
+/// Checks the whole run of `scene` on `hw` (with the float reference when `reference`, the
+/// timing events when `timing`) against the limit before anything of it is allocated.
+pub fn check_run(scene: &Scene, hw: &HwConfig, reference: bool, timing: bool) -> Result<()> {
+    RunNeed::of(scene, hw, reference, timing).check(scene)
 }
 
 /// Opens `path` for reading if it is a regular file of at most `cap` bytes; `what` names the

@@ -408,7 +408,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     }
     let (sc, hw) = a.scene.load()?;
     let impls = impls_from(a)?;
-    crate::budget::check_run(&sc, &hw, false)?;
+    crate::budget::check_run(&sc, &hw, !a.no_reference || a.truth, false)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -708,7 +708,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             })
         })
         .collect::<Result<_>>()?;
-    crate::budget::check_run(&sc, &base, a.cycles)?;
+    crate::budget::check_run(&sc, &base, true, a.cycles)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -858,7 +858,7 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
 
 fn cycles_cmd(a: &CyclesArgs) -> Result<()> {
     let (sc, hw) = a.scene.load()?;
-    crate::budget::check_run(&sc, &hw, true)?;
+    crate::budget::check_run(&sc, &hw, false, true)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }

@@ -891,7 +891,7 @@ pub fn render(
     opts: &RenderOptions,
 ) -> crate::Result<Rendered> {
     hw.validate()?;
-    crate::budget::check_run(scene, hw, opts.timing)?;
+    crate::budget::check_run(scene, hw, opts.reference || opts.truth > 0, opts.timing)?;
     let progress = |phase: &str, ms: f64| progress_line(opts.progress, phase, ms);
     let t_start = Instant::now();
     let mut tm = Timings::default();

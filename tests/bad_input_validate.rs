@@ -86,13 +86,13 @@ fn run_budget_names_the_largest_part() {
     use texsim::budget::{check_run, RunNeed, DEFAULT_MAX_MEMORY};
     let hw = hw_model::HwConfig::preset("texram16").unwrap();
     let s = base();
-    check_run(&s, &hw, true).expect("the sphere fits");
+    check_run(&s, &hw, false, true).expect("the sphere fits");
     let mut s = base();
     s.width = 8192;
     s.height = 8192;
-    let need = RunNeed::of(&s, &hw, true);
+    let need = RunNeed::of(&s, &hw, false, true);
     assert!(need.total() > DEFAULT_MAX_MEMORY, "{need:?}");
-    let e = check_run(&s, &hw, true)
+    let e = check_run(&s, &hw, false, true)
         .expect_err("8192x8192 with timing")
         .to_string();
     for m in [
@@ -112,7 +112,7 @@ fn run_budget_names_the_largest_part() {
         texels: vec![],
         prebuilt_levels: None,
     });
-    let e = check_run(&s, &hw, false)
+    let e = check_run(&s, &hw, true, false)
         .expect_err("huge texture")
         .to_string();
     assert!(e.contains("field 'textures'"), "{e}");
