@@ -943,12 +943,13 @@ pub fn render(
         &rough_owned
     };
 
+    let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
     if crate::pipeline::ndf_stages::shade_is_float_only(hw)
         && geo.plans.iter().any(|p| p.ndf.is_some())
         && opts.hw_impls.of(StageKind::NdfShade) == Impl::Fixed
     {
-        eprintln!("texsim: ndf_norm = exact is float only: ndf-shade runs in float");
+        warnings.push("field 'ndf.ndf_norm': exact is float only: ndf-shade runs in float".into());
         opts.hw_impls = opts.hw_impls.with(StageKind::NdfShade, Impl::Float);
     }
     let opts = &opts;
@@ -1157,9 +1158,14 @@ pub fn render(
             error_8bit: e8,
             error_16bit: e16,
             roughness,
-            warnings: crate::warnings::depth_warning(scene, setup.depth_bits, &raster_stats)
-                .into_iter()
-                .collect(),
+            warnings: {
+                warnings.extend(crate::warnings::depth_warning(
+                    scene,
+                    setup.depth_bits,
+                    &raster_stats,
+                ));
+                warnings
+            },
         },
     })
 }
