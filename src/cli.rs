@@ -17,6 +17,10 @@ pub struct Cli {
     /// Worker threads (default: all cores). Output is bit-identical for any count.
     #[arg(long, global = true)]
     pub threads: Option<usize>,
+    /// Memory limit of the run (bytes, or with K, M, G, T: 4G). Every input is budgeted
+    /// against it before anything large is allocated. Default: TEXSIM_MAX_MEMORY, else 2G.
+    #[arg(long, global = true, value_name = "SIZE")]
+    pub max_memory: Option<String>,
     #[command(subcommand)]
     pub command: Option<Command>,
 }
@@ -216,9 +220,10 @@ pub struct RenderArgs {
     /// float) to summary.json; roughness scenes also get baseline.png and baseline_error.
     #[arg(long)]
     pub truth: bool,
-    /// Ground-truth sub-samples per pixel axis (N x N per pixel).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
-    pub truth_samples: u32,
+    /// Ground-truth sub-samples per pixel axis (N x N per pixel; default 16); only with
+    /// --truth.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub truth_samples: Option<u32>,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -301,6 +306,11 @@ pub fn run(cli: Cli) -> Result<()> {
             .num_threads(n)
             .build_global();
     }
+    crate::budget::check_env()?;
+    if let Some(m) = &cli.max_memory {
+        let bytes = crate::budget::parse_size(m).map_err(|e| e.context("--max-memory"))?;
+        crate::budget::set_max_memory(bytes);
+    }
     match cli.command {
         None => render_cmd(&RenderArgs {
             scene: SceneArgs {
@@ -313,7 +323,7 @@ pub fn run(cli: Cli) -> Result<()> {
             isolate: None,
             no_reference: false,
             truth: false,
-            truth_samples: 16,
+            truth_samples: None,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -390,8 +400,15 @@ fn impls_from(a: &RenderArgs) -> Result<StageImpls> {
 }
 
 fn render_cmd(a: &RenderArgs) -> Result<()> {
+    if a.truth_samples.is_some() && !a.truth {
+        return Err(Error::field(
+            "--truth-samples",
+            "only means something with --truth (add --truth, or drop --truth-samples)",
+        ));
+    }
     let (sc, hw) = a.scene.load()?;
     let impls = impls_from(a)?;
+    crate::budget::check_run(&sc, &hw, !a.no_reference || a.truth, false)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -419,7 +436,11 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
             CoverageArg::Shared => CoverageMode::Shared,
             CoverageArg::Independent => CoverageMode::Independent,
         },
-        truth: if a.truth { a.truth_samples } else { 0 },
+        truth: if a.truth {
+            a.truth_samples.unwrap_or(DEFAULT_TRUTH_SAMPLES)
+        } else {
+            0
+        },
         progress: true,
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
@@ -429,7 +450,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     if a.truth {
         truth_outputs(&sc, &maps, &hw, &mut r, &mut out)?;
     }
+    let prov = crate::provenance::Provenance::of_process();
     let json = serde_json::json!({
+        "provenance": &prov,
         "scene": &r.stats.scene,
         "hw_config": &hw,
         "stats": &r.stats,
@@ -439,11 +462,24 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         "summary.json",
         serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
     );
+    // Wall times differ between two runs: their own file, so summary.json compares with cmp.
+    let times = serde_json::json!({
+        "provenance": &prov,
+        "scene": &r.stats.scene,
+        "timings": &r.stats.timings,
+    });
+    out.add(
+        "timings.json",
+        serde_json::to_vec_pretty(&times).map_err(|e| Error::msg(e.to_string()))?,
+    );
     out.family(RENDER_OUTPUTS);
     let stale = out.stale_in(&a.scene.out);
     let written = out.write_to(&a.scene.out)?;
     progress_line(true, "writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
+    for w in &r.stats.warnings {
+        eprintln!("warning: {w}");
+    }
     println!("wrote:");
     for p in written {
         println!("  {}", p.display());
@@ -457,6 +493,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// Ground-truth sub-samples per pixel axis of `texsim render --truth` without `--truth-samples`.
+pub const DEFAULT_TRUTH_SAMPLES: u32 = 16;
+
 /// Every file `texsim render` may write; those a run does not produce are removed from its
 /// output directory, so no earlier run's image stays beside a new `summary.json`.
 pub const RENDER_OUTPUTS: &[&str] = &[
@@ -469,6 +508,7 @@ pub const RENDER_OUTPUTS: &[&str] = &[
     "truth.png",
     "baseline.png",
     "summary.json",
+    "timings.json",
 ];
 
 /// Writes truth.png and fills the baseline error: the same scene with every roughness material
@@ -583,10 +623,20 @@ pub fn parse_axis(s: &str) -> Result<Axis> {
                 .map_err(|_| Error::field("--vary", format!("'{x}' in '{s}' is not an integer")))
         };
         let (a, b) = (parse(a)?, parse(b)?);
-        if b < a || b - a > 4096 {
+        // i128: the length of any i64 range fits.
+        let len = i128::from(b) - i128::from(a) + 1;
+        if len < 1 {
             return Err(Error::field(
                 "--vary",
-                format!("range {a}..{b} in '{s}' is empty or too long"),
+                format!("range {a}..{b} in '{s}' is empty"),
+            ));
+        }
+        if len > MAX_AXIS_VALUES as i128 {
+            return Err(Error::field(
+                "--vary",
+                format!(
+                    "range {a}..{b} in '{s}' has {len} values, over the limit of {MAX_AXIS_VALUES} per axis"
+                ),
             ));
         }
         (a..=b).map(|v| v.to_string()).collect()
@@ -602,9 +652,26 @@ pub fn parse_axis(s: &str) -> Result<Axis> {
     Ok(Axis { field, values })
 }
 
-/// The cartesian product of the axes, first axis slowest.
+/// Most values of one `--vary` range.
+pub const MAX_AXIS_VALUES: u64 = 4097;
+
+/// The number of rows of the grid of `axes` (saturating).
 #[must_use]
-pub fn grid(axes: &[Axis]) -> Vec<Vec<(String, String)>> {
+pub fn grid_rows(axes: &[Axis]) -> u64 {
+    axes.iter()
+        .fold(1u64, |n, a| n.saturating_mul(a.values.len() as u64))
+}
+
+/// The cartesian product of the axes, first axis slowest. The grid's size is checked against
+/// the memory budget ([`crate::budget`]) before any row is built.
+pub fn grid(axes: &[Axis]) -> Result<Vec<Vec<(String, String)>>> {
+    let n = grid_rows(axes);
+    let shape: Vec<String> = axes.iter().map(|a| a.values.len().to_string()).collect();
+    crate::budget::check(
+        "--vary",
+        &format!("a grid of {} = {n} settings", shape.join(" x ")),
+        crate::budget::mul(n, crate::budget::BYTES_PER_SWEEP_ROW),
+    )?;
     let mut rows: Vec<Vec<(String, String)>> = vec![vec![]];
     for ax in axes {
         let mut next = Vec::with_capacity(rows.len() * ax.values.len());
@@ -617,7 +684,7 @@ pub fn grid(axes: &[Axis]) -> Vec<Vec<(String, String)>> {
         }
         rows = next;
     }
-    rows
+    Ok(rows)
 }
 
 fn sweep_cmd(a: &SweepArgs) -> Result<()> {
@@ -627,7 +694,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         .iter()
         .map(|s| parse_axis(s))
         .collect::<Result<_>>()?;
-    let settings = grid(&axes);
+    let settings = grid(&axes)?;
     // Validate every setting before rendering anything.
     let configs: Vec<HwConfig> = settings
         .iter()
@@ -641,6 +708,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             })
         })
         .collect::<Result<_>>()?;
+    crate::budget::check_run(&sc, &base, true, a.cycles)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -657,6 +725,9 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             ..RenderOptions::default()
         };
         let r = render(&sc, &maps, cfg, &opts)?;
+        for w in &r.stats.warnings {
+            eprintln!("  warning: {w}");
+        }
         let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
         let varies_frame = set
             .iter()
@@ -687,10 +758,24 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let table = crate::summary::sweep_table(&rows);
     print!("{table}");
     let mut out = OutputSet::new();
-    out.add("sweep.csv", crate::summary::sweep_csv(&rows).into_bytes());
+    out.add("sweep.csv", crate::summary::sweep_csv(&rows)?.into_bytes());
+    // Each row carries its provenance and the full configuration it ran on.
+    let prov = crate::provenance::Provenance::of_process();
+    let json_rows = rows
+        .iter()
+        .zip(&configs)
+        .map(|(row, cfg)| {
+            let mut v = serde_json::to_value(row).map_err(|e| Error::msg(e.to_string()))?;
+            if let Some(o) = v.as_object_mut() {
+                o.insert("hw_config".into(), serde_json::json!(cfg));
+                o.insert("provenance".into(), serde_json::json!(&prov));
+            }
+            Ok(v)
+        })
+        .collect::<Result<Vec<_>>>()?;
     out.add(
         "sweep.json",
-        serde_json::to_vec_pretty(&rows).map_err(|e| Error::msg(e.to_string()))?,
+        serde_json::to_vec_pretty(&json_rows).map_err(|e| Error::msg(e.to_string()))?,
     );
     for p in out.write_to(&a.scene.out)? {
         println!("wrote {}", p.display());
@@ -773,6 +858,7 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
 
 fn cycles_cmd(a: &CyclesArgs) -> Result<()> {
     let (sc, hw) = a.scene.load()?;
+    crate::budget::check_run(&sc, &hw, false, true)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -785,9 +871,13 @@ fn cycles_cmd(a: &CyclesArgs) -> Result<()> {
         hw.name
     );
     let maps = Maps::new(&sc, hw.trilinear.texel_bits);
-    let (_, rep) = crate::timing::cycles(&sc, &maps, &hw)?;
+    let (r, rep) = crate::timing::cycles(&sc, &maps, &hw)?;
+    for w in &r.stats.warnings {
+        eprintln!("warning: {w}");
+    }
     let mut out = OutputSet::new();
     let json = serde_json::json!({
+        "provenance": crate::provenance::Provenance::of_process(),
         "scene": &sc.name,
         "hw_config": &hw,
         "timing": &rep,

@@ -8,6 +8,13 @@ use std::path::Path;
 
 /// Resolves `spec`: a preset name, or a path to a TOML file. A file may name a `base` preset
 /// (default `texram16`) and override any subset of fields; unknown fields are errors.
+///
+/// ```
+/// let hw = texsim::hwconfig::resolve("d3d11")?;
+/// assert_eq!(hw.trilinear.weight_bits, 8);
+/// assert!(texsim::hwconfig::resolve("no-such-preset").is_err());
+/// # Ok::<(), texsim::Error>(())
+/// ```
 pub fn resolve(spec: &str) -> Result<HwConfig> {
     if let Some(c) = HwConfig::preset(spec) {
         return Ok(c);
@@ -19,7 +26,7 @@ pub fn resolve(spec: &str) -> Result<HwConfig> {
             PRESETS.join(", ")
         )));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
+    let text = crate::budget::read_text(path, "a hardware TOML file")?;
     parse(&text).map_err(|e| e.context(path.display()))
 }
 
@@ -56,6 +63,18 @@ pub fn parse(text: &str) -> Result<HwConfig> {
         )
     })?;
     let given_name = table.get("name").cloned();
+    match &given_name {
+        None | Some(toml::Value::String(_)) => {}
+        Some(v) => {
+            return Err(at(
+                "name",
+                Error::field("name", format!("expected a string, found {v}")),
+            ))
+        }
+    }
+    if matches!(&given_name, Some(toml::Value::String(n)) if n.trim().is_empty()) {
+        return Err(at("name", Error::field("name", "is empty")));
+    }
     let base_table = to_table(&base);
     let mut merged = base_table.clone();
     merge(&mut merged, table.clone(), "").map_err(|(path, e)| at(&path, e))?;
@@ -71,6 +90,21 @@ pub fn parse(text: &str) -> Result<HwConfig> {
         let field = e.field.clone();
         at(&field, e.into())
     })?;
+    // The name is what every summary reports: a preset's name must mean that preset.
+    if let Some(p) = HwConfig::preset(&cfg.name) {
+        if given_name.is_some() && p != cfg {
+            return Err(at(
+                "name",
+                Error::field(
+                    "name",
+                    format!(
+                        "'{}' is the name of a preset, but this configuration (base '{base_name}' with its overrides) differs from it; give it a name of its own",
+                        cfg.name
+                    ),
+                ),
+            ));
+        }
+    }
     Ok(cfg)
 }
 
@@ -223,7 +257,8 @@ fn merge(
             }
             (Some(dst), v) => *dst = v,
             (None, _) => {
-                let e = Error::field(&path, "unknown field");
+                let hint = did_you_mean(&k, into.keys().map(String::as_str));
+                let e = Error::field(&path, format!("unknown field{hint}"));
                 return Err((path, e));
             }
         }
@@ -252,6 +287,15 @@ pub fn fields(c: &HwConfig) -> Vec<(String, String)> {
 /// Returns `c` with the field `name` (a unique leaf name like `weight_bits`, or a dotted path
 /// like `trilinear.weight_bits`) set to `value`, validated.
 /// `frame` is an alias of `frame_kind` (`--vary frame=natural,unit,main`).
+///
+/// ```
+/// let hw = texsim::hwconfig::resolve("texram16")?;
+/// let c = texsim::hwconfig::set_field(&hw, "trilinear.weight_bits", "6")?;
+/// assert_eq!(c.trilinear.weight_bits, 6);
+/// let e = texsim::hwconfig::set_field(&hw, "weight_bit", "6").unwrap_err();
+/// assert!(e.to_string().contains("did you mean 'weight_bits'"));
+/// # Ok::<(), texsim::Error>(())
+/// ```
 pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
     let name = match name {
         "frame" => "frame_kind",
@@ -267,13 +311,16 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
     let path = match matches.as_slice() {
         [one] => (*one).clone(),
         [] => {
-            let names: Vec<&str> = all
-                .iter()
-                .filter_map(|(p, _)| p.rsplit('.').next())
-                .collect();
+            let leaf_names = all.iter().filter_map(|(p, _)| p.rsplit('.').next());
+            let paths = all.iter().map(|(p, _)| p.as_str());
+            let hint = if name.contains('.') {
+                did_you_mean(name, paths)
+            } else {
+                did_you_mean(name, leaf_names)
+            };
             return Err(Error::field(
                 name,
-                format!("no such hw config field (fields: {})", names.join(", ")),
+                format!("no such hw config field{hint} (`texsim hw show texram16` lists them all)"),
             ));
         }
         many => {
@@ -315,4 +362,22 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
         .map_err(|e: toml::de::Error| Error::field(&path, format!("'{value}': {}", e.message())))?;
     cfg.validate()?;
     Ok(cfg)
+}
+
+/// `; did you mean 'X'?` with the candidate nearest to `name` (Jaro-Winkler similarity at
+/// least 0.8, ties to the first), or an empty string.
+#[must_use]
+pub fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> String {
+    let mut best: Option<(f64, &str)> = None;
+    for c in candidates {
+        let score = strsim::jaro_winkler(name, c);
+        let better = match best {
+            None => true,
+            Some((b, _)) => score > b,
+        };
+        if score >= 0.8 && better {
+            best = Some((score, c));
+        }
+    }
+    best.map_or_else(String::new, |(_, c)| format!("; did you mean '{c}'?"))
 }

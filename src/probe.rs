@@ -47,9 +47,18 @@ pub fn probe_report(
     let lfb = hw.lod.lod_frac_bits;
     let lod_fmt = Format::signed(8, lfb, Rounding::Truncate);
     let mut sat = SatCounter::default();
+    // `interp.texcoord_reduce`: the coordinate enters the format less an integer (exact for
+    // repeat and mirror), as a triangle's do at setup.
+    let off = |x: f64, w: WrapMode| {
+        if i.texcoord_reduce {
+            crate::pipeline::stages::texcoord_offset([x; 3], w)
+        } else {
+            0.0
+        }
+    };
     let (ur, vr, lr) = (
-        to_raw(u, &uv_fmt, &mut sat),
-        to_raw(v, &uv_fmt, &mut sat),
+        to_raw(u - off(u, wrap[0]), &uv_fmt, &mut sat),
+        to_raw(v - off(v, wrap[1]), &uv_fmt, &mut sat),
         to_raw(lod, &lod_fmt, &mut sat),
     );
     let mut tr = TrilinearTrace::default();

@@ -644,6 +644,9 @@ pub struct RenderStats {
     pub bump: BumpStats,
     pub stages: Vec<StageStats>,
     pub cycles: CycleEstimate,
+    /// Wall times: not part of the results (they differ between two runs), so not serialized
+    /// with them; `texsim render` writes them into `timings.json`.
+    #[serde(skip)]
     pub timings: Timings,
     /// Error of the hardware image against the reference, in 8-bit and 16-bit LSBs.
     pub error_8bit: Option<ErrorMetrics>,
@@ -655,6 +658,8 @@ pub struct RenderStats {
     /// the hardware against the float reference (quantization), 8-bit LSBs.
     pub model_error: Option<ErrorMetrics>,
     pub quantization_error: Option<ErrorMetrics>,
+    /// Results that are valid but probably not what was meant (`crate::warnings`).
+    pub warnings: Vec<String>,
 }
 
 /// Roughness statistics of one render (8-bit LSB metrics over the covered pixels).
@@ -755,7 +760,8 @@ fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatC
             let (c2, t2) = blend(2);
             let mut sat = SatCounter::default();
             let plan = geo.draw_plan[t.src as usize];
-            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], &mut sat);
+            let wrap = geo.plans[plan as usize].wrap;
+            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
             (a, sat)
         })
         .collect();
@@ -884,6 +890,7 @@ pub fn render(
     opts: &RenderOptions,
 ) -> crate::Result<Rendered> {
     hw.validate()?;
+    crate::budget::check_run(scene, hw, opts.reference || opts.truth > 0, opts.timing)?;
     let progress = |phase: &str, ms: f64| progress_line(opts.progress, phase, ms);
     let t_start = Instant::now();
     let mut tm = Timings::default();
@@ -935,12 +942,13 @@ pub fn render(
         &rough_owned
     };
 
+    let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
     if crate::pipeline::ndf_stages::shade_is_float_only(hw)
         && geo.plans.iter().any(|p| p.ndf.is_some())
         && opts.hw_impls.of(StageKind::NdfShade) == Impl::Fixed
     {
-        eprintln!("texsim: ndf_norm = exact is float only: ndf-shade runs in float");
+        warnings.push("field 'ndf.ndf_norm': exact is float only: ndf-shade runs in float".into());
         opts.hw_impls = opts.hw_impls.with(StageKind::NdfShade, Impl::Float);
     }
     let opts = &opts;
@@ -1145,6 +1153,14 @@ pub fn render(
             error_8bit: e8,
             error_16bit: e16,
             roughness,
+            warnings: {
+                warnings.extend(crate::warnings::depth_warning(
+                    scene,
+                    setup.depth_bits,
+                    &raster_stats,
+                ));
+                warnings
+            },
         },
     })
 }

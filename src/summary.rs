@@ -302,35 +302,85 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     o
 }
 
-/// The sweep as CSV.
-#[must_use]
-pub fn sweep_csv(rows: &[SweepRow]) -> String {
-    let mut o = String::new();
-    let timed = rows.iter().any(|r| r.timing_cycles.is_some());
-    let bump = bumped(rows);
-    if let Some(r) = rows.first() {
-        let mut head: Vec<String> = r.settings.iter().map(|(f, _)| f.clone()).collect();
-        head.extend(HEADER.iter().map(|s| s.to_string()));
-        head.push("ref_ms".into());
-        if timed {
-            head.push(TIMING_HEADER.into());
-        }
-        if bump {
-            head.extend(BUMP_HEADER.iter().map(|s| s.to_string()));
-        }
-        let _ = writeln!(o, "{}", head.join(","));
+/// Columns of `sweep.csv` after the swept fields: the names of `sweep.json`'s row fields
+/// (nested metrics joined with a dot).
+pub const CSV_COLUMNS: [&str; 22] = [
+    "error_8bit.max_abs_lsb",
+    "error_8bit.mean_abs_lsb",
+    "error_8bit.rmse_lsb",
+    "error_8bit.psnr_db",
+    "error_8bit.pct_exact",
+    "error_16bit.max_abs_lsb",
+    "error_16bit.rmse_lsb",
+    "saturated",
+    "ndf_clamped",
+    "texels",
+    "cycles",
+    "cycles_per_pixel",
+    "ops_per_pixel",
+    "lookups_per_pixel",
+    "model_error.mean_abs_lsb",
+    "timing_cycles",
+    "frame_used",
+    "frame_fallback",
+    "zero_normal",
+    "offset_clamped",
+    "hw_ms",
+    "ref_ms",
+];
+
+/// The cells of [`CSV_COLUMNS`] for one row: full precision, empty where the JSON has `null`
+/// (not applicable: no reference, no cost model, no timing run, no truth; a PSNR of identical
+/// images), `frame_used` empty without bump materials.
+fn csv_cells(r: &SweepRow) -> Vec<String> {
+    fn opt<T: ToString>(v: Option<T>) -> String {
+        v.map_or_else(String::new, |x| x.to_string())
     }
+    let e8 = r.error_8bit.as_ref();
+    let e16 = r.error_16bit.as_ref();
+    vec![
+        opt(e8.map(|e| e.max_abs_lsb)),
+        opt(e8.map(|e| e.mean_abs_lsb)),
+        opt(e8.map(|e| e.rmse_lsb)),
+        opt(e8.and_then(|e| e.psnr_db)),
+        opt(e8.map(|e| e.pct_exact)),
+        opt(e16.map(|e| e.max_abs_lsb)),
+        opt(e16.map(|e| e.rmse_lsb)),
+        r.saturated.to_string(),
+        r.ndf_clamped.to_string(),
+        r.texels.to_string(),
+        opt(r.cycles),
+        opt(r.cycles_per_pixel),
+        opt(r.ops_per_pixel),
+        r.lookups_per_pixel.to_string(),
+        opt(r.model_error.as_ref().map(|e| e.mean_abs_lsb)),
+        opt(r.timing_cycles),
+        r.frame_used.clone(),
+        r.frame_fallback.to_string(),
+        r.zero_normal.to_string(),
+        r.offset_clamped.to_string(),
+        r.hw_ms.to_string(),
+        r.ref_ms.to_string(),
+    ]
+}
+
+/// The sweep as CSV (RFC 4180, written by the `csv` crate): one column per swept field, then
+/// [`CSV_COLUMNS`], named as in `sweep.json`.
+pub fn sweep_csv(rows: &[SweepRow]) -> crate::Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let err = |e: csv::Error| crate::Error::msg(format!("sweep.csv: {e}"));
+    let fields: Vec<String> = rows.first().map_or_else(Vec::new, |r| {
+        r.settings.iter().map(|(f, _)| f.clone()).collect()
+    });
+    w.write_record(fields.iter().map(String::as_str).chain(CSV_COLUMNS))
+        .map_err(err)?;
     for r in rows {
-        let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
-        line.extend(cells(r));
-        line.push(format!("{:.1}", r.ref_ms));
-        if timed {
-            line.push(timing_cell(r));
-        }
-        if bump {
-            line.extend(bump_cells(r));
-        }
-        let _ = writeln!(o, "{}", line.join(","));
+        let mut rec: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
+        rec.extend(csv_cells(r));
+        w.write_record(&rec).map_err(err)?;
     }
-    o
+    let bytes = w
+        .into_inner()
+        .map_err(|e| crate::Error::msg(format!("sweep.csv: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| crate::Error::msg(format!("sweep.csv: {e}")))
 }

@@ -78,3 +78,42 @@ fn validate_rejects_each_broken_invariant() {
     });
     expect(&s, "bad-chain");
 }
+
+/// The up-front budget of a whole run: framebuffer and timing events from the image size,
+/// texels from the textures; the error names the largest part, the need and the limit.
+#[test]
+fn run_budget_names_the_largest_part() {
+    use texsim::budget::{check_run, RunNeed, DEFAULT_MAX_MEMORY};
+    let hw = hw_model::HwConfig::preset("texram16").unwrap();
+    let s = base();
+    check_run(&s, &hw, false, true).expect("the sphere fits");
+    let mut s = base();
+    s.width = 8192;
+    s.height = 8192;
+    let need = RunNeed::of(&s, &hw, false, true);
+    assert!(need.total() > DEFAULT_MAX_MEMORY, "{need:?}");
+    let e = check_run(&s, &hw, false, true)
+        .expect_err("8192x8192 with timing")
+        .to_string();
+    for m in [
+        "width x height",
+        "8192x8192",
+        "needs about",
+        "limit",
+        "--max-memory",
+    ] {
+        assert!(e.contains(m), "'{e}' should mention '{m}'");
+    }
+    let mut s = base();
+    s.textures.push(TextureImage {
+        name: "huge".into(),
+        width: 16384,
+        height: 16384,
+        texels: vec![],
+        prebuilt_levels: None,
+    });
+    let e = check_run(&s, &hw, true, false)
+        .expect_err("huge texture")
+        .to_string();
+    assert!(e.contains("field 'textures'"), "{e}");
+}

@@ -85,11 +85,14 @@ fn sweep_over_frames_reports_each() {
     for (r, f) in rows.iter().zip(["natural", "unit", "main"]) {
         assert_eq!(r["frame"], f, "{csv}");
         assert_eq!(r["frame_used"], f, "{csv}");
-        assert_eq!(num(r, "frame_fallbacks"), 0.0);
-        assert_eq!(num(r, "zero_normals"), 0.0);
+        assert_eq!(num(r, "frame_fallback"), 0.0);
+        assert_eq!(num(r, "zero_normal"), 0.0);
     }
     let cycles: Vec<f64> = rows.iter().map(|r| num(r, "cycles")).collect();
-    let rmse: Vec<f64> = rows.iter().map(|r| num(r, "rmse16")).collect();
+    let rmse: Vec<f64> = rows
+        .iter()
+        .map(|r| num(r, "error_16bit.rmse_lsb"))
+        .collect();
     assert!(
         cycles[0] != cycles[1] && cycles[1] != cycles[2] && cycles[0] != cycles[2],
         "{cycles:?}"
@@ -187,7 +190,10 @@ fn knob_sweeps_change_the_error() {
         let csv = std::fs::read_to_string(d.join(&out).join("sweep.csv")).expect("csv");
         let rows = csv_rows(&csv);
         assert_eq!(rows.len(), 2, "{csv}");
-        let (coarse, fine) = (num(&rows[0], "rmse16"), num(&rows[1], "rmse16"));
+        let (coarse, fine) = (
+            num(&rows[0], "error_16bit.rmse_lsb"),
+            num(&rows[1], "error_16bit.rmse_lsb"),
+        );
         eprintln!("{vary}: rmse16 {coarse} -> {fine}");
         assert!(coarse > 1.5 * fine, "{vary}: {coarse} vs {fine}\n{csv}");
     }

@@ -138,7 +138,13 @@ fn render_removes_its_own_stale_outputs_only() {
     assert!(o.status.success(), "{}", text(&o));
     assert_eq!(
         list(&d.join("o")),
-        ["cycles.json", "hw.png", "notes.txt", "summary.json"]
+        [
+            "cycles.json",
+            "hw.png",
+            "notes.txt",
+            "summary.json",
+            "timings.json"
+        ]
     );
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("removed") && out.contains("ref.png"), "{out}");
@@ -474,4 +480,402 @@ fn renders_a_100k_triangle_obj() {
     assert_eq!(inv("modulate"), covered, "Kd modulates the texture");
     println!("100k-triangle textured OBJ: load + render + reference + outputs in {secs:.2} s");
     assert!(secs < BIG_OBJ_LIMIT_S, "took {secs} s");
+}
+
+/// `texsim` with an environment variable set.
+fn texsim_env(args: &[&str], cwd: &Path, env: (&str, &str)) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_texsim"))
+        .args(args)
+        .env(env.0, env.1)
+        .current_dir(cwd)
+        .output()
+        .expect("run texsim")
+}
+
+/// Abusive sweeps fail at once with a message naming `--vary`: a range whose length overflows
+/// i64 (it panicked), and a 3-axis grid of 4097 values each (materialized before any check).
+#[test]
+fn sweep_ranges_and_grids_are_budgeted() {
+    let d = tmp("sweepbudget");
+    let small = [
+        "--scene", "sphere", "--width", "32", "--height", "24", "--out", "s",
+    ];
+    let mut args = vec![
+        "sweep",
+        "--vary",
+        "weight_bits=-9223372036854775808..9223372036854775807",
+    ];
+    args.extend(small);
+    let o = texsim(&args, &d);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("--vary") && t.contains("over the limit of 4097"),
+        "{t}"
+    );
+    let mut args = vec!["sweep"];
+    for f in ["weight_bits", "texel_bits", "lod_frac_bits"] {
+        args.extend(["--vary", Box::leak(format!("{f}=0..4096").into_boxed_str())]);
+    }
+    args.extend(small);
+    let start = std::time::Instant::now();
+    let o = texsim(&args, &d);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("field '--vary'")
+            && t.contains("4097 x 4097 x 4097")
+            && t.contains("--max-memory"),
+        "{t}"
+    );
+    assert!(start.elapsed().as_secs() < 10, "{:?}", start.elapsed());
+    assert!(!d.join("s").exists());
+}
+
+/// The framebuffer and timing events of an 8192x8192 `cycles` run are over the default budget:
+/// a message naming the size, before anything is allocated.
+#[test]
+fn cycles_framebuffer_is_budgeted() {
+    let d = tmp("cyclesbudget");
+    let start = std::time::Instant::now();
+    let o = texsim(
+        &[
+            "cycles", "--scene", "w2-mesh", "--width", "8192", "--height", "8192", "--out", "c",
+        ],
+        &d,
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("width x height") && t.contains("8192x8192") && t.contains("TEXSIM_MAX_MEMORY"),
+        "{t}"
+    );
+    assert!(start.elapsed().as_secs() < 10, "{:?}", start.elapsed());
+    assert!(!d.join("c").exists());
+}
+
+/// The limit comes from `--max-memory`, else `TEXSIM_MAX_MEMORY`; a bad value is an error.
+#[test]
+fn max_memory_option_and_environment() {
+    let d = tmp("maxmem");
+    let args = [
+        "render", "--scene", "sphere", "--width", "64", "--height", "48", "--out", "o",
+    ];
+    let o = texsim_env(&args, &d, ("TEXSIM_MAX_MEMORY", "64K"));
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("over the limit of 64.00 KiB"), "{t}");
+    let mut raised = vec!["--max-memory", "1G"];
+    raised.extend(args);
+    let o = texsim_env(&raised, &d, ("TEXSIM_MAX_MEMORY", "64K"));
+    assert!(o.status.success(), "{}", text(&o));
+    let o = texsim(&["--max-memory", "lots", "scenes"], &d);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("--max-memory"), "{}", text(&o));
+    let o = texsim_env(&["scenes"], &d, ("TEXSIM_MAX_MEMORY", "0x"));
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("TEXSIM_MAX_MEMORY"), "{}", text(&o));
+}
+
+/// `--truth-samples` alone is an error, not silently ignored.
+#[test]
+fn truth_samples_without_truth_is_an_error() {
+    let d = tmp("truthsamples");
+    let o = texsim(
+        &[
+            "render",
+            "--scene",
+            "sphere",
+            "--truth-samples",
+            "4",
+            "--width",
+            "32",
+            "--height",
+            "24",
+        ],
+        &d,
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("--truth-samples") && t.contains("--truth"),
+        "{t}"
+    );
+    assert!(!d.join("out").exists());
+}
+
+/// Two runs of the same command write byte-identical summary.json files (wall times live in
+/// timings.json), and every JSON carries its provenance.
+#[test]
+fn summary_json_is_byte_identical_between_runs_with_provenance() {
+    let d = tmp("identical");
+    let args = [
+        "render", "--scene", "demo", "--width", "96", "--height", "72", "--out", "o",
+    ];
+    let o = texsim(&args, &d);
+    assert!(o.status.success(), "{}", text(&o));
+    let first = std::fs::read(d.join("o/summary.json")).unwrap();
+    let o = texsim(&args, &d);
+    assert!(o.status.success(), "{}", text(&o));
+    let second = std::fs::read(d.join("o/summary.json")).unwrap();
+    assert!(first == second, "summary.json differs between two runs");
+    let j: serde_json::Value = serde_json::from_slice(&second).unwrap();
+    assert_eq!(j["provenance"]["texsim_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(j["provenance"]["command_line"][1], "render");
+    assert!(j["provenance"].get("git_commit").is_some());
+    assert_eq!(j["hw_config"]["interp"]["texcoord_reduce"], true);
+    let times: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("o/timings.json")).unwrap()).unwrap();
+    assert!(
+        times["timings"]["hw_total_ms"].as_f64().unwrap() > 0.0,
+        "{times}"
+    );
+    assert!(times["provenance"]["texsim_version"].is_string());
+    // cycles.json and every sweep row carry it too.
+    let o = texsim(
+        &[
+            "cycles", "--scene", "sphere", "--width", "48", "--height", "36", "--out", "c",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let c: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("c/cycles.json")).unwrap()).unwrap();
+    assert_eq!(c["provenance"]["command_line"][1], "cycles");
+    let o = texsim(
+        &[
+            "sweep",
+            "--scene",
+            "sphere",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--vary",
+            "weight_bits=4,8",
+            "--out",
+            "s",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("s/sweep.json")).unwrap()).unwrap();
+    let rows = s.as_array().unwrap();
+    assert_eq!(rows[1]["hw_config"]["trilinear"]["weight_bits"], 8);
+    assert_eq!(rows[0]["provenance"]["command_line"][1], "sweep");
+}
+
+/// A tiny `near` makes every fragment fail the 24-bit depth test: the run says so, naming
+/// `camera.near` and a near that works (which then renders pixels).
+#[test]
+fn tiny_near_warns_with_a_near_that_works() {
+    let d = tmp("near");
+    let scene = |near: &str| {
+        format!(
+            "[output]\nwidth = 64\nheight = 48\n[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nnear = {near}\nfar = 100.0\n[[meshes]]\nshape = \"sphere\"\n"
+        )
+    };
+    std::fs::write(d.join("tiny.toml"), scene("1e-10")).unwrap();
+    let o = texsim(&["render", "tiny.toml", "--out", "o"], &d);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    let line = t
+        .lines()
+        .find(|l| l.starts_with("warning:") && l.contains("camera.near"))
+        .unwrap_or_else(|| panic!("no near warning: {t}"));
+    assert!(line.contains("failed the 24-bit depth test"), "{line}");
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("o/summary.json")).unwrap()).unwrap();
+    assert_eq!(j["stats"]["covered_pixels"], 0);
+    assert_eq!(j["stats"]["warnings"].as_array().unwrap().len(), 1);
+    let near = line
+        .split("near >= ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap_or_else(|| panic!("no suggested near: {line}"));
+    std::fs::write(d.join("fixed.toml"), scene(near)).unwrap();
+    let o = texsim(&["render", "fixed.toml", "--out", "p"], &d);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(!t.contains("camera.near"), "{t}");
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("p/summary.json")).unwrap()).unwrap();
+    assert!(j["stats"]["covered_pixels"].as_u64().unwrap() > 300, "{j}");
+}
+
+/// `probe --u 256.3 --wrap repeat` samples the texel of u = 0.3 (it saturated the 8 integer
+/// bits and returned the edge texel); mirror is periodic over 2.
+#[test]
+fn probe_far_coordinates_wrap_exactly() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tex = root.join("scenes/checker64.png");
+    let tex = tex.to_str().unwrap();
+    let fixed_line = |u: &str, wrap: &str| {
+        let o = texsim(
+            &[
+                "probe",
+                "--texture",
+                tex,
+                "--u",
+                u,
+                "--v",
+                "0.7",
+                "--lod",
+                "0.5",
+                "--wrap",
+                wrap,
+            ],
+            root,
+        );
+        assert!(o.status.success(), "{}", text(&o));
+        let out = String::from_utf8_lossy(&o.stdout).into_owned();
+        out.lines()
+            .filter(|l| !l.starts_with("input:") && !l.contains("float"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(fixed_line("256.3", "repeat"), fixed_line("0.3", "repeat"));
+    assert_eq!(fixed_line("-1023.7", "repeat"), fixed_line("0.3", "repeat"));
+    assert_eq!(fixed_line("258.3", "mirror"), fixed_line("0.3", "mirror"));
+    assert_eq!(fixed_line("257.3", "mirror"), fixed_line("1.3", "mirror"));
+}
+
+/// sweep.csv is RFC 4180 with sweep.json's names: every column after the swept field is a
+/// (dotted) field of the JSON row, a null is an empty cell, numbers are the JSON's numbers.
+#[test]
+fn sweep_csv_uses_the_json_names_and_empty_cells() {
+    let d = tmp("sweepcsv");
+    let o = texsim(
+        &[
+            "sweep",
+            "--scene",
+            "sphere",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--vary",
+            "weight_bits=4,8",
+            "--out",
+            "s",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("s/sweep.json")).unwrap()).unwrap();
+    let mut rd = csv::Reader::from_path(d.join("s/sweep.csv")).unwrap();
+    let head: Vec<String> = rd.headers().unwrap().iter().map(str::to_string).collect();
+    assert_eq!(head[0], "weight_bits");
+    assert!(head.contains(&"timing_cycles".to_string()), "{head:?}");
+    let recs: Vec<csv::StringRecord> = rd.records().map(Result::unwrap).collect();
+    assert_eq!(recs.len(), 2);
+    for (rec, row) in recs.iter().zip(json.as_array().unwrap()) {
+        assert_eq!(&rec[0], row["settings"][0][1].as_str().unwrap());
+        for (col, cell) in head.iter().zip(rec.iter()).skip(1) {
+            let v = col.split('.').fold(row, |v, k| &v[k]);
+            match v {
+                serde_json::Value::Null => assert_eq!(cell, "", "{col}"),
+                serde_json::Value::Number(n) => {
+                    let x: f64 = cell.parse().unwrap_or_else(|_| panic!("{col}: '{cell}'"));
+                    // serde_json's reader may round the last digit differently.
+                    let y = n.as_f64().unwrap();
+                    assert!((x - y).abs() <= 1e-12 * y.abs(), "{col}: {x} vs {y}");
+                }
+                serde_json::Value::String(s) => assert_eq!(cell, s, "{col}"),
+                other => panic!("{col}: {other} is not a JSON row field"),
+            }
+        }
+    }
+    // Not applicable here: no timing run, no bump material.
+    let tc = head.iter().position(|h| h == "timing_cycles").unwrap();
+    assert_eq!(&recs[0][tc], "");
+}
+
+/// Width and height from a PNG's IHDR chunk.
+fn png_size(p: &Path) -> (u32, u32) {
+    let b = std::fs::read(p).unwrap();
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+/// Renders killed at any moment leave the output directory all old or all new (hw.png and
+/// ref.png match summary.json's size), and the next run removes every leftover.
+#[test]
+fn killed_renders_leave_whole_output_sets() {
+    let d = tmp("killed");
+    let run = |w: &str, h: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_texsim"))
+            .args([
+                "render", "--scene", "demo", "--width", w, "--height", h, "--out", "o",
+            ])
+            .current_dir(&d)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("spawn texsim")
+    };
+    assert!(run("64", "48").wait().unwrap().success());
+    let o = d.join("o");
+    let check = |when: &str| {
+        if !o.exists() {
+            // Killed between the two renames: a complete new directory waits beside it.
+            let complete = std::fs::read_dir(&d).unwrap().any(|e| {
+                let p = e.unwrap().path();
+                p.file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .starts_with(".o.texsim-new-")
+                    && p.join(".texsim-complete").exists()
+            });
+            assert!(
+                complete,
+                "{when}: no output directory and nothing to finish"
+            );
+            return;
+        }
+        let j: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(o.join("summary.json")).unwrap()).unwrap();
+        let size = (
+            j["stats"]["width"].as_u64().unwrap() as u32,
+            j["stats"]["height"].as_u64().unwrap() as u32,
+        );
+        for f in ["hw.png", "ref.png"] {
+            assert_eq!(png_size(&o.join(f)), size, "{when}: {f} of another run");
+        }
+    };
+    for (i, ms) in [
+        0u64, 5, 15, 30, 45, 60, 80, 100, 130, 160, 200, 250, 300, 400,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let (w, h) = if i % 2 == 0 {
+            ("200", "150")
+        } else {
+            ("64", "48")
+        };
+        let mut c = run(w, h);
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+        let _ = c.kill();
+        let _ = c.wait();
+        check(&format!("killed after {ms} ms"));
+    }
+    assert!(run("64", "48").wait().unwrap().success());
+    check("final run");
+    let names = |p: &Path| -> Vec<String> {
+        std::fs::read_dir(p)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect()
+    };
+    assert_eq!(names(&d), ["o"], "leftovers beside the output directory");
+    let inside = names(&o);
+    assert!(
+        inside
+            .iter()
+            .all(|n| !n.contains(".tmp-") && !n.starts_with('.')),
+        "{inside:?}"
+    );
 }

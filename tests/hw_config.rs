@@ -183,3 +183,54 @@ fn the_machine_formats_follow_the_overflow_fields() {
     let fb = m.uv_fmt.frac_bits;
     assert_eq!((raw, sat.saturated, sat.wrapped), (-11 << (fb - 2), 0, 1));
 }
+
+/// A hardware file's `name` is used as given, or rejected: not a string, empty, or a preset's
+/// name on a configuration that is not that preset.
+#[test]
+fn hw_file_name_is_used_or_rejected() {
+    let c =
+        parse("base = \"d3d11\"\nname = \"mine\"\n[trilinear]\nweight_bits = 6\n").expect("named");
+    assert_eq!(c.name, "mine");
+    let c = parse("base = \"d3d11\"\n").expect("unnamed");
+    assert_eq!(c.name, "d3d11+custom");
+    // A complete preset printed by `texsim hw show` keeps its own name.
+    assert_eq!(parse(&to_toml(&preset("cuda"))).expect("cuda").name, "cuda");
+    for (text, needle) in [
+        ("name = 5\n", "expected a string"),
+        ("name = \"  \"\n", "is empty"),
+        ("name = \"d3d11\"\n", "name of a preset"),
+        (
+            "base = \"d3d11\"\nname = \"d3d11\"\n[lod]\nlod_frac_bits = 4\n",
+            "name of a preset",
+        ),
+    ] {
+        let e = parse(text).expect_err(text).to_string();
+        assert!(e.contains("'name'") && e.contains(needle), "{text}: {e}");
+    }
+}
+
+/// An unknown field answers with the nearest valid name, not the list of every field.
+#[test]
+fn unknown_fields_suggest_the_nearest_name() {
+    let base = preset("texram16");
+    let e = set_field(&base, "weight_bit", "4")
+        .expect_err("typo")
+        .to_string();
+    assert!(e.contains("did you mean 'weight_bits'"), "{e}");
+    assert!(e.len() < 200, "{e}");
+    let e = set_field(&base, "trilinear.wieght_bits", "4")
+        .expect_err("typo")
+        .to_string();
+    assert!(e.contains("did you mean 'trilinear.weight_bits'"), "{e}");
+    let e = set_field(&base, "zzz", "4")
+        .expect_err("nothing near")
+        .to_string();
+    assert!(!e.contains("did you mean") && e.len() < 200, "{e}");
+    let e = parse("[trilinear]\nweight_bitz = 4\n")
+        .expect_err("typo in file")
+        .to_string();
+    assert!(
+        e.contains("did you mean 'weight_bits'") && e.contains("line 2"),
+        "{e}"
+    );
+}

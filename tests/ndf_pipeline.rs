@@ -91,6 +91,12 @@ fn exact_runs_ndf_shade_in_float() {
     let r = render(&s, &maps, &hw, &RenderOptions::default()).expect("render");
     assert_eq!(stage(&r, StageKind::NdfShade).imp, Impl::Float);
     assert_eq!(stage(&r, StageKind::NdfFetch).imp, Impl::Fixed);
+    // Said in the result (the library prints nothing), naming the field.
+    assert!(
+        r.stats.warnings.iter().any(|w| w.contains("ndf.ndf_norm")),
+        "{:?}",
+        r.stats.warnings
+    );
 }
 
 #[test]

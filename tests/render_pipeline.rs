@@ -231,6 +231,8 @@ fn texcoord_overflow_rule_is_counted_per_stage() {
         let mut hw = hw_model::HwConfig::texram16();
         hw.interp.texcoord_int_bits = 2;
         hw.interp.texcoord_overflow = ov;
+        // The coordinates as given (no per-triangle offset reduction): they overflow.
+        hw.interp.texcoord_reduce = false;
         render(&s, &maps, &hw, &RenderOptions::default()).expect("render")
     };
     let sat = run(hw_model::fixed::Overflow::Saturate);

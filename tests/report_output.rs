@@ -1,5 +1,6 @@
-//! OutputSet: all files written in order, no temp files left, bad names refused, and failures
-//! (target is a file, a name collides with a directory) write nothing.
+//! OutputSet: all files written in order, no temp files left, bad names refused, failures
+//! (target is a file, a name collides with a directory) write nothing, and what killed runs
+//! leave is finished or removed.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -108,15 +109,70 @@ fn name_colliding_with_directory_writes_nothing() {
 }
 
 #[test]
-fn failed_write_removes_temps_already_written() {
+fn failed_write_removes_what_it_wrote() {
     let root = scratch("cleanup");
-    // Block the third file's temp path with a directory: its write fails after the first two
-    // temp files exist, and those must be removed again.
-    let blocker = format!("metrics.json.tmp-{}", std::process::id());
-    fs::create_dir(root.join(&blocker)).expect("dir");
-    let e = sample().write_to(&root).expect_err("blocked");
-    assert!(e.message().contains("metrics.json"), "{e}");
-    assert_eq!(listing(&root), [blocker]);
+    let dir = root.join("out");
+    sample().write_to(&dir).expect("first set");
+    // The second file's name is too long for the file system: its write fails after the first
+    // file was written, and the new directory goes again; the first set stays whole.
+    let long = "x".repeat(300);
+    let mut o = OutputSet::new();
+    o.add("hw.png", vec![9]);
+    o.add(&long, vec![1]);
+    let e = o.write_to(&dir).expect_err("name too long");
+    assert!(e.message().contains("xxxx"), "{e}");
+    assert_eq!(listing(&root), ["out"]);
+    assert_eq!(listing(&dir), ["hw.png", "metrics.json", "ref.png"]);
+    assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [1, 2, 3]);
+    fs::remove_dir_all(&root).expect("cleanup");
+}
+
+/// The id of a process that has ended.
+fn dead_pid() -> u32 {
+    let mut c = std::process::Command::new("true").spawn().expect("spawn");
+    let pid = c.id();
+    c.wait().expect("wait");
+    pid
+}
+
+/// What a killed run leaves is finished or removed by the next one: an incomplete new
+/// directory and per-file temp files (`NAME.tmp-PID`) of earlier versions go; a complete new
+/// directory whose swap was cut short is swapped in (all new), the old one removed.
+#[test]
+fn leftovers_of_killed_runs_are_finished_or_removed() {
+    let root = scratch("killed");
+    let dir = root.join("out");
+    let family = ["hw.png", "ref.png", "metrics.json"];
+    let mut first = sample();
+    first.family(&family);
+    first.write_to(&dir).expect("first");
+    fs::write(dir.join("notes.txt"), b"mine").expect("foreign file");
+    // Killed while writing.
+    let pid = dead_pid();
+    let partial = root.join(format!(".out.texsim-new-{pid}"));
+    fs::create_dir(&partial).expect("partial dir");
+    fs::write(partial.join("hw.png"), b"half").expect("half");
+    fs::write(dir.join(format!("hw.png.tmp-{pid}")), b"half").expect("old temp");
+    let mut next = OutputSet::new();
+    next.add("hw.png", vec![5]);
+    next.family(&family);
+    next.write_to(&dir).expect("next");
+    assert_eq!(listing(&root), ["out"]);
+    assert_eq!(listing(&dir), ["hw.png", "notes.txt"]);
+    assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [5]);
+    // Killed between moving the old directory aside and moving the new one in.
+    let pid = dead_pid();
+    let new = root.join(format!(".out.texsim-new-{pid}"));
+    fs::create_dir(&new).expect("new dir");
+    fs::write(new.join("hw.png"), [6]).expect("hw");
+    fs::write(new.join("metrics.json"), b"{6}").expect("json");
+    fs::rename(dir.join("notes.txt"), new.join("notes.txt")).expect("moved foreign file");
+    fs::write(new.join(".texsim-complete"), b"").expect("marker");
+    fs::rename(&dir, root.join(format!(".out.texsim-old-{pid}"))).expect("old aside");
+    OutputSet::new().write_to(&dir).expect("recovering run");
+    assert_eq!(listing(&root), ["out"]);
+    assert_eq!(listing(&dir), ["hw.png", "metrics.json", "notes.txt"]);
+    assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [6]);
     fs::remove_dir_all(&root).expect("cleanup");
 }
 
@@ -157,15 +213,13 @@ fn removes_stale_family_files_and_nothing_else() {
     third.family(&family);
     fs::write(root.join("ref.png"), b"old").expect("old ref");
     fs::write(root.join("error.png"), b"old").expect("old error");
-    let blocker = format!("metrics.json.tmp-{}", std::process::id());
-    fs::create_dir(root.join(&blocker)).expect("dir");
     let mut fourth = OutputSet::new();
     fourth.add("metrics.json", vec![1]);
+    fourth.add(&"y".repeat(300), vec![1]);
     fourth.family(&family);
-    fourth.write_to(&root).expect_err("blocked");
+    fourth.write_to(&root).expect_err("name too long");
     assert_eq!(fs::read(root.join("error.png")).expect("kept"), b"old");
     assert_eq!(fs::read(root.join("ref.png")).expect("kept"), b"old");
-    fs::remove_dir(root.join(&blocker)).expect("unblock");
     third.write_to(&root).expect("third");
     assert!(!root.join("error.png").exists(), "error.png is stale");
     assert_eq!(

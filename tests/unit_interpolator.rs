@@ -256,3 +256,89 @@ fn interpolate_exact_rounding() {
         }
     }
 }
+
+/// `interp.texcoord_reduce`: the offset is the floor of the middle of the range for repeat, an
+/// even integer for mirror (a mirror period is two repeats), nothing for clamp-to-edge.
+#[test]
+fn texcoord_offset_is_an_integer_period() {
+    use texsim::pipeline::stages::texcoord_offset;
+    use texsim::scene::WrapMode;
+    assert_eq!(
+        texcoord_offset([1e6, 1e6 + 3.0, 1e6 + 1.5], WrapMode::Repeat),
+        1e6 + 1.0
+    );
+    assert_eq!(texcoord_offset([-7.25, -6.0, -6.5], WrapMode::Repeat), -7.0);
+    assert_eq!(texcoord_offset([257.3; 3], WrapMode::Mirror), 256.0);
+    assert_eq!(texcoord_offset([258.3; 3], WrapMode::Mirror), 258.0);
+    assert_eq!(texcoord_offset([-3.5; 3], WrapMode::Mirror), -4.0);
+    assert_eq!(texcoord_offset([1e6; 3], WrapMode::ClampToEdge), 0.0);
+    assert_eq!(texcoord_offset([f64::NAN, 0.0, 1.0], WrapMode::Repeat), 0.0);
+}
+
+/// A textured plane whose coordinates sit 2^20 repeats away renders the same hardware image as
+/// the plane near 0 (repeat and mirror), with no saturation; without the reduction the far
+/// coordinates saturate the 8 integer bits, and the saturations are counted.
+#[test]
+fn far_texture_coordinates_reduce_exactly() {
+    use texsim::render::{render, Maps, RenderOptions};
+    let dir = std::env::temp_dir().join(format!("texsim-reduce-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for wrap in ["repeat", "mirror"] {
+        let p = dir.join(format!("plane_{wrap}.toml"));
+        std::fs::write(
+            &p,
+            format!(
+                "[output]\nwidth = 96\nheight = 72\n[camera]\neye = [0.0, 1.0, 2.5]\ntarget = [0.0, 0.0, 0.0]\n\
+                 [[textures]]\nname = \"c\"\nprocedural = \"noise-checker\"\nsize = 64\n\
+                 [[materials]]\nname = \"m\"\ntexture = \"c\"\nwrap_s = \"{wrap}\"\nwrap_t = \"{wrap}\"\nlit = false\n\
+                 [[meshes]]\nshape = \"plane\"\nsize = 4.0\nuv_scale = 6.0\nmaterial = \"m\"\n"
+            ),
+        )
+        .unwrap();
+        let near = texsim::scene::load(&p).unwrap();
+        let mut far = near.clone();
+        for uv in &mut far.meshes[0].uvs {
+            // 2^20 + k with k a multiple of 1/8 stays exact in f32.
+            assert_eq!(uv[0] * 8.0, (uv[0] * 8.0).round(), "{uv:?}");
+            uv[0] += 1_048_576.0;
+            uv[1] -= 1_048_576.0;
+        }
+        let hw = HwConfig::preset("texram16").unwrap();
+        let opts = RenderOptions {
+            reference: false,
+            ..RenderOptions::default()
+        };
+        let maps = Maps::new(&near, hw.trilinear.texel_bits);
+        let a = render(&near, &maps, &hw, &opts).unwrap();
+        let b = render(&far, &maps, &hw, &opts).unwrap();
+        let sat = |r: &texsim::render::Rendered| {
+            r.stats.input_saturated
+                + r.stats.input_wrapped
+                + r.stats
+                    .stages
+                    .iter()
+                    .map(|s| s.saturated + s.wrapped)
+                    .sum::<u64>()
+        };
+        assert!(
+            a.stats.covered_pixels > 3000,
+            "{wrap}: {}",
+            a.stats.covered_pixels
+        );
+        assert_eq!(sat(&a), 0, "{wrap}");
+        assert_eq!(sat(&b), 0, "{wrap}: far coordinates saturate");
+        assert!(
+            a.hw_image.px == b.hw_image.px,
+            "{wrap}: the far plane renders differently"
+        );
+        let mut off = hw.clone();
+        off.interp.texcoord_reduce = false;
+        let c = render(&far, &maps, &off, &opts).unwrap();
+        assert!(
+            c.stats.input_saturated > 0,
+            "{wrap}: saturations not counted"
+        );
+        assert!(a.hw_image.px != c.hw_image.px, "{wrap}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -45,6 +45,11 @@ const fn saturate() -> Overflow {
     Overflow::Saturate
 }
 
+/// The default of boolean knobs that are on unless a file says otherwise.
+const fn yes() -> bool {
+    true
+}
+
 /// Rasterizer: vertex snapping, depth, and its timing costs.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -97,6 +102,15 @@ pub struct InterpConfig {
     /// Absent in older files: `saturate`.
     #[serde(default = "saturate")]
     pub texcoord_overflow: Overflow,
+    /// Per-triangle texture-coordinate offset reduction at setup (the usual hardware trick for
+    /// tiled terrain and atlases): each triangle's s and t are reduced by one integer each
+    /// (the nearest integer below the middle of the triangle's range; an even one for
+    /// `mirror`; none for `clamp-to-edge`), which changes no texel for `repeat` and `mirror`.
+    /// Only a triangle whose own range of coordinates exceeds +-2^texcoord_int_bits still
+    /// saturates (or wraps) and is counted. `false`: coordinates enter the format as given.
+    /// Absent in older files: `true`.
+    #[serde(default = "yes")]
+    pub texcoord_reduce: bool,
     /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
     pub bary_cycles: u32,
     /// Cycles per interpolated scalar attribute.
@@ -213,6 +227,7 @@ impl HwConfig {
                 texcoord_int_bits: 8,
                 interp_rounding: Rounding::HalfEven,
                 texcoord_overflow: Overflow::Saturate,
+                texcoord_reduce: true,
                 bary_cycles: 2,
                 attr_cycles: 1,
             },

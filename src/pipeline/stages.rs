@@ -10,7 +10,7 @@ use crate::fixedpoint::{to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
 use crate::reference::LevelF;
-use crate::scene::{FrameKind, Light};
+use crate::scene::{FrameKind, Light, WrapMode};
 use crate::shading::reference as fref;
 use glam::DVec3;
 use hw_model::blinn_phong::ShadingUnits;
@@ -229,6 +229,26 @@ pub struct TriAttrs {
     pub bump: u32,
 }
 
+/// The integer subtracted from one axis of a triangle's texture coordinates `vals` at setup
+/// (`interp.texcoord_reduce`): the floor of the middle of their range for `repeat`, the even
+/// integer at or below it for `mirror` (a mirror period is two repeats), 0 for
+/// `clamp-to-edge` (or non-finite input). Sampling at `x - offset` gives the texel of `x`
+/// exactly for the periodic modes.
+#[must_use]
+pub fn texcoord_offset(vals: [f64; 3], wrap: WrapMode) -> f64 {
+    let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return 0.0;
+    }
+    let mid = lo * 0.5 + hi * 0.5;
+    match wrap {
+        WrapMode::Repeat => mid.floor(),
+        WrapMode::Mirror => 2.0 * (mid * 0.5).floor(),
+        WrapMode::ClampToEdge => 0.0,
+    }
+}
+
 impl TriAttrs {
     /// Converts float vertex data (post-clip) into the machine's formats. Host-to-hardware
     /// conversions that overflow are counted in `sat`.
@@ -239,8 +259,16 @@ impl TriAttrs {
         inv_w: [f64; 3],
         color: [[f64; 3]; 3],
         uv: [[f64; 2]; 3],
+        wrap: [WrapMode; 2],
         sat: &mut SatCounter,
     ) -> Self {
+        // `interp.texcoord_reduce`: the fixed coordinates enter the format less one integer per
+        // axis (exact: the offset is an integer, the coordinates f64 of f32 data).
+        let off: [f64; 2] = if m.hw.interp.texcoord_reduce {
+            [0, 1].map(|ax| texcoord_offset([uv[0][ax], uv[1][ax], uv[2][ax]], wrap[ax]))
+        } else {
+            [0.0; 2]
+        };
         let bits = m.hw.interp.inv_w_bits;
         let max = inv_w.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
         let norm = Format::unsigned(1, bits, Rounding::HalfEven);
@@ -253,7 +281,7 @@ impl TriAttrs {
             color_f: color,
             color_x: color.map(|c| c.map(|x| i64::from(to_unorm(x, cb)))),
             uv_f: uv,
-            uv_x: uv.map(|t| t.map(|x| to_raw(x, &m.uv_fmt, sat))),
+            uv_x: uv.map(|t| [0, 1].map(|ax| to_raw(t[ax] - off[ax], &m.uv_fmt, sat))),
             bump: u32::MAX,
         }
     }

@@ -28,17 +28,9 @@ pub(crate) struct ObjParts {
     pub warnings: Vec<String>,
 }
 
-/// Opens a regular file, with errors naming it.
+/// Opens a regular file of at most a budget's bytes, with errors naming it.
 pub(crate) fn open_regular(path: &Path, what: &str) -> Result<File> {
-    let meta = std::fs::metadata(path)
-        .map_err(|e| Error::file(path, format!("cannot open {what}: {e}")))?;
-    if meta.is_dir() {
-        return Err(Error::file(
-            path,
-            format!("is a directory, expected {what}"),
-        ));
-    }
-    File::open(path).map_err(|e| Error::file(path, format!("cannot open {what}: {e}")))
+    crate::budget::open_regular(path, what, crate::budget::max_binary_file_bytes())
 }
 
 /// One MTL material as read from the file.
@@ -56,10 +48,7 @@ struct MtlEntry {
 }
 
 fn parse_mtl(path: &Path) -> Result<Vec<MtlEntry>> {
-    let mut text = String::new();
-    open_regular(path, "an MTL material library")?
-        .read_to_string(&mut text)
-        .map_err(|e| Error::file(path, format!("cannot read MTL: {e}")))?;
+    let text = crate::budget::read_text(path, "an MTL material library")?;
     let mut out: Vec<MtlEntry> = Vec::new();
     for (ln, line) in text.lines().enumerate() {
         let line = line.trim();

@@ -15,21 +15,22 @@ pub const MAX_TEXTURE_SIDE: u32 = 16384;
 /// Decodes a PNG or JPEG file (8 or 16 bit; gray, gray+alpha, RGB or RGBA) to RGBA16, top row
 /// first. Gray replicates to RGB; a missing alpha is opaque. Errors name the file.
 pub fn decode_texture(path: &Path) -> Result<TextureImage> {
-    let meta = std::fs::metadata(path)
-        .map_err(|e| Error::file(path, format!("cannot open texture: {e}")))?;
-    if meta.is_dir() {
-        return Err(Error::file(
-            path,
-            "is a directory, expected a PNG or JPEG texture",
-        ));
-    }
-    let reader = ImageReader::open(path)
-        .map_err(|e| Error::file(path, format!("cannot open texture: {e}")))?
+    let file = crate::budget::open_regular(
+        path,
+        "a PNG or JPEG texture",
+        crate::budget::max_binary_file_bytes(),
+    )?;
+    let mut reader = ImageReader::new(std::io::BufReader::new(file))
         .with_guessed_format()
         .map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?;
     if reader.format().is_none() {
         return Err(Error::file(path, "not a PNG or JPEG image"));
     }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(crate::budget::max_memory() / 4);
+    reader.limits(limits);
     let img = reader
         .decode()
         .map_err(|e| Error::file(path, format!("cannot decode texture: {e}")))?;

@@ -8,10 +8,11 @@ use glam::{DMat4, DVec3};
 use serde::Deserialize;
 
 use super::geometry::{bounding_sphere, fit_camera, fit_light, transform_mesh};
-use super::obj::{load_obj_parts, open_regular};
+use super::obj::load_obj_parts;
 use super::texture::{decode_texture, procedural, MAX_TEXTURE_SIDE};
 use super::{
-    shapes, AsBrdf, Camera, FrameKind, Light, MainDirection, Material, Mesh, Scene, WrapMode,
+    shapes, AsBrdf, Camera, FrameKind, Light, MainDirection, Material, Mesh, Scene, TextureImage,
+    WrapMode,
 };
 use crate::{Error, Result};
 
@@ -270,7 +271,9 @@ fn count(field: &str, v: Option<u32>, default: u32, min: u32) -> Result<u32> {
     }
 }
 
-fn build_shape(i: usize, c: &MeshCfg, shape: &str) -> Result<Mesh> {
+/// Builds shape mesh `i`; `tris_before` triangles are already in the scene (the run's triangle
+/// budget is checked before the mesh is generated).
+fn build_shape(i: usize, c: &MeshCfg, shape: &str, tris_before: usize) -> Result<Mesh> {
     let f = |name: &str| format!("meshes[{i}].{name}");
     let used_params: &[(&str, bool)] = &[
         ("size", c.size.is_some()),
@@ -309,6 +312,25 @@ fn build_shape(i: usize, c: &MeshCfg, shape: &str) -> Result<Mesh> {
             format!("not a parameter of shape '{shape}'"),
         ));
     }
+    let grid = |seg: u32, rings: u32| 2 * u64::from(seg) * u64::from(rings);
+    let tris = match shape {
+        "plane" => 2,
+        "sphere" => grid(
+            count(&f("segments"), c.segments, 64, 3)?,
+            count(&f("rings"), c.rings, 32, 2)?,
+        ),
+        "torus" => grid(
+            count(&f("segments"), c.segments, 96, 3)?,
+            count(&f("rings"), c.rings, 48, 3)?,
+        ),
+        _ => 12,
+    };
+    let total = tris + tris_before as u64;
+    crate::budget::check(
+        &f("segments"),
+        &format!("{total} triangles (this mesh: {tris})"),
+        crate::budget::mul(total, crate::budget::BYTES_PER_TRIANGLE),
+    )?;
     Ok(match shape {
         "plane" => shapes::plane(
             positive(&f("size"), c.size, 2.0)?,
@@ -332,9 +354,7 @@ fn build_shape(i: usize, c: &MeshCfg, shape: &str) -> Result<Mesh> {
 
 /// Loads a TOML scene. Errors name the file and the field (toml's message carries the line).
 pub fn load_toml(path: &Path) -> Result<Scene> {
-    let mut text = String::new();
-    std::io::Read::read_to_string(&mut open_regular(path, "a TOML scene file")?, &mut text)
-        .map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let text = crate::budget::read_text(path, "a TOML scene file")?;
     let cfg: SceneFile = toml::from_str(&text)
         .map_err(|e| Error::file(path, crate::error::toml_message(&text, &e)))?;
     build(path, cfg).map_err(|e| e.context(path.display()))
@@ -369,6 +389,16 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
                         format!("{size} is outside 1..={MAX_TEXTURE_SIDE}"),
                     ));
                 }
+                let texels: u64 = textures
+                    .iter()
+                    .map(|t: &TextureImage| u64::from(t.width) * u64::from(t.height))
+                    .sum::<u64>()
+                    + u64::from(size) * u64::from(size);
+                crate::budget::check(
+                    &f("size"),
+                    &format!("a procedural texture of {size}x{size} ({texels} texels in all textures so far)"),
+                    crate::budget::mul(texels, crate::budget::BYTES_PER_TEXEL),
+                )?;
                 procedural(kind, size).map_err(|e| Error::field(&f("procedural"), e))?
             }
             _ => {
@@ -500,7 +530,8 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
                     .collect()
             }
             (None, Some(shape)) => {
-                let mut m = build_shape(i, c, shape)?;
+                let tris_before = meshes.iter().map(|m: &Mesh| m.indices.len()).sum();
+                let mut m = build_shape(i, c, shape, tris_before)?;
                 m.material = match explicit {
                     Some(e) => e,
                     None => *default_mat.get_or_insert_with(|| {

@@ -1,0 +1,31 @@
+//! Where a result came from: written into every JSON file texsim produces.
+
+use serde::Serialize;
+
+/// The texsim version, the git commit it was built from (when built from a checkout: its HEAD
+/// at build time; uncommitted changes are not recorded) and the command line.
+#[derive(Clone, Debug, Serialize, PartialEq, Eq)]
+pub struct Provenance {
+    pub texsim_version: &'static str,
+    pub git_commit: Option<&'static str>,
+    pub command_line: Vec<String>,
+}
+
+impl Provenance {
+    /// The provenance of this process, with `command_line` as given (the CLI passes its own
+    /// arguments).
+    #[must_use]
+    pub fn new(command_line: Vec<String>) -> Self {
+        Self {
+            texsim_version: env!("CARGO_PKG_VERSION"),
+            git_commit: option_env!("TEXSIM_GIT_COMMIT"),
+            command_line,
+        }
+    }
+
+    /// The provenance of this process with its own command line (`std::env::args`).
+    #[must_use]
+    pub fn of_process() -> Self {
+        Self::new(std::env::args().collect())
+    }
+}
