@@ -2,7 +2,7 @@
 
 use crate::hwconfig;
 use crate::pipeline::{Impl, StageImpls, StageKind};
-use crate::render::{progress_line, render, CoverageMode, Maps, RenderOptions, Rendered};
+use crate::render::{render, CoverageMode, Maps, RenderOptions, Rendered};
 use crate::report::{self, OutputSet};
 use crate::scene::{self, Scene};
 use crate::{Error, Result};
@@ -346,7 +346,10 @@ pub fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Some(Command::Probe(a)) => crate::probe::probe_cmd(&a),
+        Some(Command::Probe(a)) => {
+            print!("{}", crate::probe::probe_cmd(&a)?);
+            Ok(())
+        }
         Some(Command::Brdf { cmd }) => brdf_cmd(&cmd),
         Some(Command::Cycles(a)) => cycles_cmd(&a),
     }
@@ -427,7 +430,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         hw.trilinear.texel_bits,
         hw.shading.vector.offset_int_bits,
     );
-    progress_line(true, "texture maps", elapsed_ms(t));
+    progress_line("texture maps", elapsed_ms(t));
     let opts = RenderOptions {
         hw_impls: impls,
         reference: !a.no_reference || a.truth,
@@ -441,7 +444,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         } else {
             0
         },
-        progress: true,
+        progress: Some(progress_line),
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
     let t = std::time::Instant::now();
@@ -475,7 +478,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     out.family(RENDER_OUTPUTS);
     let stale = out.stale_in(&a.scene.out);
     let written = out.write_to(&a.scene.out)?;
-    progress_line(true, "writing outputs", elapsed_ms(t));
+    progress_line("writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
     for w in &r.stats.warnings {
         eprintln!("warning: {w}");
@@ -892,4 +895,9 @@ fn cycles_cmd(a: &CyclesArgs) -> Result<()> {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// One progress line on stderr: a finished phase and its wall time.
+fn progress_line(phase: &str, ms: f64) {
+    eprintln!("texsim:   {phase:<18} {ms:>9.1} ms");
 }

@@ -12,8 +12,8 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::trilinear::{trilinear, TrilinearTrace};
 use std::fmt::Write;
 
-/// Runs the probe and prints the report.
-pub fn probe_cmd(a: &ProbeArgs) -> Result<()> {
+/// Runs the probe: the report the CLI prints.
+pub fn probe_cmd(a: &ProbeArgs) -> Result<String> {
     for (name, v) in [("--u", a.u), ("--v", a.v), ("--lod", a.lod)] {
         if !v.is_finite() {
             return Err(Error::field(name, format!("{v} is not a finite number")));
@@ -22,8 +22,7 @@ pub fn probe_cmd(a: &ProbeArgs) -> Result<()> {
     let hw = hwconfig::resolve(&a.hw)?;
     let wrap = a.wrap.into();
     let tex = decode_texture(&a.texture)?;
-    print!("{}", probe_report(&tex, &hw, a.u, a.v, a.lod, [wrap, wrap]));
-    Ok(())
+    Ok(probe_report(&tex, &hw, a.u, a.v, a.lod, [wrap, wrap]))
 }
 
 /// The probe report for one texture and sample position.

@@ -8,8 +8,7 @@
 //! fragments by default (shared coverage).
 
 use crate::fixedpoint::to_unorm;
-use crate::maps::quantize_unorm;
-use crate::maps::{build_mip_chain, quantize_chain, FixedMipChain, MipChain};
+pub use crate::maps::{bump_sources, ndf_sources, BumpSource, Maps};
 use crate::pipeline::bump_stages::{BumpAttrs, BumpVertex};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{
@@ -18,11 +17,7 @@ use crate::pipeline::{
 use crate::raster::{self, Coverage, DrawTri, RasterStats, Setup, SetupStats, VisBuffer, NO_TRI};
 use crate::report::{compare, ErrorMetrics, Image};
 use crate::scene::{Light, Scene};
-use crate::scene::{MainDirection, Mesh, TextureImage};
-use crate::shading::bump::{
-    height_to_offsets, heights_from_texture, normal_map_to_offsets, offsets_to_image, BumpParams,
-    OffsetEncoding,
-};
+use crate::scene::{MainDirection, Mesh};
 use crate::shading::reference as fref;
 use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
 use crate::timing::events::{record_pixel, FrameEvents, PlanTiming, RowEvents};
@@ -32,271 +27,6 @@ use hw_model::{HwConfig, UnitCost};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
-
-/// The prepared texture maps of a scene: float MIP chains (host) and their quantization to the
-/// texel width of the machine. The scene's textures come first, then one offset map per
-/// distinct (height map, bump scale) of the bump materials ([`bump_sources`]).
-#[derive(Clone)]
-pub struct Maps {
-    pub float: Vec<MipChain>,
-    pub fixed: Vec<FixedMipChain>,
-    /// Per offset map: its level-0 offsets `(f_u, f_v)` before encoding (size, values).
-    #[allow(clippy::type_complexity)]
-    pub bump_offsets: Vec<(u32, u32, String, Vec<[f32; 2]>)>,
-    /// `offset_int_bits` of the offset encoding (range `2^bits`).
-    pub offset_int_bits: u32,
-    /// Offsets clamped (all offset maps): by the encoding, plus `normal_nz_clamped`.
-    pub bump_clamped: u64,
-    /// Normal-map texels whose `n_z` was clamped to `shading::bump::NORMAL_MAP_MIN_Z` (all
-    /// normal maps), which bounds their offsets before the encoding.
-    pub normal_nz_clamped: u64,
-    /// NDF moment maps ([`ndf_sources`]): four chains each (A, B, C, normalization) after the
-    /// offset maps, quantized to `moment_bits`, and the config they were built for.
-    pub ndf: Vec<(usize, u32)>,
-    pub ndf_cfg: hw_model::ndf::NdfConfig,
-    /// Moment channels clamped by the encoding (all moment maps).
-    pub ndf_clamped: u64,
-}
-
-/// One offset map to prepare: the source texture, the bump scale, and whether the source is
-/// a tangent-space normal map (else a height map, channel 0).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BumpSource {
-    pub texture: usize,
-    pub scale: f32,
-    pub normal_map: bool,
-}
-
-impl BumpSource {
-    fn of(m: &crate::scene::Material) -> Option<Self> {
-        m.bump.map(|texture| Self {
-            texture,
-            scale: m.bump_scale,
-            normal_map: m.bump_normal_map,
-        })
-    }
-
-    fn same(&self, o: &Self) -> bool {
-        self.texture == o.texture
-            && self.scale.to_bits() == o.scale.to_bits()
-            && self.normal_map == o.normal_map
-    }
-}
-
-/// The distinct offset maps of the scene's bump materials, in material order; offset map `k`
-/// is map `scene.textures.len() + k`.
-#[must_use]
-pub fn bump_sources(scene: &Scene) -> Vec<BumpSource> {
-    let mut out: Vec<BumpSource> = Vec::new();
-    for m in &scene.materials {
-        if let Some(b) = BumpSource::of(m) {
-            if !out.iter().any(|o| o.same(&b)) {
-                out.push(b);
-            }
-        }
-    }
-    out
-}
-
-/// The distinct (offset map, base shininess) pairs of the scene's NDF materials, in material
-/// order; pair `j` is prepared as maps `scene.textures.len() + bump_sources.len() + 4 j ..+4`.
-#[must_use]
-pub fn ndf_sources(scene: &Scene) -> Vec<(usize, u32)> {
-    let sources = bump_sources(scene);
-    let mut out: Vec<(usize, u32)> = Vec::new();
-    for m in scene.materials.iter().filter(|m| m.ndf) {
-        let Some(b) = BumpSource::of(m) else { continue };
-        let Some(k) = sources.iter().position(|o| o.same(&b)) else {
-            continue;
-        };
-        if !out.contains(&(k, m.shininess)) {
-            out.push((k, m.shininess));
-        }
-    }
-    out
-}
-
-/// Encodes offsets (range `2^offset_int_bits`) and builds the offset map's MIP chain with the
-/// ordinary texture path (16-bit unorm level 0, box-filtered levels). Returns the chain and
-/// the number of clamped offsets.
-fn offset_chain(w: u32, h: u32, name: &str, offs: &[[f32; 2]], bits: u32) -> (MipChain, u64) {
-    let enc = OffsetEncoding::for_offset_int_bits(bits);
-    let img = offsets_to_image(offs, w, h, &enc);
-    let tex = TextureImage {
-        name: format!("{name} (offsets)"),
-        width: w,
-        height: h,
-        texels: img
-            .texels
-            .iter()
-            .map(|t| t.map(|c| quantize_unorm(c, 16)))
-            .collect(),
-        prebuilt_levels: None,
-    };
-    (build_mip_chain(&tex), img.clamped)
-}
-
-impl Maps {
-    /// Builds every texture's MIP chain and quantizes it to `texel_bits`; bump height maps
-    /// become offset maps encoded for the default (texram16) `offset_int_bits`.
-    #[must_use]
-    pub fn new(scene: &Scene, texel_bits: u32) -> Self {
-        Self::with_offset_bits(
-            scene,
-            texel_bits,
-            hw_model::vector::VectorConfig::texram16().offset_int_bits,
-        )
-    }
-
-    /// As [`Maps::new`] with the offset encoding of `offset_int_bits`. A height map that
-    /// cannot be converted (bad size) gives a flat offset map.
-    #[must_use]
-    pub fn with_offset_bits(scene: &Scene, texel_bits: u32, offset_int_bits: u32) -> Self {
-        let mut float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
-        let mut bump_offsets = Vec::new();
-        let mut normal_nz_clamped = 0;
-        for b in bump_sources(scene) {
-            let tex = &scene.textures[b.texture];
-            let p = BumpParams {
-                scale: b.scale,
-                v_up: false,
-            };
-            let offs = if b.normal_map {
-                normal_map_to_offsets(tex, true).map(|(o, nz)| {
-                    normal_nz_clamped += nz;
-                    o.into_iter()
-                        .map(|f| f.map(|x| x * b.scale))
-                        .collect::<Vec<_>>()
-                })
-            } else {
-                heights_from_texture(tex, 0)
-                    .and_then(|h| height_to_offsets(&h, tex.width, tex.height, &p))
-            }
-            .unwrap_or_else(|_| vec![[0.0; 2]; tex.texels.len()]);
-            bump_offsets.push((tex.width, tex.height, tex.name.clone(), offs));
-        }
-        let mut bump_clamped = normal_nz_clamped;
-        for (w, h, name, offs) in &bump_offsets {
-            let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
-            float.push(c);
-            bump_clamped += cl;
-        }
-        let fixed = float
-            .par_iter()
-            .map(|c| quantize_chain(c, texel_bits))
-            .collect();
-        let mut maps = Self {
-            float,
-            fixed,
-            bump_offsets,
-            offset_int_bits,
-            bump_clamped,
-            normal_nz_clamped,
-            ndf: ndf_sources(scene),
-            ndf_cfg: hw_model::ndf::NdfConfig::texram16(),
-            ndf_clamped: 0,
-        };
-        let cfg = maps.ndf_cfg.clone();
-        maps.build_ndf(&cfg, false);
-        maps
-    }
-
-    /// Number of chains of the NDF moment maps (at the end of the lists).
-    #[must_use]
-    pub fn ndf_chains(&self) -> usize {
-        4 * self.ndf.len()
-    }
-
-    /// True when the moment maps must be rebuilt for `cfg` (encoding, or the normalization
-    /// map's density and regularization when `cfg` uses it).
-    #[must_use]
-    pub fn ndf_stale(&self, cfg: &hw_model::ndf::NdfConfig) -> bool {
-        use hw_model::ndf::NdfNorm;
-        let o = &self.ndf_cfg;
-        let map = cfg.ndf_norm == NdfNorm::Map;
-        !self.ndf.is_empty()
-            && (o.moment_bits != cfg.moment_bits
-                || o.moment_scale_bits != cfg.moment_scale_bits
-                || (map
-                    && (o.ndf_norm != NdfNorm::Map
-                        || o.ndf_density != cfg.ndf_density
-                        || o.pearson_m != cfg.pearson_m
-                        || o.min_variance_bits() != cfg.min_variance_bits())))
-    }
-
-    /// Rebuilds the moment maps for `cfg` if [`Maps::ndf_stale`].
-    pub fn ensure_ndf(&mut self, cfg: &hw_model::ndf::NdfConfig) {
-        if self.ndf_stale(cfg) {
-            self.build_ndf(cfg, true);
-        }
-    }
-
-    fn build_ndf(&mut self, cfg: &hw_model::ndf::NdfConfig, replace: bool) {
-        if replace {
-            let keep = self.float.len() - self.ndf_chains();
-            self.float.truncate(keep);
-            self.fixed.truncate(keep);
-        }
-        self.ndf_cfg = cfg.clone();
-        self.ndf_clamped = 0;
-        for &(k, s) in &self.ndf {
-            let (w, h, _, offs) = &self.bump_offsets[k];
-            let normals: Vec<DVec3> = offs
-                .iter()
-                .map(|o| DVec3::new(f64::from(o[0]), f64::from(o[1]), 1.0).normalize())
-                .collect();
-            match crate::shading::ndf::build_ndf_maps(&normals, *w, *h, f64::from(s), cfg) {
-                Ok(nm) => {
-                    self.ndf_clamped += nm.clamped;
-                    self.float.extend(nm.float);
-                    self.fixed.extend([nm.mean, nm.diag, nm.off, nm.norm]);
-                }
-                Err(_) => {
-                    let flat = vec![DVec3::Z; normals.len()];
-                    let nm = crate::shading::ndf::build_ndf_maps(&flat, *w, *h, 1.0, cfg)
-                        .expect("flat maps of a valid size");
-                    self.float.extend(nm.float);
-                    self.fixed.extend([nm.mean, nm.diag, nm.off, nm.norm]);
-                }
-            }
-        }
-    }
-
-    /// Re-encodes the offset maps for another `offset_int_bits` if needed.
-    pub fn ensure_offset_bits(&mut self, offset_int_bits: u32) {
-        if self.offset_int_bits == offset_int_bits || self.bump_offsets.is_empty() {
-            self.offset_int_bits = offset_int_bits;
-            return;
-        }
-        let first = self.float.len() - self.bump_offsets.len() - self.ndf_chains();
-        let texel_bits = self.fixed.first().map_or(16, |f| f.texel_bits);
-        self.bump_clamped = self.normal_nz_clamped;
-        for (k, (w, h, name, offs)) in self.bump_offsets.iter().enumerate() {
-            let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
-            self.fixed[first + k] = quantize_chain(&c, texel_bits);
-            self.float[first + k] = c;
-            self.bump_clamped += cl;
-        }
-        self.offset_int_bits = offset_int_bits;
-    }
-
-    /// Re-quantizes for another texel width if needed (sweeps reuse the float chains).
-    pub fn ensure_texel_bits(&mut self, texel_bits: u32) {
-        if self
-            .fixed
-            .first()
-            .is_some_and(|f| f.texel_bits != texel_bits)
-        {
-            let keep = self.float.len() - self.ndf_chains();
-            let ndf = self.fixed.split_off(keep);
-            self.fixed = self.float[..keep]
-                .par_iter()
-                .map(|c| quantize_chain(c, texel_bits))
-                .collect();
-            self.fixed.extend(ndf);
-        }
-    }
-}
 
 /// Host-side geometry: clip-space vertices, Gouraud vertex colours, texture coordinates, the
 /// triangles to draw and the plan of each mesh.
@@ -512,9 +242,9 @@ pub struct RenderOptions {
     /// (`pipeline::ndf_stages::NdfTruth`); the stats gain `model_error` (float vs truth) and
     /// `quantization_error` (hardware vs float).
     pub truth: u32,
-    /// Print one line per finished phase (setup, raster, hardware shading, reference shading,
-    /// ground truth) with its wall time on stderr (`texsim render`).
-    pub progress: bool,
+    /// Called once per finished phase (setup, raster, hardware shading, reference shading,
+    /// ground truth) with its name and wall time in ms (`texsim render` prints them).
+    pub progress: Option<fn(&str, f64)>,
 }
 
 impl Default for RenderOptions {
@@ -525,15 +255,8 @@ impl Default for RenderOptions {
             coverage: CoverageMode::Shared,
             timing: false,
             truth: 0,
-            progress: false,
+            progress: None,
         }
-    }
-}
-
-/// One progress line on stderr: a finished phase and its wall time.
-pub fn progress_line(on: bool, phase: &str, ms: f64) {
-    if on {
-        eprintln!("texsim:   {phase:<18} {ms:>9.1} ms");
     }
 }
 
@@ -891,7 +614,11 @@ pub fn render(
 ) -> crate::Result<Rendered> {
     hw.validate()?;
     crate::budget::check_run(scene, hw, opts.reference || opts.truth > 0, opts.timing)?;
-    let progress = |phase: &str, ms: f64| progress_line(opts.progress, phase, ms);
+    let progress = |phase: &str, ms: f64| {
+        if let Some(report) = opts.progress {
+            report(phase, ms);
+        }
+    };
     let t_start = Instant::now();
     let mut tm = Timings::default();
     let t = Instant::now();

@@ -12,6 +12,9 @@
 //! For texels that came from exact 16-bit data (`x = v / 65535`) and `bits == 16` this gives `v`
 //! back exactly.
 
+mod prepared;
+pub use prepared::{bump_sources, ndf_sources, BumpSource, Maps};
+
 use crate::scene::TextureImage;
 
 /// One float MIP level, RGBA in 0..1, top row first.

@@ -106,7 +106,7 @@ pub struct NdfTruth {
 /// `samples x samples` sub-samples per pixel.
 #[must_use]
 pub fn truth_maps(
-    maps: &crate::render::Maps,
+    maps: &crate::maps::Maps,
     scene: &crate::scene::Scene,
     plans: &[Plan],
     samples: u32,

@@ -21,9 +21,9 @@ use super::stages::{Counters, Machine};
 use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
 use super::{Frag, Impl, Plan, Px, StageImpls, StageKind};
 use crate::fixedpoint::{from_unorm, to_raw, to_unorm};
+use crate::maps::Maps;
 use crate::maps::MipChain;
 use crate::reference::{lod_f64, trilinear_f64};
-use crate::render::Maps;
 use crate::scene::{Material, RoughChoice};
 use crate::shading::reference as fref;
 use crate::shading::roughness::{
