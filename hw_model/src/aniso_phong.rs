@@ -40,7 +40,7 @@
 //! passes zeros for `k1 = -k2` (no halfway vector) and for directions below the horizon. At
 //! `h = n` (`s = 0`, eq. 18's 0/0) the power is exactly 1. `0^0 = 1` (`nu = nv = 0`).
 //!
-//! Accuracy (texram16; `tests/brdf_fixed.rs`, 2^21 random unit-vector inputs with integer
+//! Accuracy (texram16; `tests/units/brdf_fixed.rs`, 2^21 random unit-vector inputs with integer
 //! exponents 0..1e5, against the reference evaluated from the SAME quantized dot products):
 //! `|fixed - ref| <= 2e-4 ref` for `ref >= 1e-15` in units of `pi rho` (measured worst 6.7e-5),
 //! excluding saturated outputs (`>= 2^24`, only at extreme grazing, < 0.1% of those inputs).
@@ -397,7 +397,7 @@ fn interp(a: i64, b: i64, frac: i64, fb: u32, rnd: Rounding) -> i64 {
 /// more: `E` is a weighted average of `nu, nv`). ROMs are read from `roms` (built for a valid
 /// configuration).
 ///
-/// Declared precision (derived here, checked by `tests/as_power.rs` against `(1 - s)^(E/2)` in
+/// Declared precision (derived here, checked by `tests/units/as_power.rs` against `(1 - s)^(E/2)` in
 /// double precision). Let `f = aniso_pow_frac_bits`, `b = aniso_pow_lut_bits`, `r = aniso_ratio_bits`,
 /// `u = 1/2` for the round-to-nearest modes and `u = 1` for `Truncate`, `L = -log2(1 - s)`
 /// and `X = E L / 2`, so the exact power is `P = 2^-X`.

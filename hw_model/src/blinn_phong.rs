@@ -15,7 +15,7 @@
 //!
 //! ERROR BOUND (absolute, per channel, colours in [0, 1], texram16: F = 14, C = 16, power unit
 //! L = 8, G = 24, P = 16; against the float twin on the same quantized `n`, `l`, `v`,
-//! colours; asserted in `tests/frames_shade.rs`, exponents 1..=1024, 1M cases log-exp and 300k
+//! colours; asserted in `tests/units/frames_shade.rs`, exponents 1..=1024, 1M cases log-exp and 300k
 //! squaring, grazing light and view and `l = -v` included), with `x = n.h` and `s` the
 //! exponent: `light * (ks * (E + s x^(s-1) 2.5 * 2^-F) + kd * 2^-F + T) + 1 / (2^C - 1)`, where
 //! `E = x^s (2^(s (0.1803 * 2^-2L + 2^-G)) - 1) + 2 s 2^-G + 2^-(P+1)` is the power unit's
@@ -263,7 +263,7 @@ pub struct BumpShadeOut {
 /// ERROR BOUND (texram16, ulp = 2^-14, against `texsim::shading::reference::bump_shade` on the
 /// same quantized inputs and decoded offsets, every frame and [`crate::frame::MainRole`],
 /// offsets within +-2, lengths in [0.5, 1.5], exponents 1..=64; asserted in
-/// `tests/frames_pixel.rs`, 200k cases per frame): perturbed normal <= 16 ulp per component
+/// `tests/units/frames_pixel.rs`, 200k cases per frame): perturbed normal <= 16 ulp per component
 /// (measured 3.40 / 1.35 / 4.60 ulp natural / unit / main); colour per channel
 /// `light * (kd * 40 ulp + ks * (s * 40 ulp + 4e-4)) + 2 / (2^C - 1)` (the normal error
 /// through `n.l` and `n.h`, and the power unit; measured max 3.25e-3 absolute).

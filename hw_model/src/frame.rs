@@ -43,7 +43,7 @@
 //! saturation event each by the normalizer.
 //!
 //! ERROR BOUNDS (texram16, s1.14, ulp = 2^-14; stated bound / measured max over 1M random
-//! cases each in `tests/frames_frame.rs`): main frame orthonormality (| |x| - 1 | and pairwise
+//! cases each in `tests/units/frames_frame.rs`): main frame orthonormality (| |x| - 1 | and pairwise
 //! dot products) <= 3 ulp / 1.95 ulp; main frame components against the float twin on the
 //! same quantized inputs <= 4 ulp + 2.5 ulp / sin(m, n) / 0.47 of that; unit and natural frame
 //! components <= 0.61 ulp / 0.59 ulp; perturbed normal ([`perturb_normal`]) <= 2.5 ulp /
@@ -355,7 +355,7 @@ pub fn build_frame(
 /// multiply-add is exact with one rounding into wide format, then normalized (a zero result
 /// falls back to the frame normal).
 /// ERROR BOUND per component against the float twin on the same frame and offsets (texram16,
-/// ulp = 2^-14, offsets in [-2, 2]; asserted in `tests/frames_frame.rs`, 1M cases): 2.5 ulp
+/// ulp = 2^-14, offsets in [-2, 2]; asserted in `tests/units/frames_frame.rs`, 1M cases): 2.5 ulp
 /// with lengths 1 (madd rounding, at most sqrt(3)/2 ulp relative to `|n'|`, plus the
 /// normalize bound 0.61 ulp), 8 ulp with natural lengths in [0.25, 2.25] (adds the rounding
 /// of each `f len` to the offset format, 1/2 ulp of s3.12 = 2 ulp of s1.14 per offset);

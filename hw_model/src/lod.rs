@@ -14,7 +14,7 @@
 //! (< 2^-31 relative) contributes < 2^-30 to `log2(L)`; so the result is `floor(lambda * 2^F)`
 //! exactly unless `lambda * 2^F` lies less than `F * 2^(F-31)` LSB above an integer (<= 2^-11
 //! LSB for F = 16), where it may be exactly 1 LSB low. It is never above the floor. Powers of
-//! two are exact. Measured (`tests/unit_lod.rs`, all 2^24 pairs (du/dx, dv/dx) in 0..4096, F =
+//! two are exact. Measured (`tests/units/unit_lod.rs`, all 2^24 pairs (du/dx, dv/dx) in 0..4096, F =
 //! 16): 118 results 1 LSB low, all within 9e-6 LSB above an integer.
 //!
 //! Range: `rho == 0` returns [`lod_zero`] = `-(32 << F)`; any smaller result is clamped to it

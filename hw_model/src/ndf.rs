@@ -9,7 +9,7 @@
 //!   the paper print the denominator as `2^m`; that form is `(1 - t/2^m)^m ~ exp(-t m/2^m)`,
 //!   with m = 8 `(1 - t/256)^8 ~ exp(-t/32)`: `d` scaled down 16 times (a variance 16 times too
 //!   large, a lobe 4 times too wide in angle), while `(1 - t/(2m))^m -> exp(-t/2)` as m grows
-//!   (the Gaussian the paper says it approximates). `tests/ndf_unit.rs` checks both limits. m = 8 is three
+//!   (the Gaussian the paper says it approximates). `tests/units/ndf_unit.rs` checks both limits. m = 8 is three
 //!   squarings.
 //! - `gauss`: `exp(-t/2) = 2^(-t log2(e)/2)`: integer part by shift, fraction by a `2^f` table
 //!   of `2^ndf_exp_lut_bits + 1` entries with linear interpolation.
@@ -34,7 +34,7 @@
 //!    trilinearly filtered channels errs by up to one LSB of `E_ii` (`2^k 2^-B`: half from the
 //!    storage rounding, half from the filter's output rounding) plus `2 |mu_i|` times one LSB
 //!    of `mu_i` (`2^(1-B)`), at most `(2^k + 4) 2^-B <= 2^(3-B)` for `k <= 2`; the storage half
-//!    is checked in `tests/ndf_unit.rs`); each clamp is counted
+//!    is checked in `tests/units/ndf_unit.rs`); each clamp is counted
 //!    as a saturation. Below that floor the stored variance is quantization noise, so a lobe
 //!    sharper than `s = 2^v` degrades to the floor's broader lobe instead of an arbitrarily
 //!    sharp one. If a leading minor is then not positive (quantization made the matrix
@@ -50,7 +50,7 @@
 //! `h` with `h_z <= 0` (at or below the horizon of the tangent frame) gives `D = 0`.
 //!
 //! ERROR BOUND (texram16 widths, against the float twin `texsim::shading::ndf::eval_float` on
-//! the same decoded texels, `tests/ndf_unit.rs`, 1.02M seeded cases over every option): `d`
+//! the same decoded texels, `tests/units/ndf_unit.rs`, 1.02M seeded cases over every option): `d`
 //! within 1e-4 relative (measured 4.8e-5); the density unit within 8 LSB of `2^-F` (measured
 //! 6.8 Pearson, 1.5 Gauss; exhaustive over 2^23 inputs: 6.79 and 0.50); `D` within 5e-5 of the
 //! texel's peak value where `g > 1e-3` (measured 3.1e-5). With narrow widths `d` can err by

@@ -15,7 +15,7 @@
 //! - `squaring`: left-to-right binary exponentiation on G-bit values, each product rounded by
 //!   `pow_rounding`; ERROR BOUND (absolute): `2 n 2^-G + 2^-(P+1)`.
 //!
-//! Both measured against the exact power of the quantized input in `tests/frames_pow.rs`
+//! Both measured against the exact power of the quantized input in `tests/units/frames_pow.rs`
 //! (exponents 1..=1024): texram16 log-exp max 15.6 ulp of 2^-16 (L = 8; 2.1 ulp at L = 10),
 //! squaring max 1.7 ulp (8 guard bits); the test asserts exactly the bounds above (ratio <= 1;
 //! the log-exp ratio reaches 1.000 where the final rounding dominates).

@@ -20,7 +20,7 @@
 //! error halves per LUT bit and squares per iteration: with L = 8 and M = 24, one iteration is
 //! limited by the seed (~2^-18, 128 ulps), so texram16 (L=8, N=2, M=24) uses two, which reach
 //! the rounding floor (<= 1 ulp). Measured max error (ulps, M = 24, HalfEven;
-//! `cargo test --test unit_reciprocal -- --nocapture`): (L,N) = (8,0) 65352, (8,1) 128.0 and
+//! `cargo test --test units unit_reciprocal:: -- --nocapture`): (L,N) = (8,0) 65352, (8,1) 128.0 and
 //! (8,2) 0.75 (both exhaustive over all 24-bit x), (10,1) 8.3, (12,1) 1.16, (6,2) 0.82,
 //! (4,3) 0.74, (16,0) 256.
 

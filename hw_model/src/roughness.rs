@@ -32,7 +32,7 @@
 //! ERROR BOUND (absolute, against the float twin `texsim::shading::roughness::rough_cos_twin`
 //! on the same quantized inputs): `1.5 * 2^-div_bits + 2^-sqrt_bits + 2^-(P+1) + 2^-20`
 //! (divider `2^-B` relative twice, half of it through the square root; square root `2^-B`;
-//! output rounding; the `Q` cap). Measured in `tests/roughness_unit.rs` (docs/ROUGHNESS.md).
+//! output rounding; the `Q` cap). Measured in `tests/units/roughness_unit.rs` (docs/ROUGHNESS.md).
 
 use crate::blinn_phong::{
     blinn_phong_cost, lit_color, BlinnPhongInput, BlinnPhongOut, ShadingUnits,
@@ -403,7 +403,7 @@ pub const D_RAW_LIMIT: i64 = 1 << 20;
 /// ERROR BOUND: each entry within 1/2 LSB (`2^-(t+1)`) of the exact product, i.e. of the
 /// float twin `texsim::shading::roughness::scale_d_f` on the same decoded D and lengths;
 /// a saturated entry is exactly `+-D_RAW_LIMIT` and counts one saturation. Tested in
-/// `tests/roughness_shade.rs` (2 M random D texels, range exponents, lengths over the whole
+/// `tests/units/roughness_shade.rs` (2 M random D texels, range exponents, lengths over the whole
 /// length format, `len_frac_bits` 4..16).
 #[must_use]
 pub fn scale_d(
@@ -623,7 +623,7 @@ pub struct RoughShadeInput {
 /// `2^-div_bits` and D off by `2^-(t+1)` per entry (`[0, 1]` if `d1` or `d3 <= 2^-(t+1)`).
 /// Within 1 ulp of `n.l = 0` the specular term may switch on or off (the whole term is
 /// allowed); D saturated by [`scale_d`] (counted) is outside the bound. Measured in
-/// `tests/roughness_shade.rs`: 1.2 M random cases over variants, normalization, exponent
+/// `tests/units/roughness_shade.rs`: 1.2 M random cases over variants, normalization, exponent
 /// modes, `F` 8..15, `P` 12..24, range exponents -4..4, divider and root widths, orthonormal
 /// and sheared frames, lengths 0..16 and D texels; worst error / bound 0.995 (where the bound
 /// exceeds 8 LSB; the diffuse `n.l` rounding term is what is tight).
@@ -681,7 +681,7 @@ pub fn rough_blinn_phong(
 ///
 /// ERROR BOUND (in LSBs of `spec`, against `spec min(1, (e/s)/(d1 d3))` of the same D in
 /// float, `texsim::shading::roughness::normalize_factor`): `spec f 2^-div_bits + 1/2`, and
-/// never above `spec`. Tested in `tests/roughness_unit.rs` (200 000 random cases per
+/// never above `spec`. Tested in `tests/units/roughness_unit.rs` (200 000 random cases per
 /// variant).
 #[must_use]
 pub fn normalize_spec(

@@ -152,7 +152,7 @@ pub struct Normalized {
 ///
 /// ERROR BOUND per component, against the exact `v/|v|` of the given raw input:
 /// `rsqrt relative error + 2^-(F+1)` (texram16: 0.607 ulp of s1.14; measured 0.577 ulp over
-/// 1M random inputs of 1..40-bit components in `tests/frames_vector.rs`).
+/// 1M random inputs of 1..40-bit components in `tests/units/frames_vector.rs`).
 #[must_use]
 pub fn normalize3(
     v: &[i64; 3],

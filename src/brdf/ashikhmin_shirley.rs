@@ -16,7 +16,7 @@
 //! - Eq. 5 is the EXACT density of the sampler of eqs. 21-22 (not only an approximation): the
 //!   Jacobian of eq. 21 gives `p(phi) = sqrt((nu+1)(nv+1)) / (2 pi ((nu+1)cos^2 + (nv+1)sin^2))`
 //!   and eq. 22 gives `(E+1) cos^E theta` in `cos theta`; their product cancels `E + 1`.
-//!   `tests/brdf_sampling.rs` verifies it by quadrature (integral = 1) and by chi-square.
+//!   `tests/shading/brdf_sampling.rs` verifies it by quadrature (integral = 1) and by chi-square.
 //! - The quadrant mapping of the text ("phi(1 - 4(0.5 - xi1))" then flip about pi/2) is
 //!   implemented in the monotone form `phi = pi - phi'(4(0.5 - xi1))` for `xi1 in [0.25, 0.5)`
 //!   (and likewise for the other quadrants), so that `phi(xi1)` is continuous and increasing:
@@ -28,7 +28,7 @@
 //! the specular denominator `(h.k) max(n.k1, n.k2)` is floored at [`DENOM_FLOOR`] so the value
 //! stays finite at grazing (the true lobe is unbounded there only for exponents below 1).
 //!
-//! Bounds (asserted by `tests/brdf_props.rs` over random and boundary inputs, and reached: the
+//! Bounds (asserted by `tests/shading/brdf_props.rs` over random and boundary inputs, and reached: the
 //! floor is hit at grazing with `h = k1 = k2`): for every input, including the dot-product form
 //! [`AshikhminShirley::eval_from_dots`] with any dots,
 //! - `0 <= rho_s <= sqrt((nu+1)(nv+1)) / (8 pi DENOM_FLOOR)` (power and Fresnel are in
@@ -423,7 +423,7 @@ impl AshikhminShirley {
     /// horizon and at `n.k2 = n.k1`), and integrated by 4x4-point Gauss-Legendre on a
     /// `4 res x res` grid of cells aligned with the quadrants of `xi1`. Diffuse part: eq. 16 is
     /// a degree-6 polynomial in `n.k2` and independent of azimuth, so Gauss-Legendre in `n.k2`
-    /// is exact. Accuracy (measured in `tests/brdf_albedo.rs` against `res = 64` and against the
+    /// is exact. Accuracy (measured in `tests/shading/brdf_albedo.rs` against `res = 64` and against the
     /// closed form at normal incidence), for exponents 0..1e5, anisotropy up to 1e4 and
     /// `theta <= 89` deg: |error| < 3e-4 at `res = 32` (worst measured 1.2e-4), < 5e-3 at
     /// `res = 6` (worst 3.5e-3, only at 89 deg with exponents <= 1). Cost: `64 res^2` BRDF

@@ -29,7 +29,7 @@
 //!   spheres, exponents 1..1e4, metal and plastic, view directions up to 88.4 degrees from the
 //!   normal at the outermost pixels) against res 32: < 7e-3 (1.8 LSB of 8 bits), worst 6.1e-3
 //!   (metal, `n_u = n_v = 1`, 88.4 degrees) and 5.5e-3 (plastic), both on the outermost ring;
-//!   below 60 degrees 1.6e-3 (metal) and 1.5e-4 (plastic). `tests/brdf_spheres.rs`
+//!   below 60 degrees 1.6e-3 (metal) and 1.5e-4 (plastic). `tests/shading/brdf_spheres.rs`
 //!   (`furnace_res3_accuracy_including_grazing_pixels`) asserts it on the grazing and diagonal
 //!   pixels. Res 6: < 5e-3, worst only within ~1 deg of grazing with exponents <= 1.
 //!

@@ -52,7 +52,7 @@ pub struct Chi2Result {
 }
 
 /// Largest anisotropy ratio [`chi2_k2`] is valid for (its binning is round around the mirror
-/// direction; `tests/brdf_sampling.rs` checks it up to a ratio of 9.2).
+/// direction; `tests/shading/brdf_sampling.rs` checks it up to a ratio of 9.2).
 pub const K2_MAX_ANISOTROPY: f64 = 10.0;
 
 /// Anisotropy ratio of the lobe: `max(nu+1, nv+1) / min(nu+1, nv+1)`.

@@ -12,7 +12,7 @@
 //! MIP levels average the nine numbers (box filter of `crate::maps`), which is exact for
 //! moments (paper: mixture mean and second moments combine linearly). The paper prints the
 //! mixture covariance as `EX^2 - mu^T mu`; the covariance is `E[x x^T] - mu mu^T` (outer
-//! product), as used here and tested in `tests/ndf_maps.rs`.
+//! product), as used here and tested in `tests/shading/ndf_maps.rs`.
 //!
 //! Encoding (`k` = `moment_scale_bits`, all channels unorm `moment_bits`): map A holds
 //! `(mu + 1)/2`, map B `E_ii / 2^k`, map C `1/2 + E_ij / 2^k`; the normalization map holds
@@ -328,7 +328,7 @@ pub fn density(t: f64, cfg: &NdfConfig) -> f64 {
             let m = f64::from(cfg.pearson_m);
             // (1 - t/(2m))^m -> exp(-t/2). The paper's printed `2^m` denominator gives
             // (1 - t/2^m)^m = exp(m ln(1 - t/2^m)) ~ exp(-t m / 2^m) instead (ln(1 - x) ~ -x
-            // for the small x = t/2^m): exp(-t/32) for m = 8 (tested in tests/ndf_unit.rs).
+            // for the small x = t/2^m): exp(-t/32) for m = 8 (tested in tests/units/ndf_unit.rs).
             let b = 1.0 - t / (2.0 * m);
             if b <= 0.0 {
                 0.0

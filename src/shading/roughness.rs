@@ -10,7 +10,7 @@
 //! `K_l = 1/4 sum_n K_{l-1,n} + 1/4 sum_n (f_n - f_bar)(f_n - f_bar)^T`, `f_n` the four child
 //! means (the bump pyramid level `l - 1`) and `f_bar` their mean (level `l`). It is what the
 //! paper says it is equivalent to: the covariance of all finest offsets under the texel
-//! (`tests/roughness_pyramid.rs` checks it against that direct covariance, bit-exactly for
+//! (`tests/shading/roughness_pyramid.rs` checks it against that direct covariance, bit-exactly for
 //! dyadic offsets and within 1e-12 for random ones). For non-power-of-two sizes the parents of
 //! `maps::downsample` (2 or 3 per axis, equal weights) are used, so the mean stays the bump MIP
 //! and K is the covariance under the weights that MIP implies.

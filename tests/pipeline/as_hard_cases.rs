@@ -407,7 +407,7 @@ fn random_fragments_fixed_within_bound_of_float() {
 }
 
 /// Measured 2.74e-3 (0.7 LSB of 8 bits) over the 20000 cases of
-/// `random_fragments_fixed_within_bound_of_float` (`cargo test --test as_hard_cases --
+/// `random_fragments_fixed_within_bound_of_float` (`cargo test --test pipeline as_hard_cases:: --
 /// --nocapture`): the rounding of `h` and of the six dot products to 2^-14, amplified by the
 /// lobe's exponent.
 const TOL_SMOOTH: f64 = 5.0e-3;

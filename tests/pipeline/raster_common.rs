@@ -5,9 +5,7 @@ use glam::{DMat4, DVec3, DVec4};
 use hw_model::config::RasterConfig;
 use texsim::raster::{DrawTri, ScreenTri, Setup};
 
-#[path = "../rng_common/mod.rs"]
-mod rng_common;
-pub use rng_common::Rng;
+pub use crate::rng_common::Rng;
 
 pub fn cfg(subpixel_bits: u32, depth_bits: u32) -> RasterConfig {
     RasterConfig {

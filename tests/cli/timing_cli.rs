@@ -1,8 +1,6 @@
 //! `texsim cycles` and `texsim sweep --cycles` as users see them.
 
-mod cli_common;
-
-use cli_common::{texsim, text, tmp};
+use crate::cli_common::{texsim, text, tmp};
 
 #[test]
 fn cycles_prints_the_report_and_writes_json() {

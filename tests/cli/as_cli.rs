@@ -2,9 +2,7 @@
 //! `eval` (values, float and `--fixed`) and `sample` (sampler statistics and chi-square
 //! verdicts), and their input errors.
 
-mod cli_common;
-
-use cli_common::{texsim, text, tmp};
+use crate::cli_common::{texsim, text, tmp};
 
 #[test]
 fn spheres_writes_four_grids_with_error_and_cost() {

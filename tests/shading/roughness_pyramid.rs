@@ -4,10 +4,8 @@
 
 #![allow(clippy::needless_range_loop)]
 
-mod rng_common;
-
+use crate::rng_common::Rng;
 use hw_model::roughness::{decode_d, RoughnessConfig, D2_CHANNEL};
-use rng_common::Rng;
 use texsim::shading::roughness::{
     build_rough_pyramid, d_factor, d_product, decode_d_texels, lambda1, quantize_d_channel,
     quantize_rough_chain, rough_mip_chain, RoughParams, RoughnessEncoding, UNIFORM_CORRECTION,

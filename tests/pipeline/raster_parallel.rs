@@ -1,9 +1,7 @@
 //! Determinism across thread counts, and the throughput figure on a 100k-triangle mesh.
 
-mod raster_common;
-
+use crate::raster_common::*;
 use glam::{DMat4, DVec3};
-use raster_common::*;
 use std::time::Instant;
 use texsim::raster::{coverage_count, rasterize, setup, Coverage, DrawTri, Setup};
 

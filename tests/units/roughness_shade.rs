@@ -5,8 +5,7 @@
 //! and the energy normalization; the D scaling unit `scale_d` against its twin; and the
 //! saturations (`D_RAW_LIMIT`, `Q >= 2^Q_CAP_BITS`) counted.
 
-mod rng_common;
-
+use crate::rng_common::Rng;
 use glam::DVec3;
 use hw_model::blinn_phong::{BlinnPhongInput, ShadingConfig, ShadingUnits};
 use hw_model::fixed::SatCounter;
@@ -15,7 +14,6 @@ use hw_model::roughness::{
     RoughVariant, RoughnessConfig, D_RAW_LIMIT, Q_CAP_BITS,
 };
 use hw_model::rsqrt::RsqrtConfig;
-use rng_common::Rng;
 use texsim::shading::reference as r;
 use texsim::shading::roughness::{
     d_and_cos, decode_d_texels, normalize_factor, rough_blinn_phong_f, rough_cos_twin, scale_d_f,

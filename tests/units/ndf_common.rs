@@ -6,9 +6,7 @@ use hw_model::ndf::{NdfConfig, NdfTexels, NdfUnit};
 use hw_model::rsqrt::RsqrtConfig;
 use texsim::shading::ndf::{quantize_texel, Moments};
 
-#[path = "../rng_common/mod.rs"]
-mod rng_common;
-pub use rng_common::Rng;
+pub use crate::rng_common::Rng;
 
 pub fn unit(cfg: &NdfConfig) -> NdfUnit {
     NdfUnit::new(

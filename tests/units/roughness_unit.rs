@@ -6,15 +6,13 @@
 
 #![allow(clippy::needless_range_loop)]
 
-mod rng_common;
-
+use crate::rng_common::Rng;
 use hw_model::fixed::SatCounter;
 use hw_model::pow::{Pow, PowConfig};
 use hw_model::roughness::{
     decode_d, div_round, rough_cos, rough_cost, rough_specular, sqrt_round, RoughExponentMode,
     RoughInput, RoughVariant, RoughnessConfig,
 };
-use rng_common::Rng;
 use texsim::shading::roughness::{d_factor, decode_d_texels, rough_cos_twin};
 
 const VARIANTS: [RoughVariant; 4] = [

@@ -1,8 +1,6 @@
 //! Fill rule on hand-built cases, spans against a brute-force model, edge functions, and depth.
 
-mod raster_common;
-
-use raster_common::*;
+use crate::raster_common::*;
 use texsim::raster::{
     coverage_count, rasterize, setup, Coverage, DrawTri, ScreenTri, Setup, NO_TRI,
 };

@@ -1,9 +1,7 @@
 //! Degenerate, non-finite, off-screen, behind-the-camera and near-crossing triangles: skipped
 //! or clipped, counted, never a panic, never a NaN in a set-up triangle.
 
-mod raster_common;
-
-use raster_common::*;
+use crate::raster_common::*;
 use texsim::raster::{
     coverage_count, rasterize, setup, Coverage, DrawTri, Setup, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
 };

@@ -1,8 +1,6 @@
 //! The command line as users and scripts see it: exit codes, files written, messages.
 
-mod cli_common;
-
-use cli_common::{texsim, text, tmp};
+use crate::cli_common::{texsim, text, tmp};
 use std::path::Path;
 
 #[test]

@@ -1,6 +1,6 @@
 //! Reciprocal unit vs exact integer arithmetic: exhaustive over all 24-bit mantissas for
 //! texram16, seeded random for other configs; asserts the documented ulp bound.
-//! Run `cargo test --test unit_reciprocal -- --nocapture` to see the error table.
+//! Run `cargo test --test units unit_reciprocal:: -- --nocapture` to see the error table.
 
 use hw_model::config::{HwConfig, ReciprocalConfig};
 use hw_model::fixed::{Rounding, SatCounter};

@@ -13,10 +13,18 @@ pub fn texsim(args: &[&str], cwd: &Path) -> Output {
         .expect("run texsim")
 }
 
-/// A fresh, empty directory private to this test binary, process and `name`.
+/// A fresh, empty directory private to this test binary, process, calling file and `name`
+/// (the test files of one binary share a process: `render` in `cli.rs` and in `bump_cli.rs`
+/// are two directories).
+#[track_caller]
 pub fn tmp(name: &str) -> PathBuf {
+    let caller = Path::new(std::panic::Location::caller().file());
+    let file = caller
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("tests");
     let d = std::env::temp_dir().join(format!(
-        "texsim-{}-{}-{name}",
+        "texsim-{}-{file}-{}-{name}",
         env!("CARGO_CRATE_NAME"),
         std::process::id()
     ));

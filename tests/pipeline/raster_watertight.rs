@@ -1,10 +1,8 @@
 //! Watertightness: closed meshes, needle fans/strips, random triangulations of a square, and
 //! meshes cut by the near plane and the guard band, for both coverage models.
 
-mod raster_common;
-
+use crate::raster_common::*;
 use glam::{DMat4, DVec3};
-use raster_common::*;
 use texsim::raster::{coverage_count, setup, Coverage, DrawTri};
 
 const BOTH: [Coverage; 2] = [Coverage::Fixed, Coverage::Float];

@@ -2,9 +2,7 @@
 //! ndf_norm=partial,map,projected,exact --truth --cycles` reports, per option, lookups per pixel,
 //! model and quantization errors, ALU ops and cycles; `exact` (float only) has no cost.
 
-mod cli_common;
-
-use cli_common::{texsim, text, tmp};
+use crate::cli_common::{texsim, text, tmp};
 
 #[test]
 fn ndf_norm_sweep_reports_errors_lookups_and_costs() {

@@ -1,14 +1,12 @@
 //! NDF shading unit (`hw_model::ndf`) against its float twin (`texsim::shading::ndf`):
 //! 1M+ random texels and halfway vectors, the Pearson II limit, the hard cases, the cost.
 
-mod ndf_common;
-
+use crate::ndf_common::{random_moments, texels, unit, Rng};
 use glam::DVec3;
 use hw_model::fixed::SatCounter;
 use hw_model::ndf::{ndf_cost, ndf_lookups, NdfConfig, NdfDensity, NdfNorm, NdfTexels, D_MAX_RAW};
 use hw_model::rsqrt::RsqrtConfig;
 use hw_model::HwConfig;
-use ndf_common::{random_moments, texels, unit, Rng};
 use texsim::shading::ndf::{
     decode_texels, density, eval_float, h_from_fixed, h_to_fixed, raw_to_f64, Moments,
 };

@@ -1,9 +1,7 @@
 //! The bump-mapping command line: `texsim render --scene bumps`, the frame sweep with its
 //! `frame` alias, the knobs of the shading units, and the real mesh's TOML scene.
 
-mod cli_common;
-
-use cli_common::{texsim, text, tmp};
+use crate::cli_common::{texsim, text, tmp};
 use std::path::Path;
 
 #[test]

@@ -1,0 +1,14 @@
+//! Integration tests of the `texsim` binary as users and scripts run it: every subcommand's
+//! exit codes, files and messages (render, scenes, sweep, cycles, brdf, the bump, roughness and
+//! NDF options).
+//!
+//! One file per module below; run one with `cargo test --test cli timing_cli::`.
+
+mod cli_common;
+
+mod as_cli;
+mod bump_cli;
+mod cli;
+mod ndf_cli;
+mod roughness_cli;
+mod timing_cli;

@@ -1,0 +1,25 @@
+//! Integration tests of whole frames (`texsim::raster`, `texsim::pipeline`, `texsim::render`,
+//! `texsim::timing`): rasterization (fill rule, watertightness, robustness, thread counts),
+//! each effect through the pipeline (plain, bumps, roughness, NDF, Ashikhmin-Shirley) fixed
+//! against float, their hard cases, determinism, and the golden cycle counts.
+//!
+//! One file per module below; run one with `cargo test --test pipeline timing_golden::`.
+
+#[path = "../rng_common/mod.rs"]
+mod rng_common;
+
+mod raster_common;
+
+mod as_hard_cases;
+mod as_pipeline;
+mod bump_hard_cases;
+mod bump_pipeline;
+mod determinism;
+mod ndf_pipeline;
+mod raster_parallel;
+mod raster_robust;
+mod raster_rules;
+mod raster_watertight;
+mod render_pipeline;
+mod roughness_scene;
+mod timing_golden;
