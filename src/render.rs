@@ -598,6 +598,11 @@ fn shade(
         height: vis.height,
         ..FrameEvents::default()
     };
+    // Sized once: the rows are copied in without reallocating the frame's lists.
+    fe.pixels
+        .reserve_exact(rows.iter().map(|r| r.1.pixels.len()).sum());
+    fe.footprints
+        .reserve_exact(rows.iter().map(|r| r.1.footprints.len()).sum());
     for (c, ev) in rows {
         counters.add(&c);
         fe.append_row(ev);
