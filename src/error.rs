@@ -68,10 +68,29 @@ pub fn text_position(text: &str, offset: usize) -> String {
 /// alone when toml gives no position).
 #[must_use]
 pub fn toml_message(text: &str, e: &toml::de::Error) -> String {
-    let msg = e.message().trim_end().replace('\n', " ");
+    let msg = nearest_field(e.message().trim_end().replace('\n', " "));
     match e.span() {
         Some(span) => format!("{}: {msg}", text_position(text, span.start)),
         None => msg,
+    }
+}
+
+/// serde's `unknown field `x`, expected one of `a`, `b`, ...` answered with the nearest valid
+/// name instead of the whole list (`unknown field `x`; did you mean 'a'?`); the list stays when
+/// no name is near.
+fn nearest_field(msg: String) -> String {
+    let Some(rest) = msg.strip_prefix("unknown field `") else {
+        return msg;
+    };
+    let Some((name, expected)) = rest.split_once('`') else {
+        return msg;
+    };
+    let candidates = expected.split('`').skip(1).step_by(2);
+    let hint = crate::hwconfig::did_you_mean(name, candidates);
+    if hint.is_empty() {
+        msg
+    } else {
+        format!("unknown field `{name}`{hint}")
     }
 }
 

@@ -73,6 +73,25 @@ fn example_toml_loads_everything() {
     );
 }
 
+/// An unknown TOML field answers with the nearest valid name (not serde's list of every
+/// field), with the file and line; a name near nothing keeps the list.
+#[test]
+fn unknown_scene_field_suggests_the_nearest_name() {
+    let d = temp_dir("unknown_field");
+    let p = d.join("typo.toml");
+    std::fs::write(&p, "[output]\nwidht = 64\n").unwrap();
+    let e = load(&p).unwrap_err().to_string();
+    assert!(e.contains("typo.toml"), "{e}");
+    assert!(
+        e.contains("unknown field `widht`; did you mean 'width'?"),
+        "{e}"
+    );
+    assert!(!e.contains("expected one of"), "{e}");
+    std::fs::write(&p, "[output]\nzzzzzz = 64\n").unwrap();
+    let e = load(&p).unwrap_err().to_string();
+    assert!(e.contains("expected one of"), "{e}");
+}
+
 #[test]
 fn cube_obj_texture_and_uv_flip() {
     let s = load_obj(&scenes_dir().join("cube.obj")).unwrap();

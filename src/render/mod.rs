@@ -1,0 +1,370 @@
+//! One frame, end to end: host geometry (float) -> raster setup and traversal (fixed) ->
+//! the planned stages per visible fragment, once with the hardware's twins and once with the
+//! float reference -> images, error metrics, per-stage counts and a first cycle estimate.
+//!
+//! The simulated machine textures visible fragments only (a visibility buffer resolves depth
+//! first, then each covered pixel runs its material's stages once), so stage counts and cycles
+//! do not depend on triangle order, and the hardware and reference passes see the same
+//! fragments by default (shared coverage).
+//!
+//! The phases, one file each, dependencies one way (the stages never import this module):
+//! [`geometry`] (host transforms, lighting, plans), [`shading`] (per-triangle attributes,
+//! the compiled programs over every covered pixel, timing events), [`stats`] (what the render
+//! measured); maps come prepared from [`crate::maps`], visibility from [`crate::raster`].
+
+mod geometry;
+mod shading;
+mod stats;
+
+pub use geometry::Geometry;
+use shading::{bump_attrs, shade, tri_attrs, ShadeInput};
+use stats::bump_frames;
+pub use stats::{BumpStats, CycleEstimate, RenderStats, Rendered, RoughStats, StageStats, Timings};
+
+use crate::fixedpoint::to_unorm;
+pub use crate::maps::{bump_sources, ndf_sources, BumpSource, Maps};
+use crate::pipeline::stages::Machine;
+use crate::pipeline::{Impl, StageImpls, StageKind, MAX_POINT_LIGHTS};
+use crate::raster::{self, Coverage, NO_TRI};
+use crate::report::compare;
+use crate::scene::Scene;
+use crate::timing::events::PlanTiming;
+use hw_model::{HwConfig, UnitCost};
+use serde::Serialize;
+use std::time::Instant;
+
+/// How the reference pass chooses its fragments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CoverageMode {
+    /// The reference shades exactly the fragments the hardware rasterizer produced.
+    Shared,
+    /// The reference rasterizes with unsnapped float coverage and float depth.
+    Independent,
+}
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Twins of the "hardware" image (all Fixed = the machine; one Fixed = that stage alone).
+    pub hw_impls: StageImpls,
+    /// Also render the all-float reference and compare.
+    pub reference: bool,
+    pub coverage: CoverageMode,
+    /// Collect the timing model's event stream (`Rendered::events`). Off by default: a render
+    /// without it allocates no event buffer and does no extra work per pixel.
+    pub timing: bool,
+    /// Also render the ground truth, with this many sub-samples per pixel axis (0 = off):
+    /// roughness materials supersample their full-resolution bump map
+    /// (`pipeline::rough_stages`), NDF materials their finest normal map
+    /// (`pipeline::ndf_stages::NdfTruth`); the stats gain `model_error` (float vs truth) and
+    /// `quantization_error` (hardware vs float).
+    pub truth: u32,
+    /// Called once per finished phase (setup, raster, hardware shading, reference shading,
+    /// ground truth) with its name and wall time in ms (`texsim render` prints them).
+    pub progress: Option<fn(&str, f64)>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            hw_impls: StageImpls::FIXED,
+            reference: true,
+            coverage: CoverageMode::Shared,
+            timing: false,
+            truth: 0,
+            progress: None,
+        }
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Renders `scene` on the machine `hw` (and, if asked, the float reference) and measures both.
+pub fn render(
+    scene: &Scene,
+    maps: &Maps,
+    hw: &HwConfig,
+    opts: &RenderOptions,
+) -> crate::Result<Rendered> {
+    hw.validate()?;
+    crate::budget::check_run(scene, hw, opts.reference || opts.truth > 0, opts.timing)?;
+    let progress = |phase: &str, ms: f64| {
+        if let Some(report) = opts.progress {
+            report(phase, ms);
+        }
+    };
+    let t_start = Instant::now();
+    let mut tm = Timings::default();
+    let t = Instant::now();
+    let mut geo = Geometry::new(scene);
+    tm.geometry_ms = ms(t);
+    let bumped = geo.plans.iter().any(|p| p.bump.is_some());
+    if bumped && geo.point_lights.len() > MAX_POINT_LIGHTS {
+        return Err(crate::Error::field(
+            "lights",
+            format!(
+                "{} point lights; bump-mapped materials shade at most {MAX_POINT_LIGHTS} per pixel",
+                geo.point_lights.len()
+            ),
+        ));
+    }
+    let offset_bits = hw.shading.vector.offset_int_bits;
+    let reencoded;
+    let maps = if maps.offset_int_bits == offset_bits || maps.bump_offsets.is_empty() {
+        maps
+    } else {
+        let mut mm = maps.clone();
+        mm.ensure_offset_bits(offset_bits);
+        reencoded = mm;
+        &reencoded
+    };
+    // NDF chains first: `ensure_ndf` replaces the chains at the end of the list, and the
+    // roughness maps of this render are appended after them.
+    let ndf_rebuilt;
+    let maps = if maps.ndf_stale(&hw.ndf) {
+        let mut mm = maps.clone();
+        mm.ensure_ndf(&hw.ndf);
+        ndf_rebuilt = mm;
+        &ndf_rebuilt
+    } else {
+        maps
+    };
+    let rough_sources =
+        crate::pipeline::rough_stages::resolve_plans(&mut geo.plans, hw, maps.float.len());
+    let has_rough = geo.plans.iter().any(|p| p.rough.is_some());
+    let mut d_clamped = 0;
+    let rough_owned;
+    let maps = if rough_sources.is_empty() {
+        maps
+    } else {
+        let (mm, cl) = crate::pipeline::rough_stages::rough_maps(maps, &rough_sources, hw)?;
+        d_clamped = cl;
+        rough_owned = mm;
+        &rough_owned
+    };
+
+    let mut warnings: Vec<String> = Vec::new();
+    let mut opts = opts.clone();
+    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+        && geo.plans.iter().any(|p| p.ndf.is_some())
+        && opts.hw_impls.of(StageKind::NdfShade) == Impl::Fixed
+    {
+        warnings.push("field 'ndf.ndf_norm': exact is float only: ndf-shade runs in float".into());
+        opts.hw_impls = opts.hw_impls.with(StageKind::NdfShade, Impl::Float);
+    }
+    let opts = &opts;
+
+    let t = Instant::now();
+    let setup = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &hw.raster);
+    let m0 = Machine::new(hw, &maps.float, &maps.fixed).with_lights(&scene.lights, scene.ambient);
+    let (mut attrs, mut input_sat) = tri_attrs(&setup, &geo, &m0);
+    let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
+    input_sat.add(&bsat);
+    let m = m0.with_bump_attrs(&battrs);
+    let costs: Vec<[UnitCost; StageKind::COUNT]> =
+        geo.plans.iter().map(|p| m.plan_costs(p)).collect();
+    tm.setup_ms = ms(t);
+    progress("setup", ms(t_start));
+
+    let t = Instant::now();
+    let (vis, raster_stats) = raster::rasterize(&setup, Coverage::Fixed, true);
+    tm.raster_ms = ms(t);
+    progress("raster", tm.raster_ms);
+
+    let bg = scene.background.map(|c| to_unorm(f64::from(c), 16) as u16);
+    let t = Instant::now();
+    let inp = ShadeInput {
+        vis: &vis,
+        setup: &setup,
+        attrs: &attrs,
+        geo: &geo,
+        m: &m,
+    };
+    let (hw_image, counters, mut events) = shade(&inp, &opts.hw_impls, bg, opts.timing);
+    if let Some(fe) = events.as_mut() {
+        fe.triangles = setup.tris.len() as u64;
+        fe.spans = raster_stats.spans;
+        fe.fragments = raster_stats.fragments;
+        fe.plans = geo
+            .plans
+            .iter()
+            .zip(&costs)
+            .map(|(p, c)| PlanTiming {
+                stages: p.stages.iter().map(|&k| (k, c[k.index()])).collect(),
+            })
+            .collect();
+        fe.textures = maps
+            .fixed
+            .iter()
+            .map(|ch| ch.levels.iter().map(|l| (l.width, l.height)).collect())
+            .collect();
+    }
+    tm.shade_hw_ms = ms(t);
+    progress("hardware shading", tm.shade_hw_ms);
+    tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
+
+    let mut mask: Vec<bool> = vis.tri.iter().map(|&t| t != NO_TRI).collect();
+    let mut ref_image = None;
+    let mut ref_nonfinite = 0;
+    let (mut e8, mut e16) = (None, None);
+    if opts.reference {
+        let t_ref = Instant::now();
+        let ref_vis;
+        let rv = match opts.coverage {
+            CoverageMode::Shared => {
+                tm.raster_ref_ms = tm.raster_ms;
+                &vis
+            }
+            CoverageMode::Independent => {
+                let t = Instant::now();
+                ref_vis = raster::rasterize(&setup, Coverage::Float, true).0;
+                tm.raster_ref_ms = ms(t);
+                for (mk, &t) in mask.iter_mut().zip(&ref_vis.tri) {
+                    *mk |= t != NO_TRI;
+                }
+                &ref_vis
+            }
+        };
+        let t = Instant::now();
+        let (img, rc, _) = shade(
+            &ShadeInput { vis: rv, ..inp },
+            &StageImpls::FLOAT,
+            bg,
+            false,
+        );
+        ref_nonfinite = rc.nonfinite;
+        tm.shade_ref_ms = ms(t);
+        progress("reference", ms(t_ref));
+        tm.ref_total_ms = tm.setup_ms + tm.raster_ref_ms + tm.shade_ref_ms;
+        e8 = Some(compare(&hw_image, &img, 8, Some(&mask)));
+        e16 = Some(compare(&hw_image, &img, 16, Some(&mask)));
+        ref_image = Some(img);
+    }
+    let mut truth_image = None;
+    let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
+    if opts.truth > 0 && (has_rough || has_ndf) {
+        let t_truth = Instant::now();
+        // One float pass over every material: roughness materials shade their supersampled
+        // bump map (`rough_stages::truth_plans`), NDF materials their supersampled finest normal
+        // map (`ndf_stages::NdfTruth`), all others are their own float reference.
+        let tp = crate::pipeline::rough_stages::truth_plans(&geo.plans, opts.truth);
+        let saved = std::mem::replace(&mut geo.plans, tp);
+        let ndf_truth =
+            crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans, opts.truth);
+        let mt = Machine::new(hw, &maps.float, &maps.fixed)
+            .with_lights(&scene.lights, scene.ambient)
+            .with_bump_attrs(&battrs)
+            .with_ndf_truth(&ndf_truth);
+        let tin = ShadeInput {
+            vis: &vis,
+            setup: &setup,
+            attrs: &attrs,
+            geo: &geo,
+            m: &mt,
+        };
+        let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, false);
+        geo.plans = saved;
+        truth_image = Some(img);
+        progress("ground truth", ms(t_truth));
+    }
+    let model_error = match (&ref_image, &truth_image) {
+        (Some(r), Some(t)) => Some(compare(r, t, 8, Some(&mask))),
+        _ => None,
+    };
+    let roughness = has_rough.then(|| RoughStats {
+        d_clamped,
+        truth_samples: if truth_image.is_some() { opts.truth } else { 0 },
+        model_error: model_error.clone(),
+        quantization_error: e8.clone(),
+        baseline_error: None,
+    });
+
+    let mut stages = Vec::with_capacity(StageKind::COUNT);
+    let mut stage_cycles = 0u64;
+    for kind in StageKind::ALL {
+        let k = kind.index();
+        let inv = counters.invocations[k];
+        let [ops, cyc, texels] = counters.cost[k];
+        let s = StageStats {
+            stage: kind,
+            imp: opts.hw_impls.of(kind),
+            invocations: inv,
+            saturated: counters.sat[k].saturated,
+            wrapped: counters.sat[k].wrapped,
+            ops,
+            cycles: cyc,
+            texels,
+        };
+        stage_cycles += s.cycles;
+        stages.push(s);
+    }
+    let covered = vis.tri.iter().filter(|&&t| t != NO_TRI).count() as u64;
+    let rc = &hw.raster;
+    let mut cycles = CycleEstimate {
+        setup: setup.tris.len() as u64 * u64::from(rc.setup_cycles),
+        spans: raster_stats.spans * u64::from(rc.span_cycles),
+        stages: stage_cycles,
+        ..Default::default()
+    };
+    cycles.total = cycles.setup + cycles.spans + cycles.stages;
+    cycles.per_covered_pixel = cycles.total as f64 / covered.max(1) as f64;
+    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+        && counters.invocations[StageKind::NdfShade.index()] > 0
+    {
+        cycles.not_modelled = Some(crate::pipeline::ndf_stages::EXACT_NOT_MODELLED);
+    }
+
+    Ok(Rendered {
+        hw_image,
+        ref_image,
+        truth_image,
+        mask,
+        events,
+        stats: RenderStats {
+            scene: scene.name.clone(),
+            hw: hw.name.clone(),
+            width: scene.width,
+            height: scene.height,
+            triangles: scene.triangle_count() as u64,
+            coverage: opts.coverage,
+            setup: setup.stats,
+            raster: raster_stats,
+            covered_pixels: covered,
+            input_saturated: input_sat.saturated,
+            input_wrapped: input_sat.wrapped,
+            bump: BumpStats {
+                frame_fallback: counters.frame_fallback,
+                zero_normal: counters.zero_normal,
+                h_zero: counters.h_zero,
+                nonfinite: counters.nonfinite,
+                ref_nonfinite,
+                offset_clamped: if bumped { maps.bump_clamped } else { 0 },
+                ndf_clamped: maps.ndf_clamped,
+                frame: bump_frames(&geo, hw),
+            },
+            stages,
+            cycles,
+            timings: tm,
+            quantization_error: if model_error.is_some() {
+                e8.clone()
+            } else {
+                None
+            },
+            model_error,
+            error_8bit: e8,
+            error_16bit: e16,
+            roughness,
+            warnings: {
+                warnings.extend(crate::warnings::depth_warning(
+                    scene,
+                    setup.depth_bits,
+                    &raster_stats,
+                ));
+                warnings
+            },
+        },
+    })
+}

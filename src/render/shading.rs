@@ -1,0 +1,219 @@
+//! The shading phase: per-triangle attributes in the units' formats, then every covered pixel
+//! through its plan's compiled program (in parallel by rows, bit-identical for any thread
+//! count), with the stages' traces collected into timing events when asked.
+
+use super::Geometry;
+use crate::pipeline::bump_stages::{BumpAttrs, BumpVertex};
+use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
+use crate::pipeline::{Frag, Program, StageImpls, StageKind};
+use crate::raster::{Setup, VisBuffer, NO_TRI};
+use crate::report::Image;
+use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
+use hw_model::fixed::SatCounter;
+use rayon::prelude::*;
+
+/// Bump data of every screen triangle of a bump plan (clipped vertices blended from their
+/// source vertices); sets `TriAttrs::bump`.
+pub(super) fn bump_attrs(
+    setup: &Setup,
+    geo: &Geometry,
+    m: &Machine,
+    attrs: &mut [TriAttrs],
+) -> (Vec<BumpAttrs>, SatCounter) {
+    let mut out = Vec::new();
+    let mut sat = SatCounter::default();
+    if geo.bump.is_empty() {
+        return (out, sat);
+    }
+    for (t, a) in setup.tris.iter().zip(attrs.iter_mut()) {
+        let plan = &geo.plans[a.plan as usize];
+        if plan.bump.is_none() {
+            continue;
+        }
+        let d = &geo.draws[t.src as usize];
+        let blend = |k: usize| -> BumpVertex {
+            let w = t.src_bary[k];
+            let mut r = BumpVertex::default();
+            for (&wj, &vi) in w.iter().zip(&d.v) {
+                let Some(b) = geo.bump.get(vi as usize) else {
+                    continue;
+                };
+                for c in 0..3 {
+                    r.n[c] += wj * b.n[c];
+                    r.du[c] += wj * b.du[c];
+                    r.dv[c] += wj * b.dv[c];
+                    r.m[c] += wj * b.m[c];
+                    r.p[c] += wj * b.p[c];
+                }
+                for c in 0..2 {
+                    r.len[c] += wj * b.len[c];
+                }
+            }
+            r
+        };
+        let verts = [blend(0), blend(1), blend(2)];
+        a.bump = out.len() as u32;
+        out.push(BumpAttrs::new(
+            m,
+            &verts,
+            geo.eye,
+            &geo.point_lights,
+            &mut sat,
+        ));
+    }
+    (out, sat)
+}
+
+/// Per-triangle attributes of every screen triangle, in the machine's formats.
+pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
+    let out: Vec<(TriAttrs, SatCounter)> = setup
+        .tris
+        .par_iter()
+        .map(|t| {
+            let d = &geo.draws[t.src as usize];
+            let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
+                let w = t.src_bary[k];
+                let mut c = [0.0; 3];
+                let mut uv = [0.0; 2];
+                for (&wj, &vi) in w.iter().zip(&d.v) {
+                    let vi = vi as usize;
+                    for (acc, &x) in c.iter_mut().zip(&geo.color[vi]) {
+                        *acc += wj * x;
+                    }
+                    for (acc, &x) in uv.iter_mut().zip(&geo.uv[vi]) {
+                        *acc += wj * x;
+                    }
+                }
+                (c, uv)
+            };
+            let (c0, t0) = blend(0);
+            let (c1, t1) = blend(1);
+            let (c2, t2) = blend(2);
+            let mut sat = SatCounter::default();
+            let plan = geo.draw_plan[t.src as usize];
+            let wrap = geo.plans[plan as usize].wrap;
+            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
+            (a, sat)
+        })
+        .collect();
+    let mut sat = SatCounter::default();
+    let attrs = out
+        .into_iter()
+        .map(|(a, s)| {
+            sat.add(&s);
+            a
+        })
+        .collect();
+    (attrs, sat)
+}
+
+/// What the shading pass reads: the visible triangles and everything prepared for them.
+pub(super) struct ShadeInput<'a> {
+    pub(super) vis: &'a VisBuffer,
+    pub(super) setup: &'a Setup,
+    pub(super) attrs: &'a [TriAttrs],
+    pub(super) geo: &'a Geometry,
+    pub(super) m: &'a Machine<'a>,
+}
+
+/// Shades row `y` into `row` with the plans compiled as `progs`, adding to `c`; `on_pixel(plan index, triangle, frag)` sees every
+/// shaded fragment (a no-op closure compiles to the plain loop; the timing model records its
+/// events through it, from the footprints the stages traced when `trace`).
+#[allow(clippy::too_many_arguments)]
+fn shade_row(
+    inp: &ShadeInput,
+    progs: &[Program],
+    y: usize,
+    row: &mut [[u16; 4]],
+    c: &mut Counters,
+    trace: bool,
+    mut on_pixel: impl FnMut(u32, u32, &Frag),
+) {
+    let w = inp.vis.width as usize;
+    let mut frag = Frag::default();
+    frag.trace.on = trace;
+    let tris = &inp.vis.tri[y * w..(y + 1) * w];
+    for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
+        if t == NO_TRI {
+            continue;
+        }
+        let a = &inp.attrs[t as usize];
+        let pi = a.plan as usize;
+        let tri = &inp.setup.tris[t as usize];
+        let plan = &inp.geo.plans[pi];
+        run(
+            &progs[pi], plan, inp.m, tri, a, x as i64, y as i64, &mut frag, c,
+        );
+        *out = output16(&frag);
+        on_pixel(a.plan, t, &frag);
+    }
+}
+
+/// Shades every covered pixel with `impls`; returns the image, the counters and, when
+/// `timing`, the event stream (rows concatenated in row order).
+pub(super) fn shade(
+    inp: &ShadeInput,
+    impls: &StageImpls,
+    background: [u16; 4],
+    timing: bool,
+) -> (Image, Counters, Option<FrameEvents>) {
+    let vis = inp.vis;
+    let w = vis.width as usize;
+    let mut img = Image::new(vis.width, vis.height, background);
+    let progs: Vec<Program> = inp
+        .geo
+        .plans
+        .iter()
+        .map(|p| Program::new(p, impls, inp.m))
+        .collect();
+    let progs = &progs[..];
+    if !timing {
+        let counters = img
+            .px
+            .par_chunks_mut(w.max(1))
+            .enumerate()
+            .map(|(y, row)| {
+                let mut c = Counters::default();
+                shade_row(inp, progs, y, row, &mut c, false, |_, _, _| {});
+                c
+            })
+            .reduce(Counters::default, |mut a, b| {
+                a.add(&b);
+                a
+            });
+        return (img, counters, None);
+    }
+    let lookups = StageKind::ALL
+        .iter()
+        .map(|&k| crate::timing::events::lookups(k, inp.m.hw) as usize)
+        .sum::<usize>();
+    let rows: Vec<(Counters, RowEvents)> = img
+        .px
+        .par_chunks_mut(w.max(1))
+        .enumerate()
+        .map(|(y, row)| {
+            let mut c = Counters::default();
+            let mut ev = RowEvents::with_capacity(w, lookups);
+            shade_row(inp, progs, y, row, &mut c, true, |pi, t, frag| {
+                record_pixel(pi, t, frag, &mut ev);
+            });
+            (c, ev)
+        })
+        .collect();
+    let mut counters = Counters::default();
+    let mut fe = FrameEvents {
+        width: vis.width,
+        height: vis.height,
+        ..FrameEvents::default()
+    };
+    // Sized once: the rows are copied in without reallocating the frame's lists.
+    fe.pixels
+        .reserve_exact(rows.iter().map(|r| r.1.pixels.len()).sum());
+    fe.footprints
+        .reserve_exact(rows.iter().map(|r| r.1.footprints.len()).sum());
+    for (c, ev) in rows {
+        counters.add(&c);
+        fe.append_row(ev);
+    }
+    (img, counters, Some(fe))
+}
