@@ -196,16 +196,6 @@ impl<'a> Machine<'a> {
         bp.frame.unwrap_or(self.hw.shading.frame.frame_kind)
     }
 
-    /// Cost of one invocation of each stage kind of `plan` (zero for absent stages).
-    #[must_use]
-    pub fn plan_costs(&self, plan: &Plan) -> [UnitCost; StageKind::COUNT] {
-        let mut c = [UnitCost::default(); StageKind::COUNT];
-        for &k in &plan.stages {
-            c[k.index()] = self.stage_cost(k, plan);
-        }
-        c
-    }
-
     /// Cost of one invocation of `kind` in `plan` (fixed units' op and cycle counts).
     #[must_use]
     pub fn stage_cost(&self, kind: StageKind, plan: &Plan) -> UnitCost {

@@ -135,6 +135,23 @@ pub fn trilinear_traced(
     r
 }
 
+/// The fragment's texture coordinates as the hardware sees them: the raw values when the
+/// `texcoord` stage ran fixed (`raw_uv`), else the float carriers rounded into the machine's
+/// format (a float twin's inputs for its trace; overflows go to `sat`).
+pub fn hardware_uv(
+    m: &super::stages::Machine,
+    frag: &super::Frag,
+    raw_uv: bool,
+    sat: &mut hw_model::fixed::SatCounter,
+) -> [[i64; 2]; 3] {
+    if raw_uv {
+        frag.uv_x
+    } else {
+        frag.uv
+            .map(|s| s.map(|x| crate::fixedpoint::to_raw(x, &m.uv_fmt, sat)))
+    }
+}
+
 /// For a float twin under timing: records the footprints of the hardware lookups the fixed
 /// twin makes, `maps` maps from `at.tex` on (lookups `at.lookup..`), at the fragment's raw
 /// coordinates (its float carriers rounded into the machine's format unless `raw_uv`) with the
@@ -154,12 +171,7 @@ pub fn trace_float_fetch(
         return;
     };
     let mut scratch = hw_model::fixed::SatCounter::default();
-    let uv = if raw_uv {
-        frag.uv_x
-    } else {
-        frag.uv
-            .map(|s| s.map(|x| crate::fixedpoint::to_raw(x, &m.uv_fmt, &mut scratch)))
-    };
+    let uv = hardware_uv(m, frag, raw_uv, &mut scratch);
     let fb = m.uv_fmt.frac_bits;
     let d = super::stages::texel_derivs(&uv, l0.width, l0.height);
     let l = hw_model::lod::lod(d, fb, &m.hw.lod, &mut scratch);

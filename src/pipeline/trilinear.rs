@@ -4,7 +4,7 @@
 
 use super::stages::{unorm, Counters, Machine};
 use super::texcoord::quantize_uv;
-use super::trace::{trilinear_traced, Lookup, Trace};
+use super::trace::{hardware_uv, trilinear_traced, Lookup, Trace};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::to_raw;
 use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
@@ -74,12 +74,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     frag.out = frag.texel;
     if frag.trace.on {
         let mut scratch = SatCounter::default();
-        let uv = if px.fixed(StageKind::Texcoord) {
-            frag.uv_x
-        } else {
-            frag.uv
-                .map(|s| s.map(|x| to_raw(x, &m.uv_fmt, &mut scratch)))
-        };
+        let uv = hardware_uv(m, frag, px.fixed(StageKind::Texcoord), &mut scratch);
         let l = if px.fixed(StageKind::Lod) {
             frag.lod_x
         } else {

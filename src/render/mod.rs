@@ -29,7 +29,7 @@ use crate::raster::{self, Coverage, NO_TRI};
 use crate::report::compare;
 use crate::scene::Scene;
 use crate::timing::events::PlanTiming;
-use hw_model::{HwConfig, UnitCost};
+use hw_model::HwConfig;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -164,8 +164,6 @@ pub fn render(
     let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
     input_sat.add(&bsat);
     let m = m0.with_bump_attrs(&battrs);
-    let costs: Vec<[UnitCost; StageKind::COUNT]> =
-        geo.plans.iter().map(|p| m.plan_costs(p)).collect();
     tm.setup_ms = ms(t);
     progress("setup", ms(t_start));
 
@@ -191,9 +189,8 @@ pub fn render(
         fe.plans = geo
             .plans
             .iter()
-            .zip(&costs)
-            .map(|(p, c)| PlanTiming {
-                stages: p.stages.iter().map(|&k| (k, c[k.index()])).collect(),
+            .map(|p| PlanTiming {
+                stages: p.stages.iter().map(|&k| (k, m.stage_cost(k, p))).collect(),
             })
             .collect();
         fe.textures = maps
