@@ -48,6 +48,76 @@ pub enum Command {
     /// Run the timing model on a scene: cycles, unit utilization, stalls, cache and banks;
     /// prints the report and writes cycles.json.
     Cycles(CyclesArgs),
+    /// Test vectors for RTL: boundary and seeded random cases of a hw_model unit with the
+    /// unit's outputs, as $readmemh files (one per port) and manifest.json.
+    Vectors(VectorsArgs),
+    /// Compare two images (a render against Mesa, a GPU capture, another simulator): match %,
+    /// per-channel differences, histogram, error map, the pixels that differ most.
+    Compare(CompareArgs),
+}
+
+/// Arguments of `texsim vectors`.
+#[derive(Args, Debug, Clone)]
+pub struct VectorsArgs {
+    /// The unit (`--list` shows them).
+    #[arg(required_unless_present = "list")]
+    pub unit: Option<String>,
+    /// List the units and exit.
+    #[arg(long)]
+    pub list: bool,
+    /// Hardware preset or hw TOML file: the unit's widths and rounding.
+    #[arg(long, default_value = "texram16")]
+    pub hw: String,
+    /// Random cases (after the boundary cases).
+    #[arg(long, default_value_t = 1000)]
+    pub n: u64,
+    /// Seed of the random cases.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output directory [default: out/vectors/UNIT].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Which image's coverage selects the compared pixels (`texsim compare --coverage-from`).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CoverageFromArg {
+    /// Pixels of A that differ from the clear colour.
+    A,
+    /// Pixels of B that differ from the clear colour.
+    B,
+    /// Pixels covered in A or in B.
+    Either,
+    /// Pixels covered in both.
+    Both,
+}
+
+/// Arguments of `texsim compare`.
+#[derive(Args, Debug, Clone)]
+pub struct CompareArgs {
+    /// First image (PNG or JPEG), e.g. a texsim hw.png.
+    pub a: PathBuf,
+    /// Second image, same size.
+    pub b: PathBuf,
+    /// Compare only where this image (same size) is not black in RGB.
+    #[arg(long, conflicts_with = "coverage_from")]
+    pub mask: Option<PathBuf>,
+    /// Compare only covered pixels: those whose 8-bit RGBA differs from --clear, in A, B,
+    /// either or both (the Mesa anchor counts coverage so, with clear 0,0,0,0).
+    #[arg(long, value_enum)]
+    pub coverage_from: Option<CoverageFromArg>,
+    /// Clear colour of --coverage-from, 8-bit R,G,B,A.
+    #[arg(long, default_value = "0,0,0,0", requires = "coverage_from")]
+    pub clear: String,
+    /// Bits of the difference unit (8 = what PNG8 holds).
+    #[arg(long, default_value_t = 8)]
+    pub bits: u32,
+    /// How many of the most different pixels to list.
+    #[arg(long, default_value_t = 10)]
+    pub top: usize,
+    /// Output directory (compare.json, compare_error.png).
+    #[arg(long, default_value = "out/compare")]
+    pub out: PathBuf,
 }
 
 /// Parameters of the Ashikhmin-Shirley BRDF.
@@ -352,6 +422,8 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Brdf { cmd }) => brdf_cmd(&cmd),
         Some(Command::Cycles(a)) => cycles_cmd(&a),
+        Some(Command::Vectors(a)) => vectors_cmd(&a),
+        Some(Command::Compare(a)) => compare_cmd(&a),
     }
 }
 
@@ -891,6 +963,66 @@ fn cycles_cmd(a: &CyclesArgs) -> Result<()> {
     );
     let written = out.write_to(&a.scene.out)?;
     print!("{}", crate::timing::report::text(&rep));
+    for p in written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn vectors_cmd(a: &VectorsArgs) -> Result<()> {
+    if a.list {
+        for u in crate::vectors::UNITS {
+            println!("{:<8} {}", u.name, u.about);
+        }
+        return Ok(());
+    }
+    let name = a.unit.as_deref().unwrap_or_default();
+    let hw = hwconfig::resolve(&a.hw)?;
+    let set = crate::vectors::generate(name, &hw, a.n, a.seed)?;
+    let out = crate::vectors::output_set(&set, &crate::provenance::Provenance::of_process())?;
+    let dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out/vectors").join(set.unit));
+    let written = out.write_to(&dir)?;
+    println!(
+        "vectors '{}' on '{}': {} vectors ({} boundary, {} random, seed {})",
+        set.unit,
+        set.hw_name,
+        set.len(),
+        set.boundary,
+        set.random,
+        set.seed
+    );
+    for p in written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn compare_cmd(a: &CompareArgs) -> Result<()> {
+    use crate::compare::{CoverageFrom, Selection};
+    let ia = crate::compare::load_image(&a.a)?;
+    let ib = crate::compare::load_image(&a.b)?;
+    let sel = match (&a.mask, a.coverage_from) {
+        (Some(m), _) => Selection::Mask(crate::compare::load_image(m)?),
+        (None, Some(f)) => Selection::Coverage {
+            from: match f {
+                CoverageFromArg::A => CoverageFrom::A,
+                CoverageFromArg::B => CoverageFrom::B,
+                CoverageFromArg::Either => CoverageFrom::Either,
+                CoverageFromArg::Both => CoverageFrom::Both,
+            },
+            clear: crate::compare::parse_clear(&a.clear)?,
+        },
+        (None, None) => Selection::All,
+    };
+    let (an, bn) = (a.a.display().to_string(), a.b.display().to_string());
+    let (c, mask) = crate::compare::compare(&ia, &an, &ib, &bn, &sel, a.bits, a.top)?;
+    let prov = crate::provenance::Provenance::of_process();
+    let out = crate::compare::output_set(&c, &ia, &ib, &mask, &prov)?;
+    let written = out.write_to(&a.out)?;
+    print!("{}", crate::compare::format_report(&c));
     for p in written {
         println!("wrote {}", p.display());
     }

@@ -38,6 +38,7 @@
 pub mod brdf;
 pub mod budget;
 pub mod cli;
+pub mod compare;
 pub mod error;
 pub mod fixedpoint;
 pub mod footprint_ref;
@@ -54,6 +55,7 @@ pub mod scene;
 pub mod shading;
 pub mod summary;
 pub mod timing;
+pub mod vectors;
 pub mod warnings;
 
 pub use error::{Error, Result};

@@ -1,6 +1,6 @@
 //! Integration tests of the `texsim` binary as users and scripts run it: every subcommand's
 //! exit codes, files and messages (render, scenes, sweep, cycles, brdf, the bump, roughness and
-//! NDF options).
+//! NDF options, vectors and the SystemVerilog lerp, compare).
 //!
 //! One file per module below; run one with `cargo test --test cli timing_cli::`.
 
@@ -12,3 +12,4 @@ mod cli;
 mod ndf_cli;
 mod roughness_cli;
 mod timing_cli;
+mod vectors_cli;
