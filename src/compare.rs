@@ -9,6 +9,8 @@
 //! whose 8-bit RGBA differs from a clear colour, counted as the Mesa anchor counts coverage
 //! (`mesa_anchor.c`: read-back pixels that differ from the clear colour (0,0,0,0)).
 
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::path::Path;
 
 use image::ImageReader;
@@ -20,6 +22,9 @@ use crate::{Error, Result};
 
 /// Largest accepted image side.
 pub const MAX_SIDE: u32 = 16384;
+
+/// Largest `--top`: how many of the most different pixels a report lists.
+pub const MAX_TOP: usize = 100_000;
 
 /// Decodes a PNG or JPEG (8 or 16 bits; gray, gray+alpha, RGB, RGBA) to RGBA16 (8-bit channels
 /// as `x * 257`, exactly). Errors name the file.
@@ -92,6 +97,9 @@ pub struct WorstPixel {
     pub b: [u32; 4],
 }
 
+/// Order of the worst pixels: larger difference first, then the top row, then the left column.
+type WorstKey = (u32, Reverse<(u32, u32)>);
+
 /// Everything `compare.json` holds (beside the provenance).
 #[derive(Clone, Debug, Serialize)]
 pub struct Comparison {
@@ -163,6 +171,12 @@ pub fn compare(
             a.width, a.height, b.width, b.height
         )));
     }
+    if top > MAX_TOP {
+        return Err(Error::field(
+            "--top",
+            format!("{top} is over the limit of {MAX_TOP} pixels"),
+        ));
+    }
     if !(1..=16).contains(&bits) {
         return Err(Error::field(
             "--bits",
@@ -189,21 +203,23 @@ pub fn compare(
             n1 += u64::from(ca != cb);
         }
         (covered_a, covered_b, only_one) = (Some(na), Some(nb), Some(n1));
-        let from = serde_json::to_value(from).map_or_else(|_| String::new(), |v| v.to_string());
+        let from = match from {
+            CoverageFrom::A => "a",
+            CoverageFrom::B => "b",
+            CoverageFrom::Either => "either",
+            CoverageFrom::Both => "both",
+        };
         selection = format!(
-            "coverage from {}, clear {},{},{},{}",
-            from.trim_matches('"'),
-            clear[0],
-            clear[1],
-            clear[2],
-            clear[3]
+            "coverage from {from}, clear {},{},{},{}",
+            clear[0], clear[1], clear[2], clear[3]
         );
     }
     let mask = selection_mask(a, b, sel);
     let metrics = report::compare(a, b, bits, mask.as_deref());
     let mut sum = [0u64; 4];
     let mut max = [0u32; 4];
-    let mut worst: Vec<(u32, u32, u32)> = Vec::new();
+    // The `top` largest (difference, then top row, then left column) in a bounded min-heap.
+    let mut worst: BinaryHeap<Reverse<WorstKey>> = BinaryHeap::new();
     let q = |p: [u16; 4]| p.map(|c| report::quantize(c, bits));
     for (i, (&pa, &pb)) in a.px.iter().zip(&b.px).enumerate() {
         if mask.as_ref().is_some_and(|m| !m[i]) {
@@ -219,13 +235,19 @@ pub fn compare(
                 d = d.max(e);
             }
         }
-        if d > 0 {
+        if d > 0 && top > 0 {
             let (x, y) = ((i % a.width as usize) as u32, (i / a.width as usize) as u32);
-            worst.push((d, y, x));
+            worst.push(Reverse((d, Reverse((y, x)))));
+            if worst.len() > top {
+                worst.pop();
+            }
         }
     }
+    let mut worst: Vec<(u32, u32, u32)> = worst
+        .into_iter()
+        .map(|Reverse((d, Reverse((y, x))))| (d, y, x))
+        .collect();
     worst.sort_unstable_by(|p, o| o.0.cmp(&p.0).then((p.1, p.2).cmp(&(o.1, o.2))));
-    worst.truncate(top);
     let n = metrics.pixels.max(1) as f64;
     let channels = ["r", "g", "b", "a"]
         .iter()

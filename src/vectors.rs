@@ -278,20 +278,38 @@ pub fn generate(name: &str, hw: &HwConfig, n: u64, seed: u64) -> Result<VectorSe
         .iter()
         .filter(|p| p.direction == Direction::Input)
         .count();
-    let mut push = |inputs: &[i64]| {
+    let mut push = |inputs: &[i64]| -> Result<()> {
         let outputs = adapter.eval(inputs);
-        for (col, v) in columns.iter_mut().zip(inputs.iter().chain(&outputs)) {
-            col.push(*v);
+        if inputs.len() != n_in || inputs.len() + outputs.len() != ports.len() {
+            return Err(Error::msg(format!(
+                "unit '{name}': a case has {} inputs and {} outputs, its ports say {n_in} and {}",
+                inputs.len(),
+                outputs.len(),
+                ports.len() - n_in
+            )));
         }
+        for ((col, &v), p) in columns
+            .iter_mut()
+            .zip(inputs.iter().chain(&outputs))
+            .zip(&ports)
+        {
+            let (lo, hi) = p.range();
+            if v < lo || v > hi {
+                return Err(Error::msg(format!(
+                    "unit '{name}': value {v} of port '{}' is outside its {} bits on '{}'",
+                    p.name, p.bits, hw.name
+                )));
+            }
+            col.push(v);
+        }
+        Ok(())
     };
     for case in &boundary {
-        push(case);
+        push(case)?;
     }
     let mut rng = SplitMix64::new(seed);
     for _ in 0..n {
-        let case = adapter.random(&mut rng);
-        debug_assert_eq!(case.len(), n_in);
-        push(&case);
+        push(&adapter.random(&mut rng))?;
     }
     Ok(VectorSet {
         unit: entry.name,
@@ -566,7 +584,8 @@ impl UnitAdapter for Recip {
             v.extend([base + (1 << (extra - 1)), base + 3 * (1 << (extra - 1))]);
             v.push((base << 1) - 1);
         }
-        // Every seed-LUT interval: its first mantissa and the last of the one before.
+        // Every seed-LUT interval: its first mantissa and the last of the one before (for LUTs
+        // of up to 2^12 entries; the random cases cover larger ones).
         if l <= 12 {
             for i in 0..(1i64 << l) {
                 let m = ((1i64 << l) + i) << (p - l.min(p));
@@ -708,9 +727,13 @@ impl UnitAdapter for Wrap {
             Port::input("mode", false, 2, 0).doc("0 repeat, 1 clamp-to-edge, 2 mirror"),
             Port::output("i0", false, 14, 0).doc("first texel index, in [0, size-1]"),
             Port::output("i1", false, 14, 0).doc("second texel index, in [0, size-1]"),
-            Port::output("weight", false, 0, self.wb.max(1))
-                .rounded(self.cfg.weight_rounding)
-                .doc("weight of i1 (weight_bits fraction bits; 0 when weight_bits = 0)"),
+            if self.wb == 0 {
+                Port::output("weight", false, 1, 0).doc("weight of i1: always 0 (weight_bits = 0)")
+            } else {
+                Port::output("weight", false, 0, self.wb)
+                    .rounded(self.cfg.weight_rounding)
+                    .doc("weight of i1, in [0, 2^weight_bits - 1] (weight_bits fraction bits)")
+            },
         ]
     }
 

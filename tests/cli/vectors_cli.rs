@@ -687,7 +687,7 @@ fn compare_bad_input_fails_cleanly() {
     write_png(&d.join("a.png"), 4, 4, &[[1, 2, 3, 255]; 16]);
     write_png(&d.join("b.png"), 5, 4, &[[1, 2, 3, 255]; 20]);
     std::fs::write(d.join("text.png"), b"not an image").unwrap();
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["compare", "a.png", "b.png"], "a.png is 4x4, b.png is 5x4"),
         (&["compare", "a.png", "missing.png"], "missing.png"),
         (
@@ -713,6 +713,10 @@ fn compare_bad_input_fails_cleanly() {
         (
             &["compare", "a.png", "a.png", "--bits", "17"],
             "field '--bits'",
+        ),
+        (
+            &["compare", "a.png", "a.png", "--top", "100001"],
+            "field '--top'",
         ),
     ];
     for (args, msg) in cases {
