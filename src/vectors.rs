@@ -145,6 +145,11 @@ pub const UNITS: &[UnitEntry] = &[
         make: |hw| Box::new(Lerp::new(hw)),
     },
     UnitEntry {
+        name: "bilinear",
+        about: "one channel of the bilinear footprint: lerps along x on both rows, then along y (hw_model::trilinear::bilinear)",
+        make: |hw| Box::new(Bilinear::new(hw)),
+    },
+    UnitEntry {
         name: "recip",
         about: "the reciprocal unit 1/x: LUT seed + Newton-Raphson (hw_model::reciprocal)",
         make: |hw| Box::new(Recip::new(hw)),
@@ -524,6 +529,105 @@ impl UnitAdapter for Lerp {
             self.cfg.filter_rounding,
         );
         vec![i64::from(y)]
+    }
+}
+
+/// One channel of the bilinear filter (`hw_model::trilinear::bilinear`) from four texels and
+/// the two weights: a 2x2 level sampled with clamp-to-edge at `u = (2^wb + 2 wx) 2^-(wb+2)`, the
+/// coordinate whose texel-space fraction is exactly `wx / 2^wb` (any weight rounding).
+struct Bilinear {
+    lerp: Lerp,
+}
+
+impl Bilinear {
+    fn new(hw: &HwConfig) -> Self {
+        Self {
+            lerp: Lerp::new(hw),
+        }
+    }
+}
+
+impl UnitAdapter for Bilinear {
+    fn ports(&self) -> Vec<Port> {
+        let (tb, wb) = (self.lerp.tb, self.lerp.wb);
+        let texel = |name, doc| Port::input(name, false, tb, 0).doc(doc);
+        let weight = |name, doc| {
+            if wb == 0 {
+                Port::input(name, false, 1, 0).doc("always 0 (weight_bits = 0)")
+            } else {
+                Port::input(name, false, 0, wb).doc(doc)
+            }
+        };
+        vec![
+            texel("t00", "texel (x0, y0), unorm code"),
+            texel("t10", "texel (x1, y0)"),
+            texel("t01", "texel (x0, y1)"),
+            texel("t11", "texel (x1, y1)"),
+            weight("wx", "weight of x1, in [0, 2^weight_bits - 1]"),
+            weight("wy", "weight of y1, in [0, 2^weight_bits - 1]"),
+            Port::output("y", false, tb, 0)
+                .rounded(self.lerp.cfg.filter_rounding)
+                .doc("lerp(lerp(t00, t10, wx), lerp(t01, t11, wx), wy), each lerp rounded once"),
+        ]
+    }
+
+    fn config(&self) -> Value {
+        self.lerp.config()
+    }
+
+    fn boundary(&self) -> Vec<Vec<i64>> {
+        let max = (1i64 << self.lerp.tb) - 1;
+        let top = (1i64 << self.lerp.wb) - 1;
+        let half = (top + 1) / 2;
+        let weights = distinct([0, 1, half, top - 1, top], 0, top);
+        let texels = [
+            [0, 0, 0, 0],
+            [max, max, max, max],
+            [0, max, 0, max],
+            [0, 0, max, max],
+            [max, 0, 0, max],
+            [0, 1, 1, 0],
+            [0, 1, 2, 3],
+            [max - 1, max, max, max - 1],
+        ];
+        let mut cases = Vec::new();
+        for t in texels {
+            for &wx in &weights {
+                for &wy in &weights {
+                    cases.push(vec![t[0], t[1], t[2], t[3], wx, wy]);
+                }
+            }
+        }
+        cases
+    }
+
+    fn random(&self, rng: &mut SplitMix64) -> Vec<i64> {
+        let max = (1i64 << self.lerp.tb) - 1;
+        let top = (1i64 << self.lerp.wb) - 1;
+        let mut v: Vec<i64> = (0..4).map(|_| rng.range(0, max)).collect();
+        v.extend([rng.range(0, top), rng.range(0, top)]);
+        v
+    }
+
+    fn eval(&self, i: &[i64]) -> Vec<i64> {
+        let wb = self.lerp.wb;
+        let texels = [i[0], i[1], i[2], i[3]].map(|t| [t as u16, 0, 0, 0]);
+        let level = hw_model::trilinear::Level {
+            width: 2,
+            height: 2,
+            texels: &texels,
+        };
+        let coord = |w: i64| (1i64 << wb) + 2 * w;
+        let out = hw_model::trilinear::bilinear(
+            &level,
+            coord(i[4]),
+            coord(i[5]),
+            wb + 2,
+            [WrapMode::ClampToEdge; 2],
+            &self.lerp.cfg,
+            None,
+        );
+        vec![i64::from(out[0])]
     }
 }
 

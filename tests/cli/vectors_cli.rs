@@ -7,7 +7,7 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const UNITS: [&str; 5] = ["lerp", "recip", "rsqrt", "wrap", "lod"];
+const UNITS: [&str; 6] = ["lerp", "bilinear", "recip", "rsqrt", "wrap", "lod"];
 
 fn run_ok(args: &[&str], cwd: &Path) -> String {
     let o = texsim(args, cwd);
@@ -204,7 +204,7 @@ fn lerp_vectors_cover_the_boundaries_and_equal_the_exact_lerp() {
 fn other_units_vectors_are_the_units_outputs() {
     let d = tmp("units");
     let hw = texsim::hwconfig::resolve("texram16").unwrap();
-    for unit in ["recip", "rsqrt", "wrap", "lod"] {
+    for unit in ["bilinear", "recip", "rsqrt", "wrap", "lod"] {
         let dir = d.join(unit);
         run_ok(
             &[
@@ -220,6 +220,20 @@ fn other_units_vectors_are_the_units_outputs() {
         let cols = columns(&dir);
         let n = cols[0].1.len();
         match unit {
+            "bilinear" => {
+                // Three exact lerps in the bilinear order (rows along x, then along y).
+                let m = manifest(&dir);
+                let wb = m["ports"][4]["frac_bits"].as_u64().unwrap() as u32;
+                let r = m["ports"][6]["rounding"].as_str().unwrap().to_string();
+                let t = ["t00", "t10", "t01", "t11"].map(|p| col(&cols, p));
+                let (wx, wy, y) = (col(&cols, "wx"), col(&cols, "wy"), col(&cols, "y"));
+                for k in 0..n {
+                    let top = exact_lerp(t[0][k], t[1][k], wx[k], wb, &r);
+                    let bot = exact_lerp(t[2][k], t[3][k], wx[k], wb, &r);
+                    assert_eq!(y[k], exact_lerp(top, bot, wy[k], wb, &r), "vector {k}");
+                }
+                assert!(wx.contains(&0) && wx.contains(&((1 << wb) - 1)));
+            }
             "recip" => {
                 let u = hw_model::reciprocal::Reciprocal::new(&hw.reciprocal);
                 let (x, mant, shift, sat) = (
@@ -388,28 +402,39 @@ fn iverilog() -> &'static str {
     "iverilog"
 }
 
-/// Compiles lerp.sv and its testbench with the manifest's widths, runs the vectors in `dir`;
-/// returns (success, output).
-fn simulate(dir: &Path) -> (bool, String) {
+/// Compiles the SystemVerilog `unit` (lerp or bilinear) and its testbench with the manifest's
+/// widths and runs the vectors in `dir`; returns (success, output).
+fn simulate(dir: &Path, unit: &str) -> (bool, String) {
     let m = manifest(dir);
     let ports = m["ports"].as_array().unwrap();
-    let tb = ports[0]["bits"].as_u64().unwrap();
-    let wb = ports[2]["frac_bits"].as_u64().unwrap();
-    let round = match ports[3]["rounding"].as_str().unwrap() {
+    let port = |name: &str| ports.iter().find(|p| p["name"] == name).expect(name);
+    let (first, weight) = if unit == "lerp" {
+        ("a", "w")
+    } else {
+        ("t00", "wx")
+    };
+    let tb = port(first)["bits"].as_u64().unwrap();
+    let wb = port(weight)["frac_bits"].as_u64().unwrap();
+    let round = match port("y")["rounding"].as_str().unwrap() {
         "truncate" => 0,
         "half-up" => 1,
         _ => 2,
     };
     let n = m["vectors"].as_u64().unwrap();
     let rtl = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("hw_model/rtl");
+    let mut sources = vec![rtl.join("lerp.sv")];
+    if unit == "bilinear" {
+        sources.push(rtl.join("bilinear.sv"));
+    }
+    sources.push(rtl.join(format!("{unit}_tb.sv")));
+    let top = format!("{unit}_tb");
     let c = Command::new(iverilog())
         .args(["-g2012", "-o", "sim"])
-        .arg(format!("-Plerp_tb.TB={tb}"))
-        .arg(format!("-Plerp_tb.WB={wb}"))
-        .arg(format!("-Plerp_tb.ROUND={round}"))
-        .arg(format!("-Plerp_tb.N={n}"))
-        .arg(rtl.join("lerp.sv"))
-        .arg(rtl.join("lerp_tb.sv"))
+        .arg(format!("-P{top}.TB={tb}"))
+        .arg(format!("-P{top}.WB={wb}"))
+        .arg(format!("-P{top}.ROUND={round}"))
+        .arg(format!("-P{top}.N={n}"))
+        .args(&sources)
         .current_dir(dir)
         .output()
         .expect("run iverilog");
@@ -423,7 +448,7 @@ fn simulate(dir: &Path) -> (bool, String) {
 }
 
 #[test]
-fn systemverilog_lerp_passes_every_vector_and_catches_a_wrong_one() {
+fn systemverilog_lerp_and_bilinear_pass_every_vector_and_catch_a_wrong_one() {
     let d = tmp("rtl");
     let custom = |name: &str, body: &str| {
         let p = d.join(format!("{name}.toml"));
@@ -452,59 +477,55 @@ fn systemverilog_lerp_passes_every_vector_and_catches_a_wrong_one() {
             "half-even",
         ),
     ];
-    for (i, (hw, rounding)) in configs.iter().enumerate() {
-        let dir = d.join(format!("v{i}"));
-        run_ok(
-            &[
-                "vectors",
-                "lerp",
-                "--hw",
-                hw,
-                "--n",
-                "20000",
-                "--seed",
-                "3",
-                "--out",
-                dir.to_str().unwrap(),
-            ],
-            &d,
-        );
-        let m = manifest(&dir);
-        assert_eq!(m["ports"][3]["rounding"], *rounding, "{hw}");
-        let n = m["vectors"].as_u64().unwrap();
-        let (ok, out) = simulate(&dir);
-        assert!(ok, "{hw}: {out}");
-        assert!(
-            out.contains(&format!("lerp_tb: {n} vectors, {n} passed, 0 failed")),
-            "{hw}: {out}"
-        );
-        // Negative control: one wrong expected value is caught.
-        let y = dir.join("y.hex");
-        let text_y = std::fs::read_to_string(&y).unwrap();
-        let mut lines: Vec<String> = text_y.lines().map(str::to_string).collect();
-        let k = lines.len() / 2;
-        let v = u64::from_str_radix(&lines[k], 16).unwrap();
-        let width = lines[k].len();
-        lines[k] = format!("{:0width$x}", v ^ 1);
-        std::fs::write(&y, lines.join("\n") + "\n").unwrap();
-        let (ok, out) = simulate(&dir);
-        assert!(!ok, "{hw}: a wrong expected value passed: {out}");
-        assert!(
-            out.contains(&format!("lerp_tb: {n} vectors, {} passed, 1 failed", n - 1)),
-            "{hw}: {out}"
-        );
-        assert!(out.contains(&format!("vector {}:", k - 1)), "{hw}: {out}");
-        // A truncated file is not a pass either.
-        std::fs::write(
-            &y,
-            text_y.lines().take(10).collect::<Vec<_>>().join("\n") + "\n",
-        )
-        .unwrap();
-        let (ok, out) = simulate(&dir);
-        assert!(
-            !ok && out.contains(&format!("{} failed", n - 9)),
-            "{hw}: {out}"
-        );
+    for unit in ["lerp", "bilinear"] {
+        for (i, (hw, rounding)) in configs.iter().enumerate() {
+            let dir = d.join(format!("{unit}{i}"));
+            let dir_s = dir.to_str().unwrap();
+            run_ok(
+                &[
+                    "vectors", unit, "--hw", hw, "--n", "10000", "--seed", "3", "--out", dir_s,
+                ],
+                &d,
+            );
+            let m = manifest(&dir);
+            let y = m["ports"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|p| p["name"] == "y")
+                .unwrap();
+            assert_eq!(y["rounding"], *rounding, "{hw}");
+            let n = m["vectors"].as_u64().unwrap();
+            let (ok, out) = simulate(&dir, unit);
+            assert!(ok, "{unit} {hw}: {out}");
+            let line = format!("{unit}_tb: {n} vectors, {n} passed, 0 failed");
+            assert!(out.contains(&line), "{unit} {hw}: {out}");
+            // Negative control: one wrong expected value is caught.
+            let y = dir.join("y.hex");
+            let text_y = std::fs::read_to_string(&y).unwrap();
+            let mut lines: Vec<String> = text_y.lines().map(str::to_string).collect();
+            let k = lines.len() / 2;
+            let v = u64::from_str_radix(&lines[k], 16).unwrap();
+            let width = lines[k].len();
+            lines[k] = format!("{:0width$x}", v ^ 1);
+            std::fs::write(&y, lines.join("\n") + "\n").unwrap();
+            let (ok, out) = simulate(&dir, unit);
+            assert!(!ok, "{unit} {hw}: a wrong expected value passed: {out}");
+            let line = format!("{unit}_tb: {n} vectors, {} passed, 1 failed", n - 1);
+            assert!(out.contains(&line), "{unit} {hw}: {out}");
+            assert!(
+                out.contains(&format!("vector {}:", k - 1)),
+                "{unit} {hw}: {out}"
+            );
+            // A truncated file is not a pass either.
+            let short = text_y.lines().take(10).collect::<Vec<_>>().join("\n") + "\n";
+            std::fs::write(&y, short).unwrap();
+            let (ok, out) = simulate(&dir, unit);
+            assert!(
+                !ok && out.contains(&format!("{} failed", n - 9)),
+                "{unit} {hw}: {out}"
+            );
+        }
     }
 }
 
