@@ -877,3 +877,36 @@ fn killed_renders_leave_whole_output_sets() {
         "{inside:?}"
     );
 }
+
+/// `texsim hw show | head -1`: printing into a pipe whose reader has gone ends the process by
+/// SIGPIPE, quietly, as Unix tools do (it panicked in `println!` before).
+#[cfg(unix)]
+#[test]
+fn printing_into_a_closed_pipe_ends_quietly() {
+    use std::os::fd::FromRawFd;
+    use std::os::unix::process::ExitStatusExt;
+    let mut fds = [0i32; 2];
+    // SAFETY: `fds` holds the two descriptors pipe(2) writes.
+    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+    // SAFETY: pipe(2) returned two fresh descriptors that nothing else owns.
+    let (reader, writer) = unsafe {
+        (
+            std::fs::File::from_raw_fd(fds[0]),
+            std::fs::File::from_raw_fd(fds[1]),
+        )
+    };
+    drop(reader);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_texsim"))
+        .args(["hw", "show", "texram16"])
+        .stdout(std::process::Stdio::from(writer))
+        .output()
+        .expect("run texsim");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(
+        o.status.signal(),
+        Some(libc::SIGPIPE),
+        "{:?} {err}",
+        o.status
+    );
+}
