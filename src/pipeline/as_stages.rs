@@ -133,7 +133,7 @@ pub fn as_shade_cost(m: &Machine, plan: &Plan) -> UnitCost {
     let u = &m.units;
     let g = m.hw.timing.gate_levels_per_cycle;
     let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
-    let np = super::bump_stages::point_lights(m) as u32;
+    let np = super::bump::point_lights(m) as u32;
     let lights = m.lights.len() as u32;
     let mac = hw_model::blinn_phong::mac_cost(&u.cfg, g);
     let add = UnitCost {
@@ -371,7 +371,7 @@ pub fn run_as_shade(
                 acc[ch] += PI * (s + df * kd[ch]) * nl * light.color_f[ch];
             }
         }
-        super::bump_stages::float_output(acc, frag, c);
+        super::bump::float_output(acc, frag, c);
     }
     c.sat[k] = sat;
 }

@@ -13,11 +13,16 @@
 
 pub mod as_stages;
 pub mod bary;
-pub mod bump_stages;
+pub mod bump;
+pub mod bump_fetch;
 pub mod color;
+pub mod frame;
 pub mod lod;
 pub mod modulate;
 pub mod ndf_stages;
+pub mod normal;
+pub mod perturb;
+pub mod phong;
 pub mod rough_stages;
 pub mod stages;
 pub mod table;

@@ -166,7 +166,7 @@ pub fn ndf_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
         StageKind::NdfShade => {
             let u = &m.units;
             let lights = m.lights.len() as u32;
-            let np = super::bump_stages::point_lights(m) as u32;
+            let np = super::bump::point_lights(m) as u32;
             let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
             let mac = hw_model::blinn_phong::mac_cost(&u.cfg, g);
             // `exact` has no unit cost (float only): the stage's cost is then incomplete and
@@ -396,7 +396,7 @@ pub fn run_ndf_stage(
                             .saturating_add(sp.max(0) as u64);
                     }
                 }
-                super::bump_stages::fixed_output(acc, frag, &mut sat, cb);
+                super::bump::fixed_output(acc, frag, &mut sat, cb);
             } else {
                 let texel = if fixed_in(StageKind::NdfFetch) {
                     frag.ndf
@@ -452,7 +452,7 @@ pub fn run_ndf_stage(
                         acc[ch] += light.color_f[ch] * (bp.kd[ch] * ndl + bp.ks[ch] * spec);
                     }
                 }
-                super::bump_stages::float_output(acc, frag, c);
+                super::bump::float_output(acc, frag, c);
             }
         }
         _ => {}

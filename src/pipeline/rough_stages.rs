@@ -16,7 +16,7 @@
 //! each with its own normal perturbed by the bilinearly sampled finest offsets, shaded with
 //! the material's plain Blinn-Phong in float.
 
-use super::bump_stages::point_lights;
+use super::bump::point_lights;
 use super::stages::{Counters, Machine};
 use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
 use super::{Frag, Impl, Plan, Px, StageImpls, StageKind};
@@ -385,7 +385,7 @@ pub fn run_rough_stage(
                     dv: scale_d(dv, len, lfb, iso, &mut sat),
                     t,
                 };
-                let (kd, ks, mut acc) = super::bump_stages::fixed_material(
+                let (kd, ks, mut acc) = super::bump::fixed_material(
                     bp,
                     m,
                     plan.texture.is_some(),
@@ -422,7 +422,7 @@ pub fn run_rough_stage(
                         acc[ch] += r.color[ch];
                     }
                 }
-                super::bump_stages::fixed_output(acc, frag, &mut sat, cb);
+                super::bump::fixed_output(acc, frag, &mut sat, cb);
             } else {
                 let v = fref::normalize_or(DVec3::from(bf.to_eye), DVec3::Z).0;
                 let mut kd = bp.kd;
@@ -511,7 +511,7 @@ pub fn run_rough_stage(
                         acc[ch] += col[ch];
                     }
                 }
-                super::bump_stages::float_output(acc, frag, c);
+                super::bump::float_output(acc, frag, c);
             }
         }
         _ => {}

@@ -4,7 +4,7 @@
 //! [`Counters`], and [`run`], which runs a compiled [`Program`] on one fragment. The stages
 //! themselves are one file each, registered in [`super::table`].
 
-use super::bump_stages::BumpAttrs;
+use super::bump::BumpAttrs;
 use super::{BumpPlan, Frag, Plan, Program, Px, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};

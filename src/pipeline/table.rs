@@ -9,8 +9,8 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_stages, bary, bump_stages, color, lod, modulate, ndf_stages, rough_stages, texcoord,
-    trilinear,
+    as_stages, bary, bump_fetch, color, frame, lod, modulate, ndf_stages, normal, perturb, phong,
+    rough_stages, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -146,37 +146,27 @@ stage_table! {
     }
     /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
     Normal "normal" {
-        fixed: bump_stages::row::<{ StageKind::Normal as usize }>,
-        float: bump_stages::row::<{ StageKind::Normal as usize }>,
-        cost: bump_stages::row_cost::<{ StageKind::Normal as usize }>,
+        fixed: normal::fixed, float: normal::float, cost: normal::cost,
         lookups: no_lookups,
     }
     /// Bump materials: LOD + trilinear fetch of the offset map `(f_u, f_v)`.
     BumpFetch "bump-fetch" {
-        fixed: bump_stages::row::<{ StageKind::BumpFetch as usize }>,
-        float: bump_stages::row::<{ StageKind::BumpFetch as usize }>,
-        cost: bump_stages::row_cost::<{ StageKind::BumpFetch as usize }>,
+        fixed: bump_fetch::fixed, float: bump_fetch::float, cost: bump_fetch::cost,
         lookups: one_lookup,
     }
     /// Bump materials: the local frame (natural, unit or main direction).
     Frame "frame" {
-        fixed: bump_stages::row::<{ StageKind::Frame as usize }>,
-        float: bump_stages::row::<{ StageKind::Frame as usize }>,
-        cost: bump_stages::row_cost::<{ StageKind::Frame as usize }>,
+        fixed: frame::fixed, float: frame::float, cost: frame::cost,
         lookups: no_lookups,
     }
     /// Bump materials: `n' = normalize(n + f_u s_u + f_v s_v)`.
     Perturb "perturb" {
-        fixed: bump_stages::row::<{ StageKind::Perturb as usize }>,
-        float: bump_stages::row::<{ StageKind::Perturb as usize }>,
-        cost: bump_stages::row_cost::<{ StageKind::Perturb as usize }>,
+        fixed: perturb::fixed, float: perturb::float, cost: perturb::cost,
         lookups: no_lookups,
     }
     /// Bump materials: per-pixel Blinn-Phong over every scene light (+ ambient).
     Phong "phong" {
-        fixed: bump_stages::row::<{ StageKind::Phong as usize }>,
-        float: bump_stages::row::<{ StageKind::Phong as usize }>,
-        cost: bump_stages::row_cost::<{ StageKind::Phong as usize }>,
+        fixed: phong::fixed, float: phong::float, cost: phong::cost,
         lookups: no_lookups,
     }
     /// Ashikhmin-Shirley materials: the anisotropic Phong BRDF per pixel over every light.

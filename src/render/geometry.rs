@@ -1,7 +1,7 @@
 //! The geometry phase: host-side transforms, Gouraud lighting and one plan per mesh (float).
 
 use crate::maps::{bump_sources, ndf_sources, BumpSource};
-use crate::pipeline::bump_stages::BumpVertex;
+use crate::pipeline::bump::BumpVertex;
 use crate::pipeline::{plan_with_bump, BumpPlan, Plan};
 use crate::raster::DrawTri;
 use crate::scene::{Light, Scene};

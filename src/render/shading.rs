@@ -3,7 +3,7 @@
 //! count), with the stages' traces collected into timing events when asked.
 
 use super::Geometry;
-use crate::pipeline::bump_stages::{BumpAttrs, BumpVertex};
+use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 use crate::raster::{Setup, VisBuffer, NO_TRI};

@@ -1,0 +1,132 @@
+//! `phong`: per-pixel Blinn-Phong of the perturbed normal over every scene light, plus ambient
+//! (`hw_model::blinn_phong`); the bump materials' shading stage.
+
+use super::bump::{bump_of, d3, fixed_material, fixed_output, float_output, point_lights, raw3};
+use super::stages::{Counters, Machine};
+use super::{Frag, Plan, Px, StageKind};
+use crate::shading::reference as fref;
+use glam::DVec3;
+use hw_model::blinn_phong::{blinn_phong, blinn_phong_cost, mac_cost, BlinnPhongInput};
+use hw_model::rsqrt::rsqrt_cost;
+use hw_model::vector::{normalize3, normalize_cost};
+use hw_model::UnitCost;
+
+/// Fixed twin: normalized eye and light vectors, the Blinn-Phong unit per light, summed
+/// saturating into `shade_color_bits`.
+#[allow(clippy::needless_range_loop)]
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let Some((bp, _)) = bump_of(px) else { return };
+    let m = px.m;
+    let units = &m.units;
+    let vc = &units.cfg.vector;
+    let f = vc.vector_frac_bits;
+    let cb = units.cfg.shade.shade_color_bits;
+    let rnd = units.cfg.shade.shade_rounding;
+    let mut sat = c.sat[StageKind::Phong.index()];
+    let bf = &frag.bump;
+    let n = if px.fixed(StageKind::Perturb) {
+        bf.normal_x
+    } else {
+        raw3(&bf.normal, &m.vec_fmt, &mut sat)
+    };
+    let eye = if px.fixed(StageKind::Normal) {
+        bf.to_eye_x
+    } else {
+        raw3(&bf.to_eye, &m.vec_fmt, &mut sat)
+    };
+    let v = normalize3(&eye, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v;
+    let (kd, ks, mut acc) = fixed_material(
+        bp,
+        m,
+        px.plan.texture.is_some(),
+        px.fixed(StageKind::Trilinear),
+        frag.texel_x,
+        frag.texel,
+        cb,
+        rnd,
+    );
+    for light in &m.lights {
+        let l = match light.point {
+            Some(pi) => {
+                let lv = if px.fixed(StageKind::Normal) {
+                    bf.to_light_x[pi]
+                } else {
+                    raw3(&bf.to_light[pi], &m.vec_fmt, &mut sat)
+                };
+                normalize3(&lv, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v
+            }
+            None => light.l_x,
+        };
+        let inp = BlinnPhongInput {
+            n,
+            l,
+            v,
+            shininess: bp.shininess,
+            kd,
+            ks,
+            light: light.color_x,
+        };
+        let r = blinn_phong(&inp, units, &mut sat);
+        c.h_zero += u64::from(r.h_zero);
+        for ch in 0..3 {
+            acc[ch] += r.color[ch];
+        }
+    }
+    fixed_output(acc, frag, &mut sat, cb);
+    c.sat[StageKind::Phong.index()] = sat;
+}
+
+/// Float twin: `shading::reference::blinn_phong` per light.
+#[allow(clippy::needless_range_loop)]
+pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let Some((bp, _)) = bump_of(px) else { return };
+    let m = px.m;
+    let bf = &frag.bump;
+    let n = d3(&bf.normal);
+    let v = fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0;
+    let mut kd = bp.kd;
+    if px.plan.texture.is_some() {
+        for ch in 0..3 {
+            kd[ch] *= frag.texel[ch];
+        }
+    }
+    let mut acc = [0.0f64; 3];
+    for ch in 0..3 {
+        acc[ch] = m.ambient[ch] * kd[ch];
+    }
+    for light in &m.lights {
+        let l = match light.point {
+            Some(pi) => fref::normalize_or(d3(&bf.to_light[pi]), DVec3::Z).0,
+            None => d3(&light.l_f),
+        };
+        let (col, hz) = fref::blinn_phong(n, l, v, bp.shininess, kd, bp.ks, light.color_f);
+        c.h_zero += u64::from(hz);
+        for ch in 0..3 {
+            acc[ch] += col[ch];
+        }
+    }
+    float_output(acc, frag, c);
+}
+
+/// One invocation: the Blinn-Phong unit per light, the normalizations of the eye and point
+/// light vectors, the ambient and per-light multiply-accumulates (+1 for the texture).
+#[must_use]
+pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
+    if plan.bump.is_none() {
+        return UnitCost::default();
+    }
+    let u = &m.units;
+    let g = m.hw.timing.gate_levels_per_cycle;
+    let np = point_lights(m) as u32;
+    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
+    let mac = mac_cost(&u.cfg, g);
+    let lights = m.lights.len() as u32;
+    let mut c = blinn_phong_cost(u, g)
+        .times(lights)
+        .plus(nz.times(1 + np))
+        .plus(mac.times(1 + lights));
+    if plan.texture.is_some() {
+        c = c.plus(mac);
+    }
+    c
+}
