@@ -23,7 +23,9 @@ pub mod ndf_stages;
 pub mod normal;
 pub mod perturb;
 pub mod phong;
-pub mod rough_stages;
+pub mod rough;
+pub mod rough_fetch;
+pub mod rough_shade;
 pub mod stages;
 pub mod table;
 pub mod texcoord;
@@ -92,8 +94,8 @@ pub struct Plan {
     pub bump: Option<BumpPlan>,
     /// Ashikhmin-Shirley shading (with `bump` holding its normal/frame inputs).
     pub aniso: Option<as_stages::AsPlan>,
-    /// Roughness map and modified Blinn-Phong (`rough_stages`), for roughness materials.
-    pub rough: Option<rough_stages::RoughPlan>,
+    /// Roughness map and modified Blinn-Phong (`rough`), for roughness materials.
+    pub rough: Option<rough::RoughPlan>,
     /// NDF mapping (with `bump` for the frame), for NDF materials.
     pub ndf: Option<ndf_stages::NdfPlan>,
 }

@@ -10,7 +10,7 @@
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
     as_stages, bary, bump_fetch, color, frame, lod, modulate, ndf_stages, normal, perturb, phong,
-    rough_stages, texcoord, trilinear,
+    rough_fetch, rough_shade, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -176,16 +176,12 @@ stage_table! {
     }
     /// Roughness materials: trilinear fetch of the D map at the bump fetch's LOD.
     RoughFetch "rough-fetch" {
-        fixed: rough_stages::row::<{ StageKind::RoughFetch as usize }>,
-        float: rough_stages::row::<{ StageKind::RoughFetch as usize }>,
-        cost: rough_stages::row_cost::<{ StageKind::RoughFetch as usize }>,
+        fixed: rough_fetch::fixed, float: rough_fetch::float, cost: rough_fetch::cost,
         lookups: one_lookup,
     }
     /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
     RoughShade "rough-shade" {
-        fixed: rough_stages::row::<{ StageKind::RoughShade as usize }>,
-        float: rough_stages::row::<{ StageKind::RoughShade as usize }>,
-        cost: rough_stages::row_cost::<{ StageKind::RoughShade as usize }>,
+        fixed: rough_shade::fixed, float: rough_shade::float, cost: rough_shade::cost,
         lookups: no_lookups,
     }
     /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).

@@ -87,7 +87,7 @@ impl Geometry {
                     .map(|k| scene.textures.len() + k)
             });
             let mut p = plan_with_bump(mat, !mesh.uvs.is_empty(), bump_map);
-            crate::pipeline::rough_stages::mark_plan(&mut p, mat);
+            crate::pipeline::rough::mark_plan(&mut p, mat);
             if mat.ndf {
                 let first = scene.textures.len() + sources.len();
                 if let Some(j) = bump_map.and_then(|b| {

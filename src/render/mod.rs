@@ -56,7 +56,7 @@ pub struct RenderOptions {
     pub timing: bool,
     /// Also render the ground truth, with this many sub-samples per pixel axis (0 = off):
     /// roughness materials supersample their full-resolution bump map
-    /// (`pipeline::rough_stages`), NDF materials their finest normal map
+    /// (`pipeline::rough`), NDF materials their finest normal map
     /// (`pipeline::ndf_stages::NdfTruth`); the stats gain `model_error` (float vs truth) and
     /// `quantization_error` (hardware vs float).
     pub truth: u32,
@@ -132,15 +132,14 @@ pub fn render(
     } else {
         maps
     };
-    let rough_sources =
-        crate::pipeline::rough_stages::resolve_plans(&mut geo.plans, hw, maps.float.len());
+    let rough_sources = crate::pipeline::rough::resolve_plans(&mut geo.plans, hw, maps.float.len());
     let has_rough = geo.plans.iter().any(|p| p.rough.is_some());
     let mut d_clamped = 0;
     let rough_owned;
     let maps = if rough_sources.is_empty() {
         maps
     } else {
-        let (mm, cl) = crate::pipeline::rough_stages::rough_maps(maps, &rough_sources, hw)?;
+        let (mm, cl) = crate::pipeline::rough::rough_maps(maps, &rough_sources, hw)?;
         d_clamped = cl;
         rough_owned = mm;
         &rough_owned
@@ -245,9 +244,9 @@ pub fn render(
     if opts.truth > 0 && (has_rough || has_ndf) {
         let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
-        // bump map (`rough_stages::truth_plans`), NDF materials their supersampled finest normal
+        // bump map (`rough::truth_plans`), NDF materials their supersampled finest normal
         // map (`ndf_stages::NdfTruth`), all others are their own float reference.
-        let tp = crate::pipeline::rough_stages::truth_plans(&geo.plans, opts.truth);
+        let tp = crate::pipeline::rough::truth_plans(&geo.plans, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
         let ndf_truth =
             crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans, opts.truth);

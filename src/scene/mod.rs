@@ -101,7 +101,7 @@ pub struct Material {
     /// Specular exponent (for NDF materials, the base shininess of the moment maps).
     pub shininess: u32,
     /// Roughness map of a bump material (Schilling 1997 roughness pyramid + modified
-    /// Blinn-Phong, `pipeline::rough_stages`); `None`: plain Blinn-Phong.
+    /// Blinn-Phong, `pipeline::rough`); `None`: plain Blinn-Phong.
     pub roughness: Option<RoughChoice>,
     /// Ashikhmin-Shirley anisotropic Phong BRDF: shaded per pixel in the main-direction frame
     /// instead of Gouraud or Blinn-Phong (`pipeline::as_stages`).

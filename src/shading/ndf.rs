@@ -512,7 +512,7 @@ pub fn truth_samples_per_axis(len: f64, n: u32) -> u32 {
 /// texel space, the parallelogram `c + s a + t b`, `s, t` in `[-1/2, 1/2]` (`c` the pixel's
 /// texel coordinates, texel centres at `i + 0.5`; `a`, `b` the texel-space derivatives of the
 /// texture coordinates along x and y: the footprint of the roughness truth,
-/// `pipeline::rough_stages`). Each axis is clamped to `[1, max(w, h)]` texels (a one-texel box
+/// `pipeline::rough`). Each axis is clamped to `[1, max(w, h)]` texels (a one-texel box
 /// over the nearest-texel lobes interpolates them linearly between texel centres, as the
 /// bilinear filter does with the moments; a footprint larger than the map covers all of it)
 /// and sampled at the centres of [`truth_samples_per_axis`]`(len, n)` equal steps: `n x n`

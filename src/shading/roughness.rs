@@ -2,7 +2,7 @@
 //! pyramid", "Isotropic roughness representation", Appendix A), host side in float: the
 //! pyramid of mean offsets and offset covariances, its D factorization and unorm encoding, the
 //! float twin of `hw_model::roughness` and of its shading (the supersampled ground truth is
-//! in `crate::pipeline::rough_stages`).
+//! in `crate::pipeline::rough`).
 //!
 //! Recursive rule. The converted paper text garbles it (a sum over `n = 0..3` of `K_{l-1,n}`
 //! runs into the scatter matrix with no operator between them). The form implemented, the law
