@@ -19,7 +19,9 @@ pub mod color;
 pub mod frame;
 pub mod lod;
 pub mod modulate;
-pub mod ndf_stages;
+pub mod ndf;
+pub mod ndf_fetch;
+pub mod ndf_shade;
 pub mod normal;
 pub mod perturb;
 pub mod phong;
@@ -97,7 +99,7 @@ pub struct Plan {
     /// Roughness map and modified Blinn-Phong (`rough`), for roughness materials.
     pub rough: Option<rough::RoughPlan>,
     /// NDF mapping (with `bump` for the frame), for NDF materials.
-    pub ndf: Option<ndf_stages::NdfPlan>,
+    pub ndf: Option<ndf::NdfPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -238,7 +240,7 @@ pub struct Frag {
     pub rough: [f64; 3],
     pub rough_x: [u32; 3],
     /// NDF stages.
-    pub ndf: ndf_stages::NdfFrag,
+    pub ndf: ndf::NdfFrag,
     /// The texel footprints the stages fetched (recorded only when `trace.on`).
     pub trace: trace::Trace,
 }

@@ -95,7 +95,7 @@ pub struct Machine<'a> {
     /// The fixed NDF unit of `hw.ndf` (`None` for the float-only `exact` normalization).
     pub ndf: Option<hw_model::ndf::NdfUnit>,
     /// Ground-truth normal maps: when not empty, the float `ndf-shade` supersamples them.
-    pub ndf_truth: &'a [super::ndf_stages::NdfTruth],
+    pub ndf_truth: &'a [super::ndf::NdfTruth],
 }
 
 /// One scene light for per-pixel shading.
@@ -143,7 +143,7 @@ impl<'a> Machine<'a> {
             ambient_x: [0; 3],
             bump_attrs: &[],
             aniso_roms: std::sync::OnceLock::new(),
-            ndf: super::ndf_stages::ndf_unit(hw),
+            ndf: super::ndf::ndf_unit(hw),
             ndf_truth: &[],
         }
     }
@@ -189,7 +189,7 @@ impl<'a> Machine<'a> {
 
     /// Shades NDF materials (float twin) from the supersampled finest normals `truth`.
     #[must_use]
-    pub fn with_ndf_truth(mut self, truth: &'a [super::ndf_stages::NdfTruth]) -> Self {
+    pub fn with_ndf_truth(mut self, truth: &'a [super::ndf::NdfTruth]) -> Self {
         self.ndf_truth = truth;
         self
     }

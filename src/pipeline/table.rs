@@ -9,8 +9,8 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_stages, bary, bump_fetch, color, frame, lod, modulate, ndf_stages, normal, perturb, phong,
-    rough_fetch, rough_shade, texcoord, trilinear,
+    as_stages, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal,
+    perturb, phong, rough_fetch, rough_shade, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -186,16 +186,12 @@ stage_table! {
     }
     /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).
     NdfFetch "ndf-fetch" {
-        fixed: ndf_stages::row::<{ StageKind::NdfFetch as usize }>,
-        float: ndf_stages::row::<{ StageKind::NdfFetch as usize }>,
-        cost: ndf_stages::row_cost::<{ StageKind::NdfFetch as usize }>,
-        lookups: ndf_stages::fetch_lookups,
+        fixed: ndf_fetch::fixed, float: ndf_fetch::float, cost: ndf_fetch::cost,
+        lookups: ndf_fetch::lookups,
     }
     /// NDF materials: Sigma, its inverse, Mahalanobis distance, density, normalization, lights.
     NdfShade "ndf-shade" {
-        fixed: ndf_stages::row::<{ StageKind::NdfShade as usize }>,
-        float: ndf_stages::row::<{ StageKind::NdfShade as usize }>,
-        cost: ndf_stages::row_cost::<{ StageKind::NdfShade as usize }>,
+        fixed: ndf_shade::fixed, float: ndf_shade::float, cost: ndf_shade::cost,
         lookups: no_lookups,
     }
 }

@@ -96,7 +96,7 @@ impl Geometry {
                         .position(|&s| s == (b - scene.textures.len(), mat.shininess))
                 }) {
                     let ne = crate::shading::ndf::norm_exp_for(f64::from(mat.shininess));
-                    p = crate::pipeline::ndf_stages::with_ndf(p, first + 4 * j, mat.shininess, ne);
+                    p = crate::pipeline::ndf::with_ndf(p, first + 4 * j, mat.shininess, ne);
                 }
             }
             if let Some(bp) = &p.bump {

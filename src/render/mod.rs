@@ -57,7 +57,7 @@ pub struct RenderOptions {
     /// Also render the ground truth, with this many sub-samples per pixel axis (0 = off):
     /// roughness materials supersample their full-resolution bump map
     /// (`pipeline::rough`), NDF materials their finest normal map
-    /// (`pipeline::ndf_stages::NdfTruth`); the stats gain `model_error` (float vs truth) and
+    /// (`pipeline::ndf::NdfTruth`); the stats gain `model_error` (float vs truth) and
     /// `quantization_error` (hardware vs float).
     pub truth: u32,
     /// Called once per finished phase (setup, raster, hardware shading, reference shading,
@@ -147,7 +147,7 @@ pub fn render(
 
     let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
-    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+    if crate::pipeline::ndf::shade_is_float_only(hw)
         && geo.plans.iter().any(|p| p.ndf.is_some())
         && opts.hw_impls.of(StageKind::NdfShade) == Impl::Fixed
     {
@@ -245,11 +245,10 @@ pub fn render(
         let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
         // bump map (`rough::truth_plans`), NDF materials their supersampled finest normal
-        // map (`ndf_stages::NdfTruth`), all others are their own float reference.
+        // map (`ndf::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough::truth_plans(&geo.plans, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
-        let ndf_truth =
-            crate::pipeline::ndf_stages::truth_maps(maps, scene, &geo.plans, opts.truth);
+        let ndf_truth = crate::pipeline::ndf::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)
             .with_lights(&scene.lights, scene.ambient)
             .with_bump_attrs(&battrs)
@@ -307,10 +306,10 @@ pub fn render(
     };
     cycles.total = cycles.setup + cycles.spans + cycles.stages;
     cycles.per_covered_pixel = cycles.total as f64 / covered.max(1) as f64;
-    if crate::pipeline::ndf_stages::shade_is_float_only(hw)
+    if crate::pipeline::ndf::shade_is_float_only(hw)
         && counters.invocations[StageKind::NdfShade.index()] > 0
     {
-        cycles.not_modelled = Some(crate::pipeline::ndf_stages::EXACT_NOT_MODELLED);
+        cycles.not_modelled = Some(crate::pipeline::ndf::EXACT_NOT_MODELLED);
     }
 
     Ok(Rendered {

@@ -1,5 +1,5 @@
 //! Built-in scenes of NDF mapping (Olano and North 1997), shaded by `ndf-fetch`/`ndf-shade`
-//! (see `crate::pipeline::ndf_stages`): `ripple-sphere` (their Figure 1: one rippled sphere at
+//! (see `crate::pipeline::ndf`): `ripple-sphere` (their Figure 1: one rippled sphere at
 //! three distances, the highlight blurs and stretches along the ripples as the MIP level
 //! coarsens), `lod-pair` (their Figure 2: one wavy object at two polygon counts, per-vertex
 //! normals against the NDF map), `foil` (crumpled foil: many small facets whose coarse
