@@ -11,7 +11,7 @@
 //! of Fixed stages is bit-accurate, and a Fixed stage after a Float one sees the float value
 //! rounded into its input format (how a mixed run isolates one stage's error).
 
-pub mod as_stages;
+pub mod as_shade;
 pub mod bary;
 pub mod bump;
 pub mod bump_fetch;
@@ -95,7 +95,7 @@ pub struct Plan {
     /// Bump mapping and per-pixel shading, for bump-mapped materials.
     pub bump: Option<BumpPlan>,
     /// Ashikhmin-Shirley shading (with `bump` holding its normal/frame inputs).
-    pub aniso: Option<as_stages::AsPlan>,
+    pub aniso: Option<as_shade::AsPlan>,
     /// Roughness map and modified Blinn-Phong (`rough`), for roughness materials.
     pub rough: Option<rough::RoughPlan>,
     /// NDF mapping (with `bump` for the frame), for NDF materials.
@@ -140,7 +140,7 @@ pub fn plan(material: &Material, has_uvs: bool) -> Plan {
 #[must_use]
 pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize>) -> Plan {
     let textured = material.texture.is_some() && has_uvs;
-    if let Some(p) = as_stages::plan_as(material, has_uvs) {
+    if let Some(p) = as_shade::plan_as(material, has_uvs) {
         return p;
     }
     if let (Some(map), true, Some(_)) = (bump_map, has_uvs, material.bump) {

@@ -9,8 +9,8 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_stages, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal,
-    perturb, phong, rough_fetch, rough_shade, texcoord, trilinear,
+    as_shade, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal, perturb,
+    phong, rough_fetch, rough_shade, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -171,7 +171,7 @@ stage_table! {
     }
     /// Ashikhmin-Shirley materials: the anisotropic Phong BRDF per pixel over every light.
     AsShade "as-shade" {
-        fixed: as_stages::row, float: as_stages::row, cost: as_stages::as_shade_cost,
+        fixed: as_shade::fixed, float: as_shade::float, cost: as_shade::cost,
         lookups: no_lookups,
     }
     /// Roughness materials: trilinear fetch of the D map at the bump fetch's LOD.

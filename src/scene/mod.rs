@@ -104,7 +104,7 @@ pub struct Material {
     /// Blinn-Phong, `pipeline::rough`); `None`: plain Blinn-Phong.
     pub roughness: Option<RoughChoice>,
     /// Ashikhmin-Shirley anisotropic Phong BRDF: shaded per pixel in the main-direction frame
-    /// instead of Gouraud or Blinn-Phong (`pipeline::as_stages`).
+    /// instead of Gouraud or Blinn-Phong (`pipeline::as_shade`).
     pub brdf: Option<AsBrdf>,
     /// NDF mapping (Olano and North 1997): the `bump` map's normals become moment maps,
     /// shaded by `ndf-fetch` and `ndf-shade` instead of the bump path's Blinn-Phong.

@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 use texsim::brdf::ashikhmin_shirley::BRDF_MAX;
 use texsim::brdf::fixed_twin::{pf_to_f64, quantize, twin_pi_rho};
 use texsim::brdf::{AshikhminShirley, Dots};
-use texsim::pipeline::as_stages::{plan_as, run_as_shade};
+use texsim::pipeline::as_shade::{plan_as, shade_fixed, shade_float};
 use texsim::pipeline::stages::{Counters, Machine};
 use texsim::pipeline::StageKind;
 use texsim::pipeline::{Frag, StageImpls};
@@ -68,9 +68,9 @@ fn shade<'a>(m: Machine<'a>, c: &Case) -> (Machine<'a>, [f64; 3], [f64; 3], Coun
     b.fr_t_v = from_vec3x(&b.fr_t_v_x, f).to_array();
     b.to_eye = from_vec3x(&b.to_eye_x, f).to_array();
     let mut cnt = Counters::default();
-    run_as_shade(&plan, &StageImpls::FIXED, &m, &mut frag, &mut cnt);
+    shade_fixed(&plan, &StageImpls::FIXED, &m, &mut frag, &mut cnt);
     let fx = [frag.out[0], frag.out[1], frag.out[2]];
-    run_as_shade(&plan, &StageImpls::FLOAT, &m, &mut frag, &mut cnt);
+    shade_float(&plan, &m, &mut frag, &mut cnt);
     let fl = [frag.out[0], frag.out[1], frag.out[2]];
     (m, fx, fl, cnt)
 }

@@ -1,4 +1,4 @@
-//! The Ashikhmin-Shirley shading stage `as-shade` (Ashikhmin & Shirley 2000, "An Anisotropic
+//! `as-shade`: the Ashikhmin-Shirley shading stage (Ashikhmin & Shirley 2000, "An Anisotropic
 //! Phong Light Reflection Model": specular eq. 10/18 with Schlick's Fresnel eq. 11, diffuse
 //! eq. 16), fixed (`hw_model::aniso_phong`) and float ([`AshikhminShirley::eval_from_dots`]).
 //!
@@ -31,6 +31,7 @@
 //! `2^bits - 1` exactly).
 //! `l + v = 0` (`k1 = -k2`) gives no contribution and is counted in `h_zero`.
 
+use super::bump::float_output;
 use super::stages::{Counters, Machine};
 use super::{BumpPlan, Frag, Impl, Plan, Px, StageImpls, StageKind};
 use crate::brdf::{AshikhminShirley, Dots};
@@ -129,7 +130,7 @@ impl Machine<'_> {
 /// colour multiply-adds; the ambient (and texture) multiply-adds. The per-material square root
 /// (`aniso_phong_material_cost`) is a constant loaded with the material, not a per-pixel cost.
 #[must_use]
-pub fn as_shade_cost(m: &Machine, plan: &Plan) -> UnitCost {
+pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
     let u = &m.units;
     let g = m.hw.timing.gate_levels_per_cycle;
     let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
@@ -190,10 +191,20 @@ fn guarded(prod: u128, exp: i32, fmt: &Format) -> i128 {
     }
 }
 
-/// Runs `as-shade` of `plan` on `frag` (see the module docs); writes `frag.out`.
+/// Fixed twin (see the module docs); writes `frag.out_x` and its carriers.
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    shade_fixed(px.plan, px.impls, px.m, frag, c);
+}
+
+/// Float twin: [`AshikhminShirley::eval_from_dots`] per light; writes `frag.out`.
+pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    shade_float(px.plan, px.m, frag, c);
+}
+
+/// The fixed twin on one fragment of `plan`: its inputs are raw where `impls` ran the
+/// producing stage fixed, the quantized carriers otherwise.
 #[allow(clippy::needless_range_loop)]
-#[inline]
-pub fn run_as_shade(
+pub fn shade_fixed(
     plan: &Plan,
     impls: &StageImpls,
     m: &Machine,
@@ -210,173 +221,172 @@ pub fn run_as_shade(
     let cb = units.cfg.shade.shade_color_bits;
     let max = (1u64 << cb) - 1;
     let bf = &frag.bump;
-    if fixed_in(StageKind::AsShade) {
-        let cfg = &m.hw.aniso_phong;
-        let rnd = units.cfg.shade.shade_rounding;
-        let raw3 = |v: &[f64; 3], sat: &mut SatCounter| v.map(|x| to_raw(x, &m.vec_fmt, sat));
-        let (n, tu, tv) = if fixed_in(StageKind::Frame) {
-            (bf.fr_n_x, bf.fr_t_u_x, bf.fr_t_v_x)
-        } else {
-            (
-                raw3(&bf.fr_n, &mut sat),
-                raw3(&bf.fr_t_u, &mut sat),
-                raw3(&bf.fr_t_v, &mut sat),
-            )
-        };
-        let eye = if fixed_in(StageKind::Normal) {
-            bf.to_eye_x
-        } else {
-            raw3(&bf.to_eye, &mut sat)
-        };
-        let one = 1i64 << f;
-        let v = normalize3(&eye, [0, 0, one], &units.rsqrt, vc, &mut sat).v;
-        let mut kd = ap.kd.map(|x| u64::from(to_unorm(x, cb)));
-        if plan.texture.is_some() {
-            let tb = m.hw.trilinear.texel_bits;
-            let tex = if fixed_in(StageKind::Trilinear) {
-                frag.texel_x
-            } else {
-                frag.texel.map(|x| to_unorm(x, tb))
-            };
-            for ch in 0..3 {
-                kd[ch] = u64::from(modulate(kd[ch] as u32, cb, tex[ch], tb, cb, rnd));
-            }
-        }
-        let dfmt = Format::signed(1, cfg.aniso_dot_frac_bits, cfg.aniso_rounding);
-        let ofmt = Format::unsigned(0, cb, rnd);
-        let fb = cfg.fresnel_bits;
-        let unorm_f = |x: f64| {
-            (x * (1u64 << fb) as f64)
-                .round()
-                .clamp(0.0, (1u64 << fb) as f64)
-        };
-        let p = &ap.brdf;
-        let mut nu = p.nu.clamp(0.0, f64::from(u32::MAX)) as u64;
-        let mut nv = p.nv.clamp(0.0, f64::from(u32::MAX)) as u64;
-        if ap.exponent_map {
-            let tb = m.hw.trilinear.texel_bits;
-            let tex = if fixed_in(StageKind::BumpFetch) {
-                bf.texel_x
-            } else {
-                bf.texel.map(|x| to_unorm(x, tb))
-            };
-            let tmax = (1u64 << tb) - 1;
-            let scale = |n: u64, t: u32| (2 * u64::from(t) * n + tmax) / (2 * tmax);
-            nu = scale(nu, tex[0]);
-            nv = scale(nv, tex[1]);
-        }
-        let mut inp = AnisoPhongInputs {
-            nu: nu.min(u64::from(u32::MAX)) as u32,
-            nv: nv.min(u64::from(u32::MAX)) as u32,
-            rs: unorm_f(p.rs) as u32,
-            rd: unorm_f(p.rd) as u32,
-            ..AnisoPhongInputs::default()
-        };
-        // Ambient: ambient x kd x Rd (fresnel_bits unorm), one product per channel.
-        let mut acc = [0i128; 3];
-        for ch in 0..3 {
-            let prod = u128::from(m.ambient_x[ch]) * u128::from(kd[ch]) * u128::from(inp.rd);
-            acc[ch] = guarded(prod, -((cb + fb) as i32), &ofmt);
-        }
-        let roms = m.aniso_roms();
-        for light in &m.lights {
-            let l = match light.point {
-                Some(pi) => {
-                    let lv = if fixed_in(StageKind::Normal) {
-                        bf.to_light_x[pi]
-                    } else {
-                        raw3(&bf.to_light[pi], &mut sat)
-                    };
-                    normalize3(&lv, [0, 0, one], &units.rsqrt, vc, &mut sat).v
-                }
-                None => light.l_x,
-            };
-            let sum = [l[0] + v[0], l[1] + v[1], l[2] + v[2]];
-            if sum == [0; 3] {
-                c.h_zero += 1;
-                continue;
-            }
-            let h = normalize3(&sum, [0, 0, one], &units.rsqrt, vc, &mut sat).v;
-            inp.hn = dot_to(&h, &n, f, &dfmt);
-            inp.hu = dot_to(&h, &tu, f, &dfmt);
-            inp.hv = dot_to(&h, &tv, f, &dfmt);
-            inp.kh = dot_to(&l, &h, f, &dfmt);
-            inp.nk1 = dot_to(&n, &l, f, &dfmt);
-            inp.nk2 = dot_to(&n, &v, f, &dfmt);
-            if inp.nk1 <= 0 {
-                continue;
-            }
-            let out = aniso_phong_prepared(&inp, roms, &mut sat);
-            let d = cfg.aniso_dot_frac_bits as i32;
-            let nk1 = inp.nk1 as u128;
-            let term = |x: PseudoFloat, tint: u64, tint_bits: u32, col: u64| {
-                let prod = u128::from(x.mant) * nk1 * u128::from(tint) * u128::from(col);
-                guarded(prod, x.exp - d - tint_bits as i32, &ofmt)
-            };
-            for ch in 0..3 {
-                let col = light.color_x[ch];
-                acc[ch] += term(out.spec, 1, 0, col) + term(out.diffuse, kd[ch], cb, col);
-            }
-        }
-        for ch in 0..3 {
-            let r = round_shift_right_wide(acc[ch], GUARD, rnd);
-            let r = ofmt.fit(r, &mut sat) as u64;
-            frag.out_x[ch] = r as u32;
-            frag.out[ch] = r as f64 / max as f64;
-        }
-        frag.out_x[3] = max as u32;
-        frag.out[3] = 1.0;
-        frag.out_bits = cb;
+    let cfg = &m.hw.aniso_phong;
+    let rnd = units.cfg.shade.shade_rounding;
+    let raw3 = |v: &[f64; 3], sat: &mut SatCounter| v.map(|x| to_raw(x, &m.vec_fmt, sat));
+    let (n, tu, tv) = if fixed_in(StageKind::Frame) {
+        (bf.fr_n_x, bf.fr_t_u_x, bf.fr_t_v_x)
     } else {
-        let d3 = |v: &[f64; 3]| DVec3::from(*v);
-        let (n, u, vv) = (d3(&bf.fr_n), d3(&bf.fr_t_u), d3(&bf.fr_t_v));
-        let e = fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0;
-        let mut kd = ap.kd;
-        if plan.texture.is_some() {
-            for ch in 0..3 {
-                kd[ch] *= frag.texel[ch];
-            }
-        }
-        let mut p = ap.brdf;
-        if ap.exponent_map {
-            p.nu *= bf.texel[0];
-            p.nv *= bf.texel[1];
-        }
-        let mut acc = [0.0f64; 3];
+        (
+            raw3(&bf.fr_n, &mut sat),
+            raw3(&bf.fr_t_u, &mut sat),
+            raw3(&bf.fr_t_v, &mut sat),
+        )
+    };
+    let eye = if fixed_in(StageKind::Normal) {
+        bf.to_eye_x
+    } else {
+        raw3(&bf.to_eye, &mut sat)
+    };
+    let one = 1i64 << f;
+    let v = normalize3(&eye, [0, 0, one], &units.rsqrt, vc, &mut sat).v;
+    let mut kd = ap.kd.map(|x| u64::from(to_unorm(x, cb)));
+    if plan.texture.is_some() {
+        let tb = m.hw.trilinear.texel_bits;
+        let tex = if fixed_in(StageKind::Trilinear) {
+            frag.texel_x
+        } else {
+            frag.texel.map(|x| to_unorm(x, tb))
+        };
         for ch in 0..3 {
-            acc[ch] = m.ambient[ch] * kd[ch] * p.rd;
+            kd[ch] = u64::from(modulate(kd[ch] as u32, cb, tex[ch], tb, cb, rnd));
         }
-        for light in &m.lights {
-            let l = match light.point {
-                Some(pi) => fref::normalize_or(d3(&bf.to_light[pi]), DVec3::Z).0,
-                None => d3(&light.l_f),
-            };
-            let sum = l + e;
-            if sum == DVec3::ZERO {
-                c.h_zero += 1;
-                continue;
-            }
-            let h = sum.normalize();
-            let dots = Dots {
-                hn: h.dot(n),
-                hu: h.dot(u),
-                hv: h.dot(vv),
-                kh: l.dot(h),
-                nk1: n.dot(l),
-                nk2: n.dot(e),
-            };
-            let (s, df) = p.eval_from_dots(&dots);
-            let nl = dots.nk1.max(0.0);
-            for ch in 0..3 {
-                acc[ch] += PI * (s + df * kd[ch]) * nl * light.color_f[ch];
-            }
-        }
-        super::bump::float_output(acc, frag, c);
     }
+    let dfmt = Format::signed(1, cfg.aniso_dot_frac_bits, cfg.aniso_rounding);
+    let ofmt = Format::unsigned(0, cb, rnd);
+    let fb = cfg.fresnel_bits;
+    let unorm_f = |x: f64| {
+        (x * (1u64 << fb) as f64)
+            .round()
+            .clamp(0.0, (1u64 << fb) as f64)
+    };
+    let p = &ap.brdf;
+    let mut nu = p.nu.clamp(0.0, f64::from(u32::MAX)) as u64;
+    let mut nv = p.nv.clamp(0.0, f64::from(u32::MAX)) as u64;
+    if ap.exponent_map {
+        let tb = m.hw.trilinear.texel_bits;
+        let tex = if fixed_in(StageKind::BumpFetch) {
+            bf.texel_x
+        } else {
+            bf.texel.map(|x| to_unorm(x, tb))
+        };
+        let tmax = (1u64 << tb) - 1;
+        let scale = |n: u64, t: u32| (2 * u64::from(t) * n + tmax) / (2 * tmax);
+        nu = scale(nu, tex[0]);
+        nv = scale(nv, tex[1]);
+    }
+    let mut inp = AnisoPhongInputs {
+        nu: nu.min(u64::from(u32::MAX)) as u32,
+        nv: nv.min(u64::from(u32::MAX)) as u32,
+        rs: unorm_f(p.rs) as u32,
+        rd: unorm_f(p.rd) as u32,
+        ..AnisoPhongInputs::default()
+    };
+    // Ambient: ambient x kd x Rd (fresnel_bits unorm), one product per channel.
+    let mut acc = [0i128; 3];
+    for ch in 0..3 {
+        let prod = u128::from(m.ambient_x[ch]) * u128::from(kd[ch]) * u128::from(inp.rd);
+        acc[ch] = guarded(prod, -((cb + fb) as i32), &ofmt);
+    }
+    let roms = m.aniso_roms();
+    for light in &m.lights {
+        let l = match light.point {
+            Some(pi) => {
+                let lv = if fixed_in(StageKind::Normal) {
+                    bf.to_light_x[pi]
+                } else {
+                    raw3(&bf.to_light[pi], &mut sat)
+                };
+                normalize3(&lv, [0, 0, one], &units.rsqrt, vc, &mut sat).v
+            }
+            None => light.l_x,
+        };
+        let sum = [l[0] + v[0], l[1] + v[1], l[2] + v[2]];
+        if sum == [0; 3] {
+            c.h_zero += 1;
+            continue;
+        }
+        let h = normalize3(&sum, [0, 0, one], &units.rsqrt, vc, &mut sat).v;
+        inp.hn = dot_to(&h, &n, f, &dfmt);
+        inp.hu = dot_to(&h, &tu, f, &dfmt);
+        inp.hv = dot_to(&h, &tv, f, &dfmt);
+        inp.kh = dot_to(&l, &h, f, &dfmt);
+        inp.nk1 = dot_to(&n, &l, f, &dfmt);
+        inp.nk2 = dot_to(&n, &v, f, &dfmt);
+        if inp.nk1 <= 0 {
+            continue;
+        }
+        let out = aniso_phong_prepared(&inp, roms, &mut sat);
+        let d = cfg.aniso_dot_frac_bits as i32;
+        let nk1 = inp.nk1 as u128;
+        let term = |x: PseudoFloat, tint: u64, tint_bits: u32, col: u64| {
+            let prod = u128::from(x.mant) * nk1 * u128::from(tint) * u128::from(col);
+            guarded(prod, x.exp - d - tint_bits as i32, &ofmt)
+        };
+        for ch in 0..3 {
+            let col = light.color_x[ch];
+            acc[ch] += term(out.spec, 1, 0, col) + term(out.diffuse, kd[ch], cb, col);
+        }
+    }
+    for ch in 0..3 {
+        let r = round_shift_right_wide(acc[ch], GUARD, rnd);
+        let r = ofmt.fit(r, &mut sat) as u64;
+        frag.out_x[ch] = r as u32;
+        frag.out[ch] = r as f64 / max as f64;
+    }
+    frag.out_x[3] = max as u32;
+    frag.out[3] = 1.0;
+    frag.out_bits = cb;
     c.sat[k] = sat;
 }
 
-/// Stage-table entry of `as-shade`; it runs the twin `px.impls` names for it.
-pub fn row(px: &Px, frag: &mut Frag, c: &mut Counters) {
-    run_as_shade(px.plan, px.impls, px.m, frag, c);
+/// The float twin on one fragment of `plan`.
+#[allow(clippy::needless_range_loop)]
+pub fn shade_float(plan: &Plan, m: &Machine, frag: &mut Frag, c: &mut Counters) {
+    let Some(ap) = &plan.aniso else { return };
+    let bf = &frag.bump;
+    let d3 = |v: &[f64; 3]| DVec3::from(*v);
+    let (n, u, vv) = (d3(&bf.fr_n), d3(&bf.fr_t_u), d3(&bf.fr_t_v));
+    let e = fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0;
+    let mut kd = ap.kd;
+    if plan.texture.is_some() {
+        for ch in 0..3 {
+            kd[ch] *= frag.texel[ch];
+        }
+    }
+    let mut p = ap.brdf;
+    if ap.exponent_map {
+        p.nu *= bf.texel[0];
+        p.nv *= bf.texel[1];
+    }
+    let mut acc = [0.0f64; 3];
+    for ch in 0..3 {
+        acc[ch] = m.ambient[ch] * kd[ch] * p.rd;
+    }
+    for light in &m.lights {
+        let l = match light.point {
+            Some(pi) => fref::normalize_or(d3(&bf.to_light[pi]), DVec3::Z).0,
+            None => d3(&light.l_f),
+        };
+        let sum = l + e;
+        if sum == DVec3::ZERO {
+            c.h_zero += 1;
+            continue;
+        }
+        let h = sum.normalize();
+        let dots = Dots {
+            hn: h.dot(n),
+            hu: h.dot(u),
+            hv: h.dot(vv),
+            kh: l.dot(h),
+            nk1: n.dot(l),
+            nk2: n.dot(e),
+        };
+        let (s, df) = p.eval_from_dots(&dots);
+        let nl = dots.nk1.max(0.0);
+        for ch in 0..3 {
+            acc[ch] += PI * (s + df * kd[ch]) * nl * light.color_f[ch];
+        }
+    }
+    float_output(acc, frag, c);
 }
