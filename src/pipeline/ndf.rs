@@ -1,10 +1,10 @@
 //! What the NDF-mapping stages share (Olano and North 1997, "Normal Distribution Mapping",
 //! sections 5-6): their plan, fragment signals, unit and ground truth. The stages are one file
-//! each: [`super::ndf_fetch`] (LOD against the moment maps' size, then three trilinear lookups of the
-//! moment maps A, B, C through the unchanged trilinear unit, a fourth of the normalization map
-//! when `ndf_norm = map`) and [`super::ndf_shade`] (per light: `h` in the local frame, then
-//! `hw_model::ndf::NdfUnit`, times `ks` and the light; plus Lambert diffuse on the interpolated
-//! normal and the ambient term).
+//! each: [`super::ndf_fetch`] (LOD against the moment maps' size, then three trilinear lookups
+//! of the moment maps A, B, C through the unchanged trilinear unit, a fourth of the
+//! normalization map when `ndf_norm = map`) and [`super::ndf_shade`] (per light: `h` in the
+//! local frame, then `hw_model::ndf::NdfUnit`, times `ks` and the light; plus Lambert diffuse
+//! on the interpolated normal and the ambient term).
 //!
 //! An NDF material is a bump material (its `bump` texture is the normal or height map the
 //! moment maps are built from) whose plan runs `bary`, `texcoord`, `normal`, `frame` of the
