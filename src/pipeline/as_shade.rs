@@ -31,13 +31,12 @@
 //! `2^bits - 1` exactly).
 //! `l + v = 0` (`k1 = -k2`) gives no contribution and is counted in `h_zero`.
 
-use super::bump::float_output;
+use super::bump::{fixed_eye, fixed_light, float_eye, float_light, float_output};
 use super::stages::{Counters, Machine};
 use super::{BumpPlan, Frag, Impl, Plan, Px, StageImpls, StageKind};
 use crate::brdf::{AshikhminShirley, Dots};
 use crate::fixedpoint::{to_raw, to_unorm};
 use crate::scene::{FrameKind, Material};
-use crate::shading::reference as fref;
 use glam::DVec3;
 use hw_model::aniso_phong::{
     aniso_phong_cost, aniso_phong_prepared, AnisoPhongInputs, AnisoPhongRoms, PseudoFloat,
@@ -233,13 +232,8 @@ pub fn shade_fixed(
             raw3(&bf.fr_t_v, &mut sat),
         )
     };
-    let eye = if fixed_in(StageKind::Normal) {
-        bf.to_eye_x
-    } else {
-        raw3(&bf.to_eye, &mut sat)
-    };
     let one = 1i64 << f;
-    let v = normalize3(&eye, [0, 0, one], &units.rsqrt, vc, &mut sat).v;
+    let v = fixed_eye(m, bf, fixed_in(StageKind::Normal), &mut sat);
     let mut kd = ap.kd.map(|x| u64::from(to_unorm(x, cb)));
     if plan.texture.is_some() {
         let tb = m.hw.trilinear.texel_bits;
@@ -290,17 +284,7 @@ pub fn shade_fixed(
     }
     let roms = m.aniso_roms();
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => {
-                let lv = if fixed_in(StageKind::Normal) {
-                    bf.to_light_x[pi]
-                } else {
-                    raw3(&bf.to_light[pi], &mut sat)
-                };
-                normalize3(&lv, [0, 0, one], &units.rsqrt, vc, &mut sat).v
-            }
-            None => light.l_x,
-        };
+        let l = fixed_light(m, bf, light, fixed_in(StageKind::Normal), &mut sat);
         let sum = [l[0] + v[0], l[1] + v[1], l[2] + v[2]];
         if sum == [0; 3] {
             c.h_zero += 1;
@@ -347,7 +331,7 @@ pub fn shade_float(plan: &Plan, m: &Machine, frag: &mut Frag, c: &mut Counters) 
     let bf = &frag.bump;
     let d3 = |v: &[f64; 3]| DVec3::from(*v);
     let (n, u, vv) = (d3(&bf.fr_n), d3(&bf.fr_t_u), d3(&bf.fr_t_v));
-    let e = fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0;
+    let e = float_eye(bf);
     let mut kd = ap.kd;
     if plan.texture.is_some() {
         for ch in 0..3 {
@@ -364,10 +348,7 @@ pub fn shade_float(plan: &Plan, m: &Machine, frag: &mut Frag, c: &mut Counters) 
         acc[ch] = m.ambient[ch] * kd[ch] * p.rd;
     }
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => fref::normalize_or(d3(&bf.to_light[pi]), DVec3::Z).0,
-            None => d3(&light.l_f),
-        };
+        let l = float_light(bf, light);
         let sum = l + e;
         if sum == DVec3::ZERO {
             c.h_zero += 1;

@@ -15,8 +15,8 @@
 //! largest vertex length per triangle (the normalization removes any common scale), so they
 //! fit the vector format with full precision.
 
-use super::stages::{Counters, Machine};
-use super::{BumpPlan, Frag, Px, MAX_POINT_LIGHTS};
+use super::stages::{Counters, Machine, ShadeLight};
+use super::{BumpFrag, BumpPlan, Frag, Px, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{from_raw, to_raw, to_unorm};
 use crate::scene::MainDirection;
 use crate::shading::reference as fref;
@@ -24,7 +24,7 @@ use glam::DVec3;
 use hw_model::fixed::{Format, SatCounter};
 use hw_model::frame::MainRole;
 use hw_model::modulate::modulate;
-use hw_model::vector::Vec3x;
+use hw_model::vector::{normalize3, Vec3x};
 
 /// One screen triangle's bump vertex data, in float and in the machine's formats.
 #[derive(Clone, Copy, Debug, Default)]
@@ -179,6 +179,65 @@ pub(super) fn bump_of<'a>(px: &Px<'a>) -> Option<(&'a BumpPlan, &'a BumpAttrs)> 
 #[must_use]
 pub fn point_lights(m: &Machine) -> usize {
     m.lights.iter().filter(|l| l.point.is_some()).count()
+}
+
+/// The unit vector towards the eye of a fixed shading stage (vector format): the `normal`
+/// stage's raw vector when it ran fixed (`raw`), its quantized carrier otherwise, normalized.
+pub(super) fn fixed_eye(m: &Machine, bf: &BumpFrag, raw: bool, sat: &mut SatCounter) -> Vec3x {
+    let eye = if raw {
+        bf.to_eye_x
+    } else {
+        raw3(&bf.to_eye, &m.vec_fmt, sat)
+    };
+    unit_vec(m, &eye, sat)
+}
+
+/// The unit vector towards `light` of a fixed shading stage: a point light's interpolated
+/// vector (raw when `normal` ran fixed) normalized, a directional light's direction.
+pub(super) fn fixed_light(
+    m: &Machine,
+    bf: &BumpFrag,
+    light: &ShadeLight,
+    raw: bool,
+    sat: &mut SatCounter,
+) -> Vec3x {
+    match light.point {
+        Some(pi) => {
+            let lv = if raw {
+                bf.to_light_x[pi]
+            } else {
+                raw3(&bf.to_light[pi], &m.vec_fmt, sat)
+            };
+            unit_vec(m, &lv, sat)
+        }
+        None => light.l_x,
+    }
+}
+
+/// `v` normalized by the vector unit (`+z` for a zero vector).
+fn unit_vec(m: &Machine, v: &Vec3x, sat: &mut SatCounter) -> Vec3x {
+    let vc = &m.units.cfg.vector;
+    normalize3(
+        v,
+        [0, 0, 1i64 << vc.vector_frac_bits],
+        &m.units.rsqrt,
+        vc,
+        sat,
+    )
+    .v
+}
+
+/// The unit vector towards the eye of a float shading stage.
+pub(super) fn float_eye(bf: &BumpFrag) -> DVec3 {
+    fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0
+}
+
+/// The unit vector towards `light` of a float shading stage.
+pub(super) fn float_light(bf: &BumpFrag, light: &ShadeLight) -> DVec3 {
+    match light.point {
+        Some(pi) => fref::normalize_or(d3(&bf.to_light[pi]), DVec3::Z).0,
+        None => d3(&light.l_f),
+    }
 }
 
 /// Ends a float shading stage: the RGB sum `acc` (a non-finite channel becomes 0 and is

@@ -4,7 +4,9 @@
 //! "Normal Distribution Mapping", sections 5-6). The specular term is `ks light D 2 pi / s`
 //! ([`super::ndf`]). `ndf_norm = exact` has no fixed unit: the fixed twin runs the float one.
 
-use super::bump::{fixed_output, float_output, point_lights};
+use super::bump::{
+    fixed_eye, fixed_light, fixed_output, float_eye, float_light, float_output, point_lights,
+};
 use super::ndf::NdfPlan;
 use super::stages::{Counters, Machine};
 use super::{BumpPlan, Frag, Plan, Px, StageKind};
@@ -74,13 +76,8 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         norm: texels[3],
         norm_exp: np.norm_exp,
     };
-    let eye = if px.fixed(StageKind::Normal) {
-        bf.to_eye_x
-    } else {
-        bf.to_eye.map(|c| to_raw(c, &m.vec_fmt, &mut sat))
-    };
     let one = [0, 0, 1i64 << f];
-    let v = normalize3(&eye, one, &units.rsqrt, vc, &mut sat).v;
+    let v = fixed_eye(m, bf, px.fixed(StageKind::Normal), &mut sat);
     let kd = bp.kd.map(|x| to_unorm(x, cb));
     let ks = bp.ks.map(|x| to_unorm(x, cb));
     let ndf_f = hw.ndf.ndf_frac_bits;
@@ -90,17 +87,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         acc[ch] = u64::from(modulate(m.ambient_x[ch] as u32, cb, kd[ch], cb, cb, rnd));
     }
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => {
-                let lv = if px.fixed(StageKind::Normal) {
-                    bf.to_light_x[pi]
-                } else {
-                    bf.to_light[pi].map(|c| to_raw(c, &m.vec_fmt, &mut sat))
-                };
-                normalize3(&lv, one, &units.rsqrt, vc, &mut sat).v
-            }
-            None => light.l_x,
-        };
+        let l = fixed_light(m, bf, light, px.fixed(StageKind::Normal), &mut sat);
         let ndl = dot3(&n, &l, vc, &mut sat).max(0);
         if ndl == 0 {
             continue;
@@ -155,16 +142,13 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let n = DVec3::from(bf.fr_n);
     let tu = DVec3::from(bf.fr_t_u);
     let tv = DVec3::from(bf.fr_t_v);
-    let v = fref::normalize_or(DVec3::from(bf.to_eye), DVec3::Z).0;
+    let v = float_eye(bf);
     let mut acc = [0.0f64; 3];
     for ch in 0..3 {
         acc[ch] = m.ambient[ch] * bp.kd[ch];
     }
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => fref::normalize_or(DVec3::from(bf.to_light[pi]), DVec3::Z).0,
-            None => DVec3::from(light.l_f),
-        };
+        let l = float_light(bf, light);
         let ndl = n.dot(l).max(0.0);
         if ndl <= 0.0 {
             continue;

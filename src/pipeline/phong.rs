@@ -1,14 +1,16 @@
 //! `phong`: per-pixel Blinn-Phong of the perturbed normal over every scene light, plus ambient
 //! (`hw_model::blinn_phong`); the bump materials' shading stage.
 
-use super::bump::{bump_of, d3, fixed_material, fixed_output, float_output, point_lights, raw3};
+use super::bump::{
+    bump_of, d3, fixed_eye, fixed_light, fixed_material, fixed_output, float_eye, float_light,
+    float_output, point_lights, raw3,
+};
 use super::stages::{Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::shading::reference as fref;
-use glam::DVec3;
 use hw_model::blinn_phong::{blinn_phong, blinn_phong_cost, mac_cost, BlinnPhongInput};
 use hw_model::rsqrt::rsqrt_cost;
-use hw_model::vector::{normalize3, normalize_cost};
+use hw_model::vector::normalize_cost;
 use hw_model::UnitCost;
 
 /// Fixed twin: normalized eye and light vectors, the Blinn-Phong unit per light, summed
@@ -18,8 +20,6 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let Some((bp, _)) = bump_of(px) else { return };
     let m = px.m;
     let units = &m.units;
-    let vc = &units.cfg.vector;
-    let f = vc.vector_frac_bits;
     let cb = units.cfg.shade.shade_color_bits;
     let rnd = units.cfg.shade.shade_rounding;
     let mut sat = c.sat[StageKind::Phong.index()];
@@ -29,12 +29,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     } else {
         raw3(&bf.normal, &m.vec_fmt, &mut sat)
     };
-    let eye = if px.fixed(StageKind::Normal) {
-        bf.to_eye_x
-    } else {
-        raw3(&bf.to_eye, &m.vec_fmt, &mut sat)
-    };
-    let v = normalize3(&eye, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v;
+    let v = fixed_eye(m, bf, px.fixed(StageKind::Normal), &mut sat);
     let (kd, ks, mut acc) = fixed_material(
         bp,
         m,
@@ -46,17 +41,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         rnd,
     );
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => {
-                let lv = if px.fixed(StageKind::Normal) {
-                    bf.to_light_x[pi]
-                } else {
-                    raw3(&bf.to_light[pi], &m.vec_fmt, &mut sat)
-                };
-                normalize3(&lv, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v
-            }
-            None => light.l_x,
-        };
+        let l = fixed_light(m, bf, light, px.fixed(StageKind::Normal), &mut sat);
         let inp = BlinnPhongInput {
             n,
             l,
@@ -83,7 +68,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let m = px.m;
     let bf = &frag.bump;
     let n = d3(&bf.normal);
-    let v = fref::normalize_or(d3(&bf.to_eye), DVec3::Z).0;
+    let v = float_eye(bf);
     let mut kd = bp.kd;
     if px.plan.texture.is_some() {
         for ch in 0..3 {
@@ -95,10 +80,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
         acc[ch] = m.ambient[ch] * kd[ch];
     }
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => fref::normalize_or(d3(&bf.to_light[pi]), DVec3::Z).0,
-            None => d3(&light.l_f),
-        };
+        let l = float_light(bf, light);
         let (col, hz) = fref::blinn_phong(n, l, v, bp.shininess, kd, bp.ks, light.color_f);
         c.h_zero += u64::from(hz);
         for ch in 0..3 {

@@ -4,7 +4,10 @@
 //! ([`super::rough::RoughPlan::truth_samples`]) shades the box-filtered mean of `k x k`
 //! sub-samples of the finest offsets in float.
 
-use super::bump::{fixed_material, fixed_output, float_output, point_lights, raw3};
+use super::bump::{
+    fixed_eye, fixed_light, fixed_material, fixed_output, float_eye, float_light, float_output,
+    point_lights, raw3,
+};
 use super::rough::{rough_config, rough_of};
 use super::stages::{Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
@@ -19,7 +22,7 @@ use hw_model::roughness::{
     decode_d, rough_blinn_phong, rough_blinn_phong_cost, scale_d, RoughShadeInput, RoughVariant,
 };
 use hw_model::rsqrt::rsqrt_cost;
-use hw_model::vector::{normalize3, normalize_cost};
+use hw_model::vector::normalize_cost;
 use hw_model::UnitCost;
 
 /// Fixed twin: the eye and light vectors normalized, the D texel decoded and scaled by the
@@ -33,8 +36,6 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     }
     let m = px.m;
     let units = &m.units;
-    let vc = &units.cfg.vector;
-    let f = vc.vector_frac_bits;
     let lfb = units.cfg.frame.frame_len_frac_bits;
     let tb = m.hw.trilinear.texel_bits;
     let cb = units.cfg.shade.shade_color_bits;
@@ -49,12 +50,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     } else {
         raw3(&bf.normal, vf, &mut sat)
     };
-    let eye = if px.fixed(StageKind::Normal) {
-        bf.to_eye_x
-    } else {
-        raw3(&bf.to_eye, vf, &mut sat)
-    };
-    let v = normalize3(&eye, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v;
+    let v = fixed_eye(m, bf, px.fixed(StageKind::Normal), &mut sat);
     let (t_u, t_v, len) = if px.fixed(StageKind::Frame) {
         (bf.fr_t_u_x, bf.fr_t_v_x, bf.fr_len_x)
     } else {
@@ -87,17 +83,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         rnd,
     );
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => {
-                let lv = if px.fixed(StageKind::Normal) {
-                    bf.to_light_x[pi]
-                } else {
-                    raw3(&bf.to_light[pi], vf, &mut sat)
-                };
-                normalize3(&lv, [0, 0, 1i64 << f], &units.rsqrt, vc, &mut sat).v
-            }
-            None => light.l_x,
-        };
+        let l = fixed_light(m, bf, light, px.fixed(StageKind::Normal), &mut sat);
         let inp = BlinnPhongInput {
             n,
             l,
@@ -127,7 +113,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let iso = rp.variant == RoughVariant::Isotropic;
     let rcfg = rough_config(m.hw, rp);
     let bf = &frag.bump;
-    let v = fref::normalize_or(DVec3::from(bf.to_eye), DVec3::Z).0;
+    let v = float_eye(bf);
     let mut kd = bp.kd;
     if px.plan.texture.is_some() {
         for ch in 0..3 {
@@ -160,10 +146,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let range = f64::from(vc.offset_int_bits.min(30)).exp2();
     let l0 = m.tex_float.get(bp.map).and_then(|l| l.first());
     for light in &m.lights {
-        let l = match light.point {
-            Some(pi) => fref::normalize_or(DVec3::from(bf.to_light[pi]), DVec3::Z).0,
-            None => DVec3::from(light.l_f),
-        };
+        let l = float_light(bf, light);
         let (col, hz) = match (kk, l0) {
             (0, _) | (_, None) => rough_blinn_phong_f(
                 n,
