@@ -38,13 +38,25 @@ pub fn text(s: &RenderStats) -> String {
     }
     let _ = writeln!(
         o,
-        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
-        "stage", "impl", "invocations", "saturated", "wrapped", "cycles", "texels"
+        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}",
+        "stage",
+        "impl",
+        "invocations",
+        "saturated",
+        "wrapped",
+        "busy_cycles",
+        "issue_cycles",
+        "texels",
+        "tex_bytes"
     );
     for st in &s.stages {
+        let unit = s
+            .timing
+            .as_ref()
+            .and_then(|t| t.units.iter().find(|u| u.unit == st.stage.name()));
         let _ = writeln!(
             o,
-            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
+            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}",
             st.stage.name(),
             if st.invocations == 0 {
                 "-"
@@ -54,8 +66,10 @@ pub fn text(s: &RenderStats) -> String {
             st.invocations,
             st.saturated,
             st.wrapped,
-            st.cycles,
-            st.texels
+            unit.map_or_else(|| "-".into(), |u| u.busy_cycles.to_string()),
+            st.issue_cycles,
+            st.texels,
+            unit.map_or_else(|| "-".into(), |u| u.texture_bytes.to_string()),
         );
     }
     if s.input_saturated > 0 {
@@ -76,22 +90,40 @@ pub fn text(s: &RenderStats) -> String {
             b.frame, b.frame_fallback, b.zero_normal, b.h_zero, b.offset_clamped, b.nonfinite, b.ref_nonfinite
         );
     }
-    let c = &s.cycles;
+    o.push_str(&cycles_line(s));
+    let c = &s.issue_cycles;
     let _ = writeln!(
         o,
-        "cycles (first estimate, units x cycles/op): {} total = {} setup + {} spans + {} stages; {:.2} per covered pixel",
-        c.total, c.setup, c.spans, c.stages, c.per_covered_pixel
+        "issue cycles (invocations x cycles/op, no overlap; not a frame time): {} = {} setup + {} spans + {} stages",
+        c.total, c.setup, c.spans, c.stages
     );
-    if let Some(why) = c.not_modelled {
-        let _ = writeln!(o, "  (incomplete: {why})");
-    }
     let t = &s.timings;
     let _ = writeln!(
         o,
-        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1})",
-        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms
+        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1}); timing model {:.1} ms",
+        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms, t.timing_ms
     );
     o
+}
+
+/// The frame's cycles as the timing model counted them (the one cycle figure; `texsim cycles`
+/// prints the same total with its full report), or why there is none.
+#[must_use]
+pub fn cycles_line(s: &RenderStats) -> String {
+    match (&s.timing, s.issue_cycles.not_modelled) {
+        (Some(t), _) => format!(
+            "cycles (timing model): {} = visibility pass {} + shading pass {}; {:.2} per covered pixel; bottleneck {}; texture bytes {}, DRAM bytes {}\n",
+            t.total_cycles,
+            t.visibility_pass_cycles,
+            t.shading_pass_cycles,
+            t.cycles_per_pixel,
+            t.bottleneck,
+            t.memory.texture_bytes,
+            t.memory.dram_bytes
+        ),
+        (None, Some(why)) => format!("cycles: none ({why})\n"),
+        (None, None) => "cycles: not counted (the timing model did not run)\n".into(),
+    }
 }
 
 fn imp_name(i: crate::pipeline::Impl) -> &'static str {
@@ -113,15 +145,21 @@ pub struct SweepRow {
     /// NDF moment-map channels clamped by their encoding.
     pub ndf_clamped: u64,
     pub texels: u64,
-    /// Cycle estimate; `None` when a stage has no hardware cost model (`ndf_norm = exact`).
+    /// The frame's cycles from the timing model; `None` when it did not run (`--no-cycles`)
+    /// or a stage has no hardware cost model (`ndf_norm = exact`).
     pub cycles: Option<u64>,
     pub cycles_per_pixel: Option<f64>,
-    /// ALU ops of the stages per covered pixel (`None` as `cycles`).
+    /// Texel bytes read and bytes moved from DRAM, from the timing model (`None` as `cycles`).
+    pub texture_bytes: Option<u64>,
+    pub dram_bytes: Option<u64>,
+    /// Issue cycles (`render::IssueCycles`: invocations x cycles per op, no overlap; not a
+    /// frame time); `None` when a stage has no hardware cost model.
+    pub issue_cycles: Option<u64>,
+    pub issue_cycles_per_pixel: Option<f64>,
+    /// ALU ops of the stages per covered pixel (`None` as `issue_cycles`).
     pub ops_per_pixel: Option<f64>,
     pub hw_ms: f64,
     pub ref_ms: f64,
-    /// Total cycles of the timing model (`texsim sweep --cycles`), else `None`.
-    pub timing_cycles: Option<u64>,
     /// Trilinear texture lookups (8 texels each) per covered pixel.
     pub lookups_per_pixel: f64,
     /// `texsim sweep --truth`: float reference vs ground truth, 8-bit LSBs.
@@ -141,7 +179,8 @@ impl SweepRow {
     #[must_use]
     pub fn new(settings: Vec<(String, String)>, s: &RenderStats) -> Self {
         let px = s.covered_pixels.max(1) as f64;
-        let modelled = s.cycles.not_modelled.is_none();
+        let modelled = s.issue_cycles.not_modelled.is_none();
+        let t = s.timing.as_ref();
         Self {
             settings,
             error_8bit: s.error_8bit.clone(),
@@ -156,13 +195,16 @@ impl SweepRow {
                 + s.bump.ndf_clamped,
             ndf_clamped: s.bump.ndf_clamped,
             texels: s.stages.iter().map(|x| x.texels).sum(),
-            cycles: modelled.then_some(s.cycles.total),
-            cycles_per_pixel: modelled.then_some(s.cycles.per_covered_pixel),
+            cycles: t.map(|t| t.total_cycles),
+            cycles_per_pixel: t.map(|t| t.cycles_per_pixel),
+            texture_bytes: t.map(|t| t.memory.texture_bytes),
+            dram_bytes: t.map(|t| t.memory.dram_bytes),
+            issue_cycles: modelled.then_some(s.issue_cycles.total),
+            issue_cycles_per_pixel: modelled.then_some(s.issue_cycles.per_covered_pixel),
             ops_per_pixel: modelled
                 .then(|| s.stages.iter().map(|x| x.ops).sum::<u64>() as f64 / px),
             hw_ms: s.timings.hw_total_ms,
             ref_ms: s.timings.ref_total_ms,
-            timing_cycles: None,
             lookups_per_pixel: s.stages.iter().map(|x| x.texels).sum::<u64>() as f64 / 8.0 / px,
             model_error: s.model_error.clone(),
             frame_used: s.bump.frame.clone(),
@@ -199,7 +241,7 @@ fn bump_cells(r: &SweepRow) -> [String; 4] {
     ]
 }
 
-const HEADER: [&str; 14] = [
+const HEADER: [&str; 16] = [
     "max8",
     "mean8",
     "rmse8",
@@ -210,19 +252,13 @@ const HEADER: [&str; 14] = [
     "sat",
     "cycles",
     "cyc/px",
+    "tex_bytes",
+    "dram_bytes",
     "ops/px",
     "lookups/px",
     "model_mean8",
     "hw_ms",
 ];
-
-/// Column of the timing model's total cycles (present when any row has them).
-const TIMING_HEADER: &str = "timing_cycles";
-
-fn timing_cell(r: &SweepRow) -> String {
-    r.timing_cycles
-        .map_or_else(|| "-".into(), |c| c.to_string())
-}
 
 fn cells(r: &SweepRow) -> Vec<String> {
     let e8 = r.error_8bit.as_ref();
@@ -242,6 +278,8 @@ fn cells(r: &SweepRow) -> Vec<String> {
         r.saturated.to_string(),
         r.cycles.map_or("-".into(), |c| c.to_string()),
         r.cycles_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
+        r.texture_bytes.map_or("-".into(), |c| c.to_string()),
+        r.dram_bytes.map_or("-".into(), |c| c.to_string()),
         r.ops_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
         format!("{:.2}", r.lookups_per_pixel),
         r.model_error
@@ -258,13 +296,9 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     let set_names: Vec<String> = rows.first().map_or(vec![], |r| {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
-    let timed = rows.iter().any(|r| r.timing_cycles.is_some());
     let bump = bumped(rows);
     let mut head = set_names.clone();
     head.extend(HEADER.iter().map(|s| s.to_string()));
-    if timed {
-        head.push(TIMING_HEADER.into());
-    }
     if bump {
         head.push(BUMP_HEADER[0].into());
     }
@@ -272,9 +306,6 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         line.extend(cells(r));
-        if timed {
-            line.push(timing_cell(r));
-        }
         if bump {
             let [used, ..] = bump_cells(r);
             line.push(used);
@@ -304,7 +335,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 
 /// Columns of `sweep.csv` after the swept fields: the names of `sweep.json`'s row fields
 /// (nested metrics joined with a dot).
-pub const CSV_COLUMNS: [&str; 22] = [
+pub const CSV_COLUMNS: [&str; 25] = [
     "error_8bit.max_abs_lsb",
     "error_8bit.mean_abs_lsb",
     "error_8bit.rmse_lsb",
@@ -317,10 +348,13 @@ pub const CSV_COLUMNS: [&str; 22] = [
     "texels",
     "cycles",
     "cycles_per_pixel",
+    "texture_bytes",
+    "dram_bytes",
+    "issue_cycles",
+    "issue_cycles_per_pixel",
     "ops_per_pixel",
     "lookups_per_pixel",
     "model_error.mean_abs_lsb",
-    "timing_cycles",
     "frame_used",
     "frame_fallback",
     "zero_normal",
@@ -351,10 +385,13 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
         r.texels.to_string(),
         opt(r.cycles),
         opt(r.cycles_per_pixel),
+        opt(r.texture_bytes),
+        opt(r.dram_bytes),
+        opt(r.issue_cycles),
+        opt(r.issue_cycles_per_pixel),
         opt(r.ops_per_pixel),
         r.lookups_per_pixel.to_string(),
         opt(r.model_error.as_ref().map(|e| e.mean_abs_lsb)),
-        opt(r.timing_cycles),
         r.frame_used.clone(),
         r.frame_fallback.to_string(),
         r.zero_normal.to_string(),

@@ -18,7 +18,8 @@ pub struct StageStats {
     pub saturated: u64,
     pub wrapped: u64,
     pub ops: u64,
-    pub cycles: u64,
+    /// Invocations x the unit's cycles per op ([`IssueCycles`]), not a frame time.
+    pub issue_cycles: u64,
     pub texels: u64,
 }
 
@@ -65,12 +66,15 @@ pub struct Timings {
     pub hw_total_ms: f64,
     /// Setup + (shared or float) raster + reference shading.
     pub ref_total_ms: f64,
+    /// The timing model over the events (0 when it did not run); not in `hw_total_ms`.
+    pub timing_ms: f64,
 }
 
-/// First cycle estimate: each unit's invocations x its cycles from HwConfig (no overlap, no
-/// memory effects; the detailed timing model is separate).
+/// Issue cycles: each unit's invocations x its cycles per op from HwConfig, summed with no
+/// overlap and no memory: how much arithmetic the frame asks of its units, not how long it
+/// takes. The frame's cycles are the timing model's ([`RenderStats::timing`]).
 #[derive(Clone, Debug, Default, Serialize)]
-pub struct CycleEstimate {
+pub struct IssueCycles {
     pub setup: u64,
     pub spans: u64,
     pub stages: u64,
@@ -114,7 +118,10 @@ pub struct RenderStats {
     /// Bump-mapping events of the hardware pass (all zero without bump materials).
     pub bump: BumpStats,
     pub stages: Vec<StageStats>,
-    pub cycles: CycleEstimate,
+    pub issue_cycles: IssueCycles,
+    /// The timing model's report of the frame (`RenderOptions::timing`; `None` without it, or
+    /// when a stage has no hardware cost model, [`IssueCycles::not_modelled`]).
+    pub timing: Option<crate::timing::TimingReport>,
     /// Wall times: not part of the results (they differ between two runs), so not serialized
     /// with them; `texsim render` writes them into `timings.json`.
     #[serde(skip)]
