@@ -161,6 +161,13 @@ pub enum HwCmd {
     },
     /// List the presets.
     List,
+    /// Each unit's datapath (components with their widths), critical path in gate levels,
+    /// pipeline latency at the clock target and area in gate equivalents (a proxy), with totals.
+    Cost {
+        /// Preset name (texram16, d3d11, vulkan-min, cuda) or path to a hw TOML file.
+        #[arg(default_value = "texram16")]
+        preset: String,
+    },
 }
 
 /// Which scene to use: a file or a built-in.
@@ -347,6 +354,12 @@ pub fn run(cli: Cli) -> Result<()> {
             cmd: HwCmd::Show { preset },
         }) => {
             print!("{}", hwconfig::to_toml(&hwconfig::resolve(&preset)?));
+            Ok(())
+        }
+        Some(Command::Hw {
+            cmd: HwCmd::Cost { preset },
+        }) => {
+            print!("{}", hwconfig::cost_text(&hwconfig::resolve(&preset)?));
             Ok(())
         }
         Some(Command::Hw { cmd: HwCmd::List }) => {
@@ -850,9 +863,14 @@ fn brdf_cmd(cmd: &BrdfCmd) -> Result<()> {
             *seed,
         )?,
         BrdfCmd::Spheres(a) => {
-            let cfg = hwconfig::resolve(&a.hw)?.aniso_phong;
-            let (out, text) =
-                crate::brdf::spheres::spheres_report(&cfg, &a.exponents, a.size, a.furnace_res)?;
+            let hw = hwconfig::resolve(&a.hw)?;
+            let (out, text) = crate::brdf::spheres::spheres_report(
+                &hw.aniso_phong,
+                hw.timing.gate_levels_per_cycle,
+                &a.exponents,
+                a.size,
+                a.furnace_res,
+            )?;
             let mut text = text;
             for p in out.write_to(&a.out)? {
                 text.push_str(&format!("wrote {}\n", p.display()));

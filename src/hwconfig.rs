@@ -348,6 +348,10 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
     }
     let leaf = parts[parts.len() - 1];
     let new = match cur.get(leaf) {
+        // A hand-set cycle field going back to its derived value.
+        Some(toml::Value::Integer(_)) if value.trim() == "derived" => {
+            toml::Value::String("derived".into())
+        }
         Some(toml::Value::Integer(_)) => toml::Value::Integer(
             value
                 .trim()
@@ -400,4 +404,89 @@ pub fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -
         }
     }
     best.map_or_else(String::new, |(_, c)| format!("; did you mean '{c}'?"))
+}
+
+/// `texsim hw cost`: every unit's datapath, delay, latency and area at `c`'s widths and clock
+/// target (`hw_model::datapath`), then the totals.
+#[must_use]
+pub fn cost_text(c: &HwConfig) -> String {
+    use hw_model::datapath::{max_latency, total_area, units, Cycles, TOP_LEVEL};
+    use std::fmt::Write as _;
+    let g = c.timing.gate_levels_per_cycle;
+    let reports = units(c);
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "hw '{}': gate_levels_per_cycle = {g}; a stage takes ceil(delay / {g}) cycles unless its \
+         cycle field is hand-set (marked 'set'); area in gate equivalents (NAND2), a proxy",
+        c.name
+    );
+    let _ = writeln!(
+        t,
+        "{:<26} {:>6} {:>8} {:>10}",
+        "unit", "delay", "latency", "area"
+    );
+    for r in &reports {
+        let star = if TOP_LEVEL.contains(&r.name) {
+            " *"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            t,
+            "{:<26} {:>6} {:>8} {:>10}{star}",
+            r.name, r.delay, r.latency, r.area
+        );
+        for s in &r.datapath.stages {
+            let steps: Vec<String> = s
+                .steps
+                .iter()
+                .map(|step| {
+                    step.iter()
+                        .map(|p| {
+                            if p.count == 1 {
+                                p.component.to_string()
+                            } else {
+                                format!("{}x {}", p.count, p.component)
+                            }
+                        })
+                        .collect::<Vec<_>>()
+                        .join(" + ")
+                })
+                .collect();
+            let rep = if s.repeat == 1 {
+                String::new()
+            } else {
+                format!(" (x{})", s.repeat)
+            };
+            let how = match s.cycles {
+                Cycles::Derived => "",
+                Cycles::Fixed(_) => " set",
+            };
+            let _ = writeln!(
+                t,
+                "    {}{rep}: {}; delay {}, {} cycle(s){how}, area {}",
+                s.name,
+                steps.join(" -> "),
+                s.delay_once(),
+                s.latency_once(g),
+                s.area() / u64::from(s.repeat.max(1)),
+            );
+        }
+    }
+    let longest = reports.iter().max_by_key(|r| r.latency);
+    let _ = writeln!(
+        t,
+        "total area (units marked *, one per pipeline stage kind): {} GE",
+        total_area(&reports)
+    );
+    if let Some(l) = longest {
+        let _ = writeln!(
+            t,
+            "longest latency: {} cycles ({}); delays in gate levels, latencies in cycles",
+            max_latency(&reports),
+            l.name
+        );
+    }
+    t
 }

@@ -47,6 +47,7 @@
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_shift_right, round_shift_right_wide, Rounding, SatCounter};
 use serde::{Deserialize, Serialize};
 
@@ -75,9 +76,9 @@ pub struct AnisoPhongConfig {
     /// Rounding of every reduction inside the unit.
     pub aniso_rounding: Rounding,
     /// Cycles per multiply.
-    pub aniso_mul_cycles: u32,
+    pub aniso_mul_cycles: Cycles,
     /// Cycles per ROM lookup.
-    pub aniso_lut_cycles: u32,
+    pub aniso_lut_cycles: Cycles,
     /// Quotient bits a restoring divider retires per cycle.
     pub aniso_div_bits_per_cycle: u32,
 }
@@ -108,8 +109,8 @@ impl AnisoPhongConfig {
             aniso_out_mant_bits: 16,
             aniso_out_exp_max: 24,
             aniso_rounding: Rounding::HalfEven,
-            aniso_mul_cycles: 1,
-            aniso_lut_cycles: 1,
+            aniso_mul_cycles: Cycles::Derived,
+            aniso_lut_cycles: Cycles::Derived,
             aniso_div_bits_per_cycle: 4,
         }
     }
@@ -792,29 +793,72 @@ fn aniso_phong_core(
 
 /// Cycles of a restoring divider producing `qbits` quotient bits.
 #[must_use]
-fn div_cycles(qbits: u32, cfg: &AnisoPhongConfig) -> u32 {
-    qbits.div_ceil(cfg.aniso_div_bits_per_cycle.max(1))
+/// A digit-recurrence divider of `qbits` quotient bits, `aniso_div_bits_per_cycle` bits per
+/// step (each step that many subtract-and-select slices of `qbits + 2` bits).
+fn divider(name: &'static str, qbits: u32, cfg: &AnisoPhongConfig) -> Stage {
+    let k = cfg.aniso_div_bits_per_cycle.max(1);
+    let mut s = Stage::new(name);
+    for _ in 0..k {
+        s = s
+            .then(Component::Adder { width: qbits + 2 })
+            .then(Component::Mux {
+                width: qbits + 2,
+                inputs: 2,
+            });
+    }
+    s.times(qbits.div_ceil(k))
+}
+
+/// The unit's per-pixel datapath (D = `aniso_dot_frac_bits + 2`): 30 multiplies in series
+/// (`aniso_mul_cycles` each), 17 of them fused with the following add, the 4 ROM reads of
+/// the power (`aniso_lut_cycles`; `aniso_pow_lut_bits` x `aniso_pow_frac_bits`), and the
+/// exponent and reciprocal dividers at `aniso_div_bits_per_cycle`.
+#[must_use]
+pub fn datapath(cfg: &AnisoPhongConfig) -> Datapath {
+    let d = cfg.aniso_dot_frac_bits + 2;
+    let e_div = cfg.exponent_max_bits + cfg.aniso_ratio_bits + 1;
+    let r_div = cfg.aniso_recip_bits + 2;
+    Datapath::new()
+        .stage(
+            Stage::new("multiply-add")
+                .then(Component::Multiplier { a: d, b: d })
+                .then(Component::Adder { width: 2 * d + 1 })
+                .times(17)
+                .cycles(cfg.aniso_mul_cycles),
+        )
+        .stage(
+            Stage::new("multiply")
+                .then(Component::Multiplier { a: d, b: d })
+                .times(13)
+                .cycles(cfg.aniso_mul_cycles),
+        )
+        .stage(
+            Stage::new("power ROM")
+                .then(Component::Rom {
+                    addr_bits: cfg.aniso_pow_lut_bits,
+                    data_bits: cfg.aniso_pow_frac_bits,
+                })
+                .times(4)
+                .cycles(cfg.aniso_lut_cycles),
+        )
+        .stage(divider("exponent divide step", e_div, cfg))
+        .stage(divider("reciprocal divide step", r_div, cfg))
 }
 
 /// Cost of one per-pixel evaluation on a single non-pipelined datapath (one multiplier, one
 /// ROM port, one divider used in sequence; adds and compares fold into the multiplier stages).
 /// Excludes the per-material square root ([`aniso_phong_material_cost`]).
 #[must_use]
-pub fn aniso_phong_cost(cfg: &AnisoPhongConfig) -> UnitCost {
+pub fn aniso_phong_cost(cfg: &AnisoPhongConfig, gate_levels_per_cycle: u32) -> UnitCost {
     // Multiplies: exponent 4 (hu^2, hv^2, nu a, nv b); power 4 (two ROM interpolations, s g,
     // E L); Fresnel 4; k.h max 1; specular chain 3; diffuse 2 x 5 (Horner + x q) + 4 (chain).
     let muls = 4 + 4 + 4 + 1 + 3 + 10 + 4;
     let luts = 4; // two entries for each of the log ROM and the exp2 ROM
                   // Adds/compares: exponent 2, power 2, Fresnel 2, max 1, diffuse Horner 8 + (1 - Rs) 1, sum 1.
     let adds = 17;
-    let e_div = cfg.exponent_max_bits + cfg.aniso_ratio_bits + 1;
-    let r_div = cfg.aniso_recip_bits + 2;
     UnitCost {
         ops: muls + luts + adds + 2,
-        cycles: muls * cfg.aniso_mul_cycles
-            + luts * cfg.aniso_lut_cycles
-            + div_cycles(e_div, cfg)
-            + div_cycles(r_div, cfg),
+        cycles: datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
 }
@@ -822,11 +866,13 @@ pub fn aniso_phong_cost(cfg: &AnisoPhongConfig) -> UnitCost {
 /// Cost of the per-material setup: the integer square root `sqrt((nu+1)(nv+1))`, one result bit
 /// per divider step.
 #[must_use]
-pub fn aniso_phong_material_cost(cfg: &AnisoPhongConfig) -> UnitCost {
+pub fn aniso_phong_material_cost(cfg: &AnisoPhongConfig, gate_levels_per_cycle: u32) -> UnitCost {
     let bits = cfg.exponent_max_bits + 1 + cfg.aniso_pow_frac_bits;
     UnitCost {
         ops: bits,
-        cycles: div_cycles(bits, cfg),
+        cycles: Datapath::new()
+            .stage(divider("material divide step", bits, cfg))
+            .latency(gate_levels_per_cycle),
         texels: 0,
     }
 }

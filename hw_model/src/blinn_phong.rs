@@ -25,11 +25,13 @@
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_div_wide, Format, Rounding, SatCounter};
 use crate::frame::FrameConfig;
 use crate::pow::{pow_cost, Pow, PowConfig};
 use crate::rsqrt::{range, rsqrt_cost, Rsqrt, RsqrtConfig};
 use crate::vector::{dot3, dot_cost, normalize3, normalize_cost, Vec3x, VectorConfig};
+use crate::vector::{dot_datapath, normalize_datapath};
 use serde::{Deserialize, Serialize};
 
 /// Shading output configuration.
@@ -41,7 +43,7 @@ pub struct ShadeConfig {
     /// Rounding of the final colour.
     pub shade_rounding: Rounding,
     /// Cycles of the colour multiply-adds (3 channels in parallel).
-    pub shade_cycles: u32,
+    pub shade_cycles: Cycles,
 }
 
 impl ShadeConfig {
@@ -51,7 +53,7 @@ impl ShadeConfig {
         Self {
             shade_color_bits: 16,
             shade_rounding: Rounding::HalfEven,
-            shade_cycles: 1,
+            shade_cycles: Cycles::Derived,
         }
     }
 }
@@ -202,24 +204,66 @@ pub fn lit_color(
 }
 
 /// Cost of one evaluation: two dots, the half-vector add and normalize, the power, and the
-/// colour multiply-adds.
+/// colour multiply-adds; cycles those of [`datapath`].
 #[must_use]
-pub fn blinn_phong_cost(units: &ShadingUnits) -> UnitCost {
+pub fn blinn_phong_cost(units: &ShadingUnits, gate_levels_per_cycle: u32) -> UnitCost {
+    let g = gate_levels_per_cycle;
     let c = &units.cfg;
-    dot_cost(&c.vector)
+    dot_cost(&c.vector, g)
         .times(2)
         .plus(UnitCost {
             ops: 3,
-            cycles: 1,
+            cycles: half_vector_datapath(c).latency(g),
             texels: 0,
         })
-        .plus(normalize_cost(&c.vector, rsqrt_cost(&c.rsqrt)))
-        .plus(pow_cost(&c.pow))
+        .plus(normalize_cost(&c.vector, rsqrt_cost(&c.rsqrt, g), g))
+        .plus(pow_cost(&c.pow, g))
         .plus(UnitCost {
             ops: 12,
-            cycles: c.shade.shade_cycles,
+            cycles: shade_datapath(c).latency(g),
             texels: 0,
         })
+}
+
+/// The half vector `l + v` (three adds side by side; no hand-set field).
+#[must_use]
+pub fn half_vector_datapath(c: &ShadingConfig) -> Datapath {
+    let v = c.vector.vector_frac_bits + 2;
+    Datapath::new().stage(Stage::new("half vector").then_n(3, Component::Adder { width: v + 1 }))
+}
+
+/// The colour stage (`shade_cycles`; S = `shade_color_bits`): per channel the diffuse and
+/// specular products side by side, their sum, the clamp (compare, select), rounding.
+#[must_use]
+pub fn shade_datapath(c: &ShadingConfig) -> Datapath {
+    let s = c.shade.shade_color_bits;
+    Datapath::new().stage(
+        Stage::new("colour")
+            .then_n(6, Component::Multiplier { a: s, b: s })
+            .then_n(3, Component::Adder { width: 2 * s + 1 })
+            .then_n(3, Component::Comparator { width: 2 * s + 1 })
+            .then_n(
+                3,
+                Component::Mux {
+                    width: s,
+                    inputs: 2,
+                },
+            )
+            .then(Component::Register { bits: 3 * s })
+            .cycles(c.shade.shade_cycles),
+    )
+}
+
+/// One Blinn-Phong evaluation: two dots (`n.l`, then `n.h`), the half vector, its normalize,
+/// the power unit, the colour stage.
+#[must_use]
+pub fn datapath(c: &ShadingConfig) -> Datapath {
+    dot_datapath(&c.vector)
+        .times(2)
+        .then(half_vector_datapath(c))
+        .then(normalize_datapath(&c.vector, &c.rsqrt))
+        .then(crate::pow::datapath(&c.pow))
+        .then(shade_datapath(c))
 }
 
 /// Everything one bump-mapped, Blinn-Phong-lit pixel needs (already interpolated).
@@ -296,5 +340,29 @@ pub fn bump_shade(
         frame_fallback: fr.fallback,
         zero_normal: fr.zero_normal,
         h_zero: bp.h_zero,
+    }
+}
+
+/// One colour multiply-add of the shading stages (`shade_cycles`; S = `shade_color_bits`):
+/// three `S x S` products side by side, the add, the rounding.
+#[must_use]
+pub fn mac_datapath(c: &ShadingConfig) -> Datapath {
+    let s = c.shade.shade_color_bits;
+    Datapath::new().stage(
+        Stage::new("colour multiply-add")
+            .then_n(3, Component::Multiplier { a: s, b: s })
+            .then_n(3, Component::Adder { width: 2 * s + 1 })
+            .then_n(3, Component::Adder { width: s + 1 })
+            .cycles(c.shade.shade_cycles),
+    )
+}
+
+/// Cost of one colour multiply-add ([`mac_datapath`]).
+#[must_use]
+pub fn mac_cost(c: &ShadingConfig, gate_levels_per_cycle: u32) -> UnitCost {
+    UnitCost {
+        ops: 3,
+        cycles: mac_datapath(c).latency(gate_levels_per_cycle),
+        texels: 0,
     }
 }

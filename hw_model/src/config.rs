@@ -7,6 +7,7 @@
 
 use crate::aniso_phong::AnisoPhongConfig;
 use crate::blinn_phong::ShadingConfig;
+use crate::datapath::Cycles;
 use crate::fixed::{Overflow, Rounding};
 use crate::roughness::RoughnessConfig;
 use crate::timing_config::TimingConfig;
@@ -77,9 +78,9 @@ pub struct ReciprocalConfig {
     /// Rounding of each multiply inside the unit and of its result.
     pub recip_rounding: Rounding,
     /// Cycles of the LUT lookup.
-    pub recip_lut_cycles: u32,
+    pub recip_lut_cycles: Cycles,
     /// Cycles per Newton-Raphson iteration (two multiplies and a subtract).
-    pub recip_iteration_cycles: u32,
+    pub recip_iteration_cycles: Cycles,
 }
 
 /// Attribute interpolator: perspective-correct barycentrics and per-attribute interpolation.
@@ -112,9 +113,9 @@ pub struct InterpConfig {
     #[serde(default = "yes")]
     pub texcoord_reduce: bool,
     /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
-    pub bary_cycles: u32,
+    pub bary_cycles: Cycles,
     /// Cycles per interpolated scalar attribute.
-    pub attr_cycles: u32,
+    pub attr_cycles: Cycles,
 }
 
 /// LOD unit: log2 of the texel footprint from the texture-coordinate derivatives.
@@ -124,9 +125,9 @@ pub struct LodConfig {
     /// Fraction bits of the LOD (D3D11 requires 8; Vulkan's minimum `mipmapPrecisionBits` is 4).
     pub lod_frac_bits: u32,
     /// Fixed cycles of the unit (squares, compare, normalize).
-    pub lod_cycles: u32,
+    pub lod_cycles: Cycles,
     /// Extra cycles per LOD fraction bit (the log2 produces one bit per squaring step).
-    pub lod_cycles_per_bit: u32,
+    pub lod_cycles_per_bit: Cycles,
 }
 
 /// Texel address/wrap and the trilinear filter unit.
@@ -143,9 +144,9 @@ pub struct TrilinearConfig {
     /// Rounding when the texel-space coordinate is reduced to weight_bits.
     pub weight_rounding: Rounding,
     /// Cycles of one bilinear footprint (4 texels, 3 lerps per channel).
-    pub bilinear_cycles: u32,
+    pub bilinear_cycles: Cycles,
     /// Cycles of the blend between the two levels.
-    pub level_lerp_cycles: u32,
+    pub level_lerp_cycles: Cycles,
     /// Anisotropic footprint assembly (Texram): trilinear probes along the footprint's major
     /// axis, averaged; 1 = plain trilinear. A power of two, at most 16.
     pub aniso_probes: u32,
@@ -168,7 +169,7 @@ pub struct ColorConfig {
     #[serde(default = "saturate")]
     pub color_overflow: Overflow,
     /// Cycles of one modulate (4 channels in parallel).
-    pub modulate_cycles: u32,
+    pub modulate_cycles: Cycles,
 }
 
 /// The whole simulated machine.
@@ -217,8 +218,8 @@ impl HwConfig {
                 recip_iterations: 2,
                 recip_mantissa_bits: 24,
                 recip_rounding: Rounding::HalfEven,
-                recip_lut_cycles: 1,
-                recip_iteration_cycles: 2,
+                recip_lut_cycles: Cycles::Derived,
+                recip_iteration_cycles: Cycles::Derived,
             },
             interp: InterpConfig {
                 inv_w_bits: 24,
@@ -228,21 +229,21 @@ impl HwConfig {
                 interp_rounding: Rounding::HalfEven,
                 texcoord_overflow: Overflow::Saturate,
                 texcoord_reduce: true,
-                bary_cycles: 2,
-                attr_cycles: 1,
+                bary_cycles: Cycles::Derived,
+                attr_cycles: Cycles::Derived,
             },
             lod: LodConfig {
                 lod_frac_bits: 16,
-                lod_cycles: 2,
-                lod_cycles_per_bit: 0,
+                lod_cycles: Cycles::Derived,
+                lod_cycles_per_bit: Cycles::Derived,
             },
             trilinear: TrilinearConfig {
                 weight_bits: 16,
                 texel_bits: 16,
                 filter_rounding: Rounding::HalfEven,
                 weight_rounding: Rounding::Truncate,
-                bilinear_cycles: 1,
-                level_lerp_cycles: 1,
+                bilinear_cycles: Cycles::Derived,
+                level_lerp_cycles: Cycles::Derived,
                 aniso_probes: 1,
                 aniso_adaptive: false,
             },
@@ -250,7 +251,7 @@ impl HwConfig {
                 color_bits: 16,
                 color_rounding: Rounding::HalfEven,
                 color_overflow: Overflow::Saturate,
-                modulate_cycles: 1,
+                modulate_cycles: Cycles::Derived,
             },
             shading: ShadingConfig::texram16(),
             aniso_phong: AnisoPhongConfig::texram16(),

@@ -34,6 +34,7 @@
 
 use crate::config::{LodConfig, TrilinearConfig};
 use crate::cost::UnitCost;
+use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, Rounding, SatCounter};
 use crate::lod::{lod, lod_cost, lod_zero};
 use crate::trilinear::{trilinear, trilinear_cost, Level, TrilinearTrace};
@@ -181,18 +182,57 @@ pub fn footprint_filter(
 /// Cost of one footprint-assembly lookup with `probes` probes: `probes` two-level trilinear
 /// samples; with more than one probe, plus the axis selection (4 squares, 2 adds, a compare),
 /// one extra LOD evaluation, the offsets (2 multiplies per probe) and the average (4 adds per
-/// probe, 4 shifts), for the LOD unit's cycles plus one.
+/// probe, 4 shifts). Cycles from [`datapath`].
 #[must_use]
-pub fn footprint_cost(cfg: &TrilinearConfig, lod_cfg: &LodConfig, probes: u32) -> UnitCost {
+pub fn footprint_cost(
+    cfg: &TrilinearConfig,
+    lod_cfg: &LodConfig,
+    probes: u32,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
     let n = probes.clamp(1, MAX_PROBES as u32);
-    let tri = trilinear_cost(cfg, 2).times(n);
+    let mut tri = trilinear_cost(cfg, 2, gate_levels_per_cycle).times(n);
+    if n > 1 {
+        let l = lod_cost(lod_cfg, gate_levels_per_cycle);
+        tri = tri.plus(UnitCost {
+            ops: 7 + l.ops + 2 * n + 4 * n + 4,
+            cycles: 0,
+            texels: 0,
+        });
+    }
+    tri.cycles = datapath(cfg, lod_cfg, n).latency(gate_levels_per_cycle);
+    tri
+}
+
+/// Footprint assembly with `probes` probes: the probes' two-level trilinear samples in series
+/// (one filter unit); with more than one probe first the second LOD evaluation and one stage
+/// for the axis selection (compare of the squared lengths, select), the probe offsets (two
+/// multiplies per probe, side by side) and the average (an adder tree of `log2 probes` levels
+/// per channel).
+#[must_use]
+pub fn datapath(cfg: &TrilinearConfig, lod_cfg: &LodConfig, probes: u32) -> Datapath {
+    let n = probes.clamp(1, MAX_PROBES as u32);
+    let tri = crate::trilinear::datapath(cfg, 2).times(n);
     if n == 1 {
         return tri;
     }
-    let l = lod_cost(lod_cfg);
-    tri.plus(UnitCost {
-        ops: 7 + l.ops + 2 * n + 4 * n + 4,
-        cycles: l.cycles + 1,
-        texels: 0,
-    })
+    let sq = 2 * crate::lod::DERIV_BITS + 1;
+    let t = cfg.texel_bits;
+    let mut avg = Stage::new("axis select, offsets, average")
+        .then(Component::Comparator { width: sq })
+        .then(Component::Mux {
+            width: 2 * crate::lod::DERIV_BITS,
+            inputs: 2,
+        })
+        .then_n(
+            2 * n,
+            Component::Multiplier {
+                a: crate::lod::DERIV_BITS,
+                b: ceil_log2(n) + 1,
+            },
+        );
+    for level in 1..=ceil_log2(n) {
+        avg = avg.then_n(4 * (n >> level), Component::Adder { width: t + level });
+    }
+    crate::lod::datapath(lod_cfg).stage(avg).then(tri)
 }

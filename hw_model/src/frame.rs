@@ -52,14 +52,17 @@
 //! `p_u`, `p_v`, `n` (200k cases): frame components <= 6.5 ulp / 3.0 ulp, perturbed normals
 //! <= 9 ulp / 3.0 ulp.
 
+use crate::blinn_phong::ShadingConfig;
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
 use crate::rsqrt::range;
 use crate::vector::{
     cross3, cross3_exact, madd, normalize3, offset_format, vector_format, Normalized, Vec3x,
 };
 use crate::vector::{cross_cost, dot_cost, madd_cost, normalize_cost};
+use crate::vector::{cross_datapath, dot_datapath, madd_datapath, normalize_datapath};
 use serde::{Deserialize, Serialize};
 
 use crate::blinn_phong::ShadingUnits;
@@ -114,7 +117,7 @@ pub struct FrameConfig {
     /// Main-direction fallback threshold: fall back when `sin(angle(m, n)) < 2^-bits`. 1..=12.
     pub frame_min_sin_bits: u32,
     /// Cycles of the length scaling (two scalar multiplies) in the natural frame.
-    pub frame_len_cycles: u32,
+    pub frame_len_cycles: Cycles,
 }
 
 impl FrameConfig {
@@ -126,7 +129,7 @@ impl FrameConfig {
             frame_len_int_bits: 8,
             frame_len_frac_bits: 8,
             frame_min_sin_bits: 6,
-            frame_len_cycles: 1,
+            frame_len_cycles: Cycles::Derived,
         }
     }
 
@@ -386,30 +389,67 @@ pub fn perturb_normal(
 /// Cost of building one frame of `kind` (normalizer costs include the rsqrt). The natural
 /// frame includes its length scaling: the two scalar multiplies `f_u len_u`, `f_v len_v`
 /// (`frame_len_cycles`), which [`perturb_normal`] performs but only the natural frame needs
-/// (the unit and main frames have lengths 1), so they are charged here, once.
+/// (the unit and main frames have lengths 1), so they are charged here, once. Cycles are
+/// those of [`datapath`].
 #[must_use]
-pub fn frame_cost(kind: FrameKind, units: &ShadingUnits) -> UnitCost {
+pub fn frame_cost(kind: FrameKind, units: &ShadingUnits, gate_levels_per_cycle: u32) -> UnitCost {
+    let g = gate_levels_per_cycle;
     let c = &units.cfg;
-    let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt));
+    let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt, g), g);
     match kind {
         FrameKind::Unit => nz.times(3),
         FrameKind::Natural => nz.times(3).plus(UnitCost {
             ops: 2,
-            cycles: c.frame.frame_len_cycles,
+            cycles: len_datapath(c).latency(g),
             texels: 0,
         }),
         FrameKind::Main => nz
             .times(3)
-            .plus(cross_cost(&c.vector).times(2))
-            .plus(dot_cost(&c.vector)),
+            .plus(cross_cost(&c.vector, g).times(2))
+            .plus(dot_cost(&c.vector, g)),
     }
 }
 
 /// Cost of one [`perturb_normal`] of any frame: the multiply-add and a normalize (the natural
-/// frame's length multiplies are in [`frame_cost`]).
+/// frame's length multiplies are in [`frame_cost`]); cycles those of [`perturb_datapath`].
 #[must_use]
-pub fn perturb_cost(units: &ShadingUnits) -> UnitCost {
+pub fn perturb_cost(units: &ShadingUnits, gate_levels_per_cycle: u32) -> UnitCost {
+    let g = gate_levels_per_cycle;
     let c = &units.cfg;
-    let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt));
-    madd_cost(&c.vector).plus(nz)
+    let nz = normalize_cost(&c.vector, crate::rsqrt::rsqrt_cost(&c.rsqrt, g), g);
+    madd_cost(&c.vector, g).plus(nz)
+}
+
+/// The natural frame's length scaling (`frame_len_cycles`): two products of a vector by its
+/// `frame_len_int_bits.frame_len_frac_bits` length, side by side, rounded.
+#[must_use]
+pub fn len_datapath(c: &ShadingConfig) -> Datapath {
+    let v = c.vector.vector_frac_bits + 2;
+    let l = c.frame.frame_len_int_bits + c.frame.frame_len_frac_bits;
+    Datapath::new().stage(
+        Stage::new("length scaling")
+            .then_n(6, Component::Multiplier { a: v, b: l })
+            .then_n(6, Component::Adder { width: v + 1 })
+            .cycles(c.frame.frame_len_cycles),
+    )
+}
+
+/// Building a frame of `kind`: three normalizes; the natural frame adds its length scaling,
+/// the main frame two cross products and a dot.
+#[must_use]
+pub fn datapath(kind: FrameKind, c: &ShadingConfig) -> Datapath {
+    let nz = normalize_datapath(&c.vector, &c.rsqrt).times(3);
+    match kind {
+        FrameKind::Unit => nz,
+        FrameKind::Natural => nz.then(len_datapath(c)),
+        FrameKind::Main => nz
+            .then(cross_datapath(&c.vector).times(2))
+            .then(dot_datapath(&c.vector)),
+    }
+}
+
+/// [`perturb_normal`]: the multiply-add, then a normalize.
+#[must_use]
+pub fn perturb_datapath(c: &ShadingConfig) -> Datapath {
+    madd_datapath(&c.vector).then(normalize_datapath(&c.vector, &c.rsqrt))
 }

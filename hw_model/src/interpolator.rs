@@ -16,8 +16,9 @@
 //! bound (see [`crate::reciprocal`]) and `h` = 1/2 for the nearest modes, 1 for Truncate;
 //! `p_0`'s error is at most the sum of the two. Inside the triangle |P_i| <= 1.
 
-use crate::config::InterpConfig;
+use crate::config::{InterpConfig, ReciprocalConfig};
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, Format, SatCounter};
 use crate::reciprocal::{apply, square, Recip, Reciprocal};
 
@@ -228,36 +229,120 @@ pub fn interpolate(
 
 /// Cost of [`perspective_bary_derivs`]: the barycentrics, one more reciprocal and its square,
 /// and per axis 3 multiplies, 2 adds, 4 multiplies and 2 subtracts for the numerators and 2
-/// reciprocal applications.
+/// reciprocal applications; cycles from [`bary_derivs_datapath`].
 #[must_use]
-pub fn perspective_bary_derivs_cost(cfg: &InterpConfig, recip: &Reciprocal) -> UnitCost {
-    let base = perspective_bary_cost(cfg, recip);
-    let rc = recip.cost();
+pub fn perspective_bary_derivs_cost(
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
+    let base = perspective_bary_cost(cfg, recip, gate_levels_per_cycle);
+    let rc = recip.cost(gate_levels_per_cycle);
     UnitCost {
         ops: base.ops + rc.ops + 1 + 2 * 13,
-        cycles: base.cycles + rc.cycles + 2 * cfg.bary_cycles,
+        cycles: bary_derivs_datapath(cfg, recip.config()).latency(gate_levels_per_cycle),
         texels: 0,
     }
 }
 
 /// Cost of one fragment's barycentrics: 3 multiplies, 2 adds, the reciprocal, 2 multiplies
-/// and 2 subtracts.
+/// and 2 subtracts; cycles from [`bary_datapath`].
 #[must_use]
-pub fn perspective_bary_cost(cfg: &InterpConfig, recip: &Reciprocal) -> UnitCost {
-    let rc = recip.cost();
+pub fn perspective_bary_cost(
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
+    let rc = recip.cost(gate_levels_per_cycle);
     UnitCost {
         ops: 9 + rc.ops,
-        cycles: cfg.bary_cycles + rc.cycles,
+        cycles: bary_datapath(cfg, recip.config()).latency(gate_levels_per_cycle),
         texels: 0,
     }
 }
 
-/// Cost of one scalar attribute: 2 subtracts, 2 multiplies, 2 adds, 1 round.
+/// Cost of one scalar attribute: 2 subtracts, 2 multiplies, 2 adds, 1 round; cycles from
+/// [`attribute_datapath`].
 #[must_use]
-pub fn interpolate_cost(cfg: &InterpConfig) -> UnitCost {
+pub fn interpolate_cost(cfg: &InterpConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 7,
-        cycles: cfg.attr_cycles,
+        cycles: attribute_datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
+}
+
+/// Width of the edge-function values entering the barycentric multipliers (the rasterizer's
+/// snapped coordinates give at most 32 significant bits at the supported resolutions).
+pub const EDGE_BITS: u32 = 32;
+
+/// Datapath of [`perspective_bary`] (B = `bary_bits`, W = `inv_w_bits`): the reciprocal of
+/// `D`, then (`bary_cycles`) the three `E_i invw_i` products, their sum, two `q_i / D`
+/// products and the rounding to B bits.
+#[must_use]
+pub fn bary_datapath(cfg: &InterpConfig, recip: &ReciprocalConfig) -> Datapath {
+    let (b, w) = (cfg.bary_bits, cfg.inv_w_bits);
+    let q = EDGE_BITS + w + 1;
+    let r = recip.recip_mantissa_bits + 1;
+    crate::reciprocal::datapath(recip).stage(
+        Stage::new("barycentrics")
+            .then_n(
+                3,
+                Component::Multiplier {
+                    a: EDGE_BITS,
+                    b: w + 1,
+                },
+            )
+            .then(Component::Adder { width: q + 1 })
+            .then(Component::Adder { width: q + 2 })
+            .then_n(2, Component::Multiplier { a: 62, b: r })
+            .then_n(2, Component::Adder { width: b + 2 })
+            .then(Component::Register { bits: 3 * (b + 2) })
+            .cycles(cfg.bary_cycles),
+    )
+}
+
+/// Datapath of [`perspective_bary_derivs`]: [`bary_datapath`], the second reciprocal (of
+/// `D^2`), and per screen axis (`bary_cycles` each) the numerators `a D - q S` (3 multiplies,
+/// the subtract) and their scaling by `1/D^2` (2 multiplies, rounding).
+#[must_use]
+pub fn bary_derivs_datapath(cfg: &InterpConfig, recip: &ReciprocalConfig) -> Datapath {
+    let b = cfg.bary_bits;
+    let r = recip.recip_mantissa_bits + 1;
+    bary_datapath(cfg, recip)
+        .then(crate::reciprocal::datapath(recip))
+        .stage(
+            Stage::new("derivatives")
+                .then_n(
+                    3,
+                    Component::Multiplier {
+                        a: EDGE_BITS,
+                        b: 62,
+                    },
+                )
+                .then_n(2, Component::Adder { width: 96 })
+                .then_n(2, Component::Multiplier { a: 62, b: r })
+                .then_n(2, Component::Adder { width: b + 2 })
+                .then(Component::Register { bits: 2 * (b + 2) })
+                .times(2)
+                .cycles(cfg.bary_cycles),
+        )
+}
+
+/// Datapath of [`interpolate`] (A = `texcoord_int_bits + texcoord_frac_bits + 1`): the two
+/// differences, two products by the barycentrics, the sum and the rounding
+/// (`attr_cycles`).
+#[must_use]
+pub fn attribute_datapath(cfg: &InterpConfig) -> Datapath {
+    let a = cfg.texcoord_int_bits + cfg.texcoord_frac_bits + 1;
+    let b = cfg.bary_bits + 2;
+    Datapath::new().stage(
+        Stage::new("attribute")
+            .then_n(2, Component::Adder { width: a + 1 })
+            .then_n(2, Component::Multiplier { a: a + 1, b })
+            .then(Component::Adder { width: a + b + 1 })
+            .then(Component::Adder { width: a + b + 2 })
+            .then(Component::Register { bits: a })
+            .cycles(cfg.attr_cycles),
+    )
 }

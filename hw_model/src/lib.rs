@@ -11,6 +11,7 @@ pub mod aniso_phong;
 pub mod blinn_phong;
 pub mod config;
 pub mod cost;
+pub mod datapath;
 pub mod fixed;
 pub mod footprint;
 pub mod frame;

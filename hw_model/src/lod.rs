@@ -23,6 +23,7 @@
 
 use crate::config::LodConfig;
 use crate::cost::UnitCost;
+use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::SatCounter;
 
 /// Fraction bits of the mantissa in the squaring loop.
@@ -79,13 +80,61 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
     v
 }
 
-/// Cost: `lod_cycles + lod_cycles_per_bit * lod_frac_bits`; ops = 4 squares, 2 adds, compare,
+/// Cost: cycles from [`datapath`] (`lod_cycles + lod_cycles_per_bit * lod_frac_bits` when both
+/// are hand-set); ops = 4 squares, 2 adds, compare,
 /// normalize, plus one square per squaring step.
 #[must_use]
-pub fn lod_cost(cfg: &LodConfig) -> UnitCost {
+pub fn lod_cost(cfg: &LodConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 8 + cfg.lod_frac_bits.saturating_sub(1),
-        cycles: cfg.lod_cycles + cfg.lod_cycles_per_bit * cfg.lod_frac_bits,
+        cycles: datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
+}
+
+/// Width of the texture-coordinate derivatives entering the LOD unit's squarers.
+pub const DERIV_BITS: u32 = 32;
+
+/// The LOD unit's datapath (F = `lod_frac_bits`): the four squares of the derivatives, the
+/// two sums, the larger (compare, select), the leading-zero count and normalizing shift
+/// (`lod_cycles`), then one squaring step of the `MANT_BITS + 1`-bit mantissa per fraction
+/// bit, each a multiplier and the select of `m` or `m / 2` (`lod_cycles_per_bit` each).
+#[must_use]
+pub fn datapath(cfg: &LodConfig) -> Datapath {
+    let sq = 2 * DERIV_BITS + 1;
+    let m = MANT_BITS + 1;
+    Datapath::new()
+        .stage(
+            Stage::new("squared lengths")
+                .then_n(
+                    4,
+                    Component::Multiplier {
+                        a: DERIV_BITS,
+                        b: DERIV_BITS,
+                    },
+                )
+                .then_n(2, Component::Adder { width: sq })
+                .then(Component::Comparator { width: sq })
+                .then(Component::Mux {
+                    width: sq,
+                    inputs: 2,
+                })
+                .then(Component::LeadingZeros { width: sq })
+                .then(Component::Shifter {
+                    width: m,
+                    shift_bits: ceil_log2(sq),
+                })
+                .cycles(cfg.lod_cycles),
+        )
+        .stage(
+            Stage::new("log2 bit (squaring)")
+                .then(Component::Multiplier { a: m, b: m })
+                .then(Component::Mux {
+                    width: m,
+                    inputs: 2,
+                })
+                .then(Component::Register { bits: m + 16 })
+                .times(cfg.lod_frac_bits)
+                .cycles(cfg.lod_cycles_per_bit),
+        )
 }

@@ -8,6 +8,7 @@
 
 use crate::config::ColorConfig;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_div_wide, Rounding};
 
 #[inline]
@@ -60,12 +61,28 @@ pub fn unorm_convert(x: u32, from_bits: u32, to_bits: u32, rounding: Rounding) -
 }
 
 /// Cost of one modulate (4 channels in parallel): per channel a multiply and a
-/// divide-by-constant (multiply + shift).
+/// divide-by-constant (multiply + shift); cycles from [`datapath`].
 #[must_use]
-pub fn modulate_cost(cfg: &ColorConfig) -> UnitCost {
+pub fn modulate_cost(cfg: &ColorConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 4 * 3,
-        cycles: cfg.modulate_cycles,
+        cycles: datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
+}
+
+/// The modulate unit (C = `color_bits`, `modulate_cycles`): per channel, side by side, the
+/// `C x C` product, the divide by `2^C - 1` as a multiply by its reciprocal and the rounding
+/// add, the result register.
+#[must_use]
+pub fn datapath(cfg: &ColorConfig) -> Datapath {
+    let c = cfg.color_bits;
+    Datapath::new().stage(
+        Stage::new("modulate")
+            .then_n(4, Component::Multiplier { a: c, b: c })
+            .then_n(4, Component::Multiplier { a: 2 * c, b: c + 1 })
+            .then_n(4, Component::Adder { width: c + 1 })
+            .then(Component::Register { bits: 4 * c })
+            .cycles(cfg.modulate_cycles),
+    )
 }

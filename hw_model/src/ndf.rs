@@ -58,6 +58,7 @@
 
 use crate::config::{ConfigError, ReciprocalConfig};
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_div_i128, round_shift_right_wide, Rounding, SatCounter};
 use crate::reciprocal::Reciprocal;
 use crate::rsqrt::{isqrt_u128, range, rsqrt_cost, Rsqrt, RsqrtConfig};
@@ -129,11 +130,11 @@ pub struct NdfConfig {
     /// Rounding of every reduction in the unit.
     pub ndf_rounding: Rounding,
     /// Cycles per multiply.
-    pub ndf_mul_cycles: u32,
+    pub ndf_mul_cycles: Cycles,
     /// Cycles per add, compare or shift.
-    pub ndf_add_cycles: u32,
+    pub ndf_add_cycles: Cycles,
     /// Cycles per table lookup.
-    pub ndf_lut_cycles: u32,
+    pub ndf_lut_cycles: Cycles,
 }
 
 impl NdfConfig {
@@ -152,9 +153,9 @@ impl NdfConfig {
             ndf_density: NdfDensity::Pearson,
             ndf_norm: NdfNorm::Partial,
             ndf_rounding: Rounding::HalfEven,
-            ndf_mul_cycles: 1,
-            ndf_add_cycles: 1,
-            ndf_lut_cycles: 1,
+            ndf_mul_cycles: Cycles::Derived,
+            ndf_add_cycles: Cycles::Derived,
+            ndf_lut_cycles: Cycles::Derived,
         }
     }
 
@@ -685,10 +686,33 @@ pub fn ndf_lookups(cfg: &NdfConfig) -> u32 {
 /// partial 3 + rsqrt, map 2, projected 40 + 2 rsqrt. `None` for `exact`: a numerical integral
 /// over the sphere per pixel has no datapath here (float only), so it has no cost to report.
 #[must_use]
-pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> Option<UnitCost> {
-    let mc = cfg.ndf_mul_cycles;
-    let ac = cfg.ndf_add_cycles;
-    // (multiplies, adds)
+pub fn ndf_cost(
+    cfg: &NdfConfig,
+    recip: &UnitCost,
+    rsqrt: &RsqrtConfig,
+    gate_levels_per_cycle: u32,
+) -> Option<UnitCost> {
+    let (mul, add, lut) = op_counts(cfg)?;
+    let core = core_datapath(cfg, rsqrt)?;
+    let rs = rsqrt_cost(rsqrt, gate_levels_per_cycle);
+    let n_rs = match cfg.ndf_norm {
+        NdfNorm::Partial => 1,
+        NdfNorm::Projected => 2,
+        NdfNorm::Map | NdfNorm::Exact => 0,
+    };
+    Some(
+        UnitCost {
+            ops: mul + add + lut + n_rs * rs.ops,
+            cycles: core.latency(gate_levels_per_cycle),
+            texels: 8 * ndf_lookups(cfg),
+        }
+        .plus(*recip),
+    )
+}
+
+/// Multiplies, adds and table lookups of one evaluation (see [`ndf_cost`]); `None` for
+/// `exact`.
+fn op_counts(cfg: &NdfConfig) -> Option<(u32, u32, u32)> {
     let mut mul = 9 + 6 + 2 + 15 + 3 + 12 + 1;
     let mut add = 6 + 4 + 8 + 7 + 11 + 1;
     let mut lut = 0;
@@ -705,14 +729,11 @@ pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> Optio
             lut += 1;
         }
     }
-    let rs = rsqrt_cost(rsqrt);
-    let mut extra = UnitCost::default();
     match cfg.ndf_norm {
         NdfNorm::Exact => return None,
         NdfNorm::Partial => {
             mul += 2;
             add += 1;
-            extra = rs;
         }
         NdfNorm::Map => {
             mul += 2;
@@ -720,16 +741,56 @@ pub fn ndf_cost(cfg: &NdfConfig, recip: &UnitCost, rsqrt: &RsqrtConfig) -> Optio
         NdfNorm::Projected => {
             mul += 3 + 9 + 3 + 6 * 3 + 3;
             add += 2 + 6 + 2 + 18 + 3;
-            extra = rs.plus(rs);
         }
     }
-    Some(
-        UnitCost {
-            ops: mul + add + lut,
-            cycles: mul * mc + add * ac + lut * cfg.ndf_lut_cycles,
-            texels: 8 * ndf_lookups(cfg),
-        }
-        .plus(*recip)
-        .plus(extra),
-    )
+    Some((mul, add, lut))
+}
+
+/// The NDF unit without its reciprocal (N = `ndf_frac_bits`): its multiplies in series
+/// (`ndf_mul_cycles` each; `N + 2`-bit operands), its adds (`ndf_add_cycles`), the exp table
+/// of the Gauss density (`ndf_lut_cycles`) and the rsqrt units of the normalization.
+fn core_datapath(cfg: &NdfConfig, rsqrt: &RsqrtConfig) -> Option<Datapath> {
+    let (mul, add, lut) = op_counts(cfg)?;
+    let w = cfg.ndf_frac_bits + 2;
+    let mut d = Datapath::new()
+        .stage(
+            Stage::new("multiply")
+                .then(Component::Multiplier { a: w, b: w })
+                .times(mul)
+                .cycles(cfg.ndf_mul_cycles),
+        )
+        .stage(
+            Stage::new("add")
+                .then(Component::Adder { width: w + 2 })
+                .times(add)
+                .cycles(cfg.ndf_add_cycles),
+        )
+        .stage(
+            Stage::new("exp table")
+                .then(Component::Rom {
+                    addr_bits: cfg.ndf_exp_lut_bits,
+                    data_bits: w,
+                })
+                .times(lut)
+                .cycles(cfg.ndf_lut_cycles),
+        );
+    let n_rs = match cfg.ndf_norm {
+        NdfNorm::Partial => 1,
+        NdfNorm::Projected => 2,
+        NdfNorm::Map | NdfNorm::Exact => 0,
+    };
+    for _ in 0..n_rs {
+        d = d.then(crate::rsqrt::datapath(rsqrt));
+    }
+    Some(d)
+}
+
+/// The NDF unit: [`core_datapath`] and its reciprocal; `None` for `exact` (float only).
+#[must_use]
+pub fn datapath(
+    cfg: &NdfConfig,
+    recip: &ReciprocalConfig,
+    rsqrt: &RsqrtConfig,
+) -> Option<Datapath> {
+    Some(core_datapath(cfg, rsqrt)?.then(crate::reciprocal::datapath(recip)))
 }

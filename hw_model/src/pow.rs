@@ -22,6 +22,7 @@
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
 use crate::rsqrt::{isqrt_u128, range};
 use serde::{Deserialize, Serialize};
@@ -53,9 +54,9 @@ pub struct PowConfig {
     /// Rounding of every internal product and of the result.
     pub pow_rounding: Rounding,
     /// Cycles per table lookup-and-interpolate (log-exp: two of them).
-    pub pow_lut_cycles: u32,
+    pub pow_lut_cycles: Cycles,
     /// Cycles per multiply (log-exp: one; squaring: up to 2 * exponent_bits - 1).
-    pub pow_mul_cycles: u32,
+    pub pow_mul_cycles: Cycles,
 }
 
 impl PowConfig {
@@ -70,8 +71,8 @@ impl PowConfig {
             pow_guard_bits: 8,
             pow_exponent_bits: 11,
             pow_rounding: Rounding::HalfEven,
-            pow_lut_cycles: 1,
-            pow_mul_cycles: 1,
+            pow_lut_cycles: Cycles::Derived,
+            pow_mul_cycles: Cycles::Derived,
         }
     }
 
@@ -248,22 +249,74 @@ impl Pow {
 }
 
 /// Cost of one `x^n` (worst case over exponents for squaring: `2 * exponent_bits - 1`
-/// multiplies; log-exp: two interpolated lookups and one multiply).
+/// multiplies; log-exp: two interpolated lookups and one multiply); cycles from [`datapath`].
 #[must_use]
-pub fn pow_cost(cfg: &PowConfig) -> UnitCost {
+pub fn pow_cost(cfg: &PowConfig, gate_levels_per_cycle: u32) -> UnitCost {
+    let ops = match cfg.pow_method {
+        PowMethod::LogExp => 2 * 3 + 1,
+        PowMethod::Squaring => 2 * cfg.pow_exponent_bits - 1,
+    };
+    UnitCost {
+        ops,
+        cycles: datapath(cfg).latency(gate_levels_per_cycle),
+        texels: 0,
+    }
+}
+
+/// The power unit (F = `pow_frac_bits`, G = `pow_guard_bits`, L = `pow_lut_bits`, E =
+/// `pow_exponent_bits`). Log-exp: the log2 table with its linear interpolation
+/// (`pow_lut_cycles`), the product with the exponent (`pow_mul_cycles`), the exp2 table with
+/// its interpolation and the shift by the integer part (`pow_lut_cycles`). Squaring:
+/// `2 E - 1` multiplies in series (`pow_mul_cycles` each).
+#[must_use]
+pub fn datapath(cfg: &PowConfig) -> Datapath {
+    let (f, g, l, e) = (
+        cfg.pow_frac_bits,
+        cfg.pow_guard_bits,
+        cfg.pow_lut_bits,
+        cfg.pow_exponent_bits,
+    );
+    let w = f + g;
+    let rest = f.saturating_sub(l).max(1);
     match cfg.pow_method {
-        PowMethod::LogExp => UnitCost {
-            ops: 2 * 3 + 1,
-            cycles: 2 * cfg.pow_lut_cycles + cfg.pow_mul_cycles,
-            texels: 0,
-        },
-        PowMethod::Squaring => {
-            let m = 2 * cfg.pow_exponent_bits - 1;
-            UnitCost {
-                ops: m,
-                cycles: m * cfg.pow_mul_cycles,
-                texels: 0,
-            }
-        }
+        PowMethod::LogExp => Datapath::new()
+            .stage(
+                Stage::new("log2 table")
+                    .then(Component::LeadingZeros { width: f + 1 })
+                    .then(Component::Rom {
+                        addr_bits: l,
+                        data_bits: w,
+                    })
+                    .then(Component::Multiplier { a: w, b: rest })
+                    .then(Component::Adder { width: w })
+                    .cycles(cfg.pow_lut_cycles),
+            )
+            .stage(
+                Stage::new("times exponent")
+                    .then(Component::Multiplier { a: w + 6, b: e })
+                    .then(Component::Adder { width: w + 6 })
+                    .cycles(cfg.pow_mul_cycles),
+            )
+            .stage(
+                Stage::new("exp2 table")
+                    .then(Component::Rom {
+                        addr_bits: l,
+                        data_bits: w,
+                    })
+                    .then(Component::Multiplier { a: w, b: rest })
+                    .then(Component::Adder { width: w })
+                    .then(Component::Shifter {
+                        width: f + 1,
+                        shift_bits: 6,
+                    })
+                    .cycles(cfg.pow_lut_cycles),
+            ),
+        PowMethod::Squaring => Datapath::new().stage(
+            Stage::new("multiply")
+                .then(Component::Multiplier { a: w + 1, b: w + 1 })
+                .then(Component::Adder { width: w + 1 })
+                .times(2 * e - 1)
+                .cycles(cfg.pow_mul_cycles),
+        ),
     }
 }

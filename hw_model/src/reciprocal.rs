@@ -26,6 +26,7 @@
 
 use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;
+use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
 
 /// Guard bits carried by the working precision beyond `recip_mantissa_bits`.
@@ -129,13 +130,13 @@ impl Reciprocal {
         Recip { mant, shift }
     }
 
-    /// Cost of one evaluation: normalize, LUT, 3 ops per iteration, final round.
+    /// Cost of one evaluation: normalize, LUT, 3 ops per iteration, final round; cycles from
+    /// [`datapath`] at `gate_levels_per_cycle`.
     #[must_use]
-    pub fn cost(&self) -> UnitCost {
+    pub fn cost(&self, gate_levels_per_cycle: u32) -> UnitCost {
         UnitCost {
             ops: 3 + 3 * self.cfg.recip_iterations,
-            cycles: self.cfg.recip_lut_cycles
-                + self.cfg.recip_iterations * self.cfg.recip_iteration_cycles,
+            cycles: datapath(&self.cfg).latency(gate_levels_per_cycle),
             texels: 0,
         }
     }
@@ -202,4 +203,52 @@ pub fn apply(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
             round_shift_right_wide(prod.saturating_mul(1i128 << up), 0, mode)
         }
     }
+}
+
+/// The unit's datapath (P = M + G working bits): normalize (leading-zero count and shift of
+/// the P + 1-bit mantissa), the seed ROM (`recip_lut_cycles`), N Newton-Raphson steps
+/// (`m y`, `2 - t`, `y d`, each product rounded; `recip_iteration_cycles` each) and the final
+/// rounding to M + 1 bits.
+#[must_use]
+pub fn datapath(cfg: &ReciprocalConfig) -> Datapath {
+    let m = cfg.recip_mantissa_bits;
+    let p = m + GUARD_BITS;
+    let w = p + 1;
+    Datapath::new()
+        .stage(
+            Stage::new("normalize")
+                .then(Component::LeadingZeros { width: 64 })
+                .then(Component::Shifter {
+                    width: w,
+                    shift_bits: 6,
+                })
+                .then(Component::Adder { width: w }),
+        )
+        .stage(
+            Stage::new("seed ROM")
+                .then(Component::Rom {
+                    addr_bits: cfg.recip_lut_bits,
+                    data_bits: w,
+                })
+                .cycles(cfg.recip_lut_cycles),
+        )
+        .stage(
+            Stage::new("Newton-Raphson step")
+                .then(Component::Multiplier { a: w, b: w })
+                .then(Component::Adder { width: w + 1 })
+                .then(Component::Multiplier { a: w, b: w + 1 })
+                .then(Component::Adder { width: w })
+                .times(cfg.recip_iterations)
+                .cycles(cfg.recip_iteration_cycles),
+        )
+        .stage(
+            Stage::new("round")
+                .then(Component::LeadingZeros { width: w + 1 })
+                .then(Component::Shifter {
+                    width: w + 1,
+                    shift_bits: ceil_log2(w + 1),
+                })
+                .then(Component::Adder { width: m + 1 })
+                .then(Component::Register { bits: m + 1 + 8 }),
+        )
 }

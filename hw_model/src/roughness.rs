@@ -39,6 +39,7 @@ use crate::blinn_phong::{
 };
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_shift_right_sticky, round_shift_right_wide, Rounding, SatCounter};
 use crate::pow::{pow_cost, Pow, PowConfig};
 use crate::rsqrt::{isqrt_u128, range};
@@ -124,7 +125,7 @@ pub struct RoughnessConfig {
     /// The exponent in constant mode. 1..=1024.
     pub rough_const_exponent: u32,
     /// Cycles per multiplier stage.
-    pub rough_mul_cycles: u32,
+    pub rough_mul_cycles: Cycles,
     /// Quotient bits the divider produces per cycle (SRT radix). 1..=8.
     pub rough_div_bits_per_cycle: u32,
     /// Root bits the square root produces per cycle. 1..=8.
@@ -155,7 +156,7 @@ impl RoughnessConfig {
             rough_variant: RoughVariant::Directional,
             rough_exponent_mode: RoughExponentMode::Material,
             rough_const_exponent: 1,
-            rough_mul_cycles: 1,
+            rough_mul_cycles: Cycles::Derived,
             rough_div_bits_per_cycle: 2,
             rough_sqrt_bits_per_cycle: 2,
             rough_uniform: false,
@@ -552,8 +553,81 @@ pub fn rough_specular(
 }
 
 /// Cycles of one divide or square root of `bits` result bits at `per_cycle` bits per cycle.
-fn iter_cycles(bits: u32, per_cycle: u32) -> u32 {
-    bits.div_ceil(per_cycle.max(1))
+/// A digit-recurrence divider or square root of `bits` result bits retiring `per_cycle` bits
+/// per step: `ceil(bits / per_cycle)` steps in series, each `per_cycle` subtract-and-select
+/// slices of `bits + 2` bits (radix `2^per_cycle`).
+fn recurrence(name: &'static str, bits: u32, per_cycle: u32) -> Stage {
+    let k = per_cycle.max(1);
+    let mut s = Stage::new(name);
+    for _ in 0..k {
+        s = s
+            .then(Component::Adder { width: bits + 2 })
+            .then(Component::Mux {
+                width: bits + 2,
+                inputs: 2,
+            });
+    }
+    s.times(bits.div_ceil(k))
+}
+
+/// One multiplier stage of the unit (`rough_mul_cycles`): three `D x D` products side by
+/// side and their sum.
+fn mul_stage(cfg: &RoughnessConfig, n: u32) -> Stage {
+    let d = cfg.rough_d_bits + 2;
+    Stage::new("multiply")
+        .then_n(3, Component::Multiplier { a: d, b: d })
+        .then(Component::Adder { width: 2 * d + 2 })
+        .times(n)
+        .cycles(cfg.rough_mul_cycles)
+}
+
+/// The `cos a'` datapath of [`rough_cost`]: the multiplier stages (three; isotropic two), two
+/// dividers of `rough_div_bits` and the square root of `rough_sqrt_bits` at their radix
+/// (`rough_div_bits_per_cycle`, `rough_sqrt_bits_per_cycle`); empty for `none`.
+#[must_use]
+pub fn datapath(cfg: &RoughnessConfig) -> Datapath {
+    let mul_stages = match cfg.rough_variant {
+        RoughVariant::None => return Datapath::new(),
+        RoughVariant::Isotropic => 2,
+        RoughVariant::Published | RoughVariant::Directional | RoughVariant::Mahalanobis => 3,
+    };
+    Datapath::new()
+        .stage(mul_stage(cfg, mul_stages))
+        .stage(
+            recurrence(
+                "divide step",
+                cfg.rough_div_bits,
+                cfg.rough_div_bits_per_cycle,
+            )
+            .times(
+                2 * cfg
+                    .rough_div_bits
+                    .div_ceil(cfg.rough_div_bits_per_cycle.max(1)),
+            ),
+        )
+        .stage(recurrence(
+            "square-root step",
+            cfg.rough_sqrt_bits,
+            cfg.rough_sqrt_bits_per_cycle,
+        ))
+}
+
+/// [`rough_blinn_phong`]: Blinn-Phong, four dots, the D scaling (one multiplier stage), the
+/// `cos a'` datapath and, with `rough_normalize`, two multiplier stages and one divider.
+#[must_use]
+pub fn shade_datapath(cfg: &RoughnessConfig, c: &crate::blinn_phong::ShadingConfig) -> Datapath {
+    let mut d = crate::blinn_phong::datapath(c)
+        .then(crate::vector::dot_datapath(&c.vector).times(4))
+        .stage(mul_stage(cfg, 1))
+        .then(datapath(cfg));
+    if cfg.rough_normalize && cfg.rough_variant != RoughVariant::None {
+        d = d.stage(mul_stage(cfg, 2)).stage(recurrence(
+            "divide step",
+            cfg.rough_div_bits,
+            cfg.rough_div_bits_per_cycle,
+        ));
+    }
+    d
 }
 
 /// Cost of one `cos a'` for the configured variant (excluding the power unit):
@@ -562,25 +636,27 @@ fn iter_cycles(bits: u32, per_cycle: u32) -> u32 {
 /// (2 mul, 1 add) and one square root. Cycles: three multiplier stages (isotropic: two), the
 /// two divides and the root at their radix.
 #[must_use]
-pub fn rough_cost(cfg: &RoughnessConfig) -> UnitCost {
-    let div = iter_cycles(cfg.rough_div_bits, cfg.rough_div_bits_per_cycle);
-    let root = iter_cycles(cfg.rough_sqrt_bits, cfg.rough_sqrt_bits_per_cycle);
-    let (nm_ops, mul_stages) = match cfg.rough_variant {
+pub fn rough_cost(cfg: &RoughnessConfig, gate_levels_per_cycle: u32) -> UnitCost {
+    let nm_ops = match cfg.rough_variant {
         RoughVariant::None => return UnitCost::default(),
-        RoughVariant::Isotropic => (1, 2),
-        RoughVariant::Published | RoughVariant::Directional | RoughVariant::Mahalanobis => (7, 3),
+        RoughVariant::Isotropic => 1,
+        RoughVariant::Published | RoughVariant::Directional | RoughVariant::Mahalanobis => 7,
     };
     UnitCost {
         ops: 3 + nm_ops + 3 + 3,
-        cycles: mul_stages * cfg.rough_mul_cycles + 2 * div + root,
+        cycles: datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
 }
 
 /// Cost of [`rough_specular`]: [`rough_cost`] plus the power unit.
 #[must_use]
-pub fn rough_specular_cost(cfg: &RoughnessConfig, pow: &PowConfig) -> UnitCost {
-    rough_cost(cfg).plus(pow_cost(pow))
+pub fn rough_specular_cost(
+    cfg: &RoughnessConfig,
+    pow: &PowConfig,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
+    rough_cost(cfg, gate_levels_per_cycle).plus(pow_cost(pow, gate_levels_per_cycle))
 }
 
 /// Inputs of [`rough_blinn_phong`] beyond the Blinn-Phong ones.
@@ -715,25 +791,31 @@ pub fn normalize_spec(
 /// Cost of [`rough_blinn_phong`]: Blinn-Phong plus four dots and two multiply-subtracts for
 /// `d`, the D scaling (3 multiplies) and [`rough_cost`].
 #[must_use]
-pub fn rough_blinn_phong_cost(cfg: &RoughnessConfig, units: &ShadingUnits) -> UnitCost {
-    blinn_phong_cost(units)
-        .plus(dot_cost(&units.cfg.vector).times(4))
+pub fn rough_blinn_phong_cost(
+    cfg: &RoughnessConfig,
+    units: &ShadingUnits,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
+    let g = gate_levels_per_cycle;
+    let mut c = blinn_phong_cost(units, g)
+        .plus(dot_cost(&units.cfg.vector, g).times(4))
         .plus(UnitCost {
             ops: 5,
-            cycles: cfg.rough_mul_cycles,
+            cycles: 0,
             texels: 0,
         })
-        .plus(rough_cost(cfg))
+        .plus(rough_cost(cfg, g))
         .plus(
             if cfg.rough_normalize && cfg.rough_variant != RoughVariant::None {
                 UnitCost {
                     ops: 3,
-                    cycles: 2 * cfg.rough_mul_cycles
-                        + iter_cycles(cfg.rough_div_bits, cfg.rough_div_bits_per_cycle),
+                    cycles: 0,
                     texels: 0,
                 }
             } else {
                 UnitCost::default()
             },
-        )
+        );
+    c.cycles = shade_datapath(cfg, &units.cfg).latency(g);
+    c
 }

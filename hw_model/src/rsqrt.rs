@@ -19,6 +19,8 @@
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::Cycles;
+use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, Rounding};
 use serde::{Deserialize, Serialize};
 
@@ -38,9 +40,9 @@ pub struct RsqrtConfig {
     /// Rounding of the input mantissa, of each product and of the result.
     pub rsqrt_rounding: Rounding,
     /// Cycles of the LUT lookup.
-    pub rsqrt_lut_cycles: u32,
+    pub rsqrt_lut_cycles: Cycles,
     /// Cycles per Newton-Raphson iteration (three multiplies and a subtract).
-    pub rsqrt_cycles_per_iteration: u32,
+    pub rsqrt_cycles_per_iteration: Cycles,
 }
 
 impl RsqrtConfig {
@@ -52,8 +54,8 @@ impl RsqrtConfig {
             rsqrt_iterations: 1,
             rsqrt_mantissa_bits: 24,
             rsqrt_rounding: Rounding::HalfEven,
-            rsqrt_lut_cycles: 1,
-            rsqrt_cycles_per_iteration: 3,
+            rsqrt_lut_cycles: Cycles::Derived,
+            rsqrt_cycles_per_iteration: Cycles::Derived,
         }
     }
 
@@ -209,12 +211,54 @@ impl Rsqrt {
     }
 }
 
-/// Cost of one `1/sqrt`: one LUT read, then three multiplies and a subtract per iteration.
+/// Cost of one `1/sqrt`: one LUT read, then three multiplies and a subtract per iteration;
+/// cycles from [`datapath`] at `gate_levels_per_cycle`.
 #[must_use]
-pub fn rsqrt_cost(cfg: &RsqrtConfig) -> UnitCost {
+pub fn rsqrt_cost(cfg: &RsqrtConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 1 + 4 * cfg.rsqrt_iterations,
-        cycles: cfg.rsqrt_lut_cycles + cfg.rsqrt_iterations * cfg.rsqrt_cycles_per_iteration,
+        cycles: datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
+}
+
+/// The unit's datapath (P = B + 4 working bits): normalize the input (leading-zero count,
+/// even shift), the seed ROM (`rsqrt_lut_cycles`), per iteration `y^2`, `M y^2`, `3 - .`,
+/// `y (.) / 2` (`rsqrt_cycles_per_iteration`), the final rounding to B bits.
+#[must_use]
+pub fn datapath(cfg: &RsqrtConfig) -> Datapath {
+    let b = cfg.rsqrt_mantissa_bits;
+    let w = b + RSQRT_GUARD_BITS + 2;
+    Datapath::new()
+        .stage(
+            Stage::new("normalize")
+                .then(Component::LeadingZeros { width: 64 })
+                .then(Component::Shifter {
+                    width: b,
+                    shift_bits: 6,
+                })
+                .then(Component::Adder { width: b }),
+        )
+        .stage(
+            Stage::new("seed ROM")
+                .then(Component::Rom {
+                    addr_bits: cfg.rsqrt_lut_bits,
+                    data_bits: w,
+                })
+                .cycles(cfg.rsqrt_lut_cycles),
+        )
+        .stage(
+            Stage::new("Newton-Raphson step")
+                .then(Component::Multiplier { a: w, b: w })
+                .then(Component::Multiplier { a: w, b: w })
+                .then(Component::Adder { width: w + 1 })
+                .then(Component::Multiplier { a: w, b: w + 1 })
+                .times(cfg.rsqrt_iterations)
+                .cycles(cfg.rsqrt_cycles_per_iteration),
+        )
+        .stage(
+            Stage::new("round")
+                .then(Component::Adder { width: b + 1 })
+                .then(Component::Register { bits: b + 1 + 8 }),
+        )
 }

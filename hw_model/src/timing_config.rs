@@ -76,6 +76,19 @@ pub struct TimingConfig {
     /// Arithmetic units are pipelined: one operation issues per cycle and its cycles from the
     /// unit configs are latency. When false, a unit is busy for all of its cycles (iterative).
     pub alu_pipelined: bool,
+    /// The clock target: gate levels that fit in one cycle. Every unit's latency is derived
+    /// from its datapath's critical path as `ceil(delay / gate_levels_per_cycle)` per stage
+    /// (`hw_model::datapath`), unless a hand-set `*_cycles` field overrides it. Absent in older
+    /// files: 32 (an assumption, like the other timing parameters).
+    #[serde(default = "default_gate_levels_per_cycle")]
+    pub gate_levels_per_cycle: u32,
+}
+
+/// The presets' clock target (an assumption: about 32 gate levels per cycle).
+pub const DEFAULT_GATE_LEVELS_PER_CYCLE: u32 = 32;
+
+const fn default_gate_levels_per_cycle() -> u32 {
+    DEFAULT_GATE_LEVELS_PER_CYCLE
 }
 
 impl TimingConfig {
@@ -99,6 +112,7 @@ impl TimingConfig {
             shade_pixels_per_cycle: 1,
             shade_pixels_in_flight: 16,
             alu_pipelined: true,
+            gate_levels_per_cycle: DEFAULT_GATE_LEVELS_PER_CYCLE,
         }
     }
 
@@ -122,6 +136,7 @@ impl TimingConfig {
             shade_pixels_per_cycle: 1,
             shade_pixels_in_flight: 64,
             alu_pipelined: true,
+            gate_levels_per_cycle: DEFAULT_GATE_LEVELS_PER_CYCLE,
         }
     }
 
@@ -159,6 +174,12 @@ impl TimingConfig {
                 64,
             ),
             ("shade_pixels_per_cycle", self.shade_pixels_per_cycle, 1, 64),
+            (
+                "gate_levels_per_cycle",
+                self.gate_levels_per_cycle,
+                1,
+                10_000,
+            ),
             (
                 "shade_pixels_in_flight",
                 self.shade_pixels_in_flight,

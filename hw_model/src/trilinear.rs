@@ -25,6 +25,7 @@
 
 use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, Rounding};
 use crate::wrap::{wrap, WrapMode};
 
@@ -207,23 +208,65 @@ pub fn trilinear(
 
 /// Cost of one trilinear sample using `levels_used` (1 or 2) levels: per level the two wraps,
 /// 4 fetches and 3 lerps per channel; plus the level blend (4 lerps) when two levels are used.
+/// Cycles from [`datapath`] at `gate_levels_per_cycle`.
 #[must_use]
-pub fn trilinear_cost(cfg: &TrilinearConfig, levels_used: u32) -> UnitCost {
+pub fn trilinear_cost(
+    cfg: &TrilinearConfig,
+    levels_used: u32,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
     let per_level = UnitCost {
         ops: 2 * 5 + 12,
-        cycles: cfg.bilinear_cycles,
+        cycles: 0,
         texels: 4,
     };
     let blend = if levels_used > 1 {
         UnitCost {
             ops: 4,
-            cycles: cfg.level_lerp_cycles,
+            cycles: 0,
             texels: 0,
         }
     } else {
         UnitCost::default()
     };
-    per_level.times(levels_used).plus(blend)
+    let mut c = per_level.times(levels_used).plus(blend);
+    c.cycles = datapath(cfg, levels_used).latency(gate_levels_per_cycle);
+    c
+}
+
+/// Appends `n` lerps side by side (T = `texel_bits`, W = `weight_bits`): the difference
+/// `b - a`, its product with the `W + 1`-bit weight, the add of `a 2^W` with the rounding.
+fn lerp_steps(s: Stage, cfg: &TrilinearConfig, n: u32) -> Stage {
+    let (t, w) = (cfg.texel_bits, cfg.weight_bits);
+    s.then_n(n, Component::Adder { width: t + 1 })
+        .then_n(n, Component::Multiplier { a: t + 1, b: w + 1 })
+        .then_n(n, Component::Adder { width: t + w + 2 })
+}
+
+/// One bilinear footprint (`bilinear_cycles`): the address unit of both axes, the 4-channel
+/// lerps along x on both rows side by side, the lerps along y, the result register.
+#[must_use]
+pub fn bilinear_datapath(cfg: &TrilinearConfig) -> Datapath {
+    let s = crate::wrap::address_steps(Stage::new("bilinear footprint"), cfg, 2);
+    let s = lerp_steps(lerp_steps(s, cfg, 8), cfg, 4)
+        .then(Component::Register {
+            bits: 4 * cfg.texel_bits,
+        })
+        .cycles(cfg.bilinear_cycles);
+    Datapath::new().stage(s)
+}
+
+/// The trilinear unit with `levels_used` levels: a bilinear footprint per level, then
+/// (two levels) the 4-channel level blend (`level_lerp_cycles`).
+#[must_use]
+pub fn datapath(cfg: &TrilinearConfig, levels_used: u32) -> Datapath {
+    let blend = lerp_steps(Stage::new("level blend"), cfg, 4)
+        .then(Component::Register {
+            bits: 4 * cfg.texel_bits,
+        })
+        .cycles(cfg.level_lerp_cycles)
+        .times(u32::from(levels_used > 1));
+    bilinear_datapath(cfg).times(levels_used).stage(blend)
 }
 
 /// The module's error bound vs exact arithmetic (same coordinates, same quantized LOD), in
@@ -249,4 +292,13 @@ pub fn trilinear_error_bound_q8(cfg: &TrilinearConfig, coord_frac: u32, two_leve
     let weight_term = (2 * dw_units * range * 256) >> (wb + 1);
     let weight_term = weight_term + 1; // round the shifted term up
     weight_term + h * if two_levels { 3 } else { 2 }
+}
+
+/// Cycles of one bilinear footprint and of the level blend at `gate_levels_per_cycle` (the
+/// timing model's filter latency: footprints x the first + the second when two levels).
+#[must_use]
+pub fn filter_latencies(cfg: &TrilinearConfig, gate_levels_per_cycle: u32) -> (u32, u32) {
+    let bilinear = bilinear_datapath(cfg).latency(gate_levels_per_cycle);
+    let both = datapath(cfg, 2).latency(gate_levels_per_cycle);
+    (bilinear, both - 2 * bilinear)
 }

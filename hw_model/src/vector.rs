@@ -13,6 +13,7 @@
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
+use crate::datapath::{Component, Cycles, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
 use crate::rsqrt::{range, Rsqrt};
 use serde::{Deserialize, Serialize};
@@ -33,13 +34,13 @@ pub struct VectorConfig {
     /// Rounding of every vector-unit output.
     pub vector_rounding: Rounding,
     /// Cycles of one dot product (3 multiplies, 2 adds).
-    pub dot_cycles: u32,
+    pub dot_cycles: Cycles,
     /// Cycles of one cross product (6 multiplies, 3 subtracts).
-    pub cross_cycles: u32,
+    pub cross_cycles: Cycles,
     /// Cycles of the final scale in a normalize (3 multiplies), excluding dot and rsqrt.
-    pub normalize_scale_cycles: u32,
+    pub normalize_scale_cycles: Cycles,
     /// Cycles of the bump multiply-add (6 multiplies, 6 adds).
-    pub madd_cycles: u32,
+    pub madd_cycles: Cycles,
 }
 
 impl VectorConfig {
@@ -51,10 +52,10 @@ impl VectorConfig {
             offset_frac_bits: 12,
             offset_int_bits: 3,
             vector_rounding: Rounding::HalfEven,
-            dot_cycles: 1,
-            cross_cycles: 1,
-            normalize_scale_cycles: 1,
-            madd_cycles: 1,
+            dot_cycles: Cycles::Derived,
+            cross_cycles: Cycles::Derived,
+            normalize_scale_cycles: Cycles::Derived,
+            madd_cycles: Cycles::Derived,
         }
     }
 
@@ -231,44 +232,120 @@ pub fn madd(
     out
 }
 
-/// Cost of one dot product.
+/// Cost of one dot product; cycles from [`dot_datapath`].
 #[must_use]
-pub fn dot_cost(cfg: &VectorConfig) -> UnitCost {
+pub fn dot_cost(cfg: &VectorConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 5,
-        cycles: cfg.dot_cycles,
+        cycles: dot_datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
 }
 
-/// Cost of one cross product.
+/// Cost of one cross product; cycles from [`cross_datapath`].
 #[must_use]
-pub fn cross_cost(cfg: &VectorConfig) -> UnitCost {
+pub fn cross_cost(cfg: &VectorConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 9,
-        cycles: cfg.cross_cycles,
+        cycles: cross_datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
 }
 
-/// Cost of one normalize: dot (|v|^2), rsqrt, three scaling multiplies.
+/// Cost of one normalize: dot (|v|^2), rsqrt, three scaling multiplies (the stages of
+/// [`normalize_datapath`]).
 #[must_use]
-pub fn normalize_cost(cfg: &VectorConfig, rsqrt_cost: UnitCost) -> UnitCost {
-    dot_cost(cfg).plus(rsqrt_cost).plus(UnitCost {
-        ops: 3,
-        cycles: cfg.normalize_scale_cycles,
-        texels: 0,
-    })
+pub fn normalize_cost(
+    cfg: &VectorConfig,
+    rsqrt_cost: UnitCost,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
+    dot_cost(cfg, gate_levels_per_cycle)
+        .plus(rsqrt_cost)
+        .plus(UnitCost {
+            ops: 3,
+            cycles: scale_datapath(cfg).latency(gate_levels_per_cycle),
+            texels: 0,
+        })
 }
 
-/// Cost of one bump multiply-add.
+/// Cost of one bump multiply-add; cycles from [`madd_datapath`].
 #[must_use]
-pub fn madd_cost(cfg: &VectorConfig) -> UnitCost {
+pub fn madd_cost(cfg: &VectorConfig, gate_levels_per_cycle: u32) -> UnitCost {
     UnitCost {
         ops: 12,
-        cycles: cfg.madd_cycles,
+        cycles: madd_datapath(cfg).latency(gate_levels_per_cycle),
         texels: 0,
     }
+}
+
+/// Width of a vector component: sign, one integer bit, `vector_frac_bits`.
+fn vw(cfg: &VectorConfig) -> u32 {
+    cfg.vector_frac_bits + 2
+}
+
+/// A dot product (`dot_cycles`): three products side by side, two adds, the rounding.
+#[must_use]
+pub fn dot_datapath(cfg: &VectorConfig) -> Datapath {
+    let v = vw(cfg);
+    Datapath::new().stage(
+        Stage::new("dot")
+            .then_n(3, Component::Multiplier { a: v, b: v })
+            .then(Component::Adder { width: 2 * v + 1 })
+            .then(Component::Adder { width: 2 * v + 2 })
+            .then(Component::Adder { width: v + 2 })
+            .cycles(cfg.dot_cycles),
+    )
+}
+
+/// A cross product (`cross_cycles`): six products side by side, three subtracts, the rounding.
+#[must_use]
+pub fn cross_datapath(cfg: &VectorConfig) -> Datapath {
+    let v = vw(cfg);
+    Datapath::new().stage(
+        Stage::new("cross")
+            .then_n(6, Component::Multiplier { a: v, b: v })
+            .then_n(3, Component::Adder { width: 2 * v + 1 })
+            .then_n(3, Component::Adder { width: v + 1 })
+            .cycles(cfg.cross_cycles),
+    )
+}
+
+/// The normalizer's scaling (`normalize_scale_cycles`): three products by `1/|v|`, rounding.
+#[must_use]
+pub fn scale_datapath(cfg: &VectorConfig) -> Datapath {
+    let v = vw(cfg);
+    Datapath::new().stage(
+        Stage::new("scale by 1/|v|")
+            .then_n(3, Component::Multiplier { a: v, b: v + 2 })
+            .then_n(3, Component::Adder { width: v + 1 })
+            .then(Component::Register { bits: 3 * v })
+            .cycles(cfg.normalize_scale_cycles),
+    )
+}
+
+/// A normalize: [`dot_datapath`] (`|v|^2`), the rsqrt unit, [`scale_datapath`].
+#[must_use]
+pub fn normalize_datapath(cfg: &VectorConfig, rsqrt: &crate::rsqrt::RsqrtConfig) -> Datapath {
+    dot_datapath(cfg)
+        .then(crate::rsqrt::datapath(rsqrt))
+        .then(scale_datapath(cfg))
+}
+
+/// The bump multiply-add `n + f_u t_u + f_v t_v` (`madd_cycles`; O = offset width): six
+/// products side by side, two adds per component, the rounding.
+#[must_use]
+pub fn madd_datapath(cfg: &VectorConfig) -> Datapath {
+    let v = vw(cfg);
+    let o = cfg.offset_frac_bits + cfg.offset_int_bits + 1;
+    Datapath::new().stage(
+        Stage::new("multiply-add")
+            .then_n(6, Component::Multiplier { a: v, b: o })
+            .then_n(3, Component::Adder { width: v + o + 1 })
+            .then_n(3, Component::Adder { width: v + o + 2 })
+            .then_n(3, Component::Adder { width: v + 1 })
+            .cycles(cfg.madd_cycles),
+    )
 }
 
 /// Decodes a filtered offset texel (unsigned, `texel_bits` bits, value `t / 2^texel_bits`)

@@ -1,5 +1,7 @@
 //! Texel address and wrap unit.
 
+use crate::config::TrilinearConfig;
+use crate::datapath::{Component, Datapath, Stage};
 use serde::{Deserialize, Serialize};
 
 /// Texture addressing mode of one axis.
@@ -133,7 +135,7 @@ pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
 }
 
 /// Cost of the address unit for one axis of one level: multiply, subtract, round, 2 wraps
-/// (its cycles are part of `bilinear_cycles`).
+/// (its cycles are part of the bilinear stage of [`crate::trilinear::bilinear_datapath`]).
 #[must_use]
 pub fn wrap_cost(_cfg: &crate::config::TrilinearConfig) -> crate::cost::UnitCost {
     crate::cost::UnitCost {
@@ -141,4 +143,45 @@ pub fn wrap_cost(_cfg: &crate::config::TrilinearConfig) -> crate::cost::UnitCost
         cycles: 0,
         texels: 0,
     }
+}
+
+/// Width of the normalized texture coordinate entering the address unit.
+pub const COORD_BITS: u32 = 32;
+/// Width of a texel index and level size (levels up to 2^16 texels a side).
+pub const INDEX_BITS: u32 = 17;
+
+/// Appends the address unit of `axes` axes side by side to `s` (W = `weight_bits`): the
+/// coordinate times the level size, the `- 1/2` and rounding to W fraction bits, and for the
+/// two texel indices the compare against the size, the wrap subtract and the mode select.
+#[must_use]
+pub fn address_steps(s: Stage, cfg: &TrilinearConfig, axes: u32) -> Stage {
+    let w = cfg.weight_bits;
+    s.then_n(
+        axes,
+        Component::Multiplier {
+            a: COORD_BITS,
+            b: INDEX_BITS,
+        },
+    )
+    .then_n(
+        axes,
+        Component::Adder {
+            width: INDEX_BITS + w + 1,
+        },
+    )
+    .then_n(2 * axes, Component::Comparator { width: INDEX_BITS })
+    .beside(2 * axes, Component::Adder { width: INDEX_BITS })
+    .then_n(
+        2 * axes,
+        Component::Mux {
+            width: INDEX_BITS,
+            inputs: 3,
+        },
+    )
+}
+
+/// The address/wrap unit of one level (both axes side by side).
+#[must_use]
+pub fn datapath(cfg: &TrilinearConfig) -> Datapath {
+    Datapath::new().stage(address_steps(Stage::new("address and wrap"), cfg, 2))
 }

@@ -613,9 +613,9 @@ pub struct GridCost {
 
 /// The cost of rendering `spec` on the unit `cfg` (see [`GridCost`]).
 #[must_use]
-pub fn grid_cost(spec: &GridSpec, cfg: &AnisoPhongConfig) -> GridCost {
-    let unit = hw_model::aniso_phong::aniso_phong_cost(cfg);
-    let setup = hw_model::aniso_phong::aniso_phong_material_cost(cfg);
+pub fn grid_cost(spec: &GridSpec, cfg: &AnisoPhongConfig, gate_levels_per_cycle: u32) -> GridCost {
+    let unit = hw_model::aniso_phong::aniso_phong_cost(cfg, gate_levels_per_cycle);
+    let setup = hw_model::aniso_phong::aniso_phong_material_cost(cfg, gate_levels_per_cycle);
     let evals = match spec.lighting {
         Lighting::Light { .. } => 1,
         Lighting::Furnace => {
@@ -652,9 +652,11 @@ pub fn cost_line(name: &str, c: &GridCost) -> String {
 
 /// The four paper grids (metal/plastic x furnace/light) at `sphere_px` per sphere over
 /// `exponents`, furnace resolution `furnace_res`: images ([`add_grid_outputs`]) plus a text
-/// report with error and cost per grid (`texsim brdf spheres`).
+/// report with error and cost per grid (`texsim brdf spheres`); cycles at
+/// `gate_levels_per_cycle`.
 pub fn spheres_report(
     cfg: &AnisoPhongConfig,
+    gate_levels_per_cycle: u32,
     exponents: &[f64],
     sphere_px: u32,
     furnace_res: usize,
@@ -666,7 +668,10 @@ pub fn spheres_report(
         spec.sphere_px = sphere_px;
         spec.furnace_res = furnace_res;
         text.push_str(&add_grid_outputs(&mut all, &name, &spec, cfg)?);
-        text.push_str(&cost_line(&name, &grid_cost(&spec, cfg)));
+        text.push_str(&cost_line(
+            &name,
+            &grid_cost(&spec, cfg, gate_levels_per_cycle),
+        ));
     }
     Ok((all, text))
 }

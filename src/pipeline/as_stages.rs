@@ -131,23 +131,20 @@ impl Machine<'_> {
 #[must_use]
 pub fn as_shade_cost(m: &Machine, plan: &Plan) -> UnitCost {
     let u = &m.units;
-    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
+    let g = m.hw.timing.gate_levels_per_cycle;
+    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
     let np = super::bump_stages::point_lights(m) as u32;
     let lights = m.lights.len() as u32;
-    let mac = UnitCost {
-        ops: 3,
-        cycles: u.cfg.shade.shade_cycles,
-        texels: 0,
-    };
+    let mac = hw_model::blinn_phong::mac_cost(&u.cfg, g);
     let add = UnitCost {
         ops: 3,
-        cycles: 1,
+        cycles: hw_model::blinn_phong::half_vector_datapath(&u.cfg).latency(g),
         texels: 0,
     };
     let per_light = add
         .plus(nz)
-        .plus(dot_cost(&u.cfg.vector).times(6))
-        .plus(aniso_phong_cost(&m.hw.aniso_phong))
+        .plus(dot_cost(&u.cfg.vector, g).times(6))
+        .plus(aniso_phong_cost(&m.hw.aniso_phong, g))
         .plus(mac.times(2));
     let mut c = nz.times(1 + np).plus(per_light.times(lights)).plus(mac);
     if plan.texture.is_some() {

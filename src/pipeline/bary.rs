@@ -49,8 +49,8 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
 #[must_use]
 pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
     if plan.derivatives {
-        perspective_bary_derivs_cost(&m.hw.interp, &m.recip)
+        perspective_bary_derivs_cost(&m.hw.interp, &m.recip, m.hw.timing.gate_levels_per_cycle)
     } else {
-        perspective_bary_cost(&m.hw.interp, &m.recip)
+        perspective_bary_cost(&m.hw.interp, &m.recip, m.hw.timing.gate_levels_per_cycle)
     }
 }

@@ -614,20 +614,17 @@ pub fn bump_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
     let u = &m.units;
     let fk = m.frame_of(bp);
     let np = point_lights(m) as u32;
-    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
-    let mac = UnitCost {
-        ops: 3,
-        cycles: u.cfg.shade.shade_cycles,
-        texels: 0,
-    };
+    let g = m.hw.timing.gate_levels_per_cycle;
+    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
+    let mac = hw_model::blinn_phong::mac_cost(&u.cfg, g);
     match kind {
-        StageKind::Normal => interpolate_cost(&m.hw.interp).times(normal_attr_count(m, bp, fk)),
-        StageKind::BumpFetch => lod_cost(&m.hw.lod).plus(trilinear_cost(&m.hw.trilinear, 2)),
-        StageKind::Frame => frame_cost(fk, u),
-        StageKind::Perturb => perturb_cost(u),
+        StageKind::Normal => interpolate_cost(&m.hw.interp, g).times(normal_attr_count(m, bp, fk)),
+        StageKind::BumpFetch => lod_cost(&m.hw.lod, g).plus(trilinear_cost(&m.hw.trilinear, 2, g)),
+        StageKind::Frame => frame_cost(fk, u, g),
+        StageKind::Perturb => perturb_cost(u, g),
         StageKind::Phong => {
             let lights = m.lights.len() as u32;
-            let mut c = blinn_phong_cost(u)
+            let mut c = blinn_phong_cost(u, g)
                 .times(lights)
                 .plus(nz.times(1 + np))
                 .plus(mac.times(1 + lights));

@@ -44,5 +44,5 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
 /// One invocation: three interpolations.
 #[must_use]
 pub fn cost(m: &Machine, _: &Plan) -> UnitCost {
-    interpolate_cost(&m.hw.interp).times(3)
+    interpolate_cost(&m.hw.interp, m.hw.timing.gate_levels_per_cycle).times(3)
 }

@@ -36,5 +36,5 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
 /// One invocation of the LOD unit.
 #[must_use]
 pub fn cost(m: &Machine, _: &Plan) -> UnitCost {
-    lod_cost(&m.hw.lod)
+    lod_cost(&m.hw.lod, m.hw.timing.gate_levels_per_cycle)
 }

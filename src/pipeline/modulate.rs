@@ -40,5 +40,5 @@ pub fn float(_: &Px, frag: &mut Frag, _: &mut Counters) {
 /// One invocation of the modulate unit.
 #[must_use]
 pub fn cost(m: &Machine, _: &Plan) -> UnitCost {
-    modulate_cost(&m.hw.color)
+    modulate_cost(&m.hw.color, m.hw.timing.gate_levels_per_cycle)
 }

@@ -158,24 +158,21 @@ pub fn ndf_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
         return UnitCost::default();
     }
     let hw = m.hw;
+    let g = hw.timing.gate_levels_per_cycle;
     match kind {
         StageKind::NdfFetch => {
-            lod_cost(&hw.lod).plus(trilinear_cost(&hw.trilinear, 2).times(fetch_lookups(hw)))
+            lod_cost(&hw.lod, g).plus(trilinear_cost(&hw.trilinear, 2, g).times(fetch_lookups(hw)))
         }
         StageKind::NdfShade => {
             let u = &m.units;
             let lights = m.lights.len() as u32;
             let np = super::bump_stages::point_lights(m) as u32;
-            let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
-            let mac = UnitCost {
-                ops: 3,
-                cycles: u.cfg.shade.shade_cycles,
-                texels: 0,
-            };
+            let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
+            let mac = hw_model::blinn_phong::mac_cost(&u.cfg, g);
             // `exact` has no unit cost (float only): the stage's cost is then incomplete and
             // `render` marks the cycle estimate as not modelled ([`EXACT_NOT_MODELLED`]).
             let mut unit =
-                ndf_cost(&hw.ndf, &m.recip.cost(), &hw.shading.rsqrt).unwrap_or_default();
+                ndf_cost(&hw.ndf, &m.recip.cost(g), &hw.shading.rsqrt, g).unwrap_or_default();
             unit.texels = 0;
             // Per light: l (point lights), h, h in the frame (3 dots), n.l, D, two MACs.
             unit.times(lights)

@@ -206,22 +206,19 @@ pub fn rough_stage_cost(m: &Machine, kind: StageKind, plan: &Plan) -> UnitCost {
         return UnitCost::default();
     };
     let u = &m.units;
+    let g = m.hw.timing.gate_levels_per_cycle;
     let cfg = hw_model::roughness::RoughnessConfig {
         rough_variant: rp.variant,
         ..m.hw.roughness.clone()
     };
     match kind {
-        StageKind::RoughFetch => trilinear_cost(&m.hw.trilinear, 2),
+        StageKind::RoughFetch => trilinear_cost(&m.hw.trilinear, 2, g),
         StageKind::RoughShade => {
             let np = point_lights(m) as u32;
             let lights = m.lights.len() as u32;
-            let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt));
-            let mac = UnitCost {
-                ops: 3,
-                cycles: u.cfg.shade.shade_cycles,
-                texels: 0,
-            };
-            let mut c = rough_blinn_phong_cost(&cfg, u)
+            let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
+            let mac = hw_model::blinn_phong::mac_cost(&u.cfg, g);
+            let mut c = rough_blinn_phong_cost(&cfg, u, g)
                 .times(lights)
                 .plus(nz.times(1 + np))
                 .plus(mac.times(1 + lights));

@@ -63,6 +63,9 @@ impl Counters {
 pub struct Machine<'a> {
     pub hw: &'a HwConfig,
     pub recip: Reciprocal,
+    /// Cost of one footprint-assembly lookup with 1, 2, 4, 8 and 16 probes (index `log2`),
+    /// computed once from the datapaths (`aniso_adaptive` charges each pixel's own probes).
+    pub footprint_costs: [UnitCost; 5],
     /// Texture coordinates: signed, texcoord_int_bits.texcoord_frac_bits.
     pub uv_fmt: Format,
     /// Colour channels: unorm color_bits (raw 0..2^bits-1).
@@ -116,6 +119,14 @@ impl<'a> Machine<'a> {
         Self {
             hw,
             recip: Reciprocal::new(&hw.reciprocal),
+            footprint_costs: [1, 2, 4, 8, 16].map(|n| {
+                hw_model::footprint::footprint_cost(
+                    &hw.trilinear,
+                    &hw.lod,
+                    n,
+                    hw.timing.gate_levels_per_cycle,
+                )
+            }),
             uv_fmt: Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
                 .with_overflow(i.texcoord_overflow),
             color_fmt: Format::unsigned(0, hw.color.color_bits, hw.color.color_rounding)

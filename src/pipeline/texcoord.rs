@@ -43,7 +43,7 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
 #[must_use]
 pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
     let samples = if plan.derivatives { 3 } else { 1 };
-    interpolate_cost(&m.hw.interp).times(2 * samples)
+    interpolate_cost(&m.hw.interp, m.hw.timing.gate_levels_per_cycle).times(2 * samples)
 }
 
 /// Rounds the float texture coordinates of the first `samples` samples into the machine's

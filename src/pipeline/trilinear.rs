@@ -89,9 +89,14 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
 #[must_use]
 pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
     if plan.derivatives {
-        footprint_cost(&m.hw.trilinear, &m.hw.lod, m.hw.trilinear.aniso_probes)
+        footprint_cost(
+            &m.hw.trilinear,
+            &m.hw.lod,
+            m.hw.trilinear.aniso_probes,
+            m.hw.timing.gate_levels_per_cycle,
+        )
     } else {
-        trilinear_cost(&m.hw.trilinear, 2)
+        trilinear_cost(&m.hw.trilinear, 2, m.hw.timing.gate_levels_per_cycle)
     }
 }
 
@@ -104,9 +109,9 @@ pub fn lookups(hw: &HwConfig) -> u32 {
 /// A stage's accumulated `[ops, cycles, texels]` with this pixel's planned footprint-assembly
 /// cost (`aniso_probes` probes) replaced by that of the `probes` it took (`aniso_adaptive`).
 fn per_pixel_probes(acc: [u64; 3], m: &Machine, probes: u32) -> [u64; 3] {
-    let (tc, lc) = (&m.hw.trilinear, &m.hw.lod);
-    let planned = footprint_cost(tc, lc, tc.aniso_probes);
-    let took = footprint_cost(tc, lc, probes);
+    let cost = |n: u32| m.footprint_costs[(n.clamp(1, 16).ilog2()) as usize];
+    let planned = cost(m.hw.trilinear.aniso_probes);
+    let took = cost(probes);
     [
         acc[0] - u64::from(planned.ops) + u64::from(took.ops),
         acc[1] - u64::from(planned.cycles) + u64::from(took.cycles),

@@ -449,7 +449,9 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
     let mut mem_unit = Unit::default();
     let mut filters = vec![Unit::default(); tc.trilinear_units.max(1) as usize];
     let mut mem = Memory::new(&ev.textures, tc);
-    let tri_cost = trilinear_cost(&hw.trilinear, 2);
+    let glpc = hw.timing.gate_levels_per_cycle;
+    let tri_cost = trilinear_cost(&hw.trilinear, 2, glpc);
+    let (bilinear_lat, blend_lat) = hw_model::trilinear::filter_latencies(&hw.trilinear, glpc);
     let bpc = u64::from(tc.bilinear_per_cycle.max(1));
     let ppc = u64::from(tc.shade_pixels_per_cycle.max(1));
     let alu_occ = |cycles: u64| {
@@ -540,12 +542,8 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
                 }
                 let nfp = (b - a) as u64;
                 let occ = nfp.div_ceil(bpc);
-                let lat = nfp * u64::from(hw.trilinear.bilinear_cycles)
-                    + if nfp > 1 {
-                        u64::from(hw.trilinear.level_lerp_cycles)
-                    } else {
-                        0
-                    };
+                let lat =
+                    nfp * u64::from(bilinear_lat) + if nfp > 1 { u64::from(blend_lat) } else { 0 };
                 let fu = (0..filters.len())
                     .min_by_key(|&j| (filters[j].free.max(data), j))
                     .unwrap_or(0);

@@ -87,20 +87,23 @@ fn as_shade_cost_is_the_unit_costs() {
     let s = small("as-brushed", 160, 120);
     let r = go(&s, &hw, StageImpls::FIXED);
     let sh = &hw.shading;
-    let nz = normalize_cost(&sh.vector, rsqrt_cost(&sh.rsqrt));
+    let g = hw.timing.gate_levels_per_cycle;
+    let nz = normalize_cost(&sh.vector, rsqrt_cost(&sh.rsqrt, g), g);
+    let mac = hw_model::blinn_phong::mac_datapath(sh).latency(g);
+    let half = hw_model::blinn_phong::half_vector_datapath(sh).latency(g);
     // One directional and one point light: eye + point normalizations, then per light the
     // half vector (add + normalize), six dots, the unit and two colour multiply-adds; ambient.
-    let per_light = 1
+    let per_light = half
         + nz.cycles
-        + 6 * dot_cost(&sh.vector).cycles
-        + aniso_phong_cost(&hw.aniso_phong).cycles
-        + 2 * sh.shade.shade_cycles;
-    let per_px = 2 * nz.cycles + 2 * per_light + sh.shade.shade_cycles;
+        + 6 * dot_cost(&sh.vector, g).cycles
+        + aniso_phong_cost(&hw.aniso_phong, g).cycles
+        + 2 * mac;
+    let per_px = 2 * nz.cycles + 2 * per_light + mac;
     let a = stage(&r, StageKind::AsShade);
     assert_eq!(a.issue_cycles, a.invocations * u64::from(per_px));
     // A costlier unit shows up in the stage's cycles and the summary's issue cycles/px.
     let mut slow = hw.clone();
-    slow.aniso_phong.aniso_mul_cycles = 3;
+    slow.aniso_phong.aniso_mul_cycles = hw_model::datapath::Cycles::Fixed(3);
     let r2 = go(&s, &slow, StageImpls::FIXED);
     assert!(stage(&r2, StageKind::AsShade).issue_cycles > a.issue_cycles);
     assert!(r2.stats.issue_cycles.per_covered_pixel > r.stats.issue_cycles.per_covered_pixel);

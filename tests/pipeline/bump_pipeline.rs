@@ -111,7 +111,8 @@ fn per_frame_costs_follow_the_units() {
         let hw = hw_with(kind);
         let r = go(&s, &hw);
         let units = ShadingUnits::new(&hw.shading);
-        let ic = u64::from(interpolate_cost(&hw.interp).cycles);
+        let g = hw.timing.gate_levels_per_cycle;
+        let ic = u64::from(interpolate_cost(&hw.interp, g).cycles);
         // Every pixel interpolates n (3), the eye vector (3) and one point light (3).
         let inv = stage(&r, StageKind::Normal).invocations;
         let base = 9 * ic * inv;
@@ -135,7 +136,7 @@ fn per_frame_costs_follow_the_units() {
                 base + 3 * ic * interpolated_m
             }
         };
-        let exp_frame = u64::from(frame_cost(kind, &units).cycles) * inv;
+        let exp_frame = u64::from(frame_cost(kind, &units, g).cycles) * inv;
         assert_eq!(
             stage(&r, StageKind::Normal).issue_cycles,
             exp_normal,
@@ -146,10 +147,10 @@ fn per_frame_costs_follow_the_units() {
             exp_frame,
             "{kind:?}"
         );
-        let nz = normalize_cost(&hw.shading.vector, rsqrt_cost(&hw.shading.rsqrt));
-        let pert = u64::from(madd_cost(&hw.shading.vector).plus(nz).cycles) * inv;
+        let nz = normalize_cost(&hw.shading.vector, rsqrt_cost(&hw.shading.rsqrt, g), g);
+        let pert = u64::from(madd_cost(&hw.shading.vector, g).plus(nz).cycles) * inv;
         assert_eq!(stage(&r, StageKind::Perturb).issue_cycles, pert, "{kind:?}");
-        let len = u64::from(hw.shading.frame.frame_len_cycles);
+        let len = u64::from(hw_model::frame::len_datapath(&hw.shading).latency(g));
         let frame_nz = u64::from(nz.times(3).cycles);
         match kind {
             FrameKind::Natural => assert_eq!(exp_frame, (frame_nz + len) * inv),
@@ -157,8 +158,8 @@ fn per_frame_costs_follow_the_units() {
             FrameKind::Main => assert!(exp_frame > frame_nz * inv),
         }
         let fetch = u64::from(
-            lod_cost(&hw.lod)
-                .plus(trilinear_cost(&hw.trilinear, 2))
+            lod_cost(&hw.lod, g)
+                .plus(trilinear_cost(&hw.trilinear, 2, g))
                 .cycles,
         ) * inv;
         assert_eq!(stage(&r, StageKind::BumpFetch).issue_cycles, fetch);
@@ -166,9 +167,9 @@ fn per_frame_costs_follow_the_units() {
         // Two lights (directional + point): two Blinn-Phong, eye + point-light normalize,
         // three colour multiply-adds (ambient + one per light).
         let phong = u64::from(
-            blinn_phong_cost(&units).times(2).cycles
+            blinn_phong_cost(&units, g).times(2).cycles
                 + nz.times(2).cycles
-                + 3 * hw.shading.shade.shade_cycles,
+                + 3 * hw_model::blinn_phong::mac_datapath(&hw.shading).latency(g),
         ) * inv;
         assert_eq!(stage(&r, StageKind::Phong).issue_cycles, phong);
         normal.push(stage(&r, StageKind::Normal).issue_cycles);

@@ -216,7 +216,8 @@ fn precision_sweep() {
         cfg.exponent_max_bits = eb;
         let st = run(&cfg, n, 11);
         let (p90, p99) = (quantile(&st.e2e, 0.9), quantile(&st.e2e, 0.99));
-        let cycles = aniso_phong_cost(&cfg).cycles;
+        let cycles =
+            aniso_phong_cost(&cfg, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).cycles;
         println!("{eb:>17} | {p90:.2e} {p99:.2e} {cycles}");
         by_emax.push((p99, cycles));
     }
@@ -359,11 +360,21 @@ fn saturation_is_counted() {
 /// Cost: positive, and slower dividers cost more cycles.
 #[test]
 fn cost_model() {
-    let c = aniso_phong_cost(&cfg16());
+    let c = aniso_phong_cost(
+        &cfg16(),
+        hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE,
+    );
     assert!(c.ops > 20 && c.cycles > 20 && c.texels == 0, "{c:?}");
     let mut slow = cfg16();
     slow.aniso_div_bits_per_cycle = 1;
-    assert!(aniso_phong_cost(&slow).cycles > c.cycles);
+    assert!(
+        aniso_phong_cost(
+            &slow,
+            hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE
+        )
+        .cycles
+            > c.cycles
+    );
     let mut bad = cfg16();
     bad.aniso_pow_lut_bits = 40;
     assert!(bad

@@ -65,15 +65,22 @@ fn validation_names_the_field() {
 #[test]
 fn costs_follow_config() {
     let mut c = ShadingConfig::texram16();
-    let base = rsqrt_cost(&c.rsqrt);
+    let g = hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE;
+    let base = rsqrt_cost(&c.rsqrt, g);
+    // One more Newton-Raphson step adds its stage's derived latency; a hand-set value wins.
+    let step = hw_model::rsqrt::datapath(&c.rsqrt)
+        .stages
+        .iter()
+        .find(|s| s.name == "Newton-Raphson step")
+        .expect("NR stage")
+        .latency_once(g);
     c.rsqrt.rsqrt_iterations = 2;
-    assert_eq!(
-        rsqrt_cost(&c.rsqrt).cycles,
-        base.cycles + c.rsqrt.rsqrt_cycles_per_iteration
-    );
+    assert_eq!(rsqrt_cost(&c.rsqrt, g).cycles, base.cycles + step);
+    c.rsqrt.rsqrt_cycles_per_iteration = hw_model::datapath::Cycles::Fixed(7);
+    assert_eq!(rsqrt_cost(&c.rsqrt, g).cycles, base.cycles - step + 2 * 7);
     c.pow.pow_method = PowMethod::Squaring;
-    assert_eq!(pow_cost(&c.pow).ops, 2 * c.pow.pow_exponent_bits - 1);
+    assert_eq!(pow_cost(&c.pow, g).ops, 2 * c.pow.pow_exponent_bits - 1);
     let u = ShadingUnits::new(&c);
-    assert!(frame_cost(FrameKind::Main, &u).ops > frame_cost(FrameKind::Unit, &u).ops);
-    assert!(perturb_cost(&u).cycles > 0 && blinn_phong_cost(&u).ops > 0);
+    assert!(frame_cost(FrameKind::Main, &u, g).ops > frame_cost(FrameKind::Unit, &u, g).ops);
+    assert!(perturb_cost(&u, g).cycles > 0 && blinn_phong_cost(&u, g).ops > 0);
 }

@@ -135,7 +135,7 @@ fn pow_error_table() {
         println!(
             "{l:12} | {:11.2} | {r:9.3} | {}",
             w * 65536.0,
-            pow_cost(&cfg).cycles
+            pow_cost(&cfg, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).cycles
         );
     }
     println!("pow_guard_bits | squaring err | err/bound | cycles");
@@ -150,7 +150,7 @@ fn pow_error_table() {
         println!(
             "{gb:14} | {:12.2} | {r:9.3} | {}",
             w * 65536.0,
-            pow_cost(&cfg).cycles
+            pow_cost(&cfg, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).cycles
         );
     }
 }

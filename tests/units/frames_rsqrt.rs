@@ -116,10 +116,13 @@ fn rsqrt_error_table() {
             assert!(w <= bound(&cfg), "L={l} it={it}: {w} > {}", bound(&cfg));
             row.push_str(&format!(" {w:.3e} |"));
         }
-        let c = rsqrt_cost(&RsqrtConfig {
-            rsqrt_lut_bits: l,
-            ..RsqrtConfig::texram16()
-        });
+        let c = rsqrt_cost(
+            &RsqrtConfig {
+                rsqrt_lut_bits: l,
+                ..RsqrtConfig::texram16()
+            },
+            hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE,
+        );
         row.push_str(&format!(" {} cyc", c.cycles));
         println!("{row}");
     }

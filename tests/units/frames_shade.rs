@@ -143,7 +143,9 @@ fn point_and_directional_light_vectors() {
     let d = r::light_dir_directional(DVec3::new(0.0, -2.0, 0.0));
     assert!((d - DVec3::Y).length() < 1e-12);
     let u = ShadingUnits::new(&ShadingConfig::texram16());
-    assert!(blinn_phong_cost(&u).cycles > 0);
+    assert!(
+        blinn_phong_cost(&u, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).cycles > 0
+    );
     assert!(ShadingConfig::texram16().validate().is_ok());
 }
 

@@ -481,7 +481,8 @@ fn exact_is_rejected_by_fixed_unit() {
 #[test]
 fn cost_per_option() {
     let hw = HwConfig::texram16();
-    let recip = hw_model::reciprocal::Reciprocal::new(&hw.reciprocal).cost();
+    let recip =
+        hw_model::reciprocal::Reciprocal::new(&hw.reciprocal).cost(hw.timing.gate_levels_per_cycle);
     let rs = RsqrtConfig::texram16();
     println!("norm       density  lookups  texels  ops  cycles");
     let mut partial = 0;
@@ -494,7 +495,7 @@ fn cost_per_option() {
     ] {
         for dens in [NdfDensity::Pearson, NdfDensity::Gauss] {
             let c = cfg(norm, dens);
-            let Some(k) = ndf_cost(&c, &recip, &rs) else {
+            let Some(k) = ndf_cost(&c, &recip, &rs, hw.timing.gate_levels_per_cycle) else {
                 // `exact` is float only: no cost to report.
                 assert_eq!(norm, NdfNorm::Exact);
                 println!(

@@ -386,20 +386,48 @@ fn cost_grows_with_precision_and_none_is_free() {
             rough_sqrt_bits: 24,
             ..c.clone()
         };
-        assert!(rough_cost(&wide).cycles > rough_cost(&c).cycles);
-        assert!(rough_cost(&c).ops > 0);
+        assert!(
+            rough_cost(
+                &wide,
+                hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE
+            )
+            .cycles
+                > rough_cost(&c, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).cycles
+        );
+        assert!(rough_cost(&c, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).ops > 0);
     }
     let iso = RoughnessConfig {
         rough_variant: RoughVariant::Isotropic,
         ..base.clone()
     };
-    assert!(rough_cost(&iso).cycles < rough_cost(&base).cycles);
+    assert!(
+        rough_cost(&iso, hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE).cycles
+            < rough_cost(
+                &base,
+                hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE
+            )
+            .cycles
+    );
     let none = RoughnessConfig {
         rough_variant: RoughVariant::None,
         ..base
     };
-    assert_eq!(rough_cost(&none).cycles, 0);
-    assert_eq!(rough_cost(&none).ops, 0);
+    assert_eq!(
+        rough_cost(
+            &none,
+            hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE
+        )
+        .cycles,
+        0
+    );
+    assert_eq!(
+        rough_cost(
+            &none,
+            hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE
+        )
+        .ops,
+        0
+    );
 }
 
 #[test]

@@ -42,8 +42,8 @@ fn lod_and_offsets_match_the_f64_twin() {
     for f in [4u32, 8, 16] {
         let cfg = LodConfig {
             lod_frac_bits: f,
-            lod_cycles: 2,
-            lod_cycles_per_bit: 0,
+            lod_cycles: hw_model::datapath::Cycles::Fixed(2),
+            lod_cycles_per_bit: hw_model::datapath::Cycles::Fixed(0),
         };
         for _ in 0..200_000 {
             let base = [signed(&mut s, 26), signed(&mut s, 26)];

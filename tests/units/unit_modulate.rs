@@ -91,7 +91,13 @@ fn modulate_random_mixed_widths() {
     // Inputs above their range clamp; zero widths give 0.
     assert_eq!(modulate(1000, 8, 255, 8, 8, Rounding::HalfEven), 255);
     assert_eq!(modulate(5, 0, 5, 8, 8, Rounding::HalfEven), 0);
-    assert!(modulate_cost(&hw_model::HwConfig::texram16().color).ops > 0);
+    assert!(
+        modulate_cost(
+            &hw_model::HwConfig::texram16().color,
+            hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE
+        )
+        .ops > 0
+    );
 }
 
 #[test]

@@ -266,10 +266,17 @@ fn lod_rule_and_trace() {
         (2, 128, 0, 1)
     );
     assert_eq!(trilinear(&[], 0, 0, 16, 0, 8, w, &cfg, None), [0; 4]);
-    assert_eq!(trilinear_cost(&cfg, 2).texels, 8);
-    assert_eq!(trilinear_cost(&cfg, 1).texels, 4);
+    let g = hw_model::timing_config::DEFAULT_GATE_LEVELS_PER_CYCLE;
+    assert_eq!(trilinear_cost(&cfg, 2, g).texels, 8);
+    assert_eq!(trilinear_cost(&cfg, 1, g).texels, 4);
+    // Hand-set cycle fields override the derived latencies.
+    let mut set = cfg.clone();
+    set.bilinear_cycles = hw_model::datapath::Cycles::Fixed(3);
+    set.level_lerp_cycles = hw_model::datapath::Cycles::Fixed(2);
+    assert_eq!(trilinear_cost(&set, 2, g).cycles, 2 * 3 + 2);
+    assert_eq!(trilinear_cost(&set, 1, g).cycles, 3);
     assert_eq!(
-        trilinear_cost(&cfg, 2).cycles,
-        2 * cfg.bilinear_cycles + cfg.level_lerp_cycles
+        trilinear_cost(&cfg, 2, g).cycles,
+        hw_model::trilinear::datapath(&cfg, 2).latency(g)
     );
 }
