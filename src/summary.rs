@@ -38,7 +38,7 @@ pub fn text(s: &RenderStats) -> String {
     }
     let _ = writeln!(
         o,
-        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}",
+        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
         "stage",
         "impl",
         "invocations",
@@ -47,16 +47,21 @@ pub fn text(s: &RenderStats) -> String {
         "busy_cycles",
         "issue_cycles",
         "texels",
-        "tex_bytes"
+        "tex_bytes",
+        "unit",
+        "latency",
+        "area_ge"
     );
     for st in &s.stages {
         let unit = s
             .timing
             .as_ref()
             .and_then(|t| t.units.iter().find(|u| u.unit == st.stage.name()));
+        let uname = stage_unit(st.stage.name());
+        let cost = s.datapath.unit(uname);
         let _ = writeln!(
             o,
-            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}",
+            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
             st.stage.name(),
             if st.invocations == 0 {
                 "-"
@@ -70,6 +75,9 @@ pub fn text(s: &RenderStats) -> String {
             st.issue_cycles,
             st.texels,
             unit.map_or_else(|| "-".into(), |u| u.texture_bytes.to_string()),
+            if cost.is_some() { uname } else { "-" },
+            cost.map_or_else(|| "-".into(), |c| c.latency.to_string()),
+            cost.map_or_else(|| "-".into(), |c| c.area_ge.to_string()),
         );
     }
     if s.input_saturated > 0 {
@@ -91,6 +99,12 @@ pub fn text(s: &RenderStats) -> String {
         );
     }
     o.push_str(&cycles_line(s));
+    let d = &s.datapath;
+    let _ = writeln!(
+        o,
+        "datapath: area {} GE (gate equivalents, a proxy; top-level units), longest unit latency {} cycles ({}); `texsim hw cost` lists every unit",
+        d.area_ge, d.max_latency, d.max_latency_unit
+    );
     let c = &s.issue_cycles;
     let _ = writeln!(
         o,
@@ -126,11 +140,40 @@ pub fn cycles_line(s: &RenderStats) -> String {
     }
 }
 
+/// The `hw_model::datapath::units` name of the unit a stage instantiates (the stage table's
+/// `unit` column; each stage kind is its own instance in the timing model).
+#[must_use]
+pub fn stage_unit(stage: &str) -> &'static str {
+    match stage {
+        "bary" => "interpolator.bary-derivs",
+        "color" | "texcoord" | "normal" => "interpolator.attribute",
+        "lod" => "lod",
+        "trilinear" => "footprint",
+        "bump-fetch" | "rough-fetch" | "ndf-fetch" => "trilinear",
+        "modulate" => "modulate",
+        "frame" => "frame",
+        "perturb" => "perturb",
+        "phong" => "blinn_phong",
+        "as-shade" => "aniso_phong",
+        "rough-shade" => "roughness.shade",
+        "ndf-shade" => "ndf",
+        _ => "",
+    }
+}
+
 fn imp_name(i: crate::pipeline::Impl) -> &'static str {
     match i {
         crate::pipeline::Impl::Fixed => "fixed",
         crate::pipeline::Impl::Float => "float",
     }
+}
+
+/// One unit's cost in a sweep row: critical path (gate levels), latency (cycles), area (GE).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct UnitCost {
+    pub delay: u32,
+    pub latency: u32,
+    pub area_ge: u64,
 }
 
 /// One row of a sweep: the settings, the error against the reference, the cost.
@@ -156,6 +199,16 @@ pub struct SweepRow {
     /// frame time); `None` when a stage has no hardware cost model.
     pub issue_cycles: Option<u64>,
     pub issue_cycles_per_pixel: Option<f64>,
+    /// Total area of the machine's top-level units in gate equivalents (a proxy) and its
+    /// longest unit latency in cycles, with that unit.
+    pub area_ge: u64,
+    pub max_latency: u32,
+    pub max_latency_unit: String,
+    /// Delay, latency and area of every unit (`render::DatapathCost::units`).
+    pub unit_cost: std::collections::BTreeMap<String, UnitCost>,
+    /// The units in pipeline order (`hw_model::datapath::units`), for the tables.
+    #[serde(skip)]
+    pub unit_order: Vec<String>,
     /// ALU ops of the stages per covered pixel (`None` as `issue_cycles`).
     pub ops_per_pixel: Option<f64>,
     pub hw_ms: f64,
@@ -201,6 +254,23 @@ impl SweepRow {
             dram_bytes: t.map(|t| t.memory.dram_bytes),
             issue_cycles: modelled.then_some(s.issue_cycles.total),
             issue_cycles_per_pixel: modelled.then_some(s.issue_cycles.per_covered_pixel),
+            area_ge: s.datapath.area_ge,
+            max_latency: s.datapath.max_latency,
+            max_latency_unit: s.datapath.max_latency_unit.clone(),
+            unit_cost: s
+                .datapath
+                .units
+                .iter()
+                .map(|u| {
+                    let c = UnitCost {
+                        delay: u.delay,
+                        latency: u.latency,
+                        area_ge: u.area_ge,
+                    };
+                    (u.unit.clone(), c)
+                })
+                .collect(),
+            unit_order: s.datapath.units.iter().map(|u| u.unit.clone()).collect(),
             ops_per_pixel: modelled
                 .then(|| s.stages.iter().map(|x| x.ops).sum::<u64>() as f64 / px),
             hw_ms: s.timings.hw_total_ms,
@@ -241,7 +311,7 @@ fn bump_cells(r: &SweepRow) -> [String; 4] {
     ]
 }
 
-const HEADER: [&str; 16] = [
+const HEADER: [&str; 18] = [
     "max8",
     "mean8",
     "rmse8",
@@ -254,6 +324,8 @@ const HEADER: [&str; 16] = [
     "cyc/px",
     "tex_bytes",
     "dram_bytes",
+    "area_ge",
+    "max_lat",
     "ops/px",
     "lookups/px",
     "model_mean8",
@@ -280,6 +352,8 @@ fn cells(r: &SweepRow) -> Vec<String> {
         r.cycles_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
         r.texture_bytes.map_or("-".into(), |c| c.to_string()),
         r.dram_bytes.map_or("-".into(), |c| c.to_string()),
+        r.area_ge.to_string(),
+        r.max_latency.to_string(),
         r.ops_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
         format!("{:.2}", r.lookups_per_pixel),
         r.model_error
@@ -289,7 +363,110 @@ fn cells(r: &SweepRow) -> Vec<String> {
     ]
 }
 
-/// The sweep as an aligned terminal table.
+/// Units whose cost (delay, latency or area) differs from the first row's in some row, in
+/// pipeline order (units a row lacks count as changed).
+#[must_use]
+pub fn changed_units(rows: &[SweepRow]) -> Vec<String> {
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    let mut names: Vec<&String> = Vec::new();
+    for r in rows {
+        for k in &r.unit_order {
+            if !names.contains(&k) {
+                names.push(k);
+            }
+        }
+    }
+    names
+        .into_iter()
+        .filter(|n| {
+            rows.iter()
+                .any(|r| r.unit_cost.get(*n) != first.unit_cost.get(*n))
+        })
+        .cloned()
+        .collect()
+}
+
+/// One field of a [`UnitCost`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum UnitField {
+    Area,
+    Delay,
+    Latency,
+}
+
+impl UnitField {
+    const ALL: [Self; 3] = [Self::Area, Self::Delay, Self::Latency];
+
+    fn of(self, c: &UnitCost) -> u64 {
+        match self {
+            Self::Area => c.area_ge,
+            Self::Delay => u64::from(c.delay),
+            Self::Latency => u64::from(c.latency),
+        }
+    }
+
+    /// The JSON/CSV name.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Area => "area_ge",
+            Self::Delay => "delay",
+            Self::Latency => "latency",
+        }
+    }
+
+    /// The terminal column prefix.
+    fn short(self) -> &'static str {
+        match self {
+            Self::Area => "area",
+            Self::Delay => "delay",
+            Self::Latency => "lat",
+        }
+    }
+}
+
+/// The changed unit costs the terminal table shows: of the units a stage instantiates
+/// ([`stage_unit`]; sub-units such as `bilinear` inside `trilinear` are in the CSV and JSON),
+/// without a unit whose costs equal an earlier one's in every row (`footprint` is `trilinear`
+/// when `aniso_probes = 1`), each field (area, delay, latency) that differs from the first
+/// row's in some row.
+fn table_units(rows: &[SweepRow]) -> Vec<(String, UnitField)> {
+    let staged = |u: &str| {
+        crate::pipeline::StageKind::ALL
+            .iter()
+            .any(|k| stage_unit(k.name()) == u)
+    };
+    let mut out: Vec<String> = Vec::new();
+    for u in changed_units(rows).into_iter().filter(|u| staged(u)) {
+        let same = out.iter().any(|o| {
+            rows.iter()
+                .all(|r| r.unit_cost.get(o) == r.unit_cost.get(&u))
+        });
+        if !same {
+            out.push(u);
+        }
+    }
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    out.into_iter()
+        .flat_map(|u| {
+            UnitField::ALL
+                .into_iter()
+                .filter(|&f| {
+                    let v = |r: &SweepRow| r.unit_cost.get(&u).map(|c| f.of(c));
+                    rows.iter().any(|r| v(r) != v(first))
+                })
+                .map(|f| (u.clone(), f))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// The sweep as an aligned terminal table: the swept fields, the error and cost columns, then
+/// per unit whose cost changed against the first row ([`table_units`]) its area (GE) and delay
+/// (gate levels).
 #[must_use]
 pub fn sweep_table(rows: &[SweepRow]) -> String {
     let mut grid: Vec<Vec<String>> = Vec::with_capacity(rows.len() + 1);
@@ -297,8 +474,12 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
     let bump = bumped(rows);
+    let changed = table_units(rows);
     let mut head = set_names.clone();
     head.extend(HEADER.iter().map(|s| s.to_string()));
+    for (u, f) in &changed {
+        head.push(format!("{}:{u}", f.short()));
+    }
     if bump {
         head.push(BUMP_HEADER[0].into());
     }
@@ -306,6 +487,10 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         line.extend(cells(r));
+        for (u, f) in &changed {
+            let c = r.unit_cost.get(u);
+            line.push(c.map_or_else(|| "-".into(), |c| f.of(c).to_string()));
+        }
         if bump {
             let [used, ..] = bump_cells(r);
             line.push(used);
@@ -335,7 +520,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 
 /// Columns of `sweep.csv` after the swept fields: the names of `sweep.json`'s row fields
 /// (nested metrics joined with a dot).
-pub const CSV_COLUMNS: [&str; 25] = [
+pub const CSV_COLUMNS: [&str; 28] = [
     "error_8bit.max_abs_lsb",
     "error_8bit.mean_abs_lsb",
     "error_8bit.rmse_lsb",
@@ -352,6 +537,9 @@ pub const CSV_COLUMNS: [&str; 25] = [
     "dram_bytes",
     "issue_cycles",
     "issue_cycles_per_pixel",
+    "area_ge",
+    "max_latency",
+    "max_latency_unit",
     "ops_per_pixel",
     "lookups_per_pixel",
     "model_error.mean_abs_lsb",
@@ -389,6 +577,9 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
         opt(r.dram_bytes),
         opt(r.issue_cycles),
         opt(r.issue_cycles_per_pixel),
+        r.area_ge.to_string(),
+        r.max_latency.to_string(),
+        r.max_latency_unit.clone(),
         opt(r.ops_per_pixel),
         r.lookups_per_pixel.to_string(),
         opt(r.model_error.as_ref().map(|e| e.mean_abs_lsb)),
@@ -402,18 +593,41 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
 }
 
 /// The sweep as CSV (RFC 4180, written by the `csv` crate): one column per swept field, then
-/// [`CSV_COLUMNS`], named as in `sweep.json`.
+/// [`CSV_COLUMNS`], named as in `sweep.json`, then `unit_cost.NAME.area_ge`, `.delay` and
+/// `.latency` of every unit whose cost changed against the first row ([`changed_units`]; NAME
+/// may itself contain a dot, the field does not).
 pub fn sweep_csv(rows: &[SweepRow]) -> crate::Result<String> {
+    let changed = changed_units(rows);
+    let unit_cols: Vec<String> = changed
+        .iter()
+        .flat_map(|u| {
+            UnitField::ALL
+                .iter()
+                .map(move |f| format!("unit_cost.{u}.{}", f.name()))
+        })
+        .collect();
     let mut w = csv::Writer::from_writer(Vec::new());
     let err = |e: csv::Error| crate::Error::msg(format!("sweep.csv: {e}"));
     let fields: Vec<String> = rows.first().map_or_else(Vec::new, |r| {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
-    w.write_record(fields.iter().map(String::as_str).chain(CSV_COLUMNS))
-        .map_err(err)?;
+    w.write_record(
+        fields
+            .iter()
+            .map(String::as_str)
+            .chain(CSV_COLUMNS)
+            .chain(unit_cols.iter().map(String::as_str)),
+    )
+    .map_err(err)?;
     for r in rows {
         let mut rec: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         rec.extend(csv_cells(r));
+        for u in &changed {
+            let c = r.unit_cost.get(u);
+            for f in UnitField::ALL {
+                rec.push(c.map_or_else(String::new, |c| f.of(c).to_string()));
+            }
+        }
         w.write_record(&rec).map_err(err)?;
     }
     let bytes = w

@@ -19,7 +19,10 @@ mod stats;
 pub use geometry::Geometry;
 use shading::{bump_attrs, shade, tri_attrs, ShadeInput};
 use stats::bump_frames;
-pub use stats::{BumpStats, IssueCycles, RenderStats, Rendered, RoughStats, StageStats, Timings};
+pub use stats::{
+    BumpStats, DatapathCost, IssueCycles, RenderStats, Rendered, RoughStats, StageStats, Timings,
+    UnitCostRow,
+};
 
 use crate::fixedpoint::to_unorm;
 pub use crate::maps::{bump_sources, ndf_sources, BumpSource, Maps};
@@ -360,6 +363,7 @@ pub fn render(
             stages,
             issue_cycles,
             timing,
+            datapath: DatapathCost::of(hw),
             timings: tm,
             quantization_error: if model_error.is_some() {
                 e8.clone()

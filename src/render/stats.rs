@@ -86,6 +86,59 @@ pub struct IssueCycles {
     pub not_modelled: Option<&'static str>,
 }
 
+/// One hardware unit's cost at the machine's widths (`hw_model::datapath::units`): its
+/// critical path in gate levels, pipeline latency in cycles and area in gate equivalents.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct UnitCostRow {
+    pub unit: String,
+    pub delay: u32,
+    pub latency: u32,
+    pub area_ge: u64,
+}
+
+/// What the machine's datapath costs: every unit ([`UnitCostRow`]), the total area of the
+/// top-level units (`hw_model::datapath::total_area`, a proxy) and the longest unit latency.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct DatapathCost {
+    pub area_ge: u64,
+    pub max_latency: u32,
+    pub max_latency_unit: String,
+    pub units: Vec<UnitCostRow>,
+}
+
+impl DatapathCost {
+    /// The costs of machine `hw`.
+    #[must_use]
+    pub fn of(hw: &HwConfig) -> Self {
+        use hw_model::datapath::{max_latency, total_area, units};
+        let reps = units(hw);
+        let max = max_latency(&reps);
+        Self {
+            area_ge: total_area(&reps),
+            max_latency: max,
+            max_latency_unit: reps
+                .iter()
+                .find(|r| r.latency == max)
+                .map_or_else(String::new, |r| r.name.to_string()),
+            units: reps
+                .iter()
+                .map(|r| UnitCostRow {
+                    unit: r.name.to_string(),
+                    delay: r.delay,
+                    latency: r.latency,
+                    area_ge: r.area,
+                })
+                .collect(),
+        }
+    }
+
+    /// The row of unit `name`, if the machine has it.
+    #[must_use]
+    pub fn unit(&self, name: &str) -> Option<&UnitCostRow> {
+        self.units.iter().find(|u| u.unit == name)
+    }
+}
+
 /// Everything one render produced.
 pub struct Rendered {
     pub hw_image: Image,
@@ -122,6 +175,8 @@ pub struct RenderStats {
     /// The timing model's report of the frame (`RenderOptions::timing`; `None` without it, or
     /// when a stage has no hardware cost model, [`IssueCycles::not_modelled`]).
     pub timing: Option<crate::timing::TimingReport>,
+    /// Delay, latency and area of the machine's units (their datapaths at its widths).
+    pub datapath: DatapathCost,
     /// Wall times: not part of the results (they differ between two runs), so not serialized
     /// with them; `texsim render` writes them into `timings.json`.
     #[serde(skip)]

@@ -769,12 +769,25 @@ fn sweep_csv_uses_the_json_names_and_empty_cells() {
     assert_eq!(head[0], "weight_bits");
     assert!(head.contains(&"cycles".to_string()), "{head:?}");
     assert!(head.contains(&"texture_bytes".to_string()), "{head:?}");
+    assert!(head.contains(&"area_ge".to_string()), "{head:?}");
+    // weight_bits changes the filter's datapath: its area columns are there.
+    assert!(
+        head.contains(&"unit_cost.trilinear.area_ge".to_string()),
+        "{head:?}"
+    );
     let recs: Vec<csv::StringRecord> = rd.records().map(Result::unwrap).collect();
     assert_eq!(recs.len(), 2);
     for (rec, row) in recs.iter().zip(json.as_array().unwrap()) {
         assert_eq!(&rec[0], row["settings"][0][1].as_str().unwrap());
         for (col, cell) in head.iter().zip(rec.iter()).skip(1) {
-            let v = col.split('.').fold(row, |v, k| &v[k]);
+            // `unit_cost.NAME.FIELD`: NAME may contain a dot, FIELD does not.
+            let v = match col.strip_prefix("unit_cost.") {
+                Some(rest) => {
+                    let (unit, field) = rest.rsplit_once('.').unwrap();
+                    &row["unit_cost"][unit][field]
+                }
+                None => col.split('.').fold(row, |v, k| &v[k]),
+            };
             match v {
                 serde_json::Value::Null => assert_eq!(cell, "", "{col}"),
                 serde_json::Value::Number(n) => {

@@ -161,6 +161,7 @@ fn render_and_cycles_print_the_same_cycle_count() {
                 l.starts_with("cycles (timing model)")
                     || l.starts_with("issue cycles")
                     || l.starts_with("stage ")
+                    || l.starts_with("datapath: ")
                     || l.starts_with("wall time"),
                 "a line calls something else cycles: {l}"
             );
@@ -238,4 +239,93 @@ fn sweep_texel_bits_moves_bytes_and_cycles() {
         let rmse = |i: usize| rows[i]["error_8bit"]["rmse_lsb"].as_f64().expect("rmse");
         assert!(rmse(0) > rmse(1), "{hw}: {t}");
     }
+}
+
+/// The sweep rows of `args` (run in `d`, output directory `out`).
+fn sweep_rows(d: &std::path::Path, args: &[&str], out: &str) -> (String, Vec<serde_json::Value>) {
+    let mut a = vec!["sweep"];
+    a.extend(args);
+    a.extend(["--out", out]);
+    let o = texsim(&a, d);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join(out).join("sweep.json")).expect("json"))
+            .expect("parse");
+    (t, j.as_array().expect("rows").clone())
+}
+
+/// What accuracy costs: wider filter weights lower the error and raise the area and the
+/// trilinear unit's delay, each row beside its cycles; the table shows the changed units.
+#[test]
+fn sweep_weight_bits_shows_error_falling_and_cost_rising() {
+    let d = tmp("weightcost");
+    let (t, rows) = sweep_rows(
+        &d,
+        &[
+            "--scene",
+            "demo",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--vary",
+            "weight_bits=4,8,12,16",
+            "--cycles",
+        ],
+        "s",
+    );
+    assert_eq!(rows.len(), 4);
+    for col in [
+        "area_ge",
+        "max_lat",
+        "area:trilinear",
+        "delay:trilinear",
+        "cycles",
+    ] {
+        assert!(t.contains(col), "column {col}: {t}");
+    }
+    let f = |i: usize, k: &str| rows[i][k].as_f64().unwrap_or_else(|| panic!("{k}"));
+    let tri = |i: usize, k: &str| rows[i]["unit_cost"]["trilinear"][k].as_u64().expect(k);
+    for (i, row) in rows.iter().enumerate().skip(1) {
+        assert!(
+            f(i, "area_ge") > f(i - 1, "area_ge"),
+            "area rises with the width: {t}"
+        );
+        assert!(
+            tri(i, "delay") > tri(i - 1, "delay"),
+            "trilinear delay: {t}"
+        );
+        assert!(tri(i, "area_ge") > tri(i - 1, "area_ge"), "{t}");
+        assert!(row["cycles"].as_u64().expect("cycles") > 0);
+    }
+    let rmse = |i: usize| rows[i]["error_8bit"]["rmse_lsb"].as_f64().expect("rmse");
+    assert!(rmse(0) > rmse(1) && rmse(1) > rmse(3), "error falls: {t}");
+}
+
+/// The clock target: fewer gate levels per cycle pipeline every unit deeper, so latencies and
+/// the frame's cycles rise; areas do not change.
+#[test]
+fn sweep_gate_levels_per_cycle_changes_latency_and_cycles() {
+    let d = tmp("glpc");
+    let (t, rows) = sweep_rows(
+        &d,
+        &[
+            "--scene",
+            "bumps",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--vary",
+            "gate_levels_per_cycle=8,16,64",
+        ],
+        "s",
+    );
+    let u = |i: usize, k: &str| rows[i][k].as_u64().unwrap_or_else(|| panic!("{k}"));
+    assert!(u(0, "max_latency") > u(1, "max_latency"), "{t}");
+    assert!(u(1, "max_latency") > u(2, "max_latency"), "{t}");
+    assert!(u(0, "issue_cycles") > u(2, "issue_cycles"), "{t}");
+    assert_ne!(u(0, "cycles"), u(2, "cycles"), "{t}");
+    assert_eq!(u(0, "area_ge"), u(2, "area_ge"), "{t}");
 }
