@@ -418,7 +418,8 @@ pub fn cost_text(c: &HwConfig) -> String {
     let _ = writeln!(
         t,
         "hw '{}': gate_levels_per_cycle = {g}; a stage takes ceil(delay / {g}) cycles unless its \
-         cycle field is hand-set (marked 'set'); area in gate equivalents (NAND2), a proxy",
+         cycle field is hand-set (marked 'set'); area in gate equivalents (NAND2), a proxy; \
+         a stage line is one copy (xN: N copies in series)",
         c.name
     );
     let _ = writeln!(
@@ -437,7 +438,13 @@ pub fn cost_text(c: &HwConfig) -> String {
             "{:<26} {:>6} {:>8} {:>10}{star}",
             r.name, r.delay, r.latency, r.area
         );
-        for s in &r.datapath.stages {
+        // Consecutive identical stages (a unit instantiated twice in series) print once.
+        let stages = &r.datapath.stages;
+        let mut i = 0;
+        while i < stages.len() {
+            let s = &stages[i];
+            let same = stages[i..].iter().take_while(|t| *t == s).count();
+            i += same;
             let steps: Vec<String> = s
                 .steps
                 .iter()
@@ -454,10 +461,11 @@ pub fn cost_text(c: &HwConfig) -> String {
                         .join(" + ")
                 })
                 .collect();
-            let rep = if s.repeat == 1 {
+            let copies = s.repeat * same as u32;
+            let rep = if copies == 1 {
                 String::new()
             } else {
-                format!(" (x{})", s.repeat)
+                format!(" (x{copies})")
             };
             let how = match s.cycles {
                 Cycles::Derived => "",

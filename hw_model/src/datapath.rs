@@ -31,8 +31,8 @@
 //! | ROM, `2^a` words of `d` bits | `a` + 1 (decoder tree, bit line) | `ceil(2^a d / ` [`ROM_BITS_PER_GE`] `)`, 4 bits per GE | mask ROM about 0.25 GE per bit (proxy) |
 //! | register, `b` bits | 0 (setup folded into the stage) | `b` x [`FF_GE`] = 6 | D flip-flop 4.5 to 6.5 GE in standard-cell libraries |
 //!
-//! `gate_levels_per_cycle` (the clock target, `[timing]` of a hw config; presets 24, an
-//! assumption) turns delays into cycles.
+//! `gate_levels_per_cycle` (the clock target, `[timing]` of a hw config; 32 in every preset, an
+//! assumption) turns delays into cycles. docs/COST.md prints every unit at texram16.
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::fmt;

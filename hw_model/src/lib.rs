@@ -1,8 +1,9 @@
 //! Bit-accurate, integer-only models of texture and shading hardware units.
 //!
 //! Each unit is one file and a pure function of (inputs, unit config) -> outputs, with its cost
-//! beside it. Every intermediate lands in a declared [`fixed::Format`]; rounding goes through the
-//! one routine [`fixed::round_shift_right`]; overflow is saturated or wrapped as the format says,
+//! and its datapath ([`datapath`]: components, delay, latency, area) beside it. Every
+//! intermediate lands in a declared [`fixed::Format`]; rounding goes through the one routine
+//! [`fixed::round_shift_right`]; overflow is saturated or wrapped as the format says,
 //! and each event is counted in a [`fixed::SatCounter`]. No floating point anywhere in this crate
 //! (`clippy::float_arithmetic` is denied); conversions to and from float live in `texsim`.
 #![deny(clippy::float_arithmetic)]

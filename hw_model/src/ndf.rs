@@ -785,7 +785,8 @@ fn core_datapath(cfg: &NdfConfig, rsqrt: &RsqrtConfig) -> Option<Datapath> {
     Some(d)
 }
 
-/// The NDF unit: [`core_datapath`] and its reciprocal; `None` for `exact` (float only).
+/// The NDF unit: its multiplies, adds, exp table and rsqrt units, then its reciprocal; `None`
+/// for `exact` (float only).
 #[must_use]
 pub fn datapath(
     cfg: &NdfConfig,

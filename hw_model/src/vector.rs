@@ -316,7 +316,7 @@ pub fn cross_datapath(cfg: &VectorConfig) -> Datapath {
 pub fn scale_datapath(cfg: &VectorConfig) -> Datapath {
     let v = vw(cfg);
     Datapath::new().stage(
-        Stage::new("scale by 1/|v|")
+        Stage::new("scale by rsqrt")
             .then_n(3, Component::Multiplier { a: v, b: v + 2 })
             .then_n(3, Component::Adder { width: v + 1 })
             .then(Component::Register { bits: 3 * v })

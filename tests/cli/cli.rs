@@ -894,3 +894,56 @@ fn killed_renders_leave_whole_output_sets() {
         "{inside:?}"
     );
 }
+
+/// `texsim hw cost` prints every unit with its stages and totals, follows a hw file's widths,
+/// clock target and hand-set cycles, and fails clearly on bad input.
+#[test]
+fn hw_cost_prints_units_and_follows_the_file() {
+    let d = tmp("hwcost");
+    let o = texsim(&["hw", "cost"], &d);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    for unit in hw_model::datapath::units(&hw_model::HwConfig::texram16()) {
+        let line = format!("{} ", unit.name);
+        assert!(
+            out.lines().any(|l| l.starts_with(&line)),
+            "no line for {}",
+            unit.name
+        );
+    }
+    assert!(
+        out.contains("mul17x17") && out.contains("total area"),
+        "{out}"
+    );
+    let unit_line = |out: &str, name: &str| -> Vec<String> {
+        out.lines()
+            .find(|l| l.starts_with(&format!("{name} ")))
+            .map(|l| l.split_whitespace().map(str::to_string).collect())
+            .unwrap_or_default()
+    };
+    // texram16: trilinear 256 levels, 4 + 4 + 2 cycles at 32 levels per cycle.
+    assert_eq!(unit_line(&out, "trilinear")[1..3], ["256", "10"]);
+    std::fs::write(
+        d.join("mine.toml"),
+        "base = \"texram16\"\n[trilinear]\nweight_bits = 8\nbilinear_cycles = 1\n\
+         [timing]\ngate_levels_per_cycle = 16\n",
+    )
+    .unwrap();
+    let o = texsim(&["hw", "cost", "mine.toml"], &d);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    // weight_bits 8: 224 levels; bilinear hand-set to 1 cycle, blend ceil(30 / 16) = 2.
+    assert_eq!(unit_line(&out, "trilinear")[1..3], ["224", "4"]);
+    assert!(out.contains("cycle(s) set"), "{out}");
+    std::fs::write(
+        d.join("zero.toml"),
+        "base = \"texram16\"\n[timing]\ngate_levels_per_cycle = 0\n",
+    )
+    .unwrap();
+    let o = texsim(&["hw", "cost", "zero.toml"], &d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("gate_levels_per_cycle"), "{}", text(&o));
+    let o = texsim(&["hw", "cost", "no-such-preset"], &d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("no-such-preset"), "{}", text(&o));
+}

@@ -27,6 +27,7 @@ mod roughness_unit;
 mod timing_footprint;
 mod timing_units;
 mod unit_bary_derivs;
+mod unit_cost;
 mod unit_fixed;
 mod unit_fixedpoint;
 mod unit_interpolator;
