@@ -117,9 +117,9 @@ fn absent_stages_are_never_invoked() {
             "{:?} ran for an unlit untextured scene",
             st.stage
         );
-        assert_eq!(st.cycles, 0);
+        assert_eq!(st.issue_cycles, 0);
     }
-    assert_eq!(r.stats.cycles.stages, 0);
+    assert_eq!(r.stats.issue_cycles.stages, 0);
 
     for m in &mut s.materials {
         m.lit = true;

@@ -234,3 +234,26 @@ fn unknown_fields_suggest_the_nearest_name() {
         "{e}"
     );
 }
+
+#[test]
+fn texel_bytes_was_removed_with_a_message() {
+    let base = preset("texram16");
+    for name in ["texel_bytes", "timing.texel_bytes"] {
+        let e = set_field(&base, name, "4")
+            .expect_err("removed")
+            .to_string();
+        assert!(e.contains("was removed") && e.contains("texel_bits"), "{e}");
+    }
+    let e = parse("base = \"d3d11\"\n[timing]\ntexel_bytes = 8\n")
+        .expect_err("removed field in a file")
+        .to_string();
+    assert!(
+        e.contains("timing.texel_bytes") && e.contains("was removed") && e.contains("line 3"),
+        "{e}"
+    );
+    // A line or page must hold the widest texel (4 x 16 bits).
+    let e = parse("[timing]\ncache_line_bytes = 4\n")
+        .expect_err("line below a texel")
+        .to_string();
+    assert!(e.contains("cache_line_bytes") && e.contains("8..="), "{e}");
+}

@@ -341,7 +341,7 @@ fn adaptive_probes_follow_the_anisotropy_and_cost_what_they_take() {
         let st = &r.stats.stages[StageKind::Trilinear.index()];
         let ev = r.events.as_ref().expect("events");
         let fps = ev.footprints.len() as u64;
-        // The first estimate counts the probes each pixel took: 4 texels per footprint (8 on
+        // The stage counts the probes each pixel took: 4 texels per footprint (8 on
         // two levels), as the timing model's event stream has them.
         assert!(
             4 * fps <= st.texels && st.texels <= 8 * fps,
@@ -352,7 +352,7 @@ fn adaptive_probes_follow_the_anisotropy_and_cost_what_they_take() {
         (
             blur_error(&r.hw_image, &ss.hw_image, &r.mask),
             st.texels,
-            st.cycles,
+            st.issue_cycles,
             cycles,
         )
     };
