@@ -309,8 +309,8 @@ mod tests {
         }
     }
 
-    /// 3M seeded arguments per configuration (every mode; LUT, iteration and mantissa widths
-    /// varied; arguments of 1 to 64 bits and 0): `eval` and `apply` give the old bits, `apply`
+    /// 3M seeded arguments over 15 configurations (every mode; LUT, iteration and mantissa
+    /// widths varied; arguments of 1 to 64 bits and 0): `eval` and `apply` give the old bits, `apply`
     /// across the 64-bit path, the unchecked 128-bit product (|x| < 2^96) and the saturating
     /// one beyond it, with positive and negative scale.
     #[test]
