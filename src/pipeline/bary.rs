@@ -24,8 +24,10 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         let e = tri.edges_fixed(px.x, px.y, sub);
         frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
     }
-    for s in 0..px.samples() {
-        frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+    if px.carriers {
+        for s in 0..px.samples() {
+            frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+        }
     }
 }
 

@@ -22,7 +22,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let d = texel_derivs(&frag.uv_x, l0.width, l0.height);
     let fb = m.uv_fmt.frac_bits;
     frag.lod_x = hw_model::lod::lod(d, fb, &m.hw.lod, sat);
-    frag.lod = from_raw(frag.lod_x, m.hw.lod.lod_frac_bits);
+    if px.carriers {
+        frag.lod = from_raw(frag.lod_x, m.hw.lod.lod_frac_bits);
+    }
 }
 
 /// Float twin.
