@@ -127,6 +127,28 @@ pub struct LodConfig {
     pub lod_cycles: u32,
     /// Extra cycles per LOD fraction bit (the log2 produces one bit per squaring step).
     pub lod_cycles_per_bit: u32,
+    /// The log2: `exact` (bit-serial squaring) or `piecewise-linear` (exponent plus mantissa
+    /// fraction, llvmpipe's `lp_build_fast_log2`). Absent in older files: `exact`.
+    #[serde(default)]
+    pub lod_log2: LodLog2,
+    /// Derivatives per 2x2 quad (llvmpipe's default): the finite differences between the
+    /// quad's first pixel (even x, even y) and its right and lower neighbours, shared by the
+    /// four pixels; `false`: the analytic derivatives at each pixel. Absent in older files:
+    /// `false`.
+    #[serde(default)]
+    pub lod_per_quad: bool,
+}
+
+/// How the LOD unit forms `log2` of the squared footprint length.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LodLog2 {
+    /// Bit-serial repeated squaring: `floor(log2(L) 2^(F-1))` (see `hw_model::lod`).
+    #[default]
+    Exact,
+    /// `log2(L) ~= e + (L / 2^e - 1)`, `e = floor(log2 L)`: exact at powers of two, at most
+    /// 0.0861 low in between (Mesa llvmpipe's `lp_build_fast_log2`).
+    PiecewiseLinear,
 }
 
 /// Texel address/wrap and the trilinear filter unit.
@@ -198,7 +220,7 @@ pub struct HwConfig {
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
-pub const PRESETS: &[&str] = &["texram16", "d3d11", "vulkan-min", "cuda"];
+pub const PRESETS: &[&str] = &["texram16", "d3d11", "vulkan-min", "cuda", "llvmpipe"];
 
 impl HwConfig {
     /// Texram-style machine: 16-bit datapath throughout (texels, weights, LOD fraction, colour).
@@ -235,6 +257,8 @@ impl HwConfig {
                 lod_frac_bits: 16,
                 lod_cycles: 2,
                 lod_cycles_per_bit: 0,
+                lod_log2: LodLog2::Exact,
+                lod_per_quad: false,
             },
             trilinear: TrilinearConfig {
                 weight_bits: 16,
@@ -297,13 +321,33 @@ impl HwConfig {
         c
     }
 
-    /// A preset by name (`texram16`, `d3d11`, `vulkan-min`, `cuda`).
+    /// Mesa llvmpipe's 8-bit AoS texture path (Mesa 22.3, `lp_bld_sample_aos.c`,
+    /// `lp_bld_sample.c`): 8-bit texels, coordinates rounded to 8 sub-texel bits, lerps
+    /// `a + ((b - a) w + 128) >> 8` (pmulhrsw), LOD per 2x2 quad from finite differences
+    /// with the piecewise-linear `lp_build_fast_log2`, level fraction truncated to 8 bits.
+    #[must_use]
+    pub fn llvmpipe() -> Self {
+        let mut c = Self::texram16();
+        c.name = "llvmpipe".into();
+        c.timing = TimingConfig::modern();
+        c.trilinear.texel_bits = 8;
+        c.trilinear.weight_bits = 8;
+        c.trilinear.filter_rounding = Rounding::HalfUp;
+        c.trilinear.weight_rounding = Rounding::HalfUp;
+        c.lod.lod_frac_bits = 8;
+        c.lod.lod_log2 = LodLog2::PiecewiseLinear;
+        c.lod.lod_per_quad = true;
+        c
+    }
+
+    /// A preset by name (`texram16`, `d3d11`, `vulkan-min`, `cuda`, `llvmpipe`).
     pub fn preset(name: &str) -> Option<Self> {
         match name {
             "texram16" => Some(Self::texram16()),
             "d3d11" => Some(Self::d3d11()),
             "vulkan-min" => Some(Self::vulkan_min()),
             "cuda" => Some(Self::cuda()),
+            "llvmpipe" => Some(Self::llvmpipe()),
             _ => None,
         }
     }

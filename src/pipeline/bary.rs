@@ -1,5 +1,6 @@
 //! `bary`: perspective-correct barycentrics at the pixel and, when the plan needs derivatives,
-//! at its two first-order neighbours (Heckbert & Moreton 1991; `hw_model::interpolator`).
+//! at its two first-order neighbours (Heckbert & Moreton 1991; `hw_model::interpolator`);
+//! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad.
 
 use super::stages::{Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
@@ -17,7 +18,28 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let sub = hw.raster.subpixel_bits;
     let bb = hw.interp.bary_bits;
     let (tri, a, m) = (px.tri, px.a, px.m);
-    if px.plan.derivatives {
+    if px.plan.derivatives && hw.lod.lod_per_quad {
+        // The pixel, then its helpers carry the quad's finite differences.
+        let b = |x: i64, y: i64, sat: &mut _| {
+            perspective_bary(
+                tri.edges_fixed(x, y, sub),
+                a.inv_w_x,
+                &hw.interp,
+                &m.recip,
+                sat,
+            )
+        };
+        let p = b(px.x, px.y, sat);
+        let (qx, qy) = (px.x & !1, px.y & !1);
+        let q0 = b(qx, qy, sat);
+        let q1 = b(qx + 1, qy, sat);
+        let q2 = b(qx, qy + 1, sat);
+        frag.bary_x = [
+            p,
+            [0, 1, 2].map(|i| p[i] + q1[i] - q0[i]),
+            [0, 1, 2].map(|i| p[i] + q2[i] - q0[i]),
+        ];
+    } else if px.plan.derivatives {
         let (e, dx, dy) = tri.edges_fixed_with_steps(px.x, px.y, sub);
         frag.bary_x = perspective_bary_derivs(e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat);
     } else {
@@ -34,7 +56,17 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let (x, y) = (px.x as f64, px.y as f64);
     let (tri, a) = (px.tri, px.a);
     let e = tri.edges_float(x, y);
-    if px.plan.derivatives {
+    if px.plan.derivatives && px.m.hw.lod.lod_per_quad {
+        let p = perspective_bary_f64(e, a.inv_w_f);
+        let (qx, qy) = ((px.x & !1) as f64, (px.y & !1) as f64);
+        let b = |x: f64, y: f64| perspective_bary_f64(tri.edges_float(x, y), a.inv_w_f);
+        let (q0, q1, q2) = (b(qx, qy), b(qx + 1.0, qy), b(qx, qy + 1.0));
+        frag.bary = [
+            p,
+            [0, 1, 2].map(|i| p[i] + q1[i] - q0[i]),
+            [0, 1, 2].map(|i| p[i] + q2[i] - q0[i]),
+        ];
+    } else if px.plan.derivatives {
         let ex = tri.edges_float(x + 1.0, y);
         let ey = tri.edges_float(x, y + 1.0);
         let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
@@ -48,7 +80,9 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
 /// One invocation: the barycentrics, plus their derivatives when the plan needs them.
 #[must_use]
 pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
-    if plan.derivatives {
+    if plan.derivatives && m.hw.lod.lod_per_quad {
+        perspective_bary_cost(&m.hw.interp, &m.recip).times(4)
+    } else if plan.derivatives {
         perspective_bary_derivs_cost(&m.hw.interp, &m.recip)
     } else {
         perspective_bary_cost(&m.hw.interp, &m.recip)
