@@ -111,6 +111,12 @@ pub struct InterpConfig {
     /// Absent in older files: `true`.
     #[serde(default = "yes")]
     pub texcoord_reduce: bool,
+    /// Sub-pixel bits of the vertex positions the barycentrics (the attribute setup) use:
+    /// 0 = the rasterizer's `subpixel_bits`; more models a setup from finer positions than
+    /// coverage (llvmpipe: coverage on 8 bits, attribute planes from the float positions).
+    /// Absent in older files: 0.
+    #[serde(default)]
+    pub attr_subpixel_bits: u32,
     /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
     pub bary_cycles: u32,
     /// Cycles per interpolated scalar attribute.
@@ -250,6 +256,7 @@ impl HwConfig {
                 interp_rounding: Rounding::HalfEven,
                 texcoord_overflow: Overflow::Saturate,
                 texcoord_reduce: true,
+                attr_subpixel_bits: 0,
                 bary_cycles: 2,
                 attr_cycles: 1,
             },
@@ -324,7 +331,8 @@ impl HwConfig {
     /// Mesa llvmpipe's 8-bit AoS texture path (Mesa 22.3, `lp_bld_sample_aos.c`,
     /// `lp_bld_sample.c`): 8-bit texels, coordinates rounded to 8 sub-texel bits, lerps
     /// `a + ((b - a) w + 128) >> 8` (pmulhrsw), LOD per 2x2 quad from finite differences
-    /// with the piecewise-linear `lp_build_fast_log2`, level fraction truncated to 8 bits.
+    /// with the piecewise-linear `lp_build_fast_log2`, level fraction truncated to 8 bits;
+    /// coverage on 8 sub-pixel bits, the attribute setup from positions on 16.
     #[must_use]
     pub fn llvmpipe() -> Self {
         let mut c = Self::texram16();
@@ -337,6 +345,7 @@ impl HwConfig {
         c.lod.lod_frac_bits = 8;
         c.lod.lod_log2 = LodLog2::PiecewiseLinear;
         c.lod.lod_per_quad = true;
+        c.interp.attr_subpixel_bits = 16;
         c
     }
 
@@ -371,6 +380,7 @@ impl HwConfig {
         check("interp.bary_bits", i.bary_bits, 4, 30)?;
         check("interp.texcoord_frac_bits", i.texcoord_frac_bits, 4, 28)?;
         check("interp.texcoord_int_bits", i.texcoord_int_bits, 1, 16)?;
+        check("interp.attr_subpixel_bits", i.attr_subpixel_bits, 0, 16)?;
         check("lod.lod_frac_bits", self.lod.lod_frac_bits, 0, 16)?;
         let t = &self.trilinear;
         check("trilinear.weight_bits", t.weight_bits, 0, 16)?;

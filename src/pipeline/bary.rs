@@ -1,6 +1,7 @@
 //! `bary`: perspective-correct barycentrics at the pixel and, when the plan needs derivatives,
 //! at its two first-order neighbours (Heckbert & Moreton 1991; `hw_model::interpolator`);
-//! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad.
+//! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad;
+//! with `attr_subpixel_bits` the edges come from the float positions on that finer grid.
 
 use super::stages::{Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
@@ -18,16 +19,19 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let sub = hw.raster.subpixel_bits;
     let bb = hw.interp.bary_bits;
     let (tri, a, m) = (px.tri, px.a, px.m);
+    let grid = hw.interp.attr_subpixel_bits;
+    let regrid = grid != 0 && grid != sub;
+    let edges = |x: i64, y: i64| {
+        if regrid {
+            tri.edges_fixed_on_grid(x, y, grid)
+        } else {
+            tri.edges_fixed(x, y, sub)
+        }
+    };
     if px.plan.derivatives && hw.lod.lod_per_quad {
         // The pixel, then its helpers carry the quad's finite differences.
         let b = |x: i64, y: i64, sat: &mut _| {
-            perspective_bary(
-                tri.edges_fixed(x, y, sub),
-                a.inv_w_x,
-                &hw.interp,
-                &m.recip,
-                sat,
-            )
+            perspective_bary(edges(x, y), a.inv_w_x, &hw.interp, &m.recip, sat)
         };
         let p = b(px.x, px.y, sat);
         let (qx, qy) = (px.x & !1, px.y & !1);
@@ -40,11 +44,20 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
             [0, 1, 2].map(|i| p[i] + q2[i] - q0[i]),
         ];
     } else if px.plan.derivatives {
-        let (e, dx, dy) = tri.edges_fixed_with_steps(px.x, px.y, sub);
+        let (e, dx, dy) = if regrid {
+            let e = edges(px.x, px.y);
+            let (ex, ey) = (edges(px.x + 1, px.y), edges(px.x, px.y + 1));
+            (
+                e,
+                [0, 1, 2].map(|i| ex[i].wrapping_sub(e[i])),
+                [0, 1, 2].map(|i| ey[i].wrapping_sub(e[i])),
+            )
+        } else {
+            tri.edges_fixed_with_steps(px.x, px.y, sub)
+        };
         frag.bary_x = perspective_bary_derivs(e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat);
     } else {
-        let e = tri.edges_fixed(px.x, px.y, sub);
-        frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
+        frag.bary_x[0] = perspective_bary(edges(px.x, px.y), a.inv_w_x, &hw.interp, &m.recip, sat);
     }
     for s in 0..px.samples() {
         frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));

@@ -78,6 +78,15 @@ fn llvmpipe_preset_pins_its_texture_path() {
     assert_eq!(l.lod.lod_frac_bits, 8);
     assert_eq!(l.lod.lod_log2, LodLog2::PiecewiseLinear);
     assert!(l.lod.lod_per_quad);
+    assert_eq!(
+        l.raster.subpixel_bits, 8,
+        "coverage on llvmpipe's 8 sub-pixel bits"
+    );
+    assert_eq!(
+        l.interp.attr_subpixel_bits, 16,
+        "attribute planes from finer positions"
+    );
+    assert_eq!(t.interp.attr_subpixel_bits, 0);
     assert_eq!(t.lod.lod_log2, LodLog2::Exact, "other presets unchanged");
     assert!(PRESETS
         .iter()
@@ -88,6 +97,7 @@ fn llvmpipe_preset_pins_its_texture_path() {
     back.timing = t.timing.clone();
     back.trilinear = t.trilinear.clone();
     back.lod = t.lod.clone();
+    back.interp = t.interp.clone();
     assert_eq!(back, t);
     assert_eq!(l.timing, preset("d3d11").timing);
 }
