@@ -226,7 +226,7 @@ pub struct SpheresArgs {
 pub enum HwCmd {
     /// Print a preset (or a hw TOML file, resolved) as TOML.
     Show {
-        /// Preset name (texram16, d3d11, vulkan-min, cuda) or path to a hw TOML file.
+        /// Preset name (texram16, d3d11, vulkan-min, cuda, llvmpipe) or path to a hw TOML file.
         preset: String,
     },
     /// List the presets.
@@ -248,7 +248,7 @@ pub struct SceneArgs {
     /// Built-in scene (see `texsim scenes`); used when no INPUT is given (default: demo).
     #[arg(long)]
     pub scene: Option<String>,
-    /// Hardware: a preset (texram16, d3d11, vulkan-min, cuda) or a hw TOML file.
+    /// Hardware: a preset (texram16, d3d11, vulkan-min, cuda, llvmpipe) or a hw TOML file.
     /// Default: the scene's `hw`, else texram16.
     #[arg(long)]
     pub hw: Option<String>,

@@ -44,6 +44,8 @@ fn lod_and_offsets_match_the_f64_twin() {
             lod_frac_bits: f,
             lod_cycles: hw_model::datapath::Cycles::Fixed(2),
             lod_cycles_per_bit: hw_model::datapath::Cycles::Fixed(0),
+            lod_log2: hw_model::config::LodLog2::Exact,
+            lod_per_quad: false,
         };
         for _ in 0..200_000 {
             let base = [signed(&mut s, 26), signed(&mut s, 26)];
