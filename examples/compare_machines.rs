@@ -1,5 +1,5 @@
 //! Using texsim from Rust: render a built-in scene on two machines and on a swept variant,
-//! and print each one's error against the float reference and its cycle estimate.
+//! and print each one's error against the float reference and its cycles (timing model).
 //!
 //! `cargo run --release --example compare_machines`
 
@@ -23,9 +23,18 @@ fn main() -> texsim::Result<()> {
     ];
     for (label, hw) in &machines {
         // The budget check `texsim` does before it allocates (`render` checks again).
-        texsim::budget::check_run(&sc, hw, true, false)?;
+        texsim::budget::check_run(&sc, hw, true, true)?;
         let maps = Maps::new(&sc, hw.trilinear.texel_bits);
-        let r = render(&sc, &maps, hw, &RenderOptions::default())?;
+        let opts = RenderOptions {
+            timing: true,
+            ..RenderOptions::default()
+        };
+        let r = render(&sc, &maps, hw, &opts)?;
+        let t = r
+            .stats
+            .timing
+            .as_ref()
+            .ok_or_else(|| texsim::Error::msg("no timing report"))?;
         let e = r
             .stats
             .error_8bit
@@ -33,11 +42,7 @@ fn main() -> texsim::Result<()> {
             .ok_or_else(|| texsim::Error::msg("no reference rendered"))?;
         println!(
             "{label:<24} {} pixels: max {} mean {:.4} rmse {:.4} (8-bit LSB), {:.2} cycles/px",
-            r.stats.covered_pixels,
-            e.max_abs_lsb,
-            e.mean_abs_lsb,
-            e.rmse_lsb,
-            r.stats.cycles.per_covered_pixel
+            r.stats.covered_pixels, e.max_abs_lsb, e.mean_abs_lsb, e.rmse_lsb, t.cycles_per_pixel
         );
         for w in &r.stats.warnings {
             println!("  warning: {w}");

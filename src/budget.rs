@@ -255,10 +255,19 @@ impl RunNeed {
             .max_by_key(|p| p.1)
             .cloned()
             .unwrap_or_default();
+        // `render` and `sweep` collect timing events by default: say when skipping them fits.
+        let hint = if self.events > 0 && total - self.events <= limit {
+            format!(
+                "; without the timing events it needs {}: `render` and `sweep` skip them with --no-cycles",
+                human(total - self.events)
+            )
+        } else {
+            String::new()
+        };
         Err(over_budget(
             field,
             &format!(
-                "the run ({what}; in all: triangles {}, textures {}, framebuffer {}, timing events {})",
+                "the run ({what}; in all: triangles {}, textures {}, framebuffer {}, timing events {}{hint})",
                 human(self.triangles),
                 human(self.texels),
                 human(self.framebuffer),

@@ -257,6 +257,9 @@ fn merge(
             }
             (Some(dst), v) => *dst = v,
             (None, _) => {
+                if let Some(why) = removed_field(&path) {
+                    return Err((path.clone(), Error::field(&path, why)));
+                }
                 let hint = did_you_mean(&k, into.keys().map(String::as_str));
                 let e = Error::field(&path, format!("unknown field{hint}"));
                 return Err((path, e));
@@ -302,6 +305,9 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
         "roughness" => "rough_variant",
         other => other,
     };
+    if let Some(why) = removed_field(name) {
+        return Err(Error::field(name, why));
+    }
     let all = fields(c);
     let matches: Vec<&String> = all
         .iter()
@@ -366,6 +372,20 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
         .map_err(|e: toml::de::Error| Error::field(&path, format!("'{value}': {}", e.message())))?;
     cfg.validate()?;
     Ok(cfg)
+}
+
+/// Fields that earlier versions had, with what replaced them: (dotted path, message).
+pub const REMOVED_FIELDS: &[(&str, &str)] = &[(
+    "timing.texel_bytes",
+    "was removed: bytes per texel now follow each map's stored format (texel_bits and the map's channels, e.g. RGBA 16-bit = 8 bytes, see docs/TIMING.md); delete this line, and vary texel_bits (or moment_bits, rough_d_bits) instead",
+)];
+
+/// The message of a removed field named by its dotted path or its leaf name.
+fn removed_field(name: &str) -> Option<&'static str> {
+    REMOVED_FIELDS
+        .iter()
+        .find(|(p, _)| *p == name || p.rsplit('.').next() == Some(name))
+        .map(|(_, why)| *why)
 }
 
 /// `; did you mean 'X'?` with the candidate nearest to `name` (Jaro-Winkler similarity at

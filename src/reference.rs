@@ -69,6 +69,28 @@ pub fn lod_f64(d: [f64; 4]) -> f64 {
     (0.5 * l.log2()).max(-32.0)
 }
 
+/// The float twin of the LOD unit with its `lod_log2` mode: [`lod_f64`] for `exact`; for
+/// `piecewise-linear` `0.5 (e + L / 2^e - 1)` with `e = floor(log2 L)` (llvmpipe's
+/// `lp_build_fast_log2` of the squared length).
+#[must_use]
+pub fn lod_mode_f64(d: [f64; 4], mode: hw_model::config::LodLog2) -> f64 {
+    if mode == hw_model::config::LodLog2::Exact {
+        return lod_f64(d);
+    }
+    let l = (d[0] * d[0] + d[1] * d[1]).max(d[2] * d[2] + d[3] * d[3]);
+    if l.is_nan() || l <= 0.0 || !l.is_finite() {
+        return -32.0;
+    }
+    let mut e = l.log2().floor();
+    // log2 may round across a power of two: fix e so that 2^e <= l < 2^(e+1).
+    if e.exp2() > l {
+        e -= 1.0;
+    } else if (e + 1.0).exp2() <= l {
+        e += 1.0;
+    }
+    (0.5 * (e + l / e.exp2() - 1.0)).max(-32.0)
+}
+
 /// Wraps a texel index by `mode` into `[0, size-1]`.
 #[inline]
 #[must_use]

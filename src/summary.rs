@@ -38,13 +38,30 @@ pub fn text(s: &RenderStats) -> String {
     }
     let _ = writeln!(
         o,
-        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
-        "stage", "impl", "invocations", "saturated", "wrapped", "cycles", "texels"
+        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
+        "stage",
+        "impl",
+        "invocations",
+        "saturated",
+        "wrapped",
+        "busy_cycles",
+        "issue_cycles",
+        "texels",
+        "tex_bytes",
+        "unit",
+        "latency",
+        "area_ge"
     );
     for st in &s.stages {
+        let unit = s
+            .timing
+            .as_ref()
+            .and_then(|t| t.units.iter().find(|u| u.unit == st.stage.name()));
+        let uname = stage_unit(st.stage.name());
+        let cost = s.datapath.unit(uname);
         let _ = writeln!(
             o,
-            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>14} {:>12}",
+            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
             st.stage.name(),
             if st.invocations == 0 {
                 "-"
@@ -54,8 +71,13 @@ pub fn text(s: &RenderStats) -> String {
             st.invocations,
             st.saturated,
             st.wrapped,
-            st.cycles,
-            st.texels
+            unit.map_or_else(|| "-".into(), |u| u.busy_cycles.to_string()),
+            st.issue_cycles,
+            st.texels,
+            unit.map_or_else(|| "-".into(), |u| u.texture_bytes.to_string()),
+            if cost.is_some() { uname } else { "-" },
+            cost.map_or_else(|| "-".into(), |c| c.latency.to_string()),
+            cost.map_or_else(|| "-".into(), |c| c.area_ge.to_string()),
         );
     }
     if s.input_saturated > 0 {
@@ -76,22 +98,67 @@ pub fn text(s: &RenderStats) -> String {
             b.frame, b.frame_fallback, b.zero_normal, b.h_zero, b.offset_clamped, b.nonfinite, b.ref_nonfinite
         );
     }
-    let c = &s.cycles;
+    o.push_str(&cycles_line(s));
+    let d = &s.datapath;
     let _ = writeln!(
         o,
-        "cycles (first estimate, units x cycles/op): {} total = {} setup + {} spans + {} stages; {:.2} per covered pixel",
-        c.total, c.setup, c.spans, c.stages, c.per_covered_pixel
+        "datapath: area {} GE (gate equivalents, a proxy; top-level units), longest unit latency {} cycles ({}); `texsim hw cost` lists every unit",
+        d.area_ge, d.max_latency, d.max_latency_unit
     );
-    if let Some(why) = c.not_modelled {
-        let _ = writeln!(o, "  (incomplete: {why})");
-    }
+    let c = &s.issue_cycles;
+    let _ = writeln!(
+        o,
+        "issue cycles (invocations x cycles/op, no overlap; not a frame time): {} = {} setup + {} spans + {} stages",
+        c.total, c.setup, c.spans, c.stages
+    );
     let t = &s.timings;
     let _ = writeln!(
         o,
-        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1})",
-        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms
+        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1}); timing model {:.1} ms",
+        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms, t.timing_ms
     );
     o
+}
+
+/// The frame's cycles as the timing model counted them (the one cycle figure; `texsim cycles`
+/// prints the same total with its full report), or why there is none.
+#[must_use]
+pub fn cycles_line(s: &RenderStats) -> String {
+    match (&s.timing, s.issue_cycles.not_modelled) {
+        (Some(t), _) => format!(
+            "cycles (timing model): {} = visibility pass {} + shading pass {}; {:.2} per covered pixel; bottleneck {}; texture bytes {}, DRAM bytes {}\n",
+            t.total_cycles,
+            t.visibility_pass_cycles,
+            t.shading_pass_cycles,
+            t.cycles_per_pixel,
+            t.bottleneck,
+            t.memory.texture_bytes,
+            t.memory.dram_bytes
+        ),
+        (None, Some(why)) => format!("cycles: none ({why})\n"),
+        (None, None) => "cycles: not counted (the timing model did not run)\n".into(),
+    }
+}
+
+/// The `hw_model::datapath::units` name of the unit a stage instantiates (the stage table's
+/// `unit` column; each stage kind is its own instance in the timing model).
+#[must_use]
+pub fn stage_unit(stage: &str) -> &'static str {
+    match stage {
+        "bary" => "interpolator.bary-derivs",
+        "color" | "texcoord" | "normal" => "interpolator.attribute",
+        "lod" => "lod",
+        "trilinear" => "footprint",
+        "bump-fetch" | "rough-fetch" | "ndf-fetch" => "trilinear",
+        "modulate" => "modulate",
+        "frame" => "frame",
+        "perturb" => "perturb",
+        "phong" => "blinn_phong",
+        "as-shade" => "aniso_phong",
+        "rough-shade" => "roughness.shade",
+        "ndf-shade" => "ndf",
+        _ => "",
+    }
 }
 
 fn imp_name(i: crate::pipeline::Impl) -> &'static str {
@@ -99,6 +166,14 @@ fn imp_name(i: crate::pipeline::Impl) -> &'static str {
         crate::pipeline::Impl::Fixed => "fixed",
         crate::pipeline::Impl::Float => "float",
     }
+}
+
+/// One unit's cost in a sweep row: critical path (gate levels), latency (cycles), area (GE).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct UnitCost {
+    pub delay: u32,
+    pub latency: u32,
+    pub area_ge: u64,
 }
 
 /// One row of a sweep: the settings, the error against the reference, the cost.
@@ -113,15 +188,31 @@ pub struct SweepRow {
     /// NDF moment-map channels clamped by their encoding.
     pub ndf_clamped: u64,
     pub texels: u64,
-    /// Cycle estimate; `None` when a stage has no hardware cost model (`ndf_norm = exact`).
+    /// The frame's cycles from the timing model; `None` when it did not run (`--no-cycles`)
+    /// or a stage has no hardware cost model (`ndf_norm = exact`).
     pub cycles: Option<u64>,
     pub cycles_per_pixel: Option<f64>,
-    /// ALU ops of the stages per covered pixel (`None` as `cycles`).
+    /// Texel bytes read and bytes moved from DRAM, from the timing model (`None` as `cycles`).
+    pub texture_bytes: Option<u64>,
+    pub dram_bytes: Option<u64>,
+    /// Issue cycles (`render::IssueCycles`: invocations x cycles per op, no overlap; not a
+    /// frame time); `None` when a stage has no hardware cost model.
+    pub issue_cycles: Option<u64>,
+    pub issue_cycles_per_pixel: Option<f64>,
+    /// Total area of the machine's top-level units in gate equivalents (a proxy) and its
+    /// longest unit latency in cycles, with that unit.
+    pub area_ge: u64,
+    pub max_latency: u32,
+    pub max_latency_unit: String,
+    /// Delay, latency and area of every unit (`render::DatapathCost::units`).
+    pub unit_cost: std::collections::BTreeMap<String, UnitCost>,
+    /// The units in pipeline order (`hw_model::datapath::units`), for the tables.
+    #[serde(skip)]
+    pub unit_order: Vec<String>,
+    /// ALU ops of the stages per covered pixel (`None` as `issue_cycles`).
     pub ops_per_pixel: Option<f64>,
     pub hw_ms: f64,
     pub ref_ms: f64,
-    /// Total cycles of the timing model (`texsim sweep --cycles`), else `None`.
-    pub timing_cycles: Option<u64>,
     /// Trilinear texture lookups (8 texels each) per covered pixel.
     pub lookups_per_pixel: f64,
     /// `texsim sweep --truth`: float reference vs ground truth, 8-bit LSBs.
@@ -141,7 +232,8 @@ impl SweepRow {
     #[must_use]
     pub fn new(settings: Vec<(String, String)>, s: &RenderStats) -> Self {
         let px = s.covered_pixels.max(1) as f64;
-        let modelled = s.cycles.not_modelled.is_none();
+        let modelled = s.issue_cycles.not_modelled.is_none();
+        let t = s.timing.as_ref();
         Self {
             settings,
             error_8bit: s.error_8bit.clone(),
@@ -156,13 +248,33 @@ impl SweepRow {
                 + s.bump.ndf_clamped,
             ndf_clamped: s.bump.ndf_clamped,
             texels: s.stages.iter().map(|x| x.texels).sum(),
-            cycles: modelled.then_some(s.cycles.total),
-            cycles_per_pixel: modelled.then_some(s.cycles.per_covered_pixel),
+            cycles: t.map(|t| t.total_cycles),
+            cycles_per_pixel: t.map(|t| t.cycles_per_pixel),
+            texture_bytes: t.map(|t| t.memory.texture_bytes),
+            dram_bytes: t.map(|t| t.memory.dram_bytes),
+            issue_cycles: modelled.then_some(s.issue_cycles.total),
+            issue_cycles_per_pixel: modelled.then_some(s.issue_cycles.per_covered_pixel),
+            area_ge: s.datapath.area_ge,
+            max_latency: s.datapath.max_latency,
+            max_latency_unit: s.datapath.max_latency_unit.clone(),
+            unit_cost: s
+                .datapath
+                .units
+                .iter()
+                .map(|u| {
+                    let c = UnitCost {
+                        delay: u.delay,
+                        latency: u.latency,
+                        area_ge: u.area_ge,
+                    };
+                    (u.unit.clone(), c)
+                })
+                .collect(),
+            unit_order: s.datapath.units.iter().map(|u| u.unit.clone()).collect(),
             ops_per_pixel: modelled
                 .then(|| s.stages.iter().map(|x| x.ops).sum::<u64>() as f64 / px),
             hw_ms: s.timings.hw_total_ms,
             ref_ms: s.timings.ref_total_ms,
-            timing_cycles: None,
             lookups_per_pixel: s.stages.iter().map(|x| x.texels).sum::<u64>() as f64 / 8.0 / px,
             model_error: s.model_error.clone(),
             frame_used: s.bump.frame.clone(),
@@ -199,7 +311,7 @@ fn bump_cells(r: &SweepRow) -> [String; 4] {
     ]
 }
 
-const HEADER: [&str; 14] = [
+const HEADER: [&str; 18] = [
     "max8",
     "mean8",
     "rmse8",
@@ -210,19 +322,15 @@ const HEADER: [&str; 14] = [
     "sat",
     "cycles",
     "cyc/px",
+    "tex_bytes",
+    "dram_bytes",
+    "area_ge",
+    "max_lat",
     "ops/px",
     "lookups/px",
     "model_mean8",
     "hw_ms",
 ];
-
-/// Column of the timing model's total cycles (present when any row has them).
-const TIMING_HEADER: &str = "timing_cycles";
-
-fn timing_cell(r: &SweepRow) -> String {
-    r.timing_cycles
-        .map_or_else(|| "-".into(), |c| c.to_string())
-}
 
 fn cells(r: &SweepRow) -> Vec<String> {
     let e8 = r.error_8bit.as_ref();
@@ -242,6 +350,10 @@ fn cells(r: &SweepRow) -> Vec<String> {
         r.saturated.to_string(),
         r.cycles.map_or("-".into(), |c| c.to_string()),
         r.cycles_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
+        r.texture_bytes.map_or("-".into(), |c| c.to_string()),
+        r.dram_bytes.map_or("-".into(), |c| c.to_string()),
+        r.area_ge.to_string(),
+        r.max_latency.to_string(),
         r.ops_per_pixel.map_or("-".into(), |c| format!("{c:.2}")),
         format!("{:.2}", r.lookups_per_pixel),
         r.model_error
@@ -251,19 +363,122 @@ fn cells(r: &SweepRow) -> Vec<String> {
     ]
 }
 
-/// The sweep as an aligned terminal table.
+/// Units whose cost (delay, latency or area) differs from the first row's in some row, in
+/// pipeline order (units a row lacks count as changed).
+#[must_use]
+pub fn changed_units(rows: &[SweepRow]) -> Vec<String> {
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    let mut names: Vec<&String> = Vec::new();
+    for r in rows {
+        for k in &r.unit_order {
+            if !names.contains(&k) {
+                names.push(k);
+            }
+        }
+    }
+    names
+        .into_iter()
+        .filter(|n| {
+            rows.iter()
+                .any(|r| r.unit_cost.get(*n) != first.unit_cost.get(*n))
+        })
+        .cloned()
+        .collect()
+}
+
+/// One field of a [`UnitCost`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum UnitField {
+    Area,
+    Delay,
+    Latency,
+}
+
+impl UnitField {
+    const ALL: [Self; 3] = [Self::Area, Self::Delay, Self::Latency];
+
+    fn of(self, c: &UnitCost) -> u64 {
+        match self {
+            Self::Area => c.area_ge,
+            Self::Delay => u64::from(c.delay),
+            Self::Latency => u64::from(c.latency),
+        }
+    }
+
+    /// The JSON/CSV name.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Area => "area_ge",
+            Self::Delay => "delay",
+            Self::Latency => "latency",
+        }
+    }
+
+    /// The terminal column prefix.
+    fn short(self) -> &'static str {
+        match self {
+            Self::Area => "area",
+            Self::Delay => "delay",
+            Self::Latency => "lat",
+        }
+    }
+}
+
+/// The changed unit costs the terminal table shows: of the units a stage instantiates
+/// ([`stage_unit`]; sub-units such as `bilinear` inside `trilinear` are in the CSV and JSON),
+/// without a unit whose costs equal an earlier one's in every row (`footprint` is `trilinear`
+/// when `aniso_probes = 1`), each field (area, delay, latency) that differs from the first
+/// row's in some row.
+fn table_units(rows: &[SweepRow]) -> Vec<(String, UnitField)> {
+    let staged = |u: &str| {
+        crate::pipeline::StageKind::ALL
+            .iter()
+            .any(|k| stage_unit(k.name()) == u)
+    };
+    let mut out: Vec<String> = Vec::new();
+    for u in changed_units(rows).into_iter().filter(|u| staged(u)) {
+        let same = out.iter().any(|o| {
+            rows.iter()
+                .all(|r| r.unit_cost.get(o) == r.unit_cost.get(&u))
+        });
+        if !same {
+            out.push(u);
+        }
+    }
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    out.into_iter()
+        .flat_map(|u| {
+            UnitField::ALL
+                .into_iter()
+                .filter(|&f| {
+                    let v = |r: &SweepRow| r.unit_cost.get(&u).map(|c| f.of(c));
+                    rows.iter().any(|r| v(r) != v(first))
+                })
+                .map(|f| (u.clone(), f))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// The sweep as an aligned terminal table: the swept fields, the error and cost columns, then
+/// per unit whose cost changed against the first row ([`table_units`]) its area (GE) and delay
+/// (gate levels).
 #[must_use]
 pub fn sweep_table(rows: &[SweepRow]) -> String {
     let mut grid: Vec<Vec<String>> = Vec::with_capacity(rows.len() + 1);
     let set_names: Vec<String> = rows.first().map_or(vec![], |r| {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
-    let timed = rows.iter().any(|r| r.timing_cycles.is_some());
     let bump = bumped(rows);
+    let changed = table_units(rows);
     let mut head = set_names.clone();
     head.extend(HEADER.iter().map(|s| s.to_string()));
-    if timed {
-        head.push(TIMING_HEADER.into());
+    for (u, f) in &changed {
+        head.push(format!("{}:{u}", f.short()));
     }
     if bump {
         head.push(BUMP_HEADER[0].into());
@@ -272,8 +487,9 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         line.extend(cells(r));
-        if timed {
-            line.push(timing_cell(r));
+        for (u, f) in &changed {
+            let c = r.unit_cost.get(u);
+            line.push(c.map_or_else(|| "-".into(), |c| f.of(c).to_string()));
         }
         if bump {
             let [used, ..] = bump_cells(r);
@@ -304,7 +520,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 
 /// Columns of `sweep.csv` after the swept fields: the names of `sweep.json`'s row fields
 /// (nested metrics joined with a dot).
-pub const CSV_COLUMNS: [&str; 22] = [
+pub const CSV_COLUMNS: [&str; 28] = [
     "error_8bit.max_abs_lsb",
     "error_8bit.mean_abs_lsb",
     "error_8bit.rmse_lsb",
@@ -317,10 +533,16 @@ pub const CSV_COLUMNS: [&str; 22] = [
     "texels",
     "cycles",
     "cycles_per_pixel",
+    "texture_bytes",
+    "dram_bytes",
+    "issue_cycles",
+    "issue_cycles_per_pixel",
+    "area_ge",
+    "max_latency",
+    "max_latency_unit",
     "ops_per_pixel",
     "lookups_per_pixel",
     "model_error.mean_abs_lsb",
-    "timing_cycles",
     "frame_used",
     "frame_fallback",
     "zero_normal",
@@ -351,10 +573,16 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
         r.texels.to_string(),
         opt(r.cycles),
         opt(r.cycles_per_pixel),
+        opt(r.texture_bytes),
+        opt(r.dram_bytes),
+        opt(r.issue_cycles),
+        opt(r.issue_cycles_per_pixel),
+        r.area_ge.to_string(),
+        r.max_latency.to_string(),
+        r.max_latency_unit.clone(),
         opt(r.ops_per_pixel),
         r.lookups_per_pixel.to_string(),
         opt(r.model_error.as_ref().map(|e| e.mean_abs_lsb)),
-        opt(r.timing_cycles),
         r.frame_used.clone(),
         r.frame_fallback.to_string(),
         r.zero_normal.to_string(),
@@ -365,18 +593,41 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
 }
 
 /// The sweep as CSV (RFC 4180, written by the `csv` crate): one column per swept field, then
-/// [`CSV_COLUMNS`], named as in `sweep.json`.
+/// [`CSV_COLUMNS`], named as in `sweep.json`, then `unit_cost.NAME.area_ge`, `.delay` and
+/// `.latency` of every unit whose cost changed against the first row ([`changed_units`]; NAME
+/// may itself contain a dot, the field does not).
 pub fn sweep_csv(rows: &[SweepRow]) -> crate::Result<String> {
+    let changed = changed_units(rows);
+    let unit_cols: Vec<String> = changed
+        .iter()
+        .flat_map(|u| {
+            UnitField::ALL
+                .iter()
+                .map(move |f| format!("unit_cost.{u}.{}", f.name()))
+        })
+        .collect();
     let mut w = csv::Writer::from_writer(Vec::new());
     let err = |e: csv::Error| crate::Error::msg(format!("sweep.csv: {e}"));
     let fields: Vec<String> = rows.first().map_or_else(Vec::new, |r| {
         r.settings.iter().map(|(f, _)| f.clone()).collect()
     });
-    w.write_record(fields.iter().map(String::as_str).chain(CSV_COLUMNS))
-        .map_err(err)?;
+    w.write_record(
+        fields
+            .iter()
+            .map(String::as_str)
+            .chain(CSV_COLUMNS)
+            .chain(unit_cols.iter().map(String::as_str)),
+    )
+    .map_err(err)?;
     for r in rows {
         let mut rec: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
         rec.extend(csv_cells(r));
+        for u in &changed {
+            let c = r.unit_cost.get(u);
+            for f in UnitField::ALL {
+                rec.push(c.map_or_else(String::new, |c| f.of(c).to_string()));
+            }
+        }
         w.write_record(&rec).map_err(err)?;
     }
     let bytes = w

@@ -112,6 +112,12 @@ pub struct InterpConfig {
     /// Absent in older files: `true`.
     #[serde(default = "yes")]
     pub texcoord_reduce: bool,
+    /// Sub-pixel bits of the vertex positions the barycentrics (the attribute setup) use:
+    /// 0 = the rasterizer's `subpixel_bits`; more models a setup from finer positions than
+    /// coverage (llvmpipe: coverage on 8 bits, attribute planes from the float positions).
+    /// Absent in older files: 0.
+    #[serde(default)]
+    pub attr_subpixel_bits: u32,
     /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
     pub bary_cycles: Cycles,
     /// Cycles per interpolated scalar attribute.
@@ -128,6 +134,28 @@ pub struct LodConfig {
     pub lod_cycles: Cycles,
     /// Extra cycles per LOD fraction bit (the log2 produces one bit per squaring step).
     pub lod_cycles_per_bit: Cycles,
+    /// The log2: `exact` (bit-serial squaring) or `piecewise-linear` (exponent plus mantissa
+    /// fraction, llvmpipe's `lp_build_fast_log2`). Absent in older files: `exact`.
+    #[serde(default)]
+    pub lod_log2: LodLog2,
+    /// Derivatives per 2x2 quad (llvmpipe's default): the finite differences between the
+    /// quad's first pixel (even x, even y) and its right and lower neighbours, shared by the
+    /// four pixels; `false`: the analytic derivatives at each pixel. Absent in older files:
+    /// `false`.
+    #[serde(default)]
+    pub lod_per_quad: bool,
+}
+
+/// How the LOD unit forms `log2` of the squared footprint length.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LodLog2 {
+    /// Bit-serial repeated squaring: `floor(log2(L) 2^(F-1))` (see `hw_model::lod`).
+    #[default]
+    Exact,
+    /// `log2(L) ~= e + (L / 2^e - 1)`, `e = floor(log2 L)`: exact at powers of two, at most
+    /// 0.0861 low in between (Mesa llvmpipe's `lp_build_fast_log2`).
+    PiecewiseLinear,
 }
 
 /// Texel address/wrap and the trilinear filter unit.
@@ -199,7 +227,7 @@ pub struct HwConfig {
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
-pub const PRESETS: &[&str] = &["texram16", "d3d11", "vulkan-min", "cuda"];
+pub const PRESETS: &[&str] = &["texram16", "d3d11", "vulkan-min", "cuda", "llvmpipe"];
 
 impl HwConfig {
     /// Texram-style machine: 16-bit datapath throughout (texels, weights, LOD fraction, colour).
@@ -229,6 +257,7 @@ impl HwConfig {
                 interp_rounding: Rounding::HalfEven,
                 texcoord_overflow: Overflow::Saturate,
                 texcoord_reduce: true,
+                attr_subpixel_bits: 0,
                 bary_cycles: Cycles::Derived,
                 attr_cycles: Cycles::Derived,
             },
@@ -236,6 +265,8 @@ impl HwConfig {
                 lod_frac_bits: 16,
                 lod_cycles: Cycles::Derived,
                 lod_cycles_per_bit: Cycles::Derived,
+                lod_log2: LodLog2::Exact,
+                lod_per_quad: false,
             },
             trilinear: TrilinearConfig {
                 weight_bits: 16,
@@ -298,13 +329,35 @@ impl HwConfig {
         c
     }
 
-    /// A preset by name (`texram16`, `d3d11`, `vulkan-min`, `cuda`).
+    /// Mesa llvmpipe's 8-bit AoS texture path (Mesa 22.3, `lp_bld_sample_aos.c`,
+    /// `lp_bld_sample.c`): 8-bit texels, coordinates rounded to 8 sub-texel bits, lerps
+    /// `a + ((b - a) w + 128) >> 8` (pmulhrsw), LOD per 2x2 quad from finite differences
+    /// with the piecewise-linear `lp_build_fast_log2`, level fraction truncated to 8 bits;
+    /// coverage on 8 sub-pixel bits, the attribute setup from positions on 16.
+    #[must_use]
+    pub fn llvmpipe() -> Self {
+        let mut c = Self::texram16();
+        c.name = "llvmpipe".into();
+        c.timing = TimingConfig::modern();
+        c.trilinear.texel_bits = 8;
+        c.trilinear.weight_bits = 8;
+        c.trilinear.filter_rounding = Rounding::HalfUp;
+        c.trilinear.weight_rounding = Rounding::HalfUp;
+        c.lod.lod_frac_bits = 8;
+        c.lod.lod_log2 = LodLog2::PiecewiseLinear;
+        c.lod.lod_per_quad = true;
+        c.interp.attr_subpixel_bits = 16;
+        c
+    }
+
+    /// A preset by name (`texram16`, `d3d11`, `vulkan-min`, `cuda`, `llvmpipe`).
     pub fn preset(name: &str) -> Option<Self> {
         match name {
             "texram16" => Some(Self::texram16()),
             "d3d11" => Some(Self::d3d11()),
             "vulkan-min" => Some(Self::vulkan_min()),
             "cuda" => Some(Self::cuda()),
+            "llvmpipe" => Some(Self::llvmpipe()),
             _ => None,
         }
     }
@@ -328,6 +381,7 @@ impl HwConfig {
         check("interp.bary_bits", i.bary_bits, 4, 30)?;
         check("interp.texcoord_frac_bits", i.texcoord_frac_bits, 4, 28)?;
         check("interp.texcoord_int_bits", i.texcoord_int_bits, 1, 16)?;
+        check("interp.attr_subpixel_bits", i.attr_subpixel_bits, 0, 16)?;
         check("lod.lod_frac_bits", self.lod.lod_frac_bits, 0, 16)?;
         let t = &self.trilinear;
         check("trilinear.weight_bits", t.weight_bits, 0, 16)?;

@@ -19,6 +19,58 @@ pub enum Rounding {
     HalfEven,
 }
 
+/// A rounding mode fixed at compile time (a zero-sized type): a unit whose datapath is
+/// generic over it is compiled once per mode, so its reductions (still [`round_shift_right`]
+/// and its siblings, with `M::MODE`) carry no run-time branch on the mode. The unit picks its
+/// instance from the configured [`Rounding`] once per call with [`with_rounding!`].
+pub trait ConstRounding {
+    /// The mode.
+    const MODE: Rounding;
+}
+
+/// [`Rounding::Truncate`] as a type.
+#[derive(Clone, Copy, Debug)]
+pub struct TruncateMode;
+/// [`Rounding::HalfUp`] as a type.
+#[derive(Clone, Copy, Debug)]
+pub struct HalfUpMode;
+/// [`Rounding::HalfEven`] as a type.
+#[derive(Clone, Copy, Debug)]
+pub struct HalfEvenMode;
+
+impl ConstRounding for TruncateMode {
+    const MODE: Rounding = Rounding::Truncate;
+}
+impl ConstRounding for HalfUpMode {
+    const MODE: Rounding = Rounding::HalfUp;
+}
+impl ConstRounding for HalfEvenMode {
+    const MODE: Rounding = Rounding::HalfEven;
+}
+
+/// `with_rounding!(mode, M => expr)`: evaluates `expr` with the type `M` bound to the
+/// [`ConstRounding`] type of the run-time [`Rounding`] `mode` (one branch, then a body
+/// compiled for that mode).
+#[macro_export]
+macro_rules! with_rounding {
+    ($mode:expr, $m:ident => $body:expr) => {
+        match $mode {
+            $crate::fixed::Rounding::Truncate => {
+                type $m = $crate::fixed::TruncateMode;
+                $body
+            }
+            $crate::fixed::Rounding::HalfUp => {
+                type $m = $crate::fixed::HalfUpMode;
+                $body
+            }
+            $crate::fixed::Rounding::HalfEven => {
+                type $m = $crate::fixed::HalfEvenMode;
+                $body
+            }
+        }
+    };
+}
+
 /// What happens to a value outside a format's range.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -99,12 +151,14 @@ impl Format {
     }
 
     /// Largest raw value.
+    #[inline(always)]
     #[must_use]
     pub const fn max_raw(&self) -> i64 {
         (1i64 << (self.int_bits + self.frac_bits)) - 1
     }
 
     /// Smallest raw value.
+    #[inline(always)]
     #[must_use]
     pub const fn min_raw(&self) -> i64 {
         if self.signed {
@@ -115,7 +169,7 @@ impl Format {
     }
 
     /// Brings `raw` into range by this format's overflow rule, counting the event.
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn fit(&self, raw: i64, sat: &mut SatCounter) -> i64 {
         let (lo, hi) = (self.min_raw(), self.max_raw());
@@ -142,7 +196,7 @@ impl Format {
 
     /// Reduces `raw` (which has `from_frac` fraction bits) into this format: rounds by this
     /// format's rounding mode, then fits by its overflow rule.
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn requantize(&self, raw: i64, from_frac: u32, sat: &mut SatCounter) -> i64 {
         let v = if from_frac >= self.frac_bits {
@@ -156,8 +210,9 @@ impl Format {
 
 /// The one rounding routine: `x / 2^shift`, rounded by `mode`. Exact for every `i64` input
 /// and every `shift` (no intermediate overflow); a shift of 64 or more yields 0 or -1 before
-/// rounding, exactly as the infinite-precision quotient does.
-#[inline]
+/// rounding, exactly as the infinite-precision quotient does. The decision is [`round_up`]'s,
+/// taken as the carry of the dropped bits plus [`round_bias`] (no branch on the data).
+#[inline(always)]
 #[must_use]
 pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     if shift == 0 {
@@ -167,10 +222,23 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
         return round_shift_right_wide(i128::from(x), shift, mode);
     }
     let floor = x >> shift;
-    // Remainder and half as unsigned so that shift = 63 does not overflow.
-    let rem = (x as u64) & ((1u64 << shift) - 1);
-    let half = 1u64 << (shift - 1);
-    floor + i64::from(round_up(rem > half, rem == half, floor & 1 == 1, mode))
+    // The dropped bits, left-aligned: one half is 2^63, and their carry out of 64 bits when
+    // the bias is added is the decision.
+    let rem = (x as u64) << (64 - shift);
+    floor + i64::from(rem.overflowing_add(round_bias(floor & 1 == 1, mode)).1)
+}
+
+/// What [`round_shift_right`] adds to the dropped bits left-aligned in 64 bits (one half =
+/// 2^63) so that their carry out is [`round_up`]'s decision: 0 for Truncate; 2^63 for HalfUp
+/// (carry iff the dropped part >= half); 2^63 - 1 + odd for HalfEven (carry iff above half,
+/// or exactly half and the floor is odd).
+#[inline(always)]
+const fn round_bias(odd: bool, mode: Rounding) -> u64 {
+    match mode {
+        Rounding::Truncate => 0,
+        Rounding::HalfUp => 1 << 63,
+        Rounding::HalfEven => (1 << 63) - 1 + odd as u64,
+    }
 }
 
 /// The divide-by-constant sibling of [`round_shift_right_wide`]: `x / den` for a constant
@@ -222,7 +290,7 @@ pub fn round_shift_right_sticky(x: u128, shift: u32, sticky: bool, mode: Roundin
 
 /// The rounding decision shared by every routine here: whether to add one to the floor,
 /// given whether the dropped part is above one half, exactly one half, and the floor's parity.
-#[inline]
+#[inline(always)]
 const fn round_up(above_half: bool, half: bool, odd: bool, mode: Rounding) -> bool {
     match mode {
         Rounding::Truncate => false,
@@ -233,7 +301,7 @@ const fn round_up(above_half: bool, half: bool, odd: bool, mode: Rounding) -> bo
 
 /// `round_shift_right` for `i128` accumulators, result saturated to `i64`. Exact for every
 /// `i128` input and every `shift` (shifts of 128 or more behave as the exact quotient).
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
     let v = if shift == 0 {
@@ -247,9 +315,15 @@ pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
         }
     } else {
         let floor = x >> shift;
-        let rem = (x as u128) & ((1u128 << shift) - 1);
-        let half = 1u128 << (shift - 1);
-        floor + i128::from(round_up(rem > half, rem == half, floor & 1 == 1, mode))
+        // As in `round_shift_right`: the dropped bits left-aligned in 128 bits (one half =
+        // 2^127), the decision their carry out with the same bias scaled.
+        let rem = (x as u128) << (128 - shift);
+        let bias: u128 = match mode {
+            Rounding::Truncate => 0,
+            Rounding::HalfUp => 1 << 127,
+            Rounding::HalfEven => (1 << 127) - 1 + u128::from(floor & 1 == 1),
+        };
+        floor + i128::from(rem.overflowing_add(bias).1)
     };
     v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
 }
@@ -286,6 +360,108 @@ mod tests {
             Rounding::HalfUp => twice >= den,
             Rounding::HalfEven => twice > den || (twice == den && q & 1 == 1),
         })
+    }
+
+    /// `round_shift_right` as it was before the carry formulation (the decision of
+    /// `round_up` on the remainder against one half): the oracle.
+    fn shift_before(x: i64, shift: u32, mode: Rounding) -> i64 {
+        if shift == 0 {
+            return x;
+        }
+        if shift >= 64 {
+            return round_shift_right_wide(i128::from(x), shift, mode);
+        }
+        let floor = x >> shift;
+        let rem = (x as u64) & ((1u64 << shift) - 1);
+        let half = 1u64 << (shift - 1);
+        floor + i64::from(round_up(rem > half, rem == half, floor & 1 == 1, mode))
+    }
+
+    /// `round_shift_right_wide` as it was before the carry formulation: the oracle.
+    fn wide_before(x: i128, shift: u32, mode: Rounding) -> i64 {
+        if shift == 0 || shift >= 128 {
+            return round_shift_right_wide(x, shift, mode);
+        }
+        let floor = x >> shift;
+        let rem = (x as u128) & ((1u128 << shift) - 1);
+        let half = 1u128 << (shift - 1);
+        let v = floor + i128::from(round_up(rem > half, rem == half, floor & 1 == 1, mode));
+        v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+    }
+
+    /// 4M seeded cases of every shift 1..=127 and mode against the previous formulation
+    /// (ties, near ties, full remainders and the ends of the `i128` range included).
+    #[test]
+    fn round_shift_right_wide_matches_the_previous_decision() {
+        let mut s = 0x5eed_0004;
+        for shift in 1..128u32 {
+            for x in [i128::MIN, i128::MIN + 1, -1, 0, 1, i128::MAX - 1, i128::MAX] {
+                for mode in MODES {
+                    assert_eq!(
+                        round_shift_right_wide(x, shift, mode),
+                        wide_before(x, shift, mode)
+                    );
+                }
+            }
+        }
+        for i in 0..4_000_000u32 {
+            let shift = i % 127 + 1;
+            let mut x =
+                (i128::from(next(&mut s)) << 64 | i128::from(next(&mut s))) >> (next(&mut s) % 128);
+            let low = (1i128 << shift).wrapping_sub(1);
+            match i / 127 % 4 {
+                0 => x = (x & !low) | (1i128 << (shift - 1)),
+                1 => x = (x & !low) | ((1i128 << (shift - 1)) + (i128::from(i % 3 == 0) * 2 - 1)),
+                2 => x |= low,
+                _ => {}
+            }
+            for mode in MODES {
+                assert_eq!(
+                    round_shift_right_wide(x, shift, mode),
+                    wide_before(x, shift, mode),
+                    "{x} >> {shift} {mode:?}"
+                );
+            }
+        }
+    }
+
+    /// 4M seeded cases of every shift 0..=66 and mode against the previous formulation, a
+    /// quarter of them exact ties and the rest near ties, the ends of the range and the
+    /// largest remainders (where `rem + bias` is largest) included.
+    #[test]
+    fn round_shift_right_matches_the_previous_decision() {
+        let mut s = 0x5eed_0003;
+        let edges = [i64::MIN, i64::MIN + 1, -1, 0, 1, i64::MAX - 1, i64::MAX];
+        for shift in 0..=66u32 {
+            for &x in &edges {
+                for mode in MODES {
+                    assert_eq!(
+                        round_shift_right(x, shift, mode),
+                        shift_before(x, shift, mode)
+                    );
+                }
+            }
+        }
+        for i in 0..4_000_000u32 {
+            let shift = i % 67;
+            let mut x = next(&mut s) as i64 >> (next(&mut s) % 64);
+            if (1..64).contains(&shift) {
+                let low = (1i64 << shift).wrapping_sub(1);
+                match i / 67 % 4 {
+                    0 => x = (x & !low) | (1i64 << (shift - 1)),
+                    1 => x = (x & !low) | ((1i64 << (shift - 1)) + (i64::from(i % 3 == 0) * 2 - 1)),
+                    2 => x |= low,
+                    _ => {}
+                }
+            }
+            for mode in MODES {
+                assert_eq!(
+                    round_shift_right(x, shift, mode),
+                    shift_before(x, shift, mode),
+                    "{x} >> {shift} {mode:?}"
+                );
+            }
+        }
     }
 
     /// 2M seeded cases over the 64-bit fast path and the 128-bit path, every mode, with

@@ -19,8 +19,8 @@
 use crate::config::{InterpConfig, ReciprocalConfig};
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, Format, SatCounter};
-use crate::reciprocal::{apply, square, Recip, Reciprocal};
+use crate::fixed::{round_shift_right_wide, ConstRounding, Format, SatCounter};
+use crate::reciprocal::{apply_in, square, Recip, Reciprocal};
 
 /// Clamp of `p_1`, `p_2` (raw), far beyond any sample near the triangle.
 pub const BARY_LIMIT: i64 = 1 << 60;
@@ -37,8 +37,28 @@ pub fn perspective_bary(
     recip: &Reciprocal,
     sat: &mut SatCounter,
 ) -> [i64; 3] {
+    crate::with_rounding!(cfg.interp_rounding, M => {
+        perspective_bary_eval::<M>(edge, inv_w, cfg, recip, sat).0
+    })
+}
+
+/// The reciprocal evaluation the barycentrics made: its argument and result (`None` when
+/// `D <= 0`).
+type Evaluated = Option<(u64, Recip)>;
+
+/// [`perspective_bary`], with the reciprocal evaluation it made: its argument and result
+/// (`None` when `D <= 0`), so [`perspective_bary_derivs`] reuses it when it needs the
+/// reciprocal of the same argument ([`Reciprocal::eval`] is a pure function of it).
+#[inline(always)]
+fn perspective_bary_eval<M: ConstRounding>(
+    edge: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+) -> ([i64; 3], Evaluated) {
     let one = 1i64 << cfg.bary_bits;
-    if let Some(p) = perspective_bary_narrow(edge, inv_w, one, cfg, recip, sat) {
+    if let Some(p) = perspective_bary_narrow::<M>(edge, inv_w, one, cfg, recip, sat) {
         return p;
     }
     let q = [
@@ -49,19 +69,19 @@ pub fn perspective_bary(
     let d = q[0] + q[1] + q[2];
     if d <= 0 {
         sat.saturated += 1;
-        return [one, 0, 0];
+        return ([one, 0, 0], None);
     }
     let bl = 128 - d.leading_zeros();
     let s = bl.saturating_sub(62);
     let dn = (d >> s) as u64;
-    let r = recip.eval(dn, sat);
+    let r0 = recip.eval(dn, sat);
     let r = Recip {
-        mant: r.mant,
-        shift: r.shift + s as i32,
+        mant: r0.mant,
+        shift: r0.shift + s as i32,
     };
     let mut p = [0i64; 3];
     for i in 1..3 {
-        let v = apply(r, q[i], cfg.bary_bits, cfg.interp_rounding);
+        let v = apply_in::<M>(r, q[i], cfg.bary_bits);
         p[i] = if v > BARY_LIMIT {
             sat.saturated += 1;
             BARY_LIMIT
@@ -73,7 +93,7 @@ pub fn perspective_bary(
         };
     }
     p[0] = one - p[1] - p[2];
-    p
+    (p, Some((dn, r0)))
 }
 
 /// Perspective-correct barycentrics and their screen-space derivatives from ONE reciprocal
@@ -102,7 +122,23 @@ pub fn perspective_bary_derivs(
     recip: &Reciprocal,
     sat: &mut SatCounter,
 ) -> [[i64; 3]; 3] {
-    let p = perspective_bary(edge, inv_w, cfg, recip, sat);
+    crate::with_rounding!(cfg.interp_rounding, M => {
+        perspective_bary_derivs_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat)
+    })
+}
+
+/// [`perspective_bary_derivs`] compiled for the rounding mode `M` (`interp_rounding`).
+#[inline(always)]
+fn perspective_bary_derivs_in<M: ConstRounding>(
+    edge: [i64; 3],
+    edge_dx: [i64; 3],
+    edge_dy: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+) -> [[i64; 3]; 3] {
+    let (p, evaluated) = perspective_bary_eval::<M>(edge, inv_w, cfg, recip, sat);
     let q = [0, 1, 2].map(|i| i128::from(edge[i]) * i128::from(inv_w[i]));
     let d = q[0] + q[1] + q[2];
     if d <= 0 {
@@ -112,35 +148,42 @@ pub fn perspective_bary_derivs(
     let (ax, ay) = (a_of(edge_dx), a_of(edge_dy));
     let (sx, sy) = (ax[0] + ax[1] + ax[2], ay[0] + ay[1] + ay[2]);
     let mag = [
-        d,
-        q[1].abs(),
-        q[2].abs(),
-        ax[1].abs(),
-        ax[2].abs(),
-        sx.abs(),
+        q[1].unsigned_abs(),
+        q[2].unsigned_abs(),
+        ax[1].unsigned_abs(),
+        ax[2].unsigned_abs(),
+        sx.unsigned_abs(),
+        ay[1].unsigned_abs(),
+        ay[2].unsigned_abs(),
+        sy.unsigned_abs(),
     ]
     .into_iter()
-    .chain([ay[1].abs(), ay[2].abs(), sy.abs()])
-    .max()
-    .unwrap_or(d);
+    .fold(d.unsigned_abs(), u128::max);
     let shift = (128 - mag.leading_zeros()).saturating_sub(62);
-    let ds = d >> shift;
+    // Every scaled operand has at most 62 significant bits: it fits `i64` exactly, and the
+    // products below are single 64x64 -> 128-bit multiplies.
+    let down = |v: i128| (v >> shift) as i64;
+    let ds = down(d);
     let mut out = [p, p, p];
     if ds <= 0 {
         sat.saturated += 1;
         return out;
     }
-    let r = recip.eval(ds as u64, sat);
-    let r2 = square(r, recip.config().recip_mantissa_bits, cfg.interp_rounding);
+    let r = match evaluated {
+        Some((x, r)) if x == ds as u64 => r,
+        _ => recip.eval(ds as u64, sat),
+    };
+    let r2 = square(r, recip.config().recip_mantissa_bits, M::MODE);
+    let ds = i128::from(ds);
     for (k, a, sum) in [(1usize, ax, sx), (2, ay, sy)] {
-        let ss = sum >> shift;
+        let ss = i128::from(down(sum));
         for i in 1..3 {
-            let n = (a[i] >> shift) * ds - (q[i] >> shift) * ss;
+            let n = i128::from(down(a[i])) * ds - i128::from(down(q[i])) * ss;
             // N can reach 2^125; `apply` is exact below 2^100 with this mantissa, so N keeps
             // its top 94 bits (relative error < 2^-93) and the dropped scale 2^ns is folded
             // into the one rounding.
             let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94);
-            let v = apply(r2, n >> ns, cfg.bary_bits + ns, cfg.interp_rounding);
+            let v = apply_in::<M>(r2, n >> ns, cfg.bary_bits + ns);
             let dp = v.clamp(-BARY_LIMIT, BARY_LIMIT);
             if dp != v {
                 sat.saturated += 1;
@@ -154,15 +197,15 @@ pub fn perspective_bary_derivs(
 
 /// The same datapath as [`perspective_bary`] when every `q_i` and their sum fit `i64`
 /// (the common case): identical bits, without `i128` arithmetic. `None` when they do not fit.
-#[inline]
-fn perspective_bary_narrow(
+#[inline(always)]
+fn perspective_bary_narrow<M: ConstRounding>(
     edge: [i64; 3],
     inv_w: [i64; 3],
     one: i64,
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-) -> Option<[i64; 3]> {
+) -> Option<([i64; 3], Evaluated)> {
     let q0 = edge[0].checked_mul(inv_w[0])?;
     let q1 = edge[1].checked_mul(inv_w[1])?;
     let q2 = edge[2].checked_mul(inv_w[2])?;
@@ -173,21 +216,22 @@ fn perspective_bary_narrow(
     // d < 2^63 has at most 63 significant bits; the wide path keeps the top 62.
     let bl = 64 - d.leading_zeros();
     let s = bl.saturating_sub(62);
-    let r = recip.eval((d >> s) as u64, sat);
+    let dn = (d >> s) as u64;
+    let r0 = recip.eval(dn, sat);
     let r = Recip {
-        mant: r.mant,
-        shift: r.shift + s as i32,
+        mant: r0.mant,
+        shift: r0.shift + s as i32,
     };
     let mut p = [0i64; 3];
     for (i, q) in [(1usize, q1), (2, q2)] {
-        let v = apply(r, i128::from(q), cfg.bary_bits, cfg.interp_rounding);
+        let v = apply_in::<M>(r, i128::from(q), cfg.bary_bits);
         if !(-BARY_LIMIT..=BARY_LIMIT).contains(&v) {
             return None;
         }
         p[i] = v;
     }
     p[0] = one - p[1] - p[2];
-    Some(p)
+    Some((p, Some((dn, r0))))
 }
 
 /// `a0 + p1 (a1 - a0) + p2 (a2 - a0)` accumulated exactly in `i128`, then ONE reduction
@@ -203,6 +247,22 @@ pub fn interpolate(
     out: &Format,
     sat: &mut SatCounter,
 ) -> i64 {
+    crate::with_rounding!(out.rounding, M => interpolate_in::<M>(bary, bary_bits, attr, out, sat))
+}
+
+/// [`interpolate`] compiled for the rounding mode `M` (`out.rounding`).
+#[inline(always)]
+fn interpolate_in<M: ConstRounding>(
+    bary: [i64; 3],
+    bary_bits: u32,
+    attr: [i64; 3],
+    out: &Format,
+    sat: &mut SatCounter,
+) -> i64 {
+    let out = &Format {
+        rounding: M::MODE,
+        ..*out
+    };
     let from = out.frac_bits + bary_bits;
     // Exact i64 fast path (same accumulator value, same single reduction).
     let narrow = (|| {
@@ -345,4 +405,148 @@ pub fn attribute_datapath(cfg: &InterpConfig) -> Datapath {
             .then(Component::Register { bits: a })
             .cycles(cfg.attr_cycles),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::HwConfig;
+    use crate::fixed::Rounding;
+    use crate::reciprocal::apply;
+
+    /// Splitmix64: the seeded generator of these tests.
+    fn next(s: &mut u64) -> u64 {
+        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// A value of up to `bits` magnitude bits, either sign.
+    fn signed(s: &mut u64, bits: u32) -> i64 {
+        let v = (next(s) >> (64 - bits.clamp(1, 63))) as i64;
+        if next(s) & 1 == 1 {
+            -v
+        } else {
+            v
+        }
+    }
+
+    /// The derivative datapath as it was before the reciprocal was shared with the
+    /// barycentrics and the scaled products became 64x64-bit multiplies: the oracle.
+    fn derivs_before(
+        edge: [i64; 3],
+        edge_dx: [i64; 3],
+        edge_dy: [i64; 3],
+        inv_w: [i64; 3],
+        cfg: &InterpConfig,
+        recip: &Reciprocal,
+        sat: &mut SatCounter,
+    ) -> [[i64; 3]; 3] {
+        let p = perspective_bary(edge, inv_w, cfg, recip, sat);
+        let q = [0, 1, 2].map(|i| i128::from(edge[i]) * i128::from(inv_w[i]));
+        let d = q[0] + q[1] + q[2];
+        if d <= 0 {
+            return [p, p, p];
+        }
+        let a_of = |de: [i64; 3]| [0, 1, 2].map(|i| i128::from(de[i]) * i128::from(inv_w[i]));
+        let (ax, ay) = (a_of(edge_dx), a_of(edge_dy));
+        let (sx, sy) = (ax[0] + ax[1] + ax[2], ay[0] + ay[1] + ay[2]);
+        let mag = [
+            d,
+            q[1].abs(),
+            q[2].abs(),
+            ax[1].abs(),
+            ax[2].abs(),
+            sx.abs(),
+        ]
+        .into_iter()
+        .chain([ay[1].abs(), ay[2].abs(), sy.abs()])
+        .max()
+        .unwrap_or(d);
+        let shift = (128 - mag.leading_zeros()).saturating_sub(62);
+        let ds = d >> shift;
+        let mut out = [p, p, p];
+        if ds <= 0 {
+            sat.saturated += 1;
+            return out;
+        }
+        let r = recip.eval(ds as u64, sat);
+        let r2 = square(r, recip.config().recip_mantissa_bits, cfg.interp_rounding);
+        for (k, a, sum) in [(1usize, ax, sx), (2, ay, sy)] {
+            let ss = sum >> shift;
+            for i in 1..3 {
+                let n = (a[i] >> shift) * ds - (q[i] >> shift) * ss;
+                let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94);
+                let v = apply(r2, n >> ns, cfg.bary_bits + ns, cfg.interp_rounding);
+                let dp = v.clamp(-BARY_LIMIT, BARY_LIMIT);
+                if dp != v {
+                    sat.saturated += 1;
+                }
+                out[k][i] = p[i] + dp;
+            }
+            out[k][0] = (1i64 << cfg.bary_bits) - out[k][1] - out[k][2];
+        }
+        out
+    }
+
+    /// 3M seeded cases: the shared-reciprocal datapath gives the old one's bits and counts,
+    /// over small and huge edge values (the 64-bit and 128-bit barycentric paths, scale
+    /// shifts of 0 and above, reciprocal arguments equal to the barycentrics' and not, D <= 0
+    /// and scaled D <= 0), on three interpolator/reciprocal configurations.
+    #[test]
+    fn derivs_match_the_previous_datapath() {
+        let mut cfgs = vec![HwConfig::texram16(), HwConfig::d3d11()];
+        let mut c = HwConfig::texram16();
+        c.reciprocal.recip_iterations = 1;
+        c.reciprocal.recip_rounding = Rounding::HalfUp;
+        c.interp.bary_bits = 16;
+        c.interp.interp_rounding = Rounding::Truncate;
+        cfgs.push(c);
+        let mut s = 0x5eed_0b41;
+        let (mut reused, mut fresh) = (0u64, 0u64);
+        for hw in &cfgs {
+            let recip = Reciprocal::new(&hw.reciprocal);
+            for i in 0..1_000_000u32 {
+                let eb = [20, 38, 40, 50, 62][(i % 5) as usize];
+                let db = [4, 26, 40, 62][(i / 5 % 4) as usize];
+                let mut edge = [0; 3].map(|_| signed(&mut s, eb));
+                if i % 3 != 0 {
+                    edge = edge.map(i64::abs);
+                }
+                let dx = [0; 3].map(|_| signed(&mut s, db));
+                let dy = [0; 3].map(|_| signed(&mut s, db));
+                let wb = hw.interp.inv_w_bits;
+                let mut inv_w = [0; 3].map(|_| (next(&mut s) >> (64 - wb)) as i64 + 1);
+                inv_w[(i % 3) as usize] = 1 << wb;
+                let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
+                let got = perspective_bary_derivs(edge, dx, dy, inv_w, &hw.interp, &recip, &mut sa);
+                let want = derivs_before(edge, dx, dy, inv_w, &hw.interp, &recip, &mut sb);
+                assert_eq!(got, want, "{edge:?} {dx:?} {dy:?} {inv_w:?}");
+                assert_eq!(sa, sb, "{edge:?} {dx:?} {dy:?} {inv_w:?}");
+                // Whether the shared evaluation was reused: the scaled D (by the largest
+                // magnitude among D, q_i, a_i and their sums) equals the barycentrics' argument.
+                let (_, ev) = crate::with_rounding!(hw.interp.interp_rounding, M => {
+                    perspective_bary_eval::<M>(edge, inv_w, &hw.interp, &recip, &mut sa)
+                });
+                let w = |e: [i64; 3]| [0, 1, 2].map(|k| i128::from(e[k]) * i128::from(inv_w[k]));
+                let (q, ax, ay) = (w(edge), w(dx), w(dy));
+                let d: i128 = q.iter().sum();
+                let mag = [q[1], q[2], ax[1], ax[2], ay[1], ay[2]]
+                    .into_iter()
+                    .chain([ax.iter().sum::<i128>(), ay.iter().sum(), d])
+                    .map(i128::unsigned_abs)
+                    .max()
+                    .unwrap_or(0);
+                let ds = d >> (128 - mag.leading_zeros()).saturating_sub(62);
+                match ev {
+                    Some((x, _)) if d > 0 && i128::from(x) == ds => reused += 1,
+                    _ => fresh += 1,
+                }
+            }
+        }
+        // Both branches of the reuse were exercised.
+        assert!(reused > 100_000 && fresh > 100_000, "{reused} {fresh}");
+    }
 }

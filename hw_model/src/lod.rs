@@ -17,11 +17,18 @@
 //! two are exact. Measured (`tests/units/unit_lod.rs`, all 2^24 pairs (du/dx, dv/dx) in 0..4096, F =
 //! 16): 118 results 1 LSB low, all within 9e-6 LSB above an integer.
 //!
+//! With `lod_log2 = piecewise-linear` (Mesa llvmpipe's `lp_build_fast_log2`) the mantissa
+//! fraction replaces the squaring loop: `log2(L) ~= e + (L - 2^e) / 2^e`, `e` = the MSB index,
+//! and the result is `floor` of that times `2^(F-1)`, exactly (the fraction is cut to 16 bits
+//! first, which cannot change a floor at F <= 16 fraction bits of lambda). ERROR BOUND vs
+//! the exact `lambda`: `0 <= lambda - pwl <= 0.04305` (half the largest deficit of the chord,
+//! `log2(1/ln 2) - 1/ln 2 + 1 = 0.08607`, at `m = 1/ln 2`), then floor-rounded.
+//!
 //! Range: `rho == 0` returns [`lod_zero`] = `-(32 << F)`; any smaller result is clamped to it
 //! (rho < 2^-32, counted as a saturation unless rho == 0). The largest result is below
 //! `64 << F`.
 
-use crate::config::LodConfig;
+use crate::config::{LodConfig, LodLog2};
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::SatCounter;
@@ -54,7 +61,23 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
         return floor_val;
     }
     let e = 127 - l.leading_zeros(); // bit index of the MSB
-                                     // Normalized mantissa with MANT_BITS fraction bits (truncated).
+    if cfg.lod_log2 == LodLog2::PiecewiseLinear {
+        // floor((e - 2 frac + (L - 2^e) / 2^e) 2^16), then floor(/ 2^(17 - F)) = floor(* 2^(F-1)).
+        let mf = l - (1u128 << e);
+        let t16 = if e >= 16 {
+            (mf >> (e - 16)) as i64
+        } else {
+            (mf << (16 - e)) as i64
+        };
+        let t = ((i64::from(e) - 2 * i64::from(frac)) << 16) + t16;
+        let v = t >> (17 - f);
+        if v < floor_val {
+            sat.saturated += 1;
+            return floor_val;
+        }
+        return v;
+    }
+    // Normalized mantissa with MANT_BITS fraction bits (truncated).
     let mut m: u64 = if e >= MANT_BITS {
         (l >> (e - MANT_BITS)) as u64
     } else {

@@ -27,7 +27,7 @@
 use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, Rounding, SatCounter};
+use crate::fixed::{round_shift_right_wide, ConstRounding, Rounding, SatCounter};
 
 /// Guard bits carried by the working precision beyond `recip_mantissa_bits`.
 pub const GUARD_BITS: u32 = 3;
@@ -86,6 +86,12 @@ impl Reciprocal {
     #[inline]
     #[must_use]
     pub fn eval(&self, x: u64, sat: &mut SatCounter) -> Recip {
+        crate::with_rounding!(self.cfg.recip_rounding, M => self.eval_in::<M>(x, sat))
+    }
+
+    /// [`Reciprocal::eval`] compiled for the rounding mode `M` (`recip_rounding`).
+    #[inline(always)]
+    fn eval_in<M: ConstRounding>(&self, x: u64, sat: &mut SatCounter) -> Recip {
         let m_bits = self.cfg.recip_mantissa_bits;
         if x == 0 {
             sat.saturated += 1;
@@ -95,7 +101,7 @@ impl Reciprocal {
             };
         }
         let p = self.p;
-        let rnd = self.cfg.recip_rounding;
+        let rnd = M::MODE;
         let mut n = 63 - x.leading_zeros();
         // m with P fraction bits, in [2^P, 2^(P+1)).
         let mut m: i64 = if n <= p {
@@ -144,7 +150,7 @@ impl Reciprocal {
 
 /// One Newton-Raphson step `y (2 - m y)` with each product rounded to `p` fraction bits.
 /// Operands are below 2^(p+2), so for p <= 29 the products fit `i64` (same bits as `i128`).
-#[inline]
+#[inline(always)]
 fn nr_step(m: i64, y: i64, two: i64, p: u32, rnd: Rounding) -> i64 {
     if p <= 29 {
         let t = crate::fixed::round_shift_right(m * y, p, rnd);
@@ -177,6 +183,14 @@ pub fn square(r: Recip, m_bits: u32, mode: Rounding) -> Recip {
 #[inline]
 #[must_use]
 pub fn apply(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
+    crate::with_rounding!(mode, M => apply_in::<M>(r, x, frac_bits))
+}
+
+/// [`apply`] compiled for the rounding mode `M`.
+#[inline(always)]
+#[must_use]
+pub fn apply_in<M: ConstRounding>(r: Recip, x: i128, frac_bits: u32) -> i64 {
+    let mode = M::MODE;
     let sh = r.shift - frac_bits as i32;
     // Exact i64 fast path: same product, same single rounding.
     if sh >= 0 {
@@ -186,7 +200,13 @@ pub fn apply(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
             }
         }
     }
-    let prod = x.saturating_mul(i128::from(r.mant));
+    // |x| < 2^96 and a mantissa below 2^31 (at most 30 bits + 1): the product is below 2^127
+    // and the saturating multiply's overflow check can be skipped (same value).
+    let prod = if x.unsigned_abs() >> 96 == 0 && r.mant >> 31 == 0 {
+        x * i128::from(r.mant)
+    } else {
+        x.saturating_mul(i128::from(r.mant))
+    };
     if sh >= 0 {
         round_shift_right_wide(prod, sh as u32, mode)
     } else {
@@ -251,4 +271,126 @@ pub fn datapath(cfg: &ReciprocalConfig) -> Datapath {
                 .then(Component::Adder { width: m + 1 })
                 .then(Component::Register { bits: m + 1 + 8 }),
         )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::HwConfig;
+    use crate::fixed::round_shift_right;
+
+    const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+    /// Splitmix64: the seeded generator of these tests.
+    fn next(s: &mut u64) -> u64 {
+        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// `eval` as it was before it was compiled per rounding mode (the mode read from the
+    /// config at every reduction): the oracle.
+    fn eval_before(u: &Reciprocal, x: u64, sat: &mut SatCounter) -> Recip {
+        let m_bits = u.cfg.recip_mantissa_bits;
+        if x == 0 {
+            sat.saturated += 1;
+            return Recip {
+                mant: (1u64 << (m_bits + 1)) - 1,
+                shift: 0,
+            };
+        }
+        let (p, rnd) = (u.p, u.cfg.recip_rounding);
+        let mut n = 63 - x.leading_zeros();
+        let mut m: i64 = if n <= p {
+            (x << (p - n)) as i64
+        } else if n < 63 {
+            round_shift_right(x as i64, n - p, rnd)
+        } else {
+            round_shift_right_wide(i128::from(x), n - p, rnd)
+        };
+        if m >> (p + 1) != 0 {
+            m >>= 1;
+            n += 1;
+        }
+        let l = u.cfg.recip_lut_bits;
+        let top = if l <= p { m >> (p - l) } else { m << (l - p) };
+        let mut y = u.lut[(top & ((1i64 << l) - 1)) as usize] as i64;
+        for _ in 0..u.cfg.recip_iterations {
+            y = nr_step(m, y, 2i64 << p, p, rnd);
+        }
+        let b = 64 - (y as u64).leading_zeros();
+        let drop = b - (m_bits + 1);
+        let mut mant = round_shift_right(y, drop, rnd) as u64;
+        let mut shift = (p + n) as i32 - drop as i32;
+        if mant >> (m_bits + 1) != 0 {
+            mant >>= 1;
+            shift -= 1;
+        }
+        Recip { mant, shift }
+    }
+
+    /// `apply` as it was before the mode became a type and the unchecked product: the oracle.
+    fn apply_before(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
+        let sh = r.shift - frac_bits as i32;
+        if sh >= 0 {
+            if let (Ok(x64), Ok(m64)) = (i64::try_from(x), i64::try_from(r.mant)) {
+                if let Some(prod) = x64.checked_mul(m64) {
+                    return round_shift_right(prod, sh as u32, mode);
+                }
+            }
+        }
+        let prod = x.saturating_mul(i128::from(r.mant));
+        if sh >= 0 {
+            round_shift_right_wide(prod, sh as u32, mode)
+        } else {
+            let up = (-sh) as u32;
+            if up >= 64 {
+                match prod.signum() {
+                    0 => 0,
+                    1 => i64::MAX,
+                    _ => i64::MIN,
+                }
+            } else {
+                round_shift_right_wide(prod.saturating_mul(1i128 << up), 0, mode)
+            }
+        }
+    }
+
+    /// 3M seeded arguments over 15 configurations (every mode; LUT, iteration and mantissa
+    /// widths varied; arguments of 1 to 64 bits and 0): `eval` and `apply` give the old bits, `apply`
+    /// across the 64-bit path, the unchecked 128-bit product (|x| < 2^96) and the saturating
+    /// one beyond it, with positive and negative scale.
+    #[test]
+    fn eval_and_apply_match_the_previous_datapath() {
+        let mut s = 0x5eed_0005;
+        let base = HwConfig::texram16().reciprocal;
+        for mode in MODES {
+            for (l, n, mb) in [(8, 2, 24), (8, 1, 24), (4, 3, 30), (12, 1, 16), (16, 0, 8)] {
+                let cfg = ReciprocalConfig {
+                    recip_lut_bits: l,
+                    recip_iterations: n,
+                    recip_mantissa_bits: mb,
+                    recip_rounding: mode,
+                    ..base.clone()
+                };
+                let u = Reciprocal::new(&cfg);
+                for i in 0..200_000u32 {
+                    let x = if i == 0 { 0 } else { next(&mut s) >> (i % 64) };
+                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
+                    let r = u.eval(x, &mut sa);
+                    assert_eq!(r, eval_before(&u, x, &mut sb), "1/{x} {cfg:?}");
+                    assert_eq!(sa, sb);
+                    let xb = [20, 62, 63, 90, 95, 96, 100, 126][(i % 8) as usize];
+                    let v =
+                        (i128::from(next(&mut s)) << 64 | i128::from(next(&mut s))) >> (127 - xb);
+                    let fb = (next(&mut s) % 100) as u32;
+                    for m2 in MODES {
+                        assert_eq!(apply(r, v, fb, m2), apply_before(r, v, fb, m2), "{v} {r:?}");
+                    }
+                }
+            }
+        }
+    }
 }

@@ -24,7 +24,23 @@ pub enum BankInterleave {
     Linear,
 }
 
-/// Throughput, latency, memory and cache parameters of the texture pipeline.
+/// Bytes of the widest stored texel (4 channels of 16 bits): cache lines and DRAM pages hold
+/// at least one.
+pub const MAX_TEXEL_BYTES: u32 = 8;
+
+/// Bytes one stored texel of `channels` channels of `bits` bits occupies in texture memory:
+/// the packed bits rounded up to a whole power-of-two number of bytes (texels are addressed by
+/// shifts, so a 48-bit texel takes 8 bytes and a 4-bit one 1 byte). Channels and bits are
+/// clamped to 1..=4 and 1..=16, so the result is 1, 2, 4 or 8 ([`MAX_TEXEL_BYTES`]).
+#[must_use]
+pub fn stored_texel_bytes(channels: u32, bits: u32) -> u32 {
+    (channels.clamp(1, 4) * bits.clamp(1, 16))
+        .div_ceil(8)
+        .next_power_of_two()
+}
+
+/// Throughput, latency, memory and cache parameters of the texture pipeline. Bytes per texel
+/// are not a field: they follow each map's format ([`stored_texel_bytes`]).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimingConfig {
@@ -50,8 +66,6 @@ pub struct TimingConfig {
     pub dram_page_hit_cycles: u32,
     /// Cycles a bank is busy for an access that opens a new page (precharge + activate + read).
     pub dram_page_miss_cycles: u32,
-    /// Bytes per stored texel.
-    pub texel_bytes: u32,
     /// Fragments the visibility pass traverses per cycle (after the span start cost).
     pub raster_fragments_per_cycle: u32,
     /// Pixels the shading pass issues per cycle.
@@ -94,7 +108,6 @@ impl TimingConfig {
             dram_page_bytes: 2048,
             dram_page_hit_cycles: 1,
             dram_page_miss_cycles: 6,
-            texel_bytes: 8,
             raster_fragments_per_cycle: 1,
             shade_pixels_per_cycle: 1,
             shade_pixels_in_flight: 16,
@@ -119,7 +132,6 @@ impl TimingConfig {
             dram_page_bytes: 2048,
             dram_page_hit_cycles: 8,
             dram_page_miss_cycles: 40,
-            texel_bytes: 8,
             raster_fragments_per_cycle: 1,
             shade_pixels_per_cycle: 1,
             shade_pixels_in_flight: 64,
@@ -139,9 +151,18 @@ impl TimingConfig {
             ("bilinear_per_cycle", self.bilinear_per_cycle, 1, 8),
             ("banks", self.banks, 1, 64),
             ("cache_ways", self.cache_ways, 1, 64),
-            ("texel_bytes", self.texel_bytes, 1, 16),
-            ("cache_line_bytes", self.cache_line_bytes, 1, 4096),
-            ("dram_page_bytes", self.dram_page_bytes, 1, 1 << 20),
+            (
+                "cache_line_bytes",
+                self.cache_line_bytes,
+                MAX_TEXEL_BYTES,
+                4096,
+            ),
+            (
+                "dram_page_bytes",
+                self.dram_page_bytes,
+                MAX_TEXEL_BYTES,
+                1 << 20,
+            ),
             ("cache_bytes", self.cache_bytes, 0, 1 << 26),
             ("cache_hit_cycles", self.cache_hit_cycles, 0, 1000),
             ("dram_page_hit_cycles", self.dram_page_hit_cycles, 1, 1000),
@@ -174,23 +195,10 @@ impl TimingConfig {
             ("banks", self.banks),
             ("cache_line_bytes", self.cache_line_bytes),
             ("dram_page_bytes", self.dram_page_bytes),
-            ("texel_bytes", self.texel_bytes),
         ] {
             if !v.is_power_of_two() {
                 return Err(err(f, format!("{v} is not a power of two")));
             }
-        }
-        if self.cache_line_bytes < self.texel_bytes {
-            return Err(err(
-                "cache_line_bytes",
-                format!("{} is smaller than one texel", self.cache_line_bytes),
-            ));
-        }
-        if self.dram_page_bytes < self.texel_bytes {
-            return Err(err(
-                "dram_page_bytes",
-                format!("{} is smaller than one texel", self.dram_page_bytes),
-            ));
         }
         if self.cache_bytes != 0 {
             let set = self.cache_line_bytes * self.cache_ways;

@@ -26,8 +26,8 @@
 use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::fixed::{round_shift_right, Rounding};
-use crate::wrap::{wrap, WrapMode};
+use crate::fixed::{round_shift_right, ConstRounding, Rounding};
+use crate::wrap::{wrap_in, WrapMode};
 
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
@@ -68,14 +68,14 @@ pub struct TrilinearTrace {
 
 /// `a + (b - a) w / 2^weight_bits` with exactly one rounding (`w` in `[0, 2^weight_bits]`,
 /// `weight_bits <= 30`). The result lies between `a` and `b`; exact for `w` = 0 or 2^wb.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn lerp(a: u32, b: u32, w: u32, weight_bits: u32, rounding: Rounding) -> u32 {
     let num = (i64::from(a) << weight_bits) + (i64::from(b) - i64::from(a)) * i64::from(w);
     round_shift_right(num, weight_bits, rounding) as u32
 }
 
-#[inline]
+#[inline(always)]
 fn fetch(level: &Level, x: u32, y: u32) -> [u16; 4] {
     let idx = y as usize * level.width as usize + x as usize;
     level.texels.get(idx).copied().unwrap_or([0; 4])
@@ -94,14 +94,33 @@ pub fn bilinear(
     cfg: &TrilinearConfig,
     trace: Option<&mut BilinearTrace>,
 ) -> [u32; 4] {
-    let wx = wrap(u, frac, level.width, wrap_mode[0], cfg);
-    let wy = wrap(v, frac, level.height, wrap_mode[1], cfg);
+    crate::with_rounding!(cfg.filter_rounding, F => {
+        crate::with_rounding!(cfg.weight_rounding, W => {
+            bilinear_in::<F, W>(level, u, v, frac, wrap_mode, cfg, trace)
+        })
+    })
+}
+
+/// [`bilinear`] compiled for the filter rounding `F` (`filter_rounding`) and the weight
+/// rounding `W` (`weight_rounding`).
+#[inline(always)]
+fn bilinear_in<F: ConstRounding, W: ConstRounding>(
+    level: &Level,
+    u: i64,
+    v: i64,
+    frac: u32,
+    wrap_mode: [WrapMode; 2],
+    cfg: &TrilinearConfig,
+    trace: Option<&mut BilinearTrace>,
+) -> [u32; 4] {
+    let wx = wrap_in::<W>(u, frac, level.width, wrap_mode[0], cfg);
+    let wy = wrap_in::<W>(v, frac, level.height, wrap_mode[1], cfg);
     let t00 = fetch(level, wx.i0, wy.i0);
     let t10 = fetch(level, wx.i1, wy.i0);
     let t01 = fetch(level, wx.i0, wy.i1);
     let t11 = fetch(level, wx.i1, wy.i1);
     let wb = cfg.weight_bits.min(16);
-    let r = cfg.filter_rounding;
+    let r = F::MODE;
     let mut out = [0u32; 4];
     for c in 0..4 {
         let top = lerp(u32::from(t00[c]), u32::from(t10[c]), wx.weight, wb, r);
@@ -136,6 +155,27 @@ pub fn trilinear(
     lod_frac_bits: u32,
     wrap_mode: [WrapMode; 2],
     cfg: &TrilinearConfig,
+    trace: Option<&mut TrilinearTrace>,
+) -> [u16; 4] {
+    crate::with_rounding!(cfg.filter_rounding, F => {
+        crate::with_rounding!(cfg.weight_rounding, W => {
+            trilinear_in::<F, W>(levels, u, v, frac, lod, lod_frac_bits, wrap_mode, cfg, trace)
+        })
+    })
+}
+
+/// [`trilinear`] compiled for the filter rounding `F` and the weight rounding `W`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn trilinear_in<F: ConstRounding, W: ConstRounding>(
+    levels: &[Level],
+    u: i64,
+    v: i64,
+    frac: u32,
+    lod: i64,
+    lod_frac_bits: u32,
+    wrap_mode: [WrapMode; 2],
+    cfg: &TrilinearConfig,
     mut trace: Option<&mut TrilinearTrace>,
 ) -> [u16; 4] {
     let n = levels.len();
@@ -155,7 +195,7 @@ pub fn trilinear(
         level: l0 as u32,
         ..BilinearTrace::default()
     };
-    let c0 = bilinear(
+    let c0 = bilinear_in::<F, W>(
         &levels[l0],
         u,
         v,
@@ -183,7 +223,7 @@ pub fn trilinear(
         level: l0 as u32 + 1,
         ..BilinearTrace::default()
     };
-    let c1 = bilinear(
+    let c1 = bilinear_in::<F, W>(
         &levels[l0 + 1],
         u,
         v,
@@ -193,7 +233,7 @@ pub fn trilinear(
         trace.as_ref().map(|_| &mut bt1),
     );
     for c in 0..4 {
-        out[c] = lerp(c0[c], c1[c], lw, lf, cfg.filter_rounding) as u16;
+        out[c] = lerp(c0[c], c1[c], lw, lf, F::MODE) as u16;
     }
     if let Some(t) = trace {
         *t = TrilinearTrace {
@@ -301,4 +341,101 @@ pub fn filter_latencies(cfg: &TrilinearConfig, gate_levels_per_cycle: u32) -> (u
     let bilinear = bilinear_datapath(cfg).latency(gate_levels_per_cycle);
     let both = datapath(cfg, 2).latency(gate_levels_per_cycle);
     (bilinear, both - 2 * bilinear)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::HwConfig;
+    use crate::wrap::wrap;
+
+    const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+    /// Splitmix64: the seeded generator of these tests.
+    fn next(s: &mut u64) -> u64 {
+        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// The bilinear footprint as it was composed before the unit was compiled per rounding
+    /// mode (each reduction reading its mode from the config): the oracle.
+    fn bilinear_before(
+        level: &Level,
+        u: i64,
+        v: i64,
+        frac: u32,
+        wm: [WrapMode; 2],
+        cfg: &TrilinearConfig,
+    ) -> [u32; 4] {
+        let wx = wrap(u, frac, level.width, wm[0], cfg);
+        let wy = wrap(v, frac, level.height, wm[1], cfg);
+        let t = |x: u32, y: u32| fetch(level, x, y);
+        let (t00, t10, t01, t11) = (
+            t(wx.i0, wy.i0),
+            t(wx.i1, wy.i0),
+            t(wx.i0, wy.i1),
+            t(wx.i1, wy.i1),
+        );
+        let (wb, r) = (cfg.weight_bits.min(16), cfg.filter_rounding);
+        std::array::from_fn(|c| {
+            let top = lerp(u32::from(t00[c]), u32::from(t10[c]), wx.weight, wb, r);
+            let bot = lerp(u32::from(t01[c]), u32::from(t11[c]), wx.weight, wb, r);
+            lerp(top, bot, wy.weight, wb, r)
+        })
+    }
+
+    /// 1.8M seeded samples over the nine (filter, weight) rounding pairs, three wrap modes,
+    /// weight widths 0 to 16 and coordinates in and far outside [0, 1]: `bilinear` and
+    /// `trilinear` give the bits of the composition from `wrap` and `lerp`.
+    #[test]
+    fn compiled_modes_match_the_composed_filter() {
+        let mut s = 0x5eed_0006;
+        let (w, h) = (13u32, 8u32);
+        let texels: Vec<[u16; 4]> = (0..w * h * 2)
+            .map(|_| [0; 4].map(|_| next(&mut s) as u16))
+            .collect();
+        let l0 = Level {
+            width: w,
+            height: h,
+            texels: &texels[..(w * h) as usize],
+        };
+        let l1 = Level {
+            width: 7,
+            height: 4,
+            texels: &texels[(w * h) as usize..],
+        };
+        let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
+        for f in MODES {
+            for wr in MODES {
+                let mut cfg = HwConfig::texram16().trilinear;
+                cfg.filter_rounding = f;
+                cfg.weight_rounding = wr;
+                for i in 0..200_000u32 {
+                    cfg.weight_bits = [16, 8, 4, 0, 12][(i % 5) as usize];
+                    let frac = [24, 16, 8, 30][(i / 5 % 4) as usize];
+                    let sh = [34, 30, 10][(i % 3) as usize];
+                    let u = (next(&mut s) as i64) >> sh;
+                    let v = (next(&mut s) as i64) >> sh;
+                    let wm = [modes[(i % 3) as usize], modes[(i / 3 % 3) as usize]];
+                    let want = bilinear_before(&l0, u, v, frac, wm, &cfg);
+                    assert_eq!(bilinear(&l0, u, v, frac, wm, &cfg, None), want);
+                    let lod = (next(&mut s) % (3 << 16)) as i64 - (1 << 16);
+                    let lw = (lod.clamp(0, 1 << 16) & 0xffff) as u32;
+                    let want = if lod <= 0 {
+                        want.map(|c| c as u16)
+                    } else if lod >> 16 >= 1 {
+                        bilinear_before(&l1, u, v, frac, wm, &cfg).map(|c| c as u16)
+                    } else {
+                        let c1 = bilinear_before(&l1, u, v, frac, wm, &cfg);
+                        std::array::from_fn(|c| lerp(want[c], c1[c], lw, 16, f) as u16)
+                    };
+                    let got = trilinear(&[l0, l1], u, v, frac, lod, 16, wm, &cfg, None);
+                    assert_eq!(got, want, "{u} {v} {lod} {cfg:?}");
+                }
+            }
+        }
+    }
 }

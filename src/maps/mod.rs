@@ -15,6 +15,9 @@
 mod prepared;
 pub use prepared::{bump_sources, ndf_sources, BumpSource, Maps};
 
+/// Stored channels of a bump offset map (`f_u`, `f_v`).
+pub const OFFSET_CHANNELS: u32 = 2;
+
 use crate::scene::TextureImage;
 
 /// One float MIP level, RGBA in 0..1, top row first.
@@ -39,10 +42,32 @@ pub struct FixedLevel {
     pub texels: Vec<[u16; 4]>,
 }
 
+/// How a map is stored in texture memory: its channels and bits per channel. The trilinear
+/// unit always filters four channels of `texel_bits`; a map stores only the channels it uses
+/// (colour RGBA 4, bump offsets 2, roughness D 3 or 1, NDF moments 3, normalization 1), at its
+/// own width, so narrower maps move fewer bytes through the cache and DRAM model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct TexelFormat {
+    pub channels: u32,
+    pub bits: u32,
+}
+
+impl TexelFormat {
+    /// Bytes one stored texel occupies ([`hw_model::timing_config::stored_texel_bytes`]).
+    #[must_use]
+    pub fn bytes(self) -> u32 {
+        hw_model::timing_config::stored_texel_bytes(self.channels, self.bits)
+    }
+}
+
 /// A quantized pyramid as the hardware's texture memory holds it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FixedMipChain {
+    /// Width of the channels the trilinear unit reads.
     pub texel_bits: u32,
+    /// The stored format (channels and their width; RGBA at `texel_bits` unless the map's
+    /// builder says otherwise with [`FixedMipChain::stored_as`]).
+    pub format: TexelFormat,
     pub levels: Vec<FixedLevel>,
 }
 
@@ -62,6 +87,13 @@ impl MipChain {
 }
 
 impl FixedMipChain {
+    /// The same chain stored as `channels` channels of `bits` bits.
+    #[must_use]
+    pub fn stored_as(mut self, channels: u32, bits: u32) -> Self {
+        self.format = TexelFormat { channels, bits };
+        self
+    }
+
     /// The levels as the fixed trilinear unit reads them.
     #[must_use]
     pub fn views(&self) -> Vec<hw_model::trilinear::Level<'_>> {
@@ -196,12 +228,14 @@ pub fn quantize_unorm(x: f32, bits: u32) -> u16 {
     v as u16
 }
 
-/// Quantizes every level of `chain` to unsigned-normalized `texel_bits` (clamped to 1..=16).
+/// Quantizes every level of `chain` to unsigned-normalized `texel_bits` (clamped to 1..=16),
+/// stored as RGBA of that width.
 #[must_use]
 pub fn quantize_chain(chain: &MipChain, texel_bits: u32) -> FixedMipChain {
     let bits = texel_bits.clamp(1, 16);
     FixedMipChain {
         texel_bits: bits,
+        format: TexelFormat { channels: 4, bits },
         levels: chain
             .levels
             .iter()

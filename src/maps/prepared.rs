@@ -2,7 +2,9 @@
 //! source, the NDF moment chains, each in float (host) and quantized to the machine's texel
 //! width. Map `i` of [`Maps`] is the same map in `float[i]` and `fixed[i]`.
 
-use super::{build_mip_chain, quantize_chain, quantize_unorm, FixedMipChain, MipChain};
+use super::{
+    build_mip_chain, quantize_chain, quantize_unorm, FixedMipChain, MipChain, OFFSET_CHANNELS,
+};
 use crate::scene::{Scene, TextureImage};
 use crate::shading::bump::{
     height_to_offsets, heights_from_texture, normal_map_to_offsets, offsets_to_image, BumpParams,
@@ -98,6 +100,28 @@ pub fn ndf_sources(scene: &Scene) -> Vec<(usize, u32)> {
     out
 }
 
+/// Quantizes the scene's textures (stored RGBA) and, from `first_offset` on, the offset maps
+/// (stored as their two channels) to `texel_bits`.
+fn quantize_host_maps(
+    float: &[MipChain],
+    first_offset: usize,
+    texel_bits: u32,
+) -> Vec<FixedMipChain> {
+    float
+        .par_iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let q = quantize_chain(c, texel_bits);
+            if i >= first_offset {
+                let bits = q.texel_bits;
+                q.stored_as(OFFSET_CHANNELS, bits)
+            } else {
+                q
+            }
+        })
+        .collect()
+}
+
 /// Encodes offsets (range `2^offset_int_bits`) and builds the offset map's MIP chain with the
 /// ordinary texture path (16-bit unorm level 0, box-filtered levels). Returns the chain and
 /// the number of clamped offsets.
@@ -163,10 +187,7 @@ impl Maps {
             float.push(c);
             bump_clamped += cl;
         }
-        let fixed = float
-            .par_iter()
-            .map(|c| quantize_chain(c, texel_bits))
-            .collect();
+        let fixed = quantize_host_maps(&float, float.len() - bump_offsets.len(), texel_bits);
         let mut maps = Self {
             float,
             fixed,
@@ -255,7 +276,8 @@ impl Maps {
         self.bump_clamped = self.normal_nz_clamped;
         for (k, (w, h, name, offs)) in self.bump_offsets.iter().enumerate() {
             let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
-            self.fixed[first + k] = quantize_chain(&c, texel_bits);
+            self.fixed[first + k] =
+                quantize_chain(&c, texel_bits).stored_as(OFFSET_CHANNELS, texel_bits);
             self.float[first + k] = c;
             self.bump_clamped += cl;
         }
@@ -271,10 +293,8 @@ impl Maps {
         {
             let keep = self.float.len() - self.ndf_chains();
             let ndf = self.fixed.split_off(keep);
-            self.fixed = self.float[..keep]
-                .par_iter()
-                .map(|c| quantize_chain(c, texel_bits))
-                .collect();
+            let first_offset = keep - self.bump_offsets.len();
+            self.fixed = quantize_host_maps(&self.float[..keep], first_offset, texel_bits);
             self.fixed.extend(ndf);
         }
     }

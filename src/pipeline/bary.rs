@@ -1,5 +1,7 @@
 //! `bary`: perspective-correct barycentrics at the pixel and, when the plan needs derivatives,
-//! at its two first-order neighbours (Heckbert & Moreton 1991; `hw_model::interpolator`).
+//! at its two first-order neighbours (Heckbert & Moreton 1991; `hw_model::interpolator`);
+//! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad;
+//! with `attr_subpixel_bits` the edges come from the float positions on that finer grid.
 
 use super::stages::{Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
@@ -17,15 +19,50 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let sub = hw.raster.subpixel_bits;
     let bb = hw.interp.bary_bits;
     let (tri, a, m) = (px.tri, px.a, px.m);
-    if px.plan.derivatives {
-        let (e, dx, dy) = tri.edges_fixed_with_steps(px.x, px.y, sub);
+    let grid = hw.interp.attr_subpixel_bits;
+    let regrid = grid != 0 && grid != sub;
+    let edges = |x: i64, y: i64| {
+        if regrid {
+            tri.edges_fixed_on_grid(x, y, grid)
+        } else {
+            tri.edges_fixed(x, y, sub)
+        }
+    };
+    if px.plan.derivatives && hw.lod.lod_per_quad {
+        // The pixel, then its helpers carry the quad's finite differences.
+        let b = |x: i64, y: i64, sat: &mut _| {
+            perspective_bary(edges(x, y), a.inv_w_x, &hw.interp, &m.recip, sat)
+        };
+        let p = b(px.x, px.y, sat);
+        let (qx, qy) = (px.x & !1, px.y & !1);
+        let q0 = b(qx, qy, sat);
+        let q1 = b(qx + 1, qy, sat);
+        let q2 = b(qx, qy + 1, sat);
+        frag.bary_x = [
+            p,
+            [0, 1, 2].map(|i| p[i] + q1[i] - q0[i]),
+            [0, 1, 2].map(|i| p[i] + q2[i] - q0[i]),
+        ];
+    } else if px.plan.derivatives {
+        let (e, dx, dy) = if regrid {
+            let e = edges(px.x, px.y);
+            let (ex, ey) = (edges(px.x + 1, px.y), edges(px.x, px.y + 1));
+            (
+                e,
+                [0, 1, 2].map(|i| ex[i].wrapping_sub(e[i])),
+                [0, 1, 2].map(|i| ey[i].wrapping_sub(e[i])),
+            )
+        } else {
+            tri.edges_fixed_with_steps(px.x, px.y, sub)
+        };
         frag.bary_x = perspective_bary_derivs(e, dx, dy, a.inv_w_x, &hw.interp, &m.recip, sat);
     } else {
-        let e = tri.edges_fixed(px.x, px.y, sub);
-        frag.bary_x[0] = perspective_bary(e, a.inv_w_x, &hw.interp, &m.recip, sat);
+        frag.bary_x[0] = perspective_bary(edges(px.x, px.y), a.inv_w_x, &hw.interp, &m.recip, sat);
     }
-    for s in 0..px.samples() {
-        frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+    if px.carriers {
+        for s in 0..px.samples() {
+            frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+        }
     }
 }
 
@@ -34,7 +71,17 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let (x, y) = (px.x as f64, px.y as f64);
     let (tri, a) = (px.tri, px.a);
     let e = tri.edges_float(x, y);
-    if px.plan.derivatives {
+    if px.plan.derivatives && px.m.hw.lod.lod_per_quad {
+        let p = perspective_bary_f64(e, a.inv_w_f);
+        let (qx, qy) = ((px.x & !1) as f64, (px.y & !1) as f64);
+        let b = |x: f64, y: f64| perspective_bary_f64(tri.edges_float(x, y), a.inv_w_f);
+        let (q0, q1, q2) = (b(qx, qy), b(qx + 1.0, qy), b(qx, qy + 1.0));
+        frag.bary = [
+            p,
+            [0, 1, 2].map(|i| p[i] + q1[i] - q0[i]),
+            [0, 1, 2].map(|i| p[i] + q2[i] - q0[i]),
+        ];
+    } else if px.plan.derivatives {
         let ex = tri.edges_float(x + 1.0, y);
         let ey = tri.edges_float(x, y + 1.0);
         let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
@@ -48,9 +95,12 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
 /// One invocation: the barycentrics, plus their derivatives when the plan needs them.
 #[must_use]
 pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
-    if plan.derivatives {
-        perspective_bary_derivs_cost(&m.hw.interp, &m.recip, m.hw.timing.gate_levels_per_cycle)
+    let glpc = m.hw.timing.gate_levels_per_cycle;
+    if plan.derivatives && m.hw.lod.lod_per_quad {
+        perspective_bary_cost(&m.hw.interp, &m.recip, glpc).times(4)
+    } else if plan.derivatives {
+        perspective_bary_derivs_cost(&m.hw.interp, &m.recip, glpc)
     } else {
-        perspective_bary_cost(&m.hw.interp, &m.recip, m.hw.timing.gate_levels_per_cycle)
+        perspective_bary_cost(&m.hw.interp, &m.recip, glpc)
     }
 }

@@ -22,13 +22,17 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     for ch in 0..3 {
         let r = interpolate(b, bb, column(&px.a.color_x, ch), &m.color_fmt, sat) as u32;
         frag.color_x[ch] = r;
-        frag.color[ch] = unorm(r, cb);
+        if px.carriers {
+            frag.color[ch] = unorm(r, cb);
+        }
     }
     frag.color_x[3] = ((1u64 << cb) - 1) as u32;
     frag.out_x = frag.color_x;
     frag.out_bits = cb;
-    frag.color[3] = 1.0;
-    frag.out = frag.color;
+    if px.carriers {
+        frag.color[3] = 1.0;
+        frag.out = frag.color;
+    }
 }
 
 /// Float twin.

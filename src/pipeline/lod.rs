@@ -5,7 +5,7 @@ use super::stages::{texel_derivs, texel_derivs_f64, Counters, Machine};
 use super::texcoord::quantize_uv;
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
-use crate::reference::lod_f64;
+use crate::reference::lod_mode_f64;
 use hw_model::lod::lod_cost;
 use hw_model::UnitCost;
 
@@ -22,7 +22,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let d = texel_derivs(&frag.uv_x, l0.width, l0.height);
     let fb = m.uv_fmt.frac_bits;
     frag.lod_x = hw_model::lod::lod(d, fb, &m.hw.lod, sat);
-    frag.lod = from_raw(frag.lod_x, m.hw.lod.lod_frac_bits);
+    if px.carriers {
+        frag.lod = from_raw(frag.lod_x, m.hw.lod.lod_frac_bits);
+    }
 }
 
 /// Float twin.
@@ -30,7 +32,8 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let Some(l0) = px.plan.texture.and_then(|t| px.m.tex_float[t].first()) else {
         return;
     };
-    frag.lod = lod_f64(texel_derivs_f64(&frag.uv, l0.width, l0.height));
+    let d = texel_derivs_f64(&frag.uv, l0.width, l0.height);
+    frag.lod = lod_mode_f64(d, px.m.hw.lod.lod_log2);
 }
 
 /// One invocation of the LOD unit.

@@ -24,7 +24,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, _: &mut Counters) {
     };
     for ch in 0..4 {
         frag.out_x[ch] = modulate(col[ch], cb, tex[ch], tb, cb, rnd);
-        frag.out[ch] = unorm(frag.out_x[ch], cb);
+        if px.carriers {
+            frag.out[ch] = unorm(frag.out_x[ch], cb);
+        }
     }
     frag.out_bits = cb;
 }

@@ -139,6 +139,6 @@ pub fn shade_is_float_only(hw: &HwConfig) -> bool {
     hw.ndf.ndf_norm == NdfNorm::Exact
 }
 
-/// Why a render with `ndf_norm = exact` has no cycle count (`CycleEstimate::not_modelled`).
+/// Why a render with `ndf_norm = exact` has no cycle count (`IssueCycles::not_modelled`).
 pub const EXACT_NOT_MODELLED: &str =
     "ndf-shade with ndf_norm = exact is float only: no hardware cost model";

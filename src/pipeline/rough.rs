@@ -189,8 +189,10 @@ pub fn rough_maps(
             RoughParams::for_material(s.shininess, rc.exponent(s.shininess), rc.rough_uniform);
         let (c, cl) = rough_mip_chain(&pyr, &params, &enc, s.isotropic);
         clamped += cl;
-        out.fixed
-            .push(quantize_rough_chain(&c, rc.rough_d_bits, tb));
+        let q = quantize_rough_chain(&c, rc.rough_d_bits, tb);
+        let stored = if s.isotropic { 1 } else { q.format.channels };
+        let bits = q.format.bits;
+        out.fixed.push(q.stored_as(stored, bits));
         out.float.push(c);
     }
     Ok((out, clamped))

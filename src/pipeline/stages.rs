@@ -332,6 +332,7 @@ pub fn run(
         x,
         y,
         color_raw: prog.color_raw,
+        carriers: prog.carriers,
     };
     for op in &prog.ops {
         let k = op.kind.index();

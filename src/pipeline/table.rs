@@ -33,6 +33,9 @@ pub struct Px<'a> {
     pub y: i64,
     /// The plan's colour comes from a Fixed `color` stage (its raw value is in `Frag::color_x`).
     pub color_raw: bool,
+    /// A stage of this run may read the float carriers of a Fixed producer (see
+    /// [`Program::carriers`]); when false, the Fixed twins write their raw values only.
+    pub carriers: bool,
 }
 
 impl Px<'_> {
@@ -250,6 +253,11 @@ pub struct Program {
     pub impls: StageImpls,
     /// The plan's colour comes from a Fixed `color` stage.
     pub color_raw: bool,
+    /// Whether the Fixed twins must also write the float carriers of their results: false
+    /// only when every stage of the plan runs Fixed and is one of `bary`, `color`,
+    /// `texcoord`, `lod`, `trilinear`, `modulate`, whose Fixed twins read their producers'
+    /// raw values only (and the fragment's output is then the last stage's raw value).
+    pub carriers: bool,
 }
 
 impl Program {
@@ -271,10 +279,23 @@ impl Program {
                 }
             })
             .collect();
+        const RAW_ONLY: [StageKind; 6] = [
+            StageKind::Bary,
+            StageKind::Color,
+            StageKind::Texcoord,
+            StageKind::Lod,
+            StageKind::Trilinear,
+            StageKind::Modulate,
+        ];
+        let raw_only = plan
+            .stages
+            .iter()
+            .all(|&k| impls.of(k) == Impl::Fixed && RAW_ONLY.contains(&k));
         Self {
             ops,
             impls: *impls,
             color_raw: plan.has(StageKind::Color) && impls.of(StageKind::Color) == Impl::Fixed,
+            carriers: !raw_only,
         }
     }
 }

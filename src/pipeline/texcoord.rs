@@ -25,7 +25,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         for ax in 0..2 {
             let r = interpolate(b, bb, column(&px.a.uv_x, ax), &m.uv_fmt, sat);
             frag.uv_x[s][ax] = r;
-            frag.uv[s][ax] = from_raw(r, fb);
+            if px.carriers {
+                frag.uv[s][ax] = from_raw(r, fb);
+            }
         }
     }
 }

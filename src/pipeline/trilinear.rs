@@ -44,10 +44,12 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     }
     let tb = m.hw.trilinear.texel_bits;
     frag.texel_x = r.map(u32::from);
-    frag.texel = frag.texel_x.map(|x| unorm(x, tb));
     frag.out_x = frag.texel_x;
     frag.out_bits = tb;
-    frag.out = frag.texel;
+    if px.carriers {
+        frag.texel = frag.texel_x.map(|x| unorm(x, tb));
+        frag.out = frag.texel;
+    }
 }
 
 /// Float twin. Under timing it records the footprints the hardware unit fetches for its

@@ -104,6 +104,29 @@ impl ScreenTri {
         e
     }
 
+    /// [`Self::edges_fixed`] from the float positions `xy_f` snapped (rounded) to `bits`
+    /// sub-pixel bits (1..=16) instead of the rasterizer's grid: the attribute setup of a
+    /// machine whose planes come from finer positions than its coverage.
+    #[must_use]
+    pub fn edges_fixed_on_grid(&self, px: i64, py: i64, bits: u32) -> [i64; 3] {
+        let s = bits.clamp(1, 16);
+        let g = f64::from(1u32 << s);
+        let v = self
+            .xy_f
+            .map(|p| p.map(|c| (c * g).round_ties_even() as i128));
+        let h = 1i128 << (s - 1);
+        let x = (i128::from(px) << s) + h;
+        let y = (i128::from(py) << s) + h;
+        let mut e = [0i64; 3];
+        for (i, out) in e.iter_mut().enumerate() {
+            let [xj, yj] = v[(i + 1) % 3];
+            let [xk, yk] = v[(i + 2) % 3];
+            let w = (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
+            *out = w.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64;
+        }
+        e
+    }
+
     /// The edge values at the centres of pixels (px, py), (px + 1, py) and (px, py + 1), as
     /// `(e, e(px + 1) - e, e(py + 1) - e)`: bit-identical to three calls of
     /// [`Self::edges_fixed`], computed once in `i64` plus the edges' constant steps

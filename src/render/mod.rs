@@ -19,7 +19,10 @@ mod stats;
 pub use geometry::Geometry;
 use shading::{bump_attrs, shade, tri_attrs, ShadeInput};
 use stats::bump_frames;
-pub use stats::{BumpStats, CycleEstimate, RenderStats, Rendered, RoughStats, StageStats, Timings};
+pub use stats::{
+    BumpStats, DatapathCost, IssueCycles, RenderStats, Rendered, RoughStats, StageStats, Timings,
+    UnitCostRow,
+};
 
 use crate::fixedpoint::to_unorm;
 pub use crate::maps::{bump_sources, ndf_sources, BumpSource, Maps};
@@ -28,7 +31,7 @@ use crate::pipeline::{Impl, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::raster::{self, Coverage, NO_TRI};
 use crate::report::compare;
 use crate::scene::Scene;
-use crate::timing::events::PlanTiming;
+use crate::timing::events::{PlanTiming, TextureLayout};
 use hw_model::HwConfig;
 use serde::Serialize;
 use std::time::Instant;
@@ -195,7 +198,10 @@ pub fn render(
         fe.textures = maps
             .fixed
             .iter()
-            .map(|ch| ch.levels.iter().map(|l| (l.width, l.height)).collect())
+            .map(|ch| TextureLayout {
+                levels: ch.levels.iter().map(|l| (l.width, l.height)).collect(),
+                texel_bytes: ch.format.bytes(),
+            })
             .collect();
     }
     tm.shade_hw_ms = ms(t);
@@ -278,7 +284,7 @@ pub fn render(
     });
 
     let mut stages = Vec::with_capacity(StageKind::COUNT);
-    let mut stage_cycles = 0u64;
+    let mut stage_issue = 0u64;
     for kind in StageKind::ALL {
         let k = kind.index();
         let inv = counters.invocations[k];
@@ -290,27 +296,39 @@ pub fn render(
             saturated: counters.sat[k].saturated,
             wrapped: counters.sat[k].wrapped,
             ops,
-            cycles: cyc,
+            issue_cycles: cyc,
             texels,
         };
-        stage_cycles += s.cycles;
+        stage_issue += s.issue_cycles;
         stages.push(s);
     }
     let covered = vis.tri.iter().filter(|&&t| t != NO_TRI).count() as u64;
     let rc = &hw.raster;
-    let mut cycles = CycleEstimate {
+    let mut issue_cycles = IssueCycles {
         setup: setup.tris.len() as u64 * u64::from(rc.setup_cycles),
         spans: raster_stats.spans * u64::from(rc.span_cycles),
-        stages: stage_cycles,
+        stages: stage_issue,
         ..Default::default()
     };
-    cycles.total = cycles.setup + cycles.spans + cycles.stages;
-    cycles.per_covered_pixel = cycles.total as f64 / covered.max(1) as f64;
+    issue_cycles.total = issue_cycles.setup + issue_cycles.spans + issue_cycles.stages;
+    issue_cycles.per_covered_pixel = issue_cycles.total as f64 / covered.max(1) as f64;
     if crate::pipeline::ndf::shade_is_float_only(hw)
         && counters.invocations[StageKind::NdfShade.index()] > 0
     {
-        cycles.not_modelled = Some(crate::pipeline::ndf::EXACT_NOT_MODELLED);
+        issue_cycles.not_modelled = Some(crate::pipeline::ndf::EXACT_NOT_MODELLED);
     }
+    // The frame's cycles: the timing model over the hardware pass's events (none for a stage
+    // without a hardware cost model).
+    let timing = match (&events, issue_cycles.not_modelled) {
+        (Some(ev), None) => {
+            let t = Instant::now();
+            let rep = crate::timing::simulate(ev, hw, &scene.name);
+            tm.timing_ms = ms(t);
+            progress("timing model", tm.timing_ms);
+            Some(rep)
+        }
+        _ => None,
+    };
 
     Ok(Rendered {
         hw_image,
@@ -341,7 +359,9 @@ pub fn render(
                 frame: bump_frames(&geo, hw),
             },
             stages,
-            cycles,
+            issue_cycles,
+            timing,
+            datapath: DatapathCost::of(hw),
             timings: tm,
             quantization_error: if model_error.is_some() {
                 e8.clone()

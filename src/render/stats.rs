@@ -18,7 +18,8 @@ pub struct StageStats {
     pub saturated: u64,
     pub wrapped: u64,
     pub ops: u64,
-    pub cycles: u64,
+    /// Invocations x the unit's cycles per op ([`IssueCycles`]), not a frame time.
+    pub issue_cycles: u64,
     pub texels: u64,
 }
 
@@ -65,12 +66,15 @@ pub struct Timings {
     pub hw_total_ms: f64,
     /// Setup + (shared or float) raster + reference shading.
     pub ref_total_ms: f64,
+    /// The timing model over the events (0 when it did not run); not in `hw_total_ms`.
+    pub timing_ms: f64,
 }
 
-/// First cycle estimate: each unit's invocations x its cycles from HwConfig (no overlap, no
-/// memory effects; the detailed timing model is separate).
+/// Issue cycles: each unit's invocations x its cycles per op from HwConfig, summed with no
+/// overlap and no memory: how much arithmetic the frame asks of its units, not how long it
+/// takes. The frame's cycles are the timing model's ([`RenderStats::timing`]).
 #[derive(Clone, Debug, Default, Serialize)]
-pub struct CycleEstimate {
+pub struct IssueCycles {
     pub setup: u64,
     pub spans: u64,
     pub stages: u64,
@@ -80,6 +84,59 @@ pub struct CycleEstimate {
     /// leave its unit out and are no machine's cost; sweeps print `-`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub not_modelled: Option<&'static str>,
+}
+
+/// One hardware unit's cost at the machine's widths (`hw_model::datapath::units`): its
+/// critical path in gate levels, pipeline latency in cycles and area in gate equivalents.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct UnitCostRow {
+    pub unit: String,
+    pub delay: u32,
+    pub latency: u32,
+    pub area_ge: u64,
+}
+
+/// What the machine's datapath costs: every unit ([`UnitCostRow`]), the total area of the
+/// top-level units (`hw_model::datapath::total_area`, a proxy) and the longest unit latency.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct DatapathCost {
+    pub area_ge: u64,
+    pub max_latency: u32,
+    pub max_latency_unit: String,
+    pub units: Vec<UnitCostRow>,
+}
+
+impl DatapathCost {
+    /// The costs of machine `hw`.
+    #[must_use]
+    pub fn of(hw: &HwConfig) -> Self {
+        use hw_model::datapath::{max_latency, total_area, units};
+        let reps = units(hw);
+        let max = max_latency(&reps);
+        Self {
+            area_ge: total_area(&reps),
+            max_latency: max,
+            max_latency_unit: reps
+                .iter()
+                .find(|r| r.latency == max)
+                .map_or_else(String::new, |r| r.name.to_string()),
+            units: reps
+                .iter()
+                .map(|r| UnitCostRow {
+                    unit: r.name.to_string(),
+                    delay: r.delay,
+                    latency: r.latency,
+                    area_ge: r.area,
+                })
+                .collect(),
+        }
+    }
+
+    /// The row of unit `name`, if the machine has it.
+    #[must_use]
+    pub fn unit(&self, name: &str) -> Option<&UnitCostRow> {
+        self.units.iter().find(|u| u.unit == name)
+    }
 }
 
 /// Everything one render produced.
@@ -114,7 +171,12 @@ pub struct RenderStats {
     /// Bump-mapping events of the hardware pass (all zero without bump materials).
     pub bump: BumpStats,
     pub stages: Vec<StageStats>,
-    pub cycles: CycleEstimate,
+    pub issue_cycles: IssueCycles,
+    /// The timing model's report of the frame (`RenderOptions::timing`; `None` without it, or
+    /// when a stage has no hardware cost model, [`IssueCycles::not_modelled`]).
+    pub timing: Option<crate::timing::TimingReport>,
+    /// Delay, latency and area of the machine's units (their datapaths at its widths).
+    pub datapath: DatapathCost,
     /// Wall times: not part of the results (they differ between two runs), so not serialized
     /// with them; `texsim render` writes them into `timings.json`.
     #[serde(skip)]

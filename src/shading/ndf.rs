@@ -269,13 +269,18 @@ pub fn build_ndf_maps(
             .collect(),
     };
     let [a, b, c] = chains.map(|levels| MipChain { levels });
-    let q = |ch: &MipChain| quantize_chain(ch, cfg.moment_bits);
+    // Stored formats: three moments per map, the normalization map its one channel.
+    let q = |ch: &MipChain, channels: u32| {
+        let f = quantize_chain(ch, cfg.moment_bits);
+        let bits = f.texel_bits;
+        f.stored_as(channels, bits)
+    };
     Ok(NdfMaps {
         levels,
-        mean: q(&a),
-        diag: q(&b),
-        off: q(&c),
-        norm: q(&norm_chain),
+        mean: q(&a, 3),
+        diag: q(&b, 3),
+        off: q(&c, 3),
+        norm: q(&norm_chain, 1),
         float: [a, b, c, norm_chain],
         inv_z,
         norm_exp,

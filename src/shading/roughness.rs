@@ -331,13 +331,19 @@ pub fn quantize_d_channel(c: f32, channel: usize, d_bits: u32) -> u64 {
 
 /// Quantizes D channels to `d_bits` ([`quantize_d_channel`]) and widens them to `texel_bits`
 /// (`hw_model::roughness::widen_d_channel`: bit replication for the unorm channels, zero
-/// padding for the offset-binary `d2`): what texture memory holds.
+/// padding for the offset-binary `d2`): what the trilinear unit reads. Texture memory holds
+/// the codes before widening (the widening is wiring): three channels of `min(d_bits,
+/// texel_bits)` bits (the isotropic map's one channel is set by its builder).
 #[must_use]
 pub fn quantize_rough_chain(chain: &MipChain, d_bits: u32, texel_bits: u32) -> FixedMipChain {
     let db = d_bits.clamp(2, 16);
     let tb = texel_bits.clamp(1, 16);
     FixedMipChain {
         texel_bits: tb,
+        format: crate::maps::TexelFormat {
+            channels: 3,
+            bits: db.min(tb),
+        },
         levels: chain
             .levels
             .iter()

@@ -43,6 +43,15 @@ impl RowEvents {
     }
 }
 
+/// One texture (map) as the memory holds it: its level sizes and the bytes of a stored texel
+/// (from its format: `crate::maps::TexelFormat::bytes`).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct TextureLayout {
+    /// Level sizes (width, height), finest first.
+    pub levels: Vec<(u32, u32)>,
+    pub texel_bytes: u32,
+}
+
 /// A plan as the timing model sees it: its stages with their per-invocation cost.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct PlanTiming {
@@ -61,8 +70,8 @@ pub struct FrameEvents {
     /// Fragments (covered samples before the depth test) of the visibility pass.
     pub fragments: u64,
     pub plans: Vec<PlanTiming>,
-    /// Level sizes (width, height) of each texture, finest first.
-    pub textures: Vec<Vec<(u32, u32)>>,
+    /// Each texture (map) as the memory holds it.
+    pub textures: Vec<TextureLayout>,
     /// Covered pixels in raster order.
     pub pixels: Vec<PixelEvent>,
     pub footprints: Vec<TexelFootprint>,

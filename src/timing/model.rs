@@ -23,7 +23,10 @@
 //!   the texel's page, else `dram_page_miss_cycles` (and opens it). Banks work in parallel, so
 //!   the footprint occupies the memory `max over banks of the summed busy cycles`; its latency
 //!   is that plus `cache_hit_cycles` when there is a cache. Bank conflicts: accesses beyond the
-//!   first in a bank within one footprint.
+//!   first in a bank within one footprint. Lines and pages are 2D tiles of texels whose count
+//!   follows each texture's stored texel size (`TextureLayout::texel_bytes`), so a narrower map
+//!   holds more texels per line and page. Texture bytes: each access's texel size; DRAM bytes:
+//!   a line per cache miss, else the texel of each DRAM access.
 //! - In flight: pixel `i` issues at `max(i / shade_pixels_per_cycle, done(i - n))` with
 //!   `n = shade_pixels_in_flight`. Stalls: every cycle by which a pixel's issue is held back
 //!   by a full window is attributed to the unit where the pixel it waited for (`i - n`) lost
@@ -33,7 +36,7 @@
 //!   bank-conflict cycles (serialization beyond the slowest single access) and miss cycles (a
 //!   cache or page miss's cycles beyond a hit's), reported with the memory counters.
 
-use super::events::{FrameEvents, TexelFootprint};
+use super::events::{FrameEvents, TexelFootprint, TextureLayout};
 use crate::pipeline::StageKind;
 use hw_model::timing_config::{BankInterleave, TimingConfig};
 use hw_model::trilinear::trilinear_cost;
@@ -47,6 +50,8 @@ pub struct UnitReport {
     pub busy_cycles: u64,
     /// busy / total cycles.
     pub utilization: f64,
+    /// Texel bytes the unit's lookups read from the memory system (texture stages; else 0).
+    pub texture_bytes: u64,
 }
 
 /// Stall cycles by cause.
@@ -72,6 +77,11 @@ pub struct MemoryReport {
     pub dram_accesses: u64,
     pub dram_page_hits: u64,
     pub dram_page_misses: u64,
+    /// Bytes of the texel accesses (each texel's stored size: what the filters read).
+    pub texture_bytes: u64,
+    /// Bytes moved from DRAM: a cache line per miss, or the texel of each access without a
+    /// cache.
+    pub dram_bytes: u64,
 }
 
 /// The timing model's result for one frame.
@@ -155,7 +165,8 @@ fn tile(n: u32) -> (u32, u32) {
     (1 << lw, n >> lw)
 }
 
-/// Address of one level: bases and tiles per row of its cache lines and DRAM pages.
+/// Address of one level: bases and tiles per row of its cache lines and DRAM pages, the log2
+/// of the line and page tiles' width and height (from its texture's texel size) and that size.
 #[derive(Clone, Copy, Debug)]
 struct LevelAddr {
     width: u32,
@@ -163,26 +174,28 @@ struct LevelAddr {
     line_row: u64,
     page_base: u64,
     page_row: u64,
+    line_shift: (u32, u32),
+    page_shift: (u32, u32),
+    texel_bytes: u32,
 }
 
 /// Address map of the textures: level base indices for cache lines and DRAM pages (tiles are
 /// powers of two, so indices are shifts).
 struct AddressMap {
     levels: Vec<Vec<LevelAddr>>,
-    /// log2 of the line tile's width and height, and of the page tile's.
-    line_shift: (u32, u32),
-    page_shift: (u32, u32),
 }
 
 impl AddressMap {
-    fn new(textures: &[Vec<(u32, u32)>], tc: &TimingConfig) -> Self {
-        let lt = tile(tc.cache_line_bytes / tc.texel_bytes);
-        let pt = tile(tc.dram_page_bytes / tc.texel_bytes);
+    fn new(textures: &[TextureLayout], tc: &TimingConfig) -> Self {
         let (mut lb, mut pb) = (0u64, 0u64);
         let levels = textures
             .iter()
-            .map(|lv| {
-                lv.iter()
+            .map(|t| {
+                let bytes = t.texel_bytes.max(1);
+                let lt = tile(tc.cache_line_bytes / bytes);
+                let pt = tile(tc.dram_page_bytes / bytes);
+                t.levels
+                    .iter()
                     .map(|&(w, h)| {
                         let line_row = u64::from(w.div_ceil(lt.0));
                         let page_row = u64::from(w.div_ceil(pt.0));
@@ -192,6 +205,9 @@ impl AddressMap {
                             line_row,
                             page_base: pb,
                             page_row,
+                            line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
+                            page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
+                            texel_bytes: bytes,
                         };
                         lb += line_row * u64::from(h.div_ceil(lt.1));
                         pb += page_row * u64::from(h.div_ceil(pt.1));
@@ -200,11 +216,7 @@ impl AddressMap {
                     .collect()
             })
             .collect();
-        Self {
-            levels,
-            line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
-            page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
-        }
+        Self { levels }
     }
 
     /// The address record of a level (a dummy 1-texel level if out of range, which a
@@ -227,14 +239,17 @@ impl AddressMap {
                 line_row: 1,
                 page_base: 0,
                 page_row: 1,
+                line_shift: (0, 0),
+                page_shift: (0, 0),
+                texel_bytes: 1,
             })
     }
 
     /// (line key, page key) of texel (x, y) of level `l`.
     #[inline]
-    fn keys(&self, l: &LevelAddr, x: u32, y: u32) -> (u64, u64) {
-        let (lx, ly) = self.line_shift;
-        let (px, py) = self.page_shift;
+    fn keys(l: &LevelAddr, x: u32, y: u32) -> (u64, u64) {
+        let (lx, ly) = l.line_shift;
+        let (px, py) = l.page_shift;
         (
             l.line_base + u64::from(y >> ly) * l.line_row + u64::from(x >> lx),
             l.page_base + u64::from(y >> py) * l.page_row + u64::from(x >> px),
@@ -297,7 +312,7 @@ struct Memory<'a> {
 }
 
 impl<'a> Memory<'a> {
-    fn new(textures: &[Vec<(u32, u32)>], tc: &'a TimingConfig) -> Self {
+    fn new(textures: &[TextureLayout], tc: &'a TimingConfig) -> Self {
         let cache = (tc.cache_bytes > 0).then(|| {
             let ways = tc.cache_ways.max(1);
             let sets = tc.cache_bytes / (tc.cache_line_bytes * ways);
@@ -314,8 +329,9 @@ impl<'a> Memory<'a> {
         }
     }
 
-    /// Performs one footprint's accesses; returns (occupancy, latency) in cycles.
-    fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64) {
+    /// Performs one footprint's accesses; returns (occupancy, latency) in cycles and the texel
+    /// bytes read.
+    fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
         let tc = self.tc;
         let banks = tc.banks.max(1) as usize;
         let mut busy = [0u64; 64];
@@ -331,9 +347,10 @@ impl<'a> Memory<'a> {
             }
             seen[n] = (x, y);
             n += 1;
-            let (line, page) = self.map.keys(&lv, x, y);
+            let (line, page) = AddressMap::keys(&lv, x, y);
             let b = bank_of(x, y, lv.width, tc.banks, tc.bank_interleave).min(banks - 1);
             self.rep.texel_accesses += 1;
+            self.rep.texture_bytes += u64::from(lv.texel_bytes);
             let hit = match &mut self.cache {
                 Some(c) => {
                     let h = c.access(line);
@@ -341,6 +358,7 @@ impl<'a> Memory<'a> {
                         self.rep.cache_hits += 1;
                     } else {
                         self.rep.cache_misses += 1;
+                        self.rep.dram_bytes += u64::from(tc.cache_line_bytes);
                     }
                     h
                 }
@@ -350,6 +368,9 @@ impl<'a> Memory<'a> {
                 1
             } else {
                 self.rep.dram_accesses += 1;
+                if self.cache.is_none() {
+                    self.rep.dram_bytes += u64::from(lv.texel_bytes);
+                }
                 if self.open_page[b] == page {
                     self.rep.dram_page_hits += 1;
                     u64::from(tc.dram_page_hit_cycles)
@@ -382,7 +403,7 @@ impl<'a> Memory<'a> {
             } else {
                 0
             };
-        (occ, lat)
+        (occ, lat, n as u64 * u64::from(lv.texel_bytes))
     }
 }
 
@@ -424,6 +445,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
     // Shading pass.
     let nk = StageKind::ALL.len();
     let mut alu = vec![Unit::default(); nk];
+    let mut stage_bytes = vec![0u64; nk];
     let mut mem_unit = Unit::default();
     let mut filters = vec![Unit::default(); tc.trilinear_units.max(1) as usize];
     let mut mem = Memory::new(&ev.textures, tc);
@@ -512,7 +534,8 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
                     .map_or(mine.len(), |e| a + e);
                 let mut data = ready;
                 for f in &mine[a..b] {
-                    let (occ, lat) = mem.footprint(f);
+                    let (occ, lat, bytes) = mem.footprint(f);
+                    stage_bytes[k] += bytes;
                     let ms = mem_unit.take(ready, occ);
                     note(ms - ready, c_mem);
                     data = data.max(ms + lat);
@@ -549,11 +572,13 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
             unit: "setup".into(),
             busy_cycles: setup_busy,
             utilization: util(setup_busy),
+            texture_bytes: 0,
         },
         UnitReport {
             unit: "traverse".into(),
             busy_cycles: traverse_busy,
             utilization: util(traverse_busy),
+            texture_bytes: 0,
         },
     ];
     for kind in StageKind::ALL {
@@ -562,18 +587,21 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
             unit: kind.name().into(),
             busy_cycles: b,
             utilization: util(b),
+            texture_bytes: stage_bytes[kind.index()],
         });
     }
     units.push(UnitReport {
         unit: "memory".into(),
         busy_cycles: mem_unit.busy,
         utilization: util(mem_unit.busy),
+        texture_bytes: 0,
     });
     for (j, f) in filters.iter().enumerate() {
         units.push(UnitReport {
             unit: format!("filter{j}"),
             busy_cycles: f.busy,
             utilization: util(f.busy),
+            texture_bytes: 0,
         });
     }
     let busiest = units

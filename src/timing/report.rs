@@ -60,6 +60,11 @@ pub fn text(r: &TimingReport) -> String {
     );
     let _ = writeln!(
         o,
+        "texture bytes {} (texel accesses x each map's stored texel size); DRAM bytes {}",
+        m.texture_bytes, m.dram_bytes
+    );
+    let _ = writeln!(
+        o,
         "memory cycles from bank conflicts {}, from cache/page misses {}",
         r.bank_conflict_cycles, r.miss_cycles
     );

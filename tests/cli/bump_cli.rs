@@ -86,7 +86,7 @@ fn sweep_over_frames_reports_each() {
         assert_eq!(num(r, "frame_fallback"), 0.0);
         assert_eq!(num(r, "zero_normal"), 0.0);
     }
-    let cycles: Vec<f64> = rows.iter().map(|r| num(r, "cycles")).collect();
+    let cycles: Vec<f64> = rows.iter().map(|r| num(r, "issue_cycles")).collect();
     let rmse: Vec<f64> = rows
         .iter()
         .map(|r| num(r, "error_16bit.rmse_lsb"))

@@ -28,7 +28,8 @@ fn render_writes_every_output() {
     let j: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("o/summary.json")).unwrap()).unwrap();
     assert!(j["stats"]["error_8bit"]["max_abs_lsb"].is_u64());
-    assert!(j["stats"]["cycles"]["total"].as_u64().unwrap() > 0);
+    assert!(j["stats"]["timing"]["total_cycles"].as_u64().unwrap() > 0);
+    assert!(j["stats"]["issue_cycles"]["total"].as_u64().unwrap() > 0);
     assert!(
         text(&o).contains("PSNR") || text(&o).contains("psnr"),
         "{}",
@@ -766,13 +767,27 @@ fn sweep_csv_uses_the_json_names_and_empty_cells() {
     let mut rd = csv::Reader::from_path(d.join("s/sweep.csv")).unwrap();
     let head: Vec<String> = rd.headers().unwrap().iter().map(str::to_string).collect();
     assert_eq!(head[0], "weight_bits");
-    assert!(head.contains(&"timing_cycles".to_string()), "{head:?}");
+    assert!(head.contains(&"cycles".to_string()), "{head:?}");
+    assert!(head.contains(&"texture_bytes".to_string()), "{head:?}");
+    assert!(head.contains(&"area_ge".to_string()), "{head:?}");
+    // weight_bits changes the filter's datapath: its area columns are there.
+    assert!(
+        head.contains(&"unit_cost.trilinear.area_ge".to_string()),
+        "{head:?}"
+    );
     let recs: Vec<csv::StringRecord> = rd.records().map(Result::unwrap).collect();
     assert_eq!(recs.len(), 2);
     for (rec, row) in recs.iter().zip(json.as_array().unwrap()) {
         assert_eq!(&rec[0], row["settings"][0][1].as_str().unwrap());
         for (col, cell) in head.iter().zip(rec.iter()).skip(1) {
-            let v = col.split('.').fold(row, |v, k| &v[k]);
+            // `unit_cost.NAME.FIELD`: NAME may contain a dot, FIELD does not.
+            let v = match col.strip_prefix("unit_cost.") {
+                Some(rest) => {
+                    let (unit, field) = rest.rsplit_once('.').unwrap();
+                    &row["unit_cost"][unit][field]
+                }
+                None => col.split('.').fold(row, |v, k| &v[k]),
+            };
             match v {
                 serde_json::Value::Null => assert_eq!(cell, "", "{col}"),
                 serde_json::Value::Number(n) => {
@@ -786,9 +801,11 @@ fn sweep_csv_uses_the_json_names_and_empty_cells() {
             }
         }
     }
-    // Not applicable here: no timing run, no bump material.
-    let tc = head.iter().position(|h| h == "timing_cycles").unwrap();
-    assert_eq!(&recs[0][tc], "");
+    // Not applicable here: no bump material; the timing model ran (the default).
+    let fu = head.iter().position(|h| h == "frame_used").unwrap();
+    assert_eq!(&recs[0][fu], "");
+    let tc = head.iter().position(|h| h == "cycles").unwrap();
+    assert!(recs[0][tc].parse::<u64>().unwrap() > 0);
 }
 
 /// Width and height from a PNG's IHDR chunk.

@@ -27,13 +27,7 @@ fn ndf_norm_sweep_reports_errors_lookups_and_costs() {
     );
     let t = text(&o);
     assert!(o.status.success(), "{t}");
-    for col in [
-        "lookups/px",
-        "ops/px",
-        "cyc/px",
-        "model_mean8",
-        "timing_cycles",
-    ] {
+    for col in ["lookups/px", "ops/px", "cyc/px", "model_mean8", "tex_bytes"] {
         assert!(t.contains(col), "column {col} missing: {t}");
     }
     assert!(t.contains("no hardware cost model"), "{t}");
@@ -62,11 +56,12 @@ fn ndf_norm_sweep_reports_errors_lookups_and_costs() {
         assert!(r["ndf_clamped"].as_u64().is_some(), "{r}");
     }
     for r in &rows[..3] {
+        assert!(r["cycles"].as_u64().expect("timing cycles") > 0, "{r}");
+        assert!(r["cycles_per_pixel"].as_f64().expect("cycles") > 0.0, "{r}");
         assert!(
-            r["timing_cycles"].as_u64().expect("timing cycles") > 0,
+            r["issue_cycles_per_pixel"].as_f64().expect("issue") > 0.0,
             "{r}"
         );
-        assert!(r["cycles_per_pixel"].as_f64().expect("cycles") > 0.0, "{r}");
         assert!(r["ops_per_pixel"].as_f64().expect("ops") > 0.0, "{r}");
     }
     // Exact normalization is float only: no cycles, ops or timing, not a fake number.
@@ -75,7 +70,8 @@ fn ndf_norm_sweep_reports_errors_lookups_and_costs() {
         "cycles",
         "cycles_per_pixel",
         "ops_per_pixel",
-        "timing_cycles",
+        "issue_cycles",
+        "texture_bytes",
     ] {
         assert!(exact[k].is_null(), "exact {k}: {exact}");
     }
@@ -87,15 +83,19 @@ fn ndf_norm_sweep_reports_errors_lookups_and_costs() {
         "cycles",
         "cycles_per_pixel",
         "ops_per_pixel",
-        "timing_cycles",
+        "issue_cycles",
+        "texture_bytes",
     ] {
         let i = head.iter().position(|h| *h == k).expect("column");
         assert_eq!(last[i], "", "exact {k} in {csv}");
     }
     // The options differ in cost: map pays a lookup, projected more arithmetic.
-    let cpp = |i: usize| rows[i]["cycles_per_pixel"].as_f64().expect("cycles");
-    assert!(cpp(2) > cpp(0), "projected costs more than partial");
-    let tc = |i: usize| rows[i]["timing_cycles"].as_u64().expect("timing");
+    let cpp = |i: usize| rows[i]["issue_cycles_per_pixel"].as_f64().expect("issue");
+    assert!(
+        cpp(2) > cpp(0),
+        "projected costs more arithmetic than partial"
+    );
+    let tc = |i: usize| rows[i]["cycles"].as_u64().expect("timing");
     assert!(
         tc(1) > tc(0),
         "map's fourth lookup shows in the timing model"

@@ -50,7 +50,7 @@ fn scenes_render_within_bounds_without_nan() {
         let e8 = st.error_8bit.as_ref().expect("reference");
         eprintln!(
             "{name} {w}x{h}: max {} mean {:.4} LSB8, {:.2} cycles/px",
-            e8.max_abs_lsb, e8.mean_abs_lsb, st.cycles.per_covered_pixel
+            e8.max_abs_lsb, e8.mean_abs_lsb, st.issue_cycles.per_covered_pixel
         );
         assert!(st.covered_pixels > 1000, "{name}");
         assert!(e8.max_abs_lsb <= max_all, "{name}: {}", e8.max_abs_lsb);
@@ -100,13 +100,13 @@ fn as_shade_cost_is_the_unit_costs() {
         + 2 * mac;
     let per_px = 2 * nz.cycles + 2 * per_light + mac;
     let a = stage(&r, StageKind::AsShade);
-    assert_eq!(a.cycles, a.invocations * u64::from(per_px));
-    // A costlier unit shows up in the stage's cycles and the summary's cycles/px.
+    assert_eq!(a.issue_cycles, a.invocations * u64::from(per_px));
+    // A costlier unit shows up in the stage's cycles and the summary's issue cycles/px.
     let mut slow = hw.clone();
     slow.aniso_phong.aniso_mul_cycles = hw_model::datapath::Cycles::Fixed(3);
     let r2 = go(&s, &slow, StageImpls::FIXED);
-    assert!(stage(&r2, StageKind::AsShade).cycles > a.cycles);
-    assert!(r2.stats.cycles.per_covered_pixel > r.stats.cycles.per_covered_pixel);
+    assert!(stage(&r2, StageKind::AsShade).issue_cycles > a.issue_cycles);
+    assert!(r2.stats.issue_cycles.per_covered_pixel > r.stats.issue_cycles.per_covered_pixel);
 }
 
 #[test]
@@ -132,7 +132,7 @@ fn deterministic_for_any_thread_count() {
         stage(&one, StageKind::AsShade),
         stage(&many, StageKind::AsShade),
     );
-    assert_eq!((a.saturated, a.cycles), (b.saturated, b.cycles));
+    assert_eq!((a.saturated, a.issue_cycles), (b.saturated, b.issue_cycles));
 }
 
 /// Mean 16-bit LSB error with only `as-shade` fixed (everything upstream float), on `hw`.

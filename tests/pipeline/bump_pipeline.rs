@@ -137,11 +137,19 @@ fn per_frame_costs_follow_the_units() {
             }
         };
         let exp_frame = u64::from(frame_cost(kind, &units, g).cycles) * inv;
-        assert_eq!(stage(&r, StageKind::Normal).cycles, exp_normal, "{kind:?}");
-        assert_eq!(stage(&r, StageKind::Frame).cycles, exp_frame, "{kind:?}");
+        assert_eq!(
+            stage(&r, StageKind::Normal).issue_cycles,
+            exp_normal,
+            "{kind:?}"
+        );
+        assert_eq!(
+            stage(&r, StageKind::Frame).issue_cycles,
+            exp_frame,
+            "{kind:?}"
+        );
         let nz = normalize_cost(&hw.shading.vector, rsqrt_cost(&hw.shading.rsqrt, g), g);
         let pert = u64::from(madd_cost(&hw.shading.vector, g).plus(nz).cycles) * inv;
-        assert_eq!(stage(&r, StageKind::Perturb).cycles, pert, "{kind:?}");
+        assert_eq!(stage(&r, StageKind::Perturb).issue_cycles, pert, "{kind:?}");
         let len = u64::from(hw_model::frame::len_datapath(&hw.shading).latency(g));
         let frame_nz = u64::from(nz.times(3).cycles);
         match kind {
@@ -154,7 +162,7 @@ fn per_frame_costs_follow_the_units() {
                 .plus(trilinear_cost(&hw.trilinear, 2, g))
                 .cycles,
         ) * inv;
-        assert_eq!(stage(&r, StageKind::BumpFetch).cycles, fetch);
+        assert_eq!(stage(&r, StageKind::BumpFetch).issue_cycles, fetch);
         assert_eq!(stage(&r, StageKind::BumpFetch).texels, 8 * inv);
         // Two lights (directional + point): two Blinn-Phong, eye + point-light normalize,
         // three colour multiply-adds (ambient + one per light).
@@ -163,10 +171,10 @@ fn per_frame_costs_follow_the_units() {
                 + nz.times(2).cycles
                 + 3 * hw_model::blinn_phong::mac_datapath(&hw.shading).latency(g),
         ) * inv;
-        assert_eq!(stage(&r, StageKind::Phong).cycles, phong);
-        normal.push(stage(&r, StageKind::Normal).cycles);
-        frame.push(stage(&r, StageKind::Frame).cycles / inv);
-        perturb.push(stage(&r, StageKind::Perturb).cycles / inv);
+        assert_eq!(stage(&r, StageKind::Phong).issue_cycles, phong);
+        normal.push(stage(&r, StageKind::Normal).issue_cycles);
+        frame.push(stage(&r, StageKind::Frame).issue_cycles / inv);
+        perturb.push(stage(&r, StageKind::Perturb).issue_cycles / inv);
     }
     eprintln!("normal cycles {normal:?} frame cycles/px {frame:?} perturb cycles/px {perturb:?}");
     assert!(normal[0] > normal[1] && normal[1] > normal[2], "{normal:?}");
@@ -185,7 +193,7 @@ fn scenes_without_bumps_run_no_bump_stage() {
         for k in BUMP_STAGES {
             let st = stage(&r, k);
             assert_eq!(
-                (st.invocations, st.cycles, st.ops, st.texels),
+                (st.invocations, st.issue_cycles, st.ops, st.texels),
                 (0, 0, 0, 0),
                 "{name} {k:?}"
             );
@@ -211,8 +219,8 @@ fn bumps_is_deterministic_across_thread_counts() {
     assert_eq!(a.ref_image, b.ref_image);
     for (x, y) in a.stats.stages.iter().zip(&b.stats.stages) {
         assert_eq!(
-            (x.invocations, x.saturated, x.cycles),
-            (y.invocations, y.saturated, y.cycles)
+            (x.invocations, x.saturated, x.issue_cycles),
+            (y.invocations, y.saturated, y.issue_cycles)
         );
     }
     assert_eq!(a.stats.bump.frame_fallback, b.stats.bump.frame_fallback);

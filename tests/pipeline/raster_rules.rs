@@ -458,3 +458,42 @@ fn edge_steps_match_three_evaluations() {
         );
     }
 }
+
+/// `edges_fixed_on_grid` (the attribute setup from the float positions on a finer grid,
+/// `interp.attr_subpixel_bits`): on the rasterizer's own grid it equals `edges_fixed` of the
+/// snapped positions, and on a grid `k` bits finer it is `edges_fixed` scaled by `4^k` when
+/// the float positions lie on the coarser grid.
+#[test]
+fn edges_on_a_finer_grid_match_the_snapped_edges() {
+    let mut rng = Rng(78);
+    let mut t = ScreenTri {
+        xy: [[0; 2]; 3],
+        xy_f: [[0.0; 2]; 3],
+        z: [0; 3],
+        z_f: [0.0; 3],
+        inv_w: [1.0; 3],
+        src: 0,
+        src_bary: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        area2: 1,
+        area2_f: 1.0,
+        bbox: [0; 4],
+    };
+    for case in 0..200_000u32 {
+        let sub = 1 + (rng.below(12) as u32);
+        let g = f64::from(1u32 << sub);
+        for (v, f) in t.xy.iter_mut().zip(t.xy_f.iter_mut()) {
+            *f = [0, 1].map(|_| (rng.below(1 << 30) as f64 / 65536.0) - 8192.0);
+            *v = f.map(|c| (c * g).round_ties_even() as i64);
+        }
+        let px = rng.below(16384) as i64 - 8192;
+        let py = rng.below(16384) as i64 - 8192;
+        let e = t.edges_fixed(px, py, sub);
+        assert_eq!(t.edges_fixed_on_grid(px, py, sub), e, "case {case}");
+        // Positions on the coarse grid: the finer grid only scales the edges.
+        let k = rng.below(16 - u64::from(sub) + 1) as u32;
+        t.xy_f = t.xy.map(|v| v.map(|c| c as f64 / g));
+        let fine = t.edges_fixed_on_grid(px, py, sub + k);
+        let scale = 1i64 << (2 * k);
+        assert_eq!(fine, e.map(|x| x * scale), "case {case}: sub {sub} + {k}");
+    }
+}

@@ -214,14 +214,14 @@ fn plans_costs_and_lookups_follow_the_variant() {
         } else {
             assert_eq!(phong.invocations, 0);
             assert_eq!(fetch.invocations, shade.invocations);
-            assert!(fetch.texels > 0 && shade.cycles > 0);
+            assert!(fetch.texels > 0 && shade.issue_cycles > 0);
             assert!(rough_lookups > 0, "{v:?}");
         }
         let rs = r.stats.roughness.as_ref().expect("stats");
         assert_eq!(rs.d_clamped, 0);
         let q = rs.quantization_error.as_ref().expect("error");
         assert!(q.max_abs_lsb <= 2, "{v:?} {q:?}");
-        cycles.push((v, r.stats.cycles.per_covered_pixel));
+        cycles.push((v, r.stats.issue_cycles.per_covered_pixel));
     }
     println!("{cycles:?}");
     let c = |v: RoughVariant| cycles.iter().find(|x| x.0 == v).expect("v").1;

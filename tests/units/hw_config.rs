@@ -32,6 +32,7 @@ fn presets_have_the_api_precision_floors() {
         ("d3d11", 8, 8, 8),
         ("vulkan-min", 4, 4, 4),
         ("cuda", 8, 8, 8),
+        ("llvmpipe", 8, 8, 8),
     ];
     for (name, sub_px, sub_texel, lod_frac) in floors {
         let p = preset(name);
@@ -58,6 +59,47 @@ fn presets_have_the_api_precision_floors() {
     for name in ["d3d11", "vulkan-min", "cuda"] {
         assert_eq!(preset(name).trilinear.texel_bits, 16, "{name}");
     }
+}
+
+/// The llvmpipe preset (Mesa 22.3's 8-bit AoS sampler): every field it changes from texram16.
+#[test]
+fn llvmpipe_preset_pins_its_texture_path() {
+    use hw_model::config::LodLog2;
+    let l = preset("llvmpipe");
+    let t = preset("texram16");
+    assert_eq!(l.name, "llvmpipe");
+    assert_eq!(
+        (l.trilinear.texel_bits, l.trilinear.weight_bits),
+        (8, 8),
+        "8-bit texels and weights"
+    );
+    assert_eq!(l.trilinear.filter_rounding, Rounding::HalfUp, "pmulhrsw");
+    assert_eq!(l.trilinear.weight_rounding, Rounding::HalfUp);
+    assert_eq!(l.lod.lod_frac_bits, 8);
+    assert_eq!(l.lod.lod_log2, LodLog2::PiecewiseLinear);
+    assert!(l.lod.lod_per_quad);
+    assert_eq!(
+        l.raster.subpixel_bits, 8,
+        "coverage on llvmpipe's 8 sub-pixel bits"
+    );
+    assert_eq!(
+        l.interp.attr_subpixel_bits, 16,
+        "attribute planes from finer positions"
+    );
+    assert_eq!(t.interp.attr_subpixel_bits, 0);
+    assert_eq!(t.lod.lod_log2, LodLog2::Exact, "other presets unchanged");
+    assert!(PRESETS
+        .iter()
+        .all(|&p| p == "llvmpipe" || !preset(p).lod.lod_per_quad));
+    // Everything else is texram16's (timing: the modern memory system of the API presets).
+    let mut back = l.clone();
+    back.name = t.name.clone();
+    back.timing = t.timing.clone();
+    back.trilinear = t.trilinear.clone();
+    back.lod = t.lod.clone();
+    back.interp = t.interp.clone();
+    assert_eq!(back, t);
+    assert_eq!(l.timing, preset("d3d11").timing);
 }
 
 /// CUDA's filter weights are 9-bit fixed point with 8 fraction bits: the unit's weight of the
@@ -233,4 +275,27 @@ fn unknown_fields_suggest_the_nearest_name() {
         e.contains("did you mean 'weight_bits'") && e.contains("line 2"),
         "{e}"
     );
+}
+
+#[test]
+fn texel_bytes_was_removed_with_a_message() {
+    let base = preset("texram16");
+    for name in ["texel_bytes", "timing.texel_bytes"] {
+        let e = set_field(&base, name, "4")
+            .expect_err("removed")
+            .to_string();
+        assert!(e.contains("was removed") && e.contains("texel_bits"), "{e}");
+    }
+    let e = parse("base = \"d3d11\"\n[timing]\ntexel_bytes = 8\n")
+        .expect_err("removed field in a file")
+        .to_string();
+    assert!(
+        e.contains("timing.texel_bytes") && e.contains("was removed") && e.contains("line 3"),
+        "{e}"
+    );
+    // A line or page must hold the widest texel (4 x 16 bits).
+    let e = parse("[timing]\ncache_line_bytes = 4\n")
+        .expect_err("line below a texel")
+        .to_string();
+    assert!(e.contains("cache_line_bytes") && e.contains("8..="), "{e}");
 }

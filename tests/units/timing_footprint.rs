@@ -44,6 +44,8 @@ fn lod_and_offsets_match_the_f64_twin() {
             lod_frac_bits: f,
             lod_cycles: hw_model::datapath::Cycles::Fixed(2),
             lod_cycles_per_bit: hw_model::datapath::Cycles::Fixed(0),
+            lod_log2: hw_model::config::LodLog2::Exact,
+            lod_per_quad: false,
         };
         for _ in 0..200_000 {
             let base = [signed(&mut s, 26), signed(&mut s, 26)];
@@ -341,7 +343,7 @@ fn adaptive_probes_follow_the_anisotropy_and_cost_what_they_take() {
         let st = &r.stats.stages[StageKind::Trilinear.index()];
         let ev = r.events.as_ref().expect("events");
         let fps = ev.footprints.len() as u64;
-        // The first estimate counts the probes each pixel took: 4 texels per footprint (8 on
+        // The stage counts the probes each pixel took: 4 texels per footprint (8 on
         // two levels), as the timing model's event stream has them.
         assert!(
             4 * fps <= st.texels && st.texels <= 8 * fps,
@@ -352,7 +354,7 @@ fn adaptive_probes_follow_the_anisotropy_and_cost_what_they_take() {
         (
             blur_error(&r.hw_image, &ss.hw_image, &r.mask),
             st.texels,
-            st.cycles,
+            st.issue_cycles,
             cycles,
         )
     };

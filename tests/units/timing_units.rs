@@ -5,7 +5,7 @@
 use hw_model::timing_config::BankInterleave;
 use hw_model::{HwConfig, UnitCost};
 use texsim::pipeline::StageKind;
-use texsim::timing::events::{FrameEvents, PixelEvent, PlanTiming, TexelFootprint};
+use texsim::timing::events::{FrameEvents, PixelEvent, PlanTiming, TexelFootprint, TextureLayout};
 use texsim::timing::model::{bank_of, footprint_conflicts};
 use texsim::timing::{simulate, Cache};
 
@@ -140,6 +140,14 @@ fn conflicts_are_counted_otherwise() {
     assert_eq!(footprint_conflicts(&thin, 1, 1, BankInterleave::Tiled), 0);
 }
 
+/// A texture of `levels` whose stored texels take `texel_bytes` bytes.
+fn layout(levels: &[(u32, u32)], texel_bytes: u32) -> TextureLayout {
+    TextureLayout {
+        levels: levels.to_vec(),
+        texel_bytes,
+    }
+}
+
 /// A frame of `fps.len()` pixels, each doing one single-level lookup (one footprint) on a
 /// 64x64 texture, with free arithmetic stages.
 fn frame(fps: &[TexelFootprint]) -> FrameEvents {
@@ -159,7 +167,7 @@ fn frame(fps: &[TexelFootprint]) -> FrameEvents {
         plans: vec![PlanTiming {
             stages: vec![(StageKind::Trilinear, UnitCost::default())],
         }],
-        textures: vec![vec![(64, 64)]],
+        textures: vec![layout(&[(64, 64)], 8)],
         pixels,
         footprints: fps.to_vec(),
     }
@@ -198,6 +206,78 @@ fn dram_open_pages() {
     let mem = r.units.iter().find(|u| u.unit == "memory").expect("memory");
     assert_eq!(mem.busy_cycles, 6 + 3);
     assert_eq!(r.bank_conflict_cycles, 3);
+}
+
+#[test]
+fn stored_texel_size_follows_channels_and_bits() {
+    use hw_model::timing_config::stored_texel_bytes;
+    // (channels, bits) -> bytes: packed bits rounded up to a power-of-two number of bytes.
+    for (c, b, bytes) in [
+        (4, 16, 8),
+        (4, 8, 4),
+        (4, 12, 8),
+        (4, 4, 2),
+        (2, 16, 4),
+        (2, 8, 2),
+        (3, 16, 8),
+        (3, 8, 4),
+        (1, 16, 2),
+        (1, 8, 1),
+        (1, 4, 1),
+        (1, 1, 1),
+    ] {
+        assert_eq!(stored_texel_bytes(c, b), bytes, "{c} x {b} bits");
+    }
+}
+
+#[test]
+fn narrower_texels_fill_more_of_a_page_and_line() {
+    // 2048-byte pages: 8-byte texels tile 16x16, 4-byte ones 32x16. Footprints at x = 2 and
+    // x = 20 (same rows) share a page only with the narrower texels.
+    let mut hw = HwConfig::texram16();
+    hw.timing.dram_page_bytes = 2048;
+    hw.timing.shade_pixels_in_flight = 1;
+    let fps = [fp(2, 2, 64, 64), fp(20, 2, 64, 64)];
+    let run = |bytes: u32, hw: &HwConfig| {
+        let mut ev = frame(&fps);
+        ev.textures = vec![layout(&[(64, 64)], bytes)];
+        simulate(&ev, hw, "t")
+    };
+    let (wide, narrow) = (run(8, &hw), run(4, &hw));
+    assert_eq!(wide.memory.dram_page_misses, 8);
+    assert_eq!(narrow.memory.dram_page_misses, 4);
+    assert!(narrow.total_cycles < wide.total_cycles);
+    // Same accesses, half the bytes (no cache: DRAM bytes are the texels').
+    assert_eq!(wide.memory.texel_accesses, narrow.memory.texel_accesses);
+    assert_eq!(wide.memory.texture_bytes, 8 * 8);
+    assert_eq!(narrow.memory.texture_bytes, 8 * 4);
+    assert_eq!(wide.memory.dram_bytes, 8 * 8);
+    assert_eq!(narrow.memory.dram_bytes, 8 * 4);
+    let tri = |r: &texsim::timing::TimingReport| {
+        r.units
+            .iter()
+            .find(|u| u.unit == "trilinear")
+            .expect("trilinear")
+            .texture_bytes
+    };
+    assert_eq!((tri(&wide), tri(&narrow)), (64, 32));
+    // A 32-byte line holds 4 texels of 8 bytes (2x2) or 8 of 4 bytes (4x2): the footprint at
+    // (1, 1) covers 4 lines of 2x2 but 2 lines of 4x2.
+    let mut hw = HwConfig::d3d11();
+    hw.timing.cache_bytes = 64 * 4;
+    hw.timing.cache_line_bytes = 32;
+    hw.timing.cache_ways = 4;
+    let run = |bytes: u32| {
+        let mut ev = frame(&[fp(1, 1, 64, 64)]);
+        ev.textures = vec![layout(&[(64, 64)], bytes)];
+        simulate(&ev, &hw, "t")
+    };
+    let (wide, narrow) = (run(8), run(4));
+    assert_eq!(wide.memory.cache_misses, 4);
+    assert_eq!(narrow.memory.cache_misses, 2);
+    // DRAM bytes with a cache: one line per miss.
+    assert_eq!(wide.memory.dram_bytes, 4 * 32);
+    assert_eq!(narrow.memory.dram_bytes, 2 * 32);
 }
 
 #[test]
@@ -342,7 +422,7 @@ fn in_flight_window_stalls_are_latency_or_the_busy_unit() {
 fn two_bilinears_per_cycle_halve_the_trilinear_filter_time() {
     // 100 pixels, each one trilinear lookup: footprints on levels 0 and 1.
     let mut ev = frame(&[]);
-    ev.textures = vec![vec![(64, 64), (32, 32)]];
+    ev.textures = vec![layout(&[(64, 64), (32, 32)], 8)];
     for i in 0..100u32 {
         ev.footprints.push(fp(2, 2, 64, 64));
         ev.footprints.push(TexelFootprint {

@@ -155,3 +155,68 @@ fn exact_cases() {
     let m = lod([i64::MIN, i64::MIN, i64::MAX, 0], 0, &c, &mut sat);
     assert_eq!(m, (63 << 8) + 128);
 }
+
+/// `lod_log2 = piecewise-linear` (llvmpipe's `lp_build_fast_log2`): exhaustive over all
+/// (du/dx, dv/dx) in 0..4096^2 at F = 8 and 16, equal to floor of its f64 twin times 2^F (exact
+/// in f64: L < 2^25) and within the doc comment's bound of 0.04305 below the exact lambda.
+#[test]
+fn piecewise_linear_log2_exhaustive_12_bit_pairs() {
+    use hw_model::config::LodLog2;
+    use texsim::reference::lod_mode_f64;
+    for f in [8u32, 16] {
+        let mut c = cfg(f);
+        c.lod_log2 = LodLog2::PiecewiseLinear;
+        let scale = f64::from(1u32 << f);
+        let mut worst = 0f64;
+        for a in 0i64..4096 {
+            for b in 0i64..4096 {
+                let mut sat = SatCounter::default();
+                let got = lod([a, b, 0, 0], 0, &c, &mut sat);
+                if a == 0 && b == 0 {
+                    assert_eq!(got, lod_zero(f));
+                    continue;
+                }
+                let d = [a as f64, b as f64, 0.0, 0.0];
+                let pwl = lod_mode_f64(d, LodLog2::PiecewiseLinear);
+                assert_eq!(got, (pwl * scale).floor() as i64, "({a},{b}) F = {f}");
+                let dev = lod_f64(d) - pwl;
+                assert!((-1e-12..=0.04305).contains(&dev), "({a},{b}): {dev}");
+                worst = worst.max(dev);
+            }
+        }
+        assert!(worst > 0.043, "the bound is reached: {worst}");
+    }
+}
+
+/// Piecewise-linear mode with fraction bits in the derivatives (`frac` 0..=20) and large
+/// lengths: 2M seeded random cases against the f64 twin (exact: the f64 values are exact here).
+#[test]
+fn piecewise_linear_log2_random_with_fraction_bits() {
+    use hw_model::config::LodLog2;
+    use texsim::reference::lod_mode_f64;
+    let mut rng = SplitMix(0x11b);
+    for i in 0..2_000_000u32 {
+        let f = i % 17;
+        let frac = (i / 17) % 21;
+        let mut c = cfg(f);
+        c.lod_log2 = LodLog2::PiecewiseLinear;
+        let d: [i64; 4] = std::array::from_fn(|_| {
+            let bits = 1 + (rng.next() % 24) as u32;
+            (rng.next() % (1u64 << bits)) as i64 - (1i64 << (bits - 1))
+        });
+        let mut sat = SatCounter::default();
+        let got = lod(d, frac, &c, &mut sat);
+        let s = f64::from(1u32 << frac);
+        let df = d.map(|x| x as f64 / s);
+        if d.iter().all(|&x| x == 0) {
+            assert_eq!(got, lod_zero(f));
+            continue;
+        }
+        let want = (lod_mode_f64(df, LodLog2::PiecewiseLinear) * f64::from(1u32 << f)).floor();
+        assert_eq!(
+            got,
+            (want as i64).max(lod_zero(f)),
+            "{d:?} frac {frac} F {f}"
+        );
+    }
+}
