@@ -388,18 +388,27 @@ fn vectors_bad_input_fails_cleanly_and_writes_nothing() {
     );
 }
 
-/// Icarus Verilog's compiler, or a failure that says how to install it.
-fn iverilog() -> &'static str {
+/// Whether Icarus Verilog is installed. Where it is missing, the test fails with how to install
+/// it when `CI` or `TEXSIM_REQUIRE_RTL_SIM` is set (`.ci/run` installs it, so CI always runs the
+/// RTL), and is skipped with that note otherwise, so that `cargo test --workspace` passes on a
+/// fresh machine without a Debian package.
+fn iverilog_installed() -> bool {
     let found = Command::new("iverilog")
         .arg("-V")
         .output()
         .is_ok_and(|o| o.status.success() || !o.stdout.is_empty());
-    assert!(
-        found,
-        "Icarus Verilog is not installed: the SystemVerilog lerp test needs it. Install it with \
-         `apt-get update && apt-get install -y iverilog` (Debian package iverilog); .ci/run does"
-    );
-    "iverilog"
+    if found {
+        return true;
+    }
+    let note = "Icarus Verilog is not installed: the SystemVerilog lerp test needs it. Install it \
+                with `apt-get update && apt-get install -y iverilog` (Debian package iverilog); \
+                .ci/run does";
+    let required = ["CI", "TEXSIM_REQUIRE_RTL_SIM"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|x| !x.is_empty() && x != "0" && x != "false"));
+    assert!(!required, "{note}");
+    eprintln!("skipped: {note}");
+    false
 }
 
 /// Compiles the SystemVerilog `unit` (lerp or bilinear) and its testbench with the manifest's
@@ -428,7 +437,7 @@ fn simulate(dir: &Path, unit: &str) -> (bool, String) {
     }
     sources.push(rtl.join(format!("{unit}_tb.sv")));
     let top = format!("{unit}_tb");
-    let c = Command::new(iverilog())
+    let c = Command::new("iverilog")
         .args(["-g2012", "-o", "sim"])
         .arg(format!("-P{top}.TB={tb}"))
         .arg(format!("-P{top}.WB={wb}"))
@@ -449,6 +458,9 @@ fn simulate(dir: &Path, unit: &str) -> (bool, String) {
 
 #[test]
 fn systemverilog_lerp_and_bilinear_pass_every_vector_and_catch_a_wrong_one() {
+    if !iverilog_installed() {
+        return;
+    }
     let d = tmp("rtl");
     let custom = |name: &str, body: &str| {
         let p = d.join(format!("{name}.toml"));
