@@ -341,14 +341,7 @@ mod tests {
 
     const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
 
-    /// Splitmix64: the seeded generator of these tests.
-    fn next(s: &mut u64) -> u64 {
-        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = *s;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
+    use crate::test_rng::splitmix64 as next;
 
     /// Rounds `num / den` (den > 0) by comparing twice the remainder with the divisor in
     /// `i128` (independent of the routines under test; operands below 2^100).

@@ -414,14 +414,7 @@ mod tests {
     use crate::fixed::Rounding;
     use crate::reciprocal::apply;
 
-    /// Splitmix64: the seeded generator of these tests.
-    fn next(s: &mut u64) -> u64 {
-        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = *s;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
+    use crate::test_rng::splitmix64 as next;
 
     /// A value of up to `bits` magnitude bits, either sign.
     fn signed(s: &mut u64, bits: u32) -> i64 {

@@ -32,3 +32,16 @@ pub mod wrap;
 pub use config::{ConfigError, HwConfig};
 pub use cost::UnitCost;
 pub use fixed::{Format, Overflow, Rounding, SatCounter};
+
+/// The seeded generator of the unit tests (splitmix64, as `tests/rng_common`).
+#[cfg(test)]
+pub(crate) mod test_rng {
+    /// Splitmix64: the next value of the sequence seeded by `*s`.
+    pub fn splitmix64(s: &mut u64) -> u64 {
+        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+}

@@ -281,14 +281,7 @@ mod tests {
 
     const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
 
-    /// Splitmix64: the seeded generator of these tests.
-    fn next(s: &mut u64) -> u64 {
-        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = *s;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
+    use crate::test_rng::splitmix64 as next;
 
     /// `eval` as it was before it was compiled per rounding mode (the mode read from the
     /// config at every reduction): the oracle.

@@ -205,14 +205,7 @@ mod tests {
     use crate::config::HwConfig;
     use crate::fixed::{round_shift_right, round_shift_right_wide, Rounding};
 
-    /// Splitmix64: the seeded generator of these tests.
-    fn next(s: &mut u64) -> u64 {
-        *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = *s;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
+    use crate::test_rng::splitmix64 as next;
 
     /// `wrap` as it was before it was compiled per rounding mode: the oracle.
     fn wrap_before(
