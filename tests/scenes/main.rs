@@ -4,6 +4,9 @@
 //!
 //! One file per module below; run one with `cargo test --test scenes scene_load::`.
 
+#[path = "../rng_common/mod.rs"]
+mod rng_common;
+
 mod bad_input_files;
 mod bad_input_validate;
 mod bump_scene;

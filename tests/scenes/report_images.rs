@@ -1,23 +1,13 @@
 //! PNG round trips, pixmap conversion, heatmap colours and legend, sheet layout and filtering.
 
+use crate::rng_common::Rng;
 use texsim::report::{
     encode_pixmap, encode_png16, encode_png8, heatmap, heatmap_colour, heatmap_layout,
     image_to_pixmap, sheet, sheet_panel_size, Image, MASKED_RGB, SHEET_PAD, SHEET_TITLE_H,
 };
 use tiny_skia::Pixmap;
 
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
-
-fn random_image(rng: &mut SplitMix, w: u32, h: u32) -> Image {
+fn random_image(rng: &mut Rng, w: u32, h: u32) -> Image {
     Image {
         width: w,
         height: h,
@@ -38,7 +28,7 @@ fn opaque(rgb: [u8; 3]) -> [u8; 4] {
 
 #[test]
 fn png16_round_trip_exact() {
-    let mut rng = SplitMix(11);
+    let mut rng = Rng(11);
     for (w, h) in [(1, 1), (7, 3), (33, 17)] {
         let img = random_image(&mut rng, w, h);
         let png = encode_png16(&img).expect("encode");
@@ -53,7 +43,7 @@ fn png16_round_trip_exact() {
 
 #[test]
 fn png8_round_trip_equals_to_rgba8() {
-    let mut rng = SplitMix(12);
+    let mut rng = Rng(12);
     for (w, h) in [(1, 1), (5, 9), (40, 3)] {
         let mut img = random_image(&mut rng, w, h);
         img.px[0][3] = 0; // transparent pixel keeps its colour (straight alpha)

@@ -1,21 +1,8 @@
 //! Metrics: hand-computed values, masks, LSB units, histogram buckets, and a randomized check
 //! against an independent float model.
 
+use crate::rng_common::Rng;
 use texsim::report::{compare, format_metrics_table, quantize, ErrorMetrics, Image};
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
 
 /// 8-bit value expanded exactly to 16 bits.
 fn e8(v: u8) -> u16 {
@@ -245,7 +232,7 @@ fn model(a: &Image, b: &Image, bits: u32, mask: &[bool]) -> Model {
 
 #[test]
 fn random_against_model() {
-    let mut rng = SplitMix(0x5EED_0001);
+    let mut rng = Rng(0x5EED_0001);
     for case in 0..400 {
         let w = 1 + rng.below(24) as u32;
         let h = 1 + rng.below(24) as u32;

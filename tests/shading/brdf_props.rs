@@ -2,6 +2,7 @@
 //! non-negativity and the stated upper bounds over random and boundary inputs, agreement of the dot-product form with the
 //! vector form, the eq. 16 constant, the h -> n limit, and the report functions.
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use std::f64::consts::PI;
 use texsim::brdf::ashikhmin_shirley::{BRDF_MAX, DENOM_FLOOR, EXPONENT_MAX};
@@ -9,51 +10,48 @@ use texsim::brdf::{
     albedo_report, dir_from_angles, eval_report, sample_report, AshikhminShirley, Dots,
 };
 
-struct Rng(u64);
-impl Rng {
-    fn u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn f(&mut self) -> f64 {
-        (self.u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
+/// Draws of this file's cases from the tests' shared generator.
+trait Draws {
+    fn sphere_dir(&mut self) -> DVec3;
+    fn upper(&mut self) -> DVec3;
+    fn exponent(&mut self) -> f64;
+    fn model(&mut self) -> AshikhminShirley;
+}
+
+impl Draws for Rng {
     /// Uniform direction on the sphere.
-    fn dir(&mut self) -> DVec3 {
-        let z = 2.0 * self.f() - 1.0;
+    fn sphere_dir(&mut self) -> DVec3 {
+        let z = 2.0 * self.unit() - 1.0;
         let r = (1.0 - z * z).max(0.0).sqrt();
-        let (s, c) = (2.0 * PI * self.f()).sin_cos();
+        let (s, c) = (2.0 * PI * self.unit()).sin_cos();
         DVec3::new(r * c, r * s, z)
     }
     /// Upper-hemisphere direction, often near the boundary cases.
     fn upper(&mut self) -> DVec3 {
-        match self.u64() % 6 {
+        match self.next() % 6 {
             0 => DVec3::Z,
-            1 => dir_from_angles(90.0 - 1e-9 * self.f(), 360.0 * self.f()),
-            2 => dir_from_angles(89.0 + self.f(), 360.0 * self.f()),
-            3 => dir_from_angles(1e-7 * self.f(), 360.0 * self.f()),
+            1 => dir_from_angles(90.0 - 1e-9 * self.unit(), 360.0 * self.unit()),
+            2 => dir_from_angles(89.0 + self.unit(), 360.0 * self.unit()),
+            3 => dir_from_angles(1e-7 * self.unit(), 360.0 * self.unit()),
             _ => {
-                let d = self.dir();
+                let d = self.sphere_dir();
                 DVec3::new(d.x, d.y, d.z.abs())
             }
         }
     }
     fn exponent(&mut self) -> f64 {
         const E: [f64; 10] = [0.0, 1e-3, 0.5, 1.0, 10.0, 100.0, 1000.0, 1e4, 1e5, 1e6];
-        if self.u64() & 1 == 0 {
-            E[(self.u64() % 10) as usize]
+        if self.next() & 1 == 0 {
+            E[(self.next() % 10) as usize]
         } else {
-            10f64.powf(6.0 * self.f())
+            10f64.powf(6.0 * self.unit())
         }
     }
     fn model(&mut self) -> AshikhminShirley {
-        let pick = |r: &mut Rng| match r.u64() % 4 {
+        let pick = |r: &mut Rng| match r.next() % 4 {
             0 => 0.0,
             1 => 1.0,
-            _ => r.f(),
+            _ => r.unit(),
         };
         let (nu, nv) = (self.exponent(), self.exponent());
         let (rs, rd) = (pick(self), pick(self));
@@ -90,11 +88,15 @@ fn finite_non_negative_and_bounded_everywhere() {
     let mut near_floor = 0;
     for i in 0..300_000 {
         let p = r.model();
-        let k1 = if i % 3 == 0 { r.dir() } else { r.upper() };
+        let k1 = if i % 3 == 0 {
+            r.sphere_dir()
+        } else {
+            r.upper()
+        };
         let k2 = match i % 5 {
             0 => -k1,
             1 => DVec3::new(-k1.x, -k1.y, k1.z),
-            2 => r.dir(),
+            2 => r.sphere_dir(),
             _ => r.upper(),
         };
         let root = ((p.nu + 1.0) * (p.nv + 1.0)).sqrt();
@@ -123,12 +125,20 @@ fn finite_non_negative_and_bounded_everywhere() {
         }
         // The dot-product form with arbitrary dots (the float twin's entry point).
         let d = Dots {
-            hn: 2.0 * r.f() - 0.5,
-            hu: 2.0 * r.f() - 1.0,
-            hv: 2.0 * r.f() - 1.0,
-            kh: if i % 2 == 0 { 1e-300 * r.f() } else { r.f() },
-            nk1: if i % 3 == 0 { 1e-200 * r.f() } else { r.f() },
-            nk2: 1.5 * r.f(),
+            hn: 2.0 * r.unit() - 0.5,
+            hu: 2.0 * r.unit() - 1.0,
+            hv: 2.0 * r.unit() - 1.0,
+            kh: if i % 2 == 0 {
+                1e-300 * r.unit()
+            } else {
+                r.unit()
+            },
+            nk1: if i % 3 == 0 {
+                1e-200 * r.unit()
+            } else {
+                r.unit()
+            },
+            nk2: 1.5 * r.unit(),
         };
         let (ds, dd) = p.eval_from_dots(&d);
         assert!(
@@ -139,7 +149,7 @@ fn finite_non_negative_and_bounded_everywhere() {
             dd.is_finite() && dd >= 0.0 && dd <= diff_max * tol,
             "{p:?} {d:?}: {dd}"
         );
-        let xi = [r.f(), r.f()];
+        let xi = [r.unit(), r.unit()];
         let xi = match i % 7 {
             0 => [0.0, 0.0],
             1 => [1.0, 1.0],

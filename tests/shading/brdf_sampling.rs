@@ -3,23 +3,13 @@
 //! the half vectors (library `chi2_h`, valid at any anisotropy) and of the reflected directions
 //! (library `chi2_k2`, anisotropy up to 10), each with negative controls.
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use std::f64::consts::PI;
 use texsim::brdf::stats::{
     chi2_h, chi2_h_of, chi2_k2, chi2_k2_of, chi2_merged, wilson_hilferty, Z_999,
 };
 use texsim::brdf::{dir_from_angles, AshikhminShirley};
-
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 const GL4: [(f64, f64); 4] = [
     (0.069_431_844_202_973_71, 0.173_927_422_568_726_93),
@@ -244,7 +234,7 @@ fn chi_square_detects_a_wrong_sampler() {
         let mut rng = Rng(5);
         let mut observed = vec![0.0; nc];
         for _ in 0..n {
-            let h = p.sample_h(rng.f(), rng.f());
+            let h = p.sample_h(rng.unit(), rng.unit());
             let t = h.z.powf(101.0);
             observed[((t * nc as f64) as usize).min(nc - 1)] += 1.0;
         }
@@ -290,8 +280,8 @@ fn sample_pdf_matches_pdf() {
     for (nu, nv) in CASES {
         let p = AshikhminShirley::new(nu, nv, 1.0, 0.0).expect("valid");
         for _ in 0..20_000 {
-            let k1 = dir_from_angles(89.0 * rng.f(), 360.0 * rng.f());
-            if let Some((k2, pdf)) = p.sample(k1, [rng.f(), rng.f()]) {
+            let k1 = dir_from_angles(89.0 * rng.unit(), 360.0 * rng.unit());
+            if let Some((k2, pdf)) = p.sample(k1, [rng.unit(), rng.unit()]) {
                 let q = p.pdf(k1, k2);
                 assert!(
                     (pdf - q).abs() <= 1e-6 * pdf,

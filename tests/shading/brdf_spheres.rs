@@ -273,14 +273,8 @@ fn anisotropic_highlight_is_elongated_along_the_expected_axis() {
 
 #[test]
 fn main_direction_frame_is_orthonormal_with_pole_fallback() {
-    let mut x = 0x1234_5678_9ABC_DEF0u64;
-    let mut next = || {
-        x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = x;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rng = crate::rng_common::Rng(0x1234_5678_9ABC_DEF0);
+    let mut next = || rng.range(-1.0, 1.0);
     for k in 0..10_000 {
         let n = DVec3::new(next(), next(), next()).normalize();
         let m = if k % 10 == 0 {

@@ -1,21 +1,10 @@
 #![allow(clippy::type_complexity)]
 //! Tangent generation: planar, mirrored, UV-degenerate, sphere poles, garbage input, random.
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use texsim::shading::reference as r;
 use texsim::shading::tangents::{generate_tangents, generate_uv_derivatives};
-
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn unif(s: &mut u64) -> f32 {
-    (splitmix(s) >> 40) as f32 / (1u64 << 24) as f32
-}
 
 fn v(t: [f32; 4]) -> DVec3 {
     DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]))
@@ -209,27 +198,27 @@ fn sphere_poles_with_spherical_uvs() {
 
 #[test]
 fn random_meshes_never_nan() {
-    let mut s = 5u64;
+    let mut s = Rng(5);
     for _ in 0..2000 {
-        let nv = 3 + (splitmix(&mut s) % 20) as usize;
+        let nv = 3 + (s.next() % 20) as usize;
         let pos: Vec<[f32; 3]> = (0..nv)
-            .map(|_| [unif(&mut s), unif(&mut s), unif(&mut s)])
+            .map(|_| [s.unit_f32(), s.unit_f32(), s.unit_f32()])
             .collect();
         let nor: Vec<[f32; 3]> = (0..nv)
             .map(|i| {
                 if i % 7 == 0 {
                     [0.0; 3]
                 } else {
-                    [unif(&mut s) - 0.5, unif(&mut s) - 0.5, unif(&mut s) - 0.5]
+                    [s.unit_f32() - 0.5, s.unit_f32() - 0.5, s.unit_f32() - 0.5]
                 }
             })
             .collect();
         // Quantized UVs so that many triangles are UV-degenerate.
         let uv: Vec<[f32; 2]> = (0..nv)
-            .map(|_| [(unif(&mut s) * 3.0).floor(), (unif(&mut s) * 3.0).floor()])
+            .map(|_| [(s.unit_f32() * 3.0).floor(), (s.unit_f32() * 3.0).floor()])
             .collect();
         let idx: Vec<[u32; 3]> = (0..nv)
-            .map(|_| [0; 3].map(|_: u32| (splitmix(&mut s) % nv as u64) as u32))
+            .map(|_| [0; 3].map(|_: u32| (s.next() % nv as u64) as u32))
             .collect();
         let t = generate_tangents(&pos, &nor, &uv, &idx);
         check_valid(&t, &nor);

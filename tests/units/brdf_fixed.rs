@@ -2,6 +2,7 @@
 //! evaluated from the same quantized dot products and parameters), its guards, saturation
 //! counting, cost, and a precision sweep (printed with `--nocapture`).
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use hw_model::aniso_phong::{aniso_phong, aniso_phong_cost, AnisoPhongConfig, AnisoPhongInputs};
 use hw_model::SatCounter;
@@ -10,42 +11,38 @@ use std::f64::consts::PI;
 use texsim::brdf::fixed_twin::{pf_to_f64, quantize, twin_pi_rho};
 use texsim::brdf::{dir_from_angles, AshikhminShirley, Dots};
 
-struct Rng(u64);
-impl Rng {
-    fn u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn f(&mut self) -> f64 {
-        (self.u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
+/// Draws of this file's cases from the tests' shared generator.
+trait Draws {
+    fn upper(&mut self) -> DVec3;
+    fn pair(&mut self, p: &AshikhminShirley) -> (DVec3, DVec3);
+    fn model(&mut self) -> AshikhminShirley;
+}
+
+impl Draws for Rng {
     fn upper(&mut self) -> DVec3 {
-        match self.u64() % 8 {
-            0 => dir_from_angles(85.0 + 5.0 * self.f(), 360.0 * self.f()),
-            1 => dir_from_angles(0.5 * self.f(), 360.0 * self.f()),
-            _ => dir_from_angles((self.f()).acos().to_degrees(), 360.0 * self.f()),
+        match self.next() % 8 {
+            0 => dir_from_angles(85.0 + 5.0 * self.unit(), 360.0 * self.unit()),
+            1 => dir_from_angles(0.5 * self.unit(), 360.0 * self.unit()),
+            _ => dir_from_angles((self.unit()).acos().to_degrees(), 360.0 * self.unit()),
         }
     }
     /// A pair biased toward the specular lobe (k2 near the mirror of k1) half of the time.
     fn pair(&mut self, p: &AshikhminShirley) -> (DVec3, DVec3) {
         let k1 = self.upper();
-        if self.u64() & 1 == 0 {
-            if let Some((k2, _)) = p.sample(k1, [self.f(), self.f()]) {
+        if self.next() & 1 == 0 {
+            if let Some((k2, _)) = p.sample(k1, [self.unit(), self.unit()]) {
                 return (k1, k2);
             }
         }
         (k1, self.upper())
     }
     fn model(&mut self) -> AshikhminShirley {
-        let e = |r: &mut Rng| match r.u64() % 4 {
-            0 => [0.0, 1.0, 10.0, 100_000.0][(r.u64() % 4) as usize],
-            _ => (10f64.powf(5.0 * r.f())).round(),
+        let e = |r: &mut Rng| match r.next() % 4 {
+            0 => [0.0, 1.0, 10.0, 100_000.0][(r.next() % 4) as usize],
+            _ => (10f64.powf(5.0 * r.unit())).round(),
         };
         let (nu, nv) = (e(self), e(self));
-        AshikhminShirley::new(nu, nv, self.f(), self.f()).expect("valid")
+        AshikhminShirley::new(nu, nv, self.unit(), self.unit()).expect("valid")
     }
 }
 

@@ -1,6 +1,7 @@
 //! Frames (natural, unit, main direction) and the perturbed normal: fixed units against their
 //! f64 twins, and the hard-case properties (near-parallel m, zero normals, continuity).
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use hw_model::blinn_phong::{ShadingConfig, ShadingUnits};
 use hw_model::frame::{
@@ -9,32 +10,6 @@ use hw_model::frame::{
 use hw_model::vector::Vec3x;
 use hw_model::SatCounter;
 use texsim::shading::reference as r;
-
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn unif(s: &mut u64) -> f64 {
-    (splitmix(s) >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn rand_dir(s: &mut u64) -> DVec3 {
-    loop {
-        let v = DVec3::new(
-            2.0 * unif(s) - 1.0,
-            2.0 * unif(s) - 1.0,
-            2.0 * unif(s) - 1.0,
-        );
-        let l = v.length();
-        if l > 0.1 && l <= 1.0 {
-            return v / l;
-        }
-    }
-}
 
 const F: u32 = 14;
 
@@ -79,18 +54,18 @@ fn main_bound(sin: f64) -> f64 {
 fn main_frame_random_orthonormal_and_matches_twin() {
     let u = units();
     let t = u.cfg.frame.frame_min_sin_bits;
-    let mut s = 11u64;
+    let mut s = Rng(11);
     let mut sat = SatCounter::default();
     let (mut worst_o, mut worst_c, mut flag_mismatch) = (0.0f64, 0.0f64, 0u32);
     for i in 0..1_000_000u32 {
-        let n_i = rand_dir(&mut s) * (0.05 + unif(&mut s));
+        let n_i = s.dir() * (0.05 + s.unit());
         // Every 4th case: m near-parallel to n (angles 2^-20 .. 2^-2 rad).
         let m = if i % 4 == 0 {
-            let eps = (-2.0 - 18.0 * unif(&mut s)).exp2();
-            let sign = if splitmix(&mut s) & 1 == 0 { 1.0 } else { -1.0 };
-            sign * n_i.normalize() + eps * rand_dir(&mut s)
+            let eps = (-2.0 - 18.0 * s.unit()).exp2();
+            let sign = if s.next() & 1 == 0 { 1.0 } else { -1.0 };
+            sign * n_i.normalize() + eps * s.dir()
         } else {
-            rand_dir(&mut s)
+            s.dir()
         };
         let (nq, mq) = (q(n_i), q(m));
         let fx = main_direction_frame(&nq, &mq, &u, &mut sat);
@@ -160,15 +135,15 @@ fn zero_normal_gives_z_frame() {
 fn main_frame_continuity_away_from_cone() {
     let u = units();
     let thr = (-f64::from(u.cfg.frame.frame_min_sin_bits)).exp2();
-    let mut s = 23u64;
+    let mut s = Rng(23);
     let mut sat = SatCounter::default();
     let step = 1e-3;
     let mut crossings = 0u32;
     for _ in 0..300 {
-        let m = rand_dir(&mut s);
-        let mut axis = rand_dir(&mut s);
+        let m = s.dir();
+        let mut axis = s.dir();
         axis = (axis - m * m.dot(axis)).normalize(); // the plane of n's path contains m
-        let start = rand_dir(&mut s);
+        let start = s.dir();
         let start = (start - axis * axis.dot(start)).normalize();
         let mut prev: Option<(DVec3, DVec3, DVec3, bool, f64)> = None;
         for k in 0..3000 {
@@ -206,14 +181,14 @@ fn main_frame_continuity_away_from_cone() {
 fn unit_and_natural_frames_match_twin() {
     let u = units();
     let lfb = u.cfg.frame.frame_len_frac_bits;
-    let mut s = 31u64;
+    let mut s = Rng(31);
     let mut sat = SatCounter::default();
     let mut worst = 0.0f64;
     for _ in 0..1_000_000 {
-        let n_i = rand_dir(&mut s) * (0.1 + unif(&mut s));
-        let du = rand_dir(&mut s) * (0.1 + unif(&mut s));
-        let dv = rand_dir(&mut s) * (0.1 + unif(&mut s));
-        let (lu, lv) = (4.0 * unif(&mut s), 4.0 * unif(&mut s));
+        let n_i = s.dir() * (0.1 + s.unit());
+        let du = s.dir() * (0.1 + s.unit());
+        let dv = s.dir() * (0.1 + s.unit());
+        let (lu, lv) = (4.0 * s.unit(), 4.0 * s.unit());
         let (lur, lvr) = (r::to_fixed(lu, lfb), r::to_fixed(lv, lfb));
         let fr = natural_frame(&q(n_i), &q(du), &q(dv), lur, lvr, &u, &mut sat);
         let tw = r::natural_frame(d(&q(n_i)), d(&q(du)), d(&q(dv)), lu, lv, 6);
@@ -237,12 +212,12 @@ fn perturbed_normal_matches_twin() {
     let u = units();
     let o = u.cfg.vector.offset_frac_bits;
     let lfb = u.cfg.frame.frame_len_frac_bits;
-    let mut s = 41u64;
+    let mut s = Rng(41);
     let mut sat = SatCounter::default();
     let (mut worst_u, mut worst_n) = (0.0f64, 0.0f64);
     for i in 0..1_000_000u32 {
-        let n_i = rand_dir(&mut s);
-        let m = rand_dir(&mut s);
+        let n_i = s.dir();
+        let m = s.dir();
         let natural = i % 2 == 1;
         let role = MainRole {
             m_is_u: i % 4 >= 2,
@@ -250,11 +225,11 @@ fn perturbed_normal_matches_twin() {
         };
         let mut fr: Frame = main_frame(&q(n_i), &q(m), role, &u, &mut sat);
         if natural {
-            fr.len_u = r::to_fixed(0.25 + 2.0 * unif(&mut s), lfb);
-            fr.len_v = r::to_fixed(0.25 + 2.0 * unif(&mut s), lfb);
+            fr.len_u = r::to_fixed(0.25 + 2.0 * s.unit(), lfb);
+            fr.len_v = r::to_fixed(0.25 + 2.0 * s.unit(), lfb);
         }
-        let fu = r::to_fixed(4.0 * unif(&mut s) - 2.0, o);
-        let fv = r::to_fixed(4.0 * unif(&mut s) - 2.0, o);
+        let fu = r::to_fixed(4.0 * s.unit() - 2.0, o);
+        let fv = r::to_fixed(4.0 * s.unit() - 2.0, o);
         let p = perturb_normal(&fr, fu, fv, &u, &mut sat);
         let tw = r::FrameF {
             n: d(&fr.n),
@@ -298,12 +273,12 @@ fn main_frame_roles_equal_unit_frame() {
     let u = units();
     let o = u.cfg.vector.offset_frac_bits;
     let t = u.cfg.frame.frame_min_sin_bits;
-    let mut s = 53u64;
+    let mut s = Rng(53);
     let mut sat = SatCounter::default();
     let (mut worst_t, mut worst_p, mut worst_f) = (0.0f64, 0.0f64, 0.0f64);
     for i in 0..200_000u32 {
-        let n = rand_dir(&mut s);
-        let a = rand_dir(&mut s);
+        let n = s.dir();
+        let a = s.dir();
         let mirrored = i % 2 == 1;
         let pu_dir = (a - n * n.dot(a)).normalize();
         let pv_dir = if mirrored {
@@ -311,13 +286,13 @@ fn main_frame_roles_equal_unit_frame() {
         } else {
             n.cross(pu_dir)
         };
-        let pu = pu_dir * (0.5 + 0.5 * unif(&mut s));
-        let pv = pv_dir * (0.5 + 0.5 * unif(&mut s));
+        let pu = pu_dir * (0.5 + 0.5 * s.unit());
+        let pv = pv_dir * (0.5 + 0.5 * s.unit());
         assert_eq!(n.dot(pu.cross(pv)) < 0.0, mirrored);
         let (du, dv) = (n.cross(pv).normalize(), pu.cross(n).normalize());
-        let n_i = n * (0.3 + unif(&mut s));
-        let fu = r::to_fixed(2.0 * unif(&mut s) - 1.0, o);
-        let fv = r::to_fixed(2.0 * unif(&mut s) - 1.0, o);
+        let n_i = n * (0.3 + s.unit());
+        let fu = r::to_fixed(2.0 * s.unit() - 1.0, o);
+        let fv = r::to_fixed(2.0 * s.unit() - 1.0, o);
         let uf = unit_frame(&q(n_i), &q(du), &q(dv), &u, &mut sat);
         let want = perturb_normal(&uf, fu, fv, &u, &mut sat);
         let tw_unit = r::unit_frame(n_i, du, dv, t);
@@ -457,10 +432,10 @@ fn natural_length_saturation_is_counted() {
 /// displaced surface `p + f n^` is `n + f_u s_u + f_v s_v` to first order (Blinn 1978).
 #[test]
 fn natural_frame_identities() {
-    let mut s = 3u64;
+    let mut s = Rng(3);
     for _ in 0..1000 {
-        let pu = rand_dir(&mut s) * (0.2 + unif(&mut s));
-        let pv = rand_dir(&mut s) * (0.2 + unif(&mut s));
+        let pu = s.dir() * (0.2 + s.unit());
+        let pv = s.dir() * (0.2 + s.unit());
         let n = pu.cross(pv);
         if n.length() < 0.05 {
             continue;
@@ -469,7 +444,7 @@ fn natural_frame_identities() {
         let (su, sv) = (nh.cross(pv), pu.cross(nh));
         assert!((su.cross(sv) - n).length() < 1e-12);
         // Displaced plane p(u, v) = u pu + v pv + f(u, v) nh with f = a u + b v (small slopes).
-        let (a, b) = (0.3 * unif(&mut s) - 0.15, 0.3 * unif(&mut s) - 0.15);
+        let (a, b) = (0.3 * s.unit() - 0.15, 0.3 * s.unit() - 0.15);
         let exact = (pu + a * nh).cross(pv + b * nh);
         let paper = n + a * su + b * sv;
         // Exact up to the second-order term a b (nh x nh) = 0: identical for a plane.

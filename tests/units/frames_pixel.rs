@@ -2,38 +2,13 @@
 //! against the f64 twin for all three frame kinds.
 #![allow(clippy::needless_range_loop)]
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use hw_model::blinn_phong::{bump_shade, BlinnPhongInput, BumpPixel, ShadingConfig, ShadingUnits};
 use hw_model::frame::{FrameKind, MainRole};
 use hw_model::SatCounter;
 use texsim::shading::bump::OffsetEncoding;
 use texsim::shading::reference as r;
-
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn unif(s: &mut u64) -> f64 {
-    (splitmix(s) >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn rand_dir(s: &mut u64) -> DVec3 {
-    loop {
-        let v = DVec3::new(
-            2.0 * unif(s) - 1.0,
-            2.0 * unif(s) - 1.0,
-            2.0 * unif(s) - 1.0,
-        );
-        let l = v.length();
-        if l > 0.1 && l <= 1.0 {
-            return v / l;
-        }
-    }
-}
 
 #[test]
 fn bump_shade_matches_twin_all_frames() {
@@ -45,22 +20,22 @@ fn bump_shade_matches_twin_all_frames() {
         let u = ShadingUnits::new(&cfg);
         let lfb = cfg.frame.frame_len_frac_bits;
         let enc = OffsetEncoding::for_offset_int_bits(cfg.vector.offset_int_bits);
-        let mut s = 1234u64;
+        let mut s = Rng(1234);
         let mut sat = SatCounter::default();
         let (mut worst_n, mut worst_c) = (0.0f64, 0.0f64);
         for _ in 0..200_000 {
-            let n_i = rand_dir(&mut s);
-            let m = rand_dir(&mut s);
+            let n_i = s.dir();
+            let m = s.dir();
             if m.cross(n_i).length() < 0.1 {
                 continue;
             }
             // Tangent directions roughly in the tangent plane, as interpolation gives them.
-            let du = (m.cross(n_i) + 0.1 * rand_dir(&mut s)).normalize();
-            let dv = (n_i.cross(du) + 0.1 * rand_dir(&mut s)).normalize();
-            let lens = [0.5 + unif(&mut s), 0.5 + unif(&mut s)];
-            let texels = [0; 2].map(|_: u64| 32768 - 8192 + splitmix(&mut s) % 16384);
+            let du = (m.cross(n_i) + 0.1 * s.dir()).normalize();
+            let dv = (n_i.cross(du) + 0.1 * s.dir()).normalize();
+            let lens = [0.5 + s.unit(), 0.5 + s.unit()];
+            let texels = [0; 2].map(|_: u64| 32768 - 8192 + s.next() % 16384);
             let q = |v: DVec3| r::to_vec3x(v, F);
-            let bits = splitmix(&mut s);
+            let bits = s.next();
             let main_role = MainRole {
                 m_is_u: bits & 1 == 1,
                 mirrored: bits & 2 == 2,
@@ -76,10 +51,10 @@ fn bump_shade_matches_twin_all_frames() {
                 offset_texels: texels,
                 texel_bits: 16,
             };
-            let l = rand_dir(&mut s);
-            let v = rand_dir(&mut s);
-            let shininess = 1 + (splitmix(&mut s) % 64) as u32;
-            let col = |s: &mut u64| [0; 3].map(|_: u64| splitmix(s) % 65536);
+            let l = s.dir();
+            let v = s.dir();
+            let shininess = 1 + (s.next() % 64) as u32;
+            let col = |s: &mut Rng| [0; 3].map(|_: u64| s.next() % 65536);
             let (kd, ks, light) = (col(&mut s), col(&mut s), col(&mut s));
             let sh = BlinnPhongInput {
                 n: [0; 3],

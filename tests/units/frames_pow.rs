@@ -1,15 +1,8 @@
 //! Power unit (log-exp tables and repeated squaring) against f64 powf, exponents 1..=1024.
 
+use crate::rng_common::Rng;
 use hw_model::pow::{pow_cost, Pow, PowConfig, PowMethod};
 use hw_model::SatCounter;
-
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
 
 /// The documented absolute bound for `x^n` (x, result in [0, 1]).
 fn bound(cfg: &PowConfig, x: f64, n: u32) -> f64 {
@@ -29,11 +22,11 @@ fn bound(cfg: &PowConfig, x: f64, n: u32) -> f64 {
 }
 
 /// Inputs: edges, values near 1 (where x^n stays large) and uniform ones.
-fn inputs(p: u32, s: &mut u64, count: usize) -> Vec<u64> {
+fn inputs(p: u32, s: &mut Rng, count: usize) -> Vec<u64> {
     let one = 1u64 << p;
     let mut v = vec![0, 1, 2, one / 2, one - 1, one];
     while v.len() < count {
-        let r = splitmix(s);
+        let r = s.next();
         let x = if r & 1 == 0 {
             one - (r >> 1) % (one / 64 + 1)
         } else {
@@ -49,7 +42,7 @@ fn measure(cfg: &PowConfig, per_n: usize, exps: &[u32]) -> (f64, f64) {
     let u = Pow::new(cfg);
     let p = cfg.pow_frac_bits;
     let scale = (-f64::from(p)).exp2();
-    let mut s = 99u64;
+    let mut s = Rng(99);
     let mut sat = SatCounter::default();
     let (mut worst, mut ratio) = (0.0f64, 0.0f64);
     for &n in exps {

@@ -1,6 +1,7 @@
 //! Blinn-Phong fixed unit against its f64 twin, including grazing light/view and l = -v.
 #![allow(clippy::needless_range_loop)]
 
+use crate::rng_common::Rng;
 use glam::DVec3;
 use hw_model::blinn_phong::{
     blinn_phong, blinn_phong_cost, BlinnPhongInput, ShadingConfig, ShadingUnits,
@@ -9,32 +10,6 @@ use hw_model::pow::PowMethod;
 use hw_model::SatCounter;
 use texsim::shading::reference as r;
 
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn unif(s: &mut u64) -> f64 {
-    (splitmix(s) >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn rand_dir(s: &mut u64) -> DVec3 {
-    loop {
-        let v = DVec3::new(
-            2.0 * unif(s) - 1.0,
-            2.0 * unif(s) - 1.0,
-            2.0 * unif(s) - 1.0,
-        );
-        let l = v.length();
-        if l > 0.1 && l <= 1.0 {
-            return v / l;
-        }
-    }
-}
-
 const F: u32 = 14;
 const C: u32 = 16;
 
@@ -42,34 +17,34 @@ fn run(method: PowMethod, cases: u32) -> f64 {
     let mut cfg = ShadingConfig::texram16();
     cfg.pow.pow_method = method;
     let u = ShadingUnits::new(&cfg);
-    let mut s = 77u64;
+    let mut s = Rng(77);
     let mut sat = SatCounter::default();
     let mut worst_ratio = 0.0f64;
     // Colours are unorm: raw x means x / (2^C - 1), as in the pipeline.
     let cu = 1.0 / ((1u64 << C) - 1) as f64;
     let ulp = (-f64::from(F)).exp2();
     for i in 0..cases {
-        let n = rand_dir(&mut s);
-        let mut l = rand_dir(&mut s);
-        let mut v = rand_dir(&mut s);
+        let n = s.dir();
+        let mut l = s.dir();
+        let mut v = s.dir();
         match i % 4 {
             // Grazing light: n.l in [-1e-3, 1e-3].
             1 => {
                 let t = (l - n * n.dot(l)).normalize();
-                l = (t + n * (2e-3 * unif(&mut s) - 1e-3)).normalize();
+                l = (t + n * (2e-3 * s.unit() - 1e-3)).normalize();
             }
             // Grazing view.
             2 => {
                 let t = (v - n * n.dot(v)).normalize();
-                v = (t + n * (2e-3 * unif(&mut s) - 1e-3)).normalize();
+                v = (t + n * (2e-3 * s.unit() - 1e-3)).normalize();
             }
             // l = -v exactly (after quantization).
             3 if i % 8 == 3 => v = -l,
             _ => {}
         }
         let (nq, lq, vq) = (r::to_vec3x(n, F), r::to_vec3x(l, F), r::to_vec3x(v, F));
-        let shininess = 1 + (splitmix(&mut s) % 1024) as u32;
-        let col = |s: &mut u64| [0; 3].map(|_: u64| splitmix(s) % (1 << C));
+        let shininess = 1 + (s.next() % 1024) as u32;
+        let col = |s: &mut Rng| [0; 3].map(|_: u64| s.next() % (1 << C));
         let (kd, ks, light) = (col(&mut s), col(&mut s), col(&mut s));
         let inp = BlinnPhongInput {
             n: nq,
@@ -154,7 +129,7 @@ fn point_and_directional_light_vectors() {
 /// and the fixed colour of random inputs has no systematic bias against the twin.
 #[test]
 fn unorm_products_at_every_colour_width() {
-    let mut s = 5u64;
+    let mut s = Rng(5);
     for c in 4..=16u32 {
         let mut cfg = ShadingConfig::texram16();
         cfg.shade.shade_color_bits = c;
@@ -183,10 +158,10 @@ fn unorm_products_at_every_colour_width() {
         let cu = 1.0 / max as f64;
         let (mut sum, mut k) = (0.0f64, 0u32);
         for _ in 0..20_000 {
-            let n = rand_dir(&mut s);
-            let l = (n + 0.8 * rand_dir(&mut s)).normalize();
+            let n = s.dir();
+            let l = (n + 0.8 * s.dir()).normalize();
             let (nq, lq) = (r::to_vec3x(n, F), r::to_vec3x(l, F));
-            let col = |s: &mut u64| [0; 3].map(|_: u64| splitmix(s) % (max + 1));
+            let col = |s: &mut Rng| [0; 3].map(|_: u64| s.next() % (max + 1));
             let (kd, light) = (col(&mut s), col(&mut s));
             let inp = BlinnPhongInput {
                 n: nq,

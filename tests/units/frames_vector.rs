@@ -1,24 +1,13 @@
 //! Vector unit (dot, cross, normalize, madd, offset decode) against an f64 model, seeded random.
 #![allow(clippy::needless_range_loop)]
 
+use crate::rng_common::Rng;
 use hw_model::rsqrt::{Rsqrt, RsqrtConfig};
 use hw_model::vector::{
     cross3, dot3, madd, normalize3, offset_format, offset_from_texel, vector_format, wide_format,
     VectorConfig,
 };
 use hw_model::SatCounter;
-
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn rnd_in(s: &mut u64, lo: i64, hi: i64) -> i64 {
-    lo + (splitmix(s) % ((hi - lo + 1) as u64)) as i64
-}
 
 fn ulp(f: u32) -> f64 {
     (-f64::from(f)).exp2()
@@ -30,12 +19,12 @@ fn dot_and_cross_half_ulp() {
     let f = cfg.vector_frac_bits;
     let fmt = vector_format(&cfg);
     let (lo, hi) = (fmt.min_raw(), fmt.max_raw());
-    let mut s = 1u64;
+    let mut s = Rng(1);
     let mut sat = SatCounter::default();
     let mut n_sat = 0u64;
     for _ in 0..1_000_000 {
-        let a = [0; 3].map(|_: i64| rnd_in(&mut s, lo, hi));
-        let b = [0; 3].map(|_: i64| rnd_in(&mut s, lo, hi) / 2);
+        let a = [0; 3].map(|_: i64| s.int_in(lo, hi));
+        let b = [0; 3].map(|_: i64| s.int_in(lo, hi) / 2);
         let exact: f64 = (0..3).map(|i| (a[i] * b[i]) as f64).sum::<f64>() * ulp(2 * f);
         let before = sat.saturated;
         let d = dot3(&a, &b, &cfg, &mut sat) as f64 * ulp(f);
@@ -79,13 +68,13 @@ fn normalize_error_bound() {
     let f = cfg.vector_frac_bits;
     let rs = Rsqrt::new(&RsqrtConfig::texram16());
     let bound = 6.53e-6 + 0.5 * ulp(f);
-    let mut s = 3u64;
+    let mut s = Rng(3);
     let mut worst = 0.0f64;
     let mut sat = SatCounter::default();
     for i in 0..1_000_000u32 {
         let k = 1 + (i % 40) as i64;
         let lim = 1i64 << k;
-        let v = [0; 3].map(|_: i64| rnd_in(&mut s, -lim, lim));
+        let v = [0; 3].map(|_: i64| s.int_in(-lim, lim));
         if v == [0; 3] {
             continue;
         }
@@ -121,15 +110,15 @@ fn madd_half_ulp_and_saturation_counted() {
     let vf = vector_format(&cfg);
     let of = offset_format(&cfg);
     let wf = wide_format(&cfg);
-    let mut s = 5u64;
+    let mut s = Rng(5);
     let mut sat = SatCounter::default();
     let mut expected_sat = 0;
     for _ in 0..1_000_000 {
-        let n = [0; 3].map(|_: i64| rnd_in(&mut s, -(1 << f), 1 << f));
-        let tu = [0; 3].map(|_: i64| rnd_in(&mut s, -(1 << f), 1 << f));
-        let tv = [0; 3].map(|_: i64| rnd_in(&mut s, -(1 << f), 1 << f));
-        let gu = rnd_in(&mut s, of.min_raw(), of.max_raw());
-        let gv = rnd_in(&mut s, of.min_raw(), of.max_raw());
+        let n = [0; 3].map(|_: i64| s.int_in(-(1 << f), 1 << f));
+        let tu = [0; 3].map(|_: i64| s.int_in(-(1 << f), 1 << f));
+        let tv = [0; 3].map(|_: i64| s.int_in(-(1 << f), 1 << f));
+        let gu = s.int_in(of.min_raw(), of.max_raw());
+        let gv = s.int_in(of.min_raw(), of.max_raw());
         let w = madd(&n, &tu, &tv, gu, gv, &cfg, &mut sat);
         for i in 0..3 {
             let e = n[i] as f64 * ulp(f)

@@ -2,25 +2,12 @@
 //! one shared reciprocal) against an exact-rational model evaluated in `f64`, on random
 //! triangles, samples and 1/w; and the float twin against the same model.
 
+use crate::rng_common::Rng;
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Rounding, SatCounter};
 use hw_model::interpolator::{perspective_bary, perspective_bary_derivs};
 use hw_model::reciprocal::{Reciprocal, GUARD_BITS};
 use texsim::reference::perspective_bary_derivs_f64;
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        lo + (self.next() % (hi - lo + 1) as u64) as i64
-    }
-}
 
 /// Relative error bound of the reciprocal (as in `hw_model::reciprocal`).
 fn recip_rel_bound(hw: &HwConfig) -> f64 {
@@ -48,7 +35,7 @@ fn edges(v: &[[i64; 2]; 3], p: [i64; 2]) -> [i64; 3] {
 
 #[test]
 fn derivatives_meet_the_stated_bound() {
-    let mut rng = SplitMix(0xde71_0001);
+    let mut rng = Rng(0xde71_0001);
     let mut configs = vec![HwConfig::texram16()];
     let mut c = HwConfig::texram16();
     c.reciprocal.recip_iterations = 1;
@@ -70,9 +57,9 @@ fn derivatives_meet_the_stated_bound() {
         for _ in 0..400_000 {
             // A triangle of up to 2^(8+s) pixels in 8-bit sub-pixel units, a sample in its
             // bounding box (inside or just outside), 1/w normalized with the largest = 1.0.
-            let span = 1i64 << rng.range(4, 20);
+            let span = 1i64 << rng.int_in(4, 20);
             let v: [[i64; 2]; 3] =
-                std::array::from_fn(|_| [rng.range(-span, span), rng.range(-span, span)]);
+                std::array::from_fn(|_| [rng.int_in(-span, span), rng.int_in(-span, span)]);
             let mut v = v;
             if cross(v[0], v[1], v[2]) < 0 {
                 v.swap(1, 2);
@@ -80,7 +67,7 @@ fn derivatives_meet_the_stated_bound() {
             if cross(v[0], v[1], v[2]) == 0 {
                 continue;
             }
-            let wts = [0, 1, 2].map(|_| rng.range(1, 1 << 16));
+            let wts = [0, 1, 2].map(|_| rng.int_in(1, 1 << 16));
             let tot: i64 = wts.iter().sum();
             let p = [0, 1].map(|ax| (0..3).map(|j| wts[j] * v[j][ax]).sum::<i64>() / tot);
             let e = edges(&v, p);
@@ -93,8 +80,8 @@ fn derivatives_meet_the_stated_bound() {
             let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
             let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
             let one = 1i64 << hw.interp.inv_w_bits;
-            let mut w = [0, 1, 2].map(|_| rng.range(1, one));
-            w[rng.range(0, 2) as usize] = one;
+            let mut w = [0, 1, 2].map(|_| rng.int_in(1, one));
+            w[rng.int_in(0, 2) as usize] = one;
             let mut sat = SatCounter::default();
             let out = perspective_bary_derivs(e, dx, dy, w, &hw.interp, &recip, &mut sat);
             assert_eq!(out[0], perspective_bary(e, w, &hw.interp, &recip, &mut sat));

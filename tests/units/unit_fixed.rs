@@ -2,21 +2,11 @@
 //! shift and sign; `round_div_wide` vs an independent half-step formula; `Format::fit`/`requantize`
 //! saturate and wrap with exact event counts.
 
+use crate::rng_common::Rng;
 use hw_model::fixed::{
     round_div_wide, round_shift_right, round_shift_right_wide, Format, Overflow, Rounding,
     SatCounter,
 };
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
 
 const ROUNDINGS: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
 
@@ -36,7 +26,7 @@ fn exact(x: i128, s: u32, mode: Rounding) -> i128 {
     }
 }
 
-fn interesting(rng: &mut SplitMix) -> i64 {
+fn interesting(rng: &mut Rng) -> i64 {
     match rng.next() % 6 {
         0 => (rng.next() % 64) as i64 - 32,
         1 => i64::MIN + (rng.next() % 8) as i64,
@@ -52,7 +42,7 @@ fn interesting(rng: &mut SplitMix) -> i64 {
 
 #[test]
 fn round_shift_right_vs_exact() {
-    let mut rng = SplitMix(0xf1_0001);
+    let mut rng = Rng(0xf1_0001);
     for k in 0..1_500_000u32 {
         let x = interesting(&mut rng);
         let s = (rng.next() % 80) as u32;
@@ -79,7 +69,7 @@ fn round_shift_right_vs_exact() {
 
 #[test]
 fn round_shift_right_wide_vs_exact() {
-    let mut rng = SplitMix(0xf1_0002);
+    let mut rng = Rng(0xf1_0002);
     for k in 0..1_000_000u32 {
         let hi = interesting(&mut rng);
         let x = (i128::from(hi) << (rng.next() % 60)) + i128::from(rng.next() % 1024);
@@ -119,7 +109,7 @@ fn round_shift_right_wide_vs_exact() {
 /// signs, saturation to i64, and `den <= 0` giving 0.
 #[test]
 fn round_div_wide_vs_half_step_formula() {
-    let mut rng = SplitMix(0xf1_0003);
+    let mut rng = Rng(0xf1_0003);
     for k in 0..1_000_000u32 {
         let den = match k % 4 {
             0 => (1i128 << (rng.next() % 24)) * ((1i128 << (1 + rng.next() % 16)) - 1),
@@ -169,7 +159,7 @@ fn round_div_wide_vs_half_step_formula() {
 
 #[test]
 fn fit_saturate_and_wrap_counts() {
-    let mut rng = SplitMix(0xf1_0003);
+    let mut rng = Rng(0xf1_0003);
     for k in 0..500_000u32 {
         let signed = k % 2 == 0;
         let int_bits = (rng.next() % 12) as u32;

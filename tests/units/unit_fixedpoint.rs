@@ -1,18 +1,8 @@
 //! texsim float <-> fixed conversion: rounding modes, ties, saturation and NaN, round trips.
 
+use crate::rng_common::Rng;
 use hw_model::fixed::{Format, Overflow, Rounding, SatCounter};
 use texsim::fixedpoint::{from_raw, from_unorm, to_raw, to_unorm};
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
 
 #[test]
 fn to_raw_rounding_and_ties() {
@@ -53,7 +43,7 @@ fn to_raw_rounding_and_ties() {
 
 #[test]
 fn to_raw_random_vs_integer_model() {
-    let mut rng = SplitMix(0xf9_0001);
+    let mut rng = Rng(0xf9_0001);
     let f = Format::signed(30, 16, Rounding::HalfEven);
     for k in 0..1_000_000u32 {
         // x = n / 2^20 exactly: the model rounds n >> 4 by each mode.

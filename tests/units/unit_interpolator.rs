@@ -1,25 +1,12 @@
 //! Perspective-correct barycentrics vs exact rationals (i128), interpolation vs exact integer
 //! rounding, and both vs the f64 twins.
 
+use crate::rng_common::Rng;
 use hw_model::config::{HwConfig, InterpConfig};
 use hw_model::fixed::{Format, Overflow, Rounding, SatCounter};
 use hw_model::interpolator::{interpolate, perspective_bary, BARY_LIMIT};
 use hw_model::reciprocal::{Reciprocal, GUARD_BITS};
 use texsim::reference::{interpolate_f64, perspective_bary_f64};
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
 
 /// Relative error bound of the reciprocal (see `hw_model::reciprocal`), plus D truncation.
 fn recip_rel_bound(hw: &HwConfig) -> f64 {
@@ -49,7 +36,7 @@ fn configs() -> Vec<HwConfig> {
     v
 }
 
-fn rand_edge(rng: &mut SplitMix, inside: bool) -> [i64; 3] {
+fn rand_edge(rng: &mut Rng, inside: bool) -> [i64; 3] {
     let bits = 1 + rng.below(54) as u32;
     let mut e = [0i64; 3];
     for x in &mut e {
@@ -62,7 +49,7 @@ fn rand_edge(rng: &mut SplitMix, inside: bool) -> [i64; 3] {
     e
 }
 
-fn rand_invw(rng: &mut SplitMix, ib: u32) -> [i64; 3] {
+fn rand_invw(rng: &mut Rng, ib: u32) -> [i64; 3] {
     let one = 1i64 << ib;
     let mut w = [0i64; 3];
     for x in &mut w {
@@ -74,7 +61,7 @@ fn rand_invw(rng: &mut SplitMix, ib: u32) -> [i64; 3] {
 
 #[test]
 fn bary_vs_exact_rational() {
-    let mut rng = SplitMix(0xba_0001);
+    let mut rng = Rng(0xba_0001);
     for hw in configs() {
         let cfg: InterpConfig = hw.interp.clone();
         let recip = Reciprocal::new(&hw.reciprocal);
@@ -193,7 +180,7 @@ fn exact_round(acc: i128, shift: u32, mode: Rounding) -> i128 {
 
 #[test]
 fn interpolate_exact_rounding() {
-    let mut rng = SplitMix(0xba_0002);
+    let mut rng = Rng(0xba_0002);
     let modes = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
     for k in 0..1_200_000u32 {
         let bb = 4 + rng.below(27) as u32;

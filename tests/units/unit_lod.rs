@@ -1,21 +1,11 @@
 //! LOD unit vs log2 in f64: exhaustive over all (du/dx, dv/dx) in 0..4096^2 (2^24 cases),
 //! seeded random otherwise; exact on powers of two and Pythagorean lengths.
 
+use crate::rng_common::Rng;
 use hw_model::config::{HwConfig, LodConfig};
 use hw_model::fixed::SatCounter;
 use hw_model::lod::{lod, lod_zero};
 use texsim::reference::lod_f64;
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
 
 fn cfg(f: u32) -> LodConfig {
     let mut c = HwConfig::texram16().lod;
@@ -85,7 +75,7 @@ fn exhaustive_12_bit_pairs() {
 
 #[test]
 fn random_all_widths() {
-    let mut rng = SplitMix(0x10d_0001);
+    let mut rng = Rng(0x10d_0001);
     let mut low = 0u32;
     for k in 0..1_500_000u32 {
         let f = k % 17;
@@ -194,7 +184,7 @@ fn piecewise_linear_log2_exhaustive_12_bit_pairs() {
 fn piecewise_linear_log2_random_with_fraction_bits() {
     use hw_model::config::LodLog2;
     use texsim::reference::lod_mode_f64;
-    let mut rng = SplitMix(0x11b);
+    let mut rng = Rng(0x11b);
     for i in 0..2_000_000u32 {
         let f = i % 17;
         let frac = (i / 17) % 21;

@@ -1,21 +1,11 @@
 //! Modulate and unorm conversion vs exact rationals: exhaustive at 8 bits (all a, b, every
 //! output width and rounding), random at 16 bits and mixed widths, and vs the f64 twin.
 
+use crate::rng_common::Rng;
 use hw_model::fixed::Rounding;
 use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
 use texsim::fixedpoint::{from_unorm, to_unorm};
 use texsim::reference::modulate_f64;
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
 
 const ROUNDINGS: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
 
@@ -64,7 +54,7 @@ fn modulate_exhaustive_8_bit() {
 
 #[test]
 fn modulate_random_mixed_widths() {
-    let mut rng = SplitMix(0x30d_0001);
+    let mut rng = Rng(0x30d_0001);
     for k in 0..1_500_000u32 {
         let (ab, bb, ob) = (
             1 + (k % 16),
@@ -125,7 +115,7 @@ fn unorm_convert_exhaustive_and_random() {
         assert_eq!(unorm_convert(x * 257, 16, 8, Rounding::HalfEven), x);
         assert_eq!(to_unorm(from_unorm(x, 8), 8), x);
     }
-    let mut rng = SplitMix(0x30d_0002);
+    let mut rng = Rng(0x30d_0002);
     for _ in 0..500_000 {
         let x = rng.next() as u32;
         let q = unorm_convert(x, 32, 16, Rounding::HalfEven);

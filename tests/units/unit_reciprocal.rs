@@ -2,20 +2,10 @@
 //! texram16, seeded random for other configs; asserts the documented ulp bound.
 //! Run `cargo test --test units unit_reciprocal:: -- --nocapture` to see the error table.
 
+use crate::rng_common::Rng;
 use hw_model::config::{HwConfig, ReciprocalConfig};
 use hw_model::fixed::{Rounding, SatCounter};
 use hw_model::reciprocal::{Recip, Reciprocal, GUARD_BITS};
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
 
 /// Signed error of `r` vs 1/x in ulps of the result (ulp = 2^-shift), exact in i128.
 fn err_ulps(x: u64, r: Recip) -> f64 {
@@ -98,7 +88,7 @@ fn one_iteration_exhaustive_24_bit_is_seed_limited() {
 
 #[test]
 fn lut_iteration_table() {
-    let mut rng = SplitMix(0x5eed_0001);
+    let mut rng = Rng(0x5eed_0001);
     let combos = [
         (8, 0),
         (8, 1),
@@ -124,7 +114,7 @@ fn lut_iteration_table() {
 
 #[test]
 fn random_configs_and_widths() {
-    let mut rng = SplitMix(0x5eed_0002);
+    let mut rng = Rng(0x5eed_0002);
     let modes = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
     for k in 0..48u32 {
         let cfg = cfg_with(
@@ -146,7 +136,7 @@ fn random_configs_and_widths() {
 
 #[test]
 fn converged_config_is_within_one_ulp() {
-    let mut rng = SplitMix(0x5eed_0003);
+    let mut rng = Rng(0x5eed_0003);
     for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
         let cfg = cfg_with(8, 2, 24, mode);
         let unit = Reciprocal::new(&cfg);

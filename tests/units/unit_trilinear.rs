@@ -1,6 +1,7 @@
 //! Filter unit: `lerp` exhaustive at 8 bits (2^24 cases per rounding mode) and random at 16 bits
 //! vs exact rationals; bilinear/trilinear vs the f64 twin within the documented LSB bound.
 
+use crate::rng_common::Rng;
 use hw_model::config::{HwConfig, TrilinearConfig};
 use hw_model::fixed::Rounding;
 use hw_model::trilinear::{
@@ -8,20 +9,6 @@ use hw_model::trilinear::{
 };
 use hw_model::wrap::WrapMode;
 use texsim::reference::{bilinear_f64, trilinear_f64, LevelF};
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
 
 const ROUNDINGS: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
 const MODES: [WrapMode; 3] = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
@@ -58,7 +45,7 @@ fn lerp_exhaustive_8_bit() {
 
 #[test]
 fn lerp_random_16_bit() {
-    let mut rng = SplitMix(0x7e_0001);
+    let mut rng = Rng(0x7e_0001);
     for k in 0..3_000_000u32 {
         let wb = 1 + (k % 16);
         let mode = ROUNDINGS[(k / 16 % 3) as usize];
@@ -81,7 +68,7 @@ struct Pyramid {
     float: Vec<Vec<[f32; 4]>>,
 }
 
-fn pyramid(rng: &mut SplitMix, texel_bits: u32) -> Pyramid {
+fn pyramid(rng: &mut Rng, texel_bits: u32) -> Pyramid {
     let mut w = 1 + rng.below(40) as u32;
     let mut h = 1 + rng.below(40) as u32;
     let levels = 1 + rng.below(5) as usize;
@@ -124,7 +111,7 @@ fn configs() -> Vec<(String, TrilinearConfig)> {
 
 #[test]
 fn trilinear_vs_f64_within_bound() {
-    let mut rng = SplitMix(0x7e_0002);
+    let mut rng = Rng(0x7e_0002);
     let frac = 16u32;
     for (name, cfg) in configs() {
         for lfb in [0u32, 4, 8, 16] {
@@ -180,7 +167,7 @@ fn trilinear_vs_f64_within_bound() {
 
 #[test]
 fn bilinear_vs_f64_and_trace() {
-    let mut rng = SplitMix(0x7e_0003);
+    let mut rng = Rng(0x7e_0003);
     let cfg = HwConfig::texram16().trilinear;
     let bound = trilinear_error_bound_q8(&cfg, 16, false) as f64 / 256.0 + 0.01;
     for _ in 0..50 {

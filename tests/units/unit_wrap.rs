@@ -3,21 +3,11 @@
 //! bits and a size 1..=256, every rounding and mode), a coordinate/size/mode/width grid for the
 //! other widths, seeded random beyond it, and vs the f64 twin.
 
+use crate::rng_common::Rng;
 use hw_model::config::{HwConfig, TrilinearConfig};
 use hw_model::fixed::Rounding;
 use hw_model::wrap::{wrap, WrapMode, WrapOut};
 use texsim::reference::wrap_f64;
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
 
 const MODES: [WrapMode; 3] = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
 const ROUNDINGS: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
@@ -99,7 +89,7 @@ fn exhaustive_grid() {
 
 #[test]
 fn random_wide() {
-    let mut rng = SplitMix(0x3a_0001);
+    let mut rng = Rng(0x3a_0001);
     for k in 0..1_000_000u32 {
         let wb = (rng.next() % 17) as u32;
         let rnd = ROUNDINGS[(k % 3) as usize];
@@ -147,7 +137,7 @@ fn nearest_like_with_zero_weight_bits() {
 
 #[test]
 fn twin_agrees() {
-    let mut rng = SplitMix(0x3a_0002);
+    let mut rng = Rng(0x3a_0002);
     for k in 0..300_000u32 {
         let wb = [4u32, 8, 16][(k % 3) as usize];
         let rnd = ROUNDINGS[(k / 3 % 3) as usize];
