@@ -7,27 +7,17 @@ use hw_model::config::HwConfig;
 use hw_model::trilinear::{trilinear, Level};
 use hw_model::wrap::WrapMode;
 use texsim::reference::{trilinear_f64, LevelF};
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
+use texsim::rng::SplitMix64;
 
 const N: usize = 1024;
 
 fn bench(c: &mut Criterion) {
-    let mut rng = SplitMix(42);
+    let mut rng = SplitMix64(42);
     let mut fixed: Vec<(u32, Vec<[u16; 4]>)> = Vec::new();
     let mut size = 256u32;
     while size >= 1 {
         let t: Vec<[u16; 4]> = (0..size * size)
-            .map(|_| [0; 4].map(|_: u16| rng.next() as u16))
+            .map(|_| [0; 4].map(|_: u16| rng.next_u64() as u16))
             .collect();
         fixed.push((size, t));
         if size == 1 {
@@ -63,9 +53,9 @@ fn bench(c: &mut Criterion) {
     let samples: Vec<(i64, i64, i64)> = (0..N)
         .map(|_| {
             (
-                (rng.next() % (4 << 16)) as i64,
-                (rng.next() % (4 << 16)) as i64,
-                (rng.next() % (6 << 16)) as i64,
+                (rng.next_u64() % (4 << 16)) as i64,
+                (rng.next_u64() % (4 << 16)) as i64,
+                (rng.next_u64() % (6 << 16)) as i64,
             )
         })
         .collect();

@@ -51,6 +51,7 @@ pub mod raster;
 pub mod reference;
 pub mod render;
 pub mod report;
+pub mod rng;
 pub mod scene;
 pub mod shading;
 pub mod summary;

@@ -22,6 +22,7 @@ use serde_json::{json, Value};
 
 use crate::provenance::Provenance;
 use crate::report::OutputSet;
+use crate::rng::SplitMix64;
 use crate::{Error, Result};
 
 /// Whether a port is driven by the testbench or checked by it.
@@ -181,52 +182,6 @@ pub fn unit(name: &str) -> Result<&'static UnitEntry> {
             names.join(", ")
         ))
     })
-}
-
-/// The seeded generator of the random cases (splitmix64, Steele et al. 2014).
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    #[must_use]
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi]` (`lo <= hi`).
-    pub fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        let span = (hi as i128 - lo as i128 + 1) as u128;
-        (lo as i128 + (u128::from(self.next_u64()) % span) as i128) as i64
-    }
-
-    /// A value of `1..=max_bits` significant bits (bit length uniform, then the value uniform):
-    /// small and large magnitudes equally often.
-    pub fn log_uniform(&mut self, max_bits: u32) -> u64 {
-        let len = self.range(1, i64::from(max_bits)) as u32;
-        let lo = 1u64 << (len - 1);
-        self.range(lo as i64, ((lo - 1) | lo) as i64) as u64
-    }
-
-    /// A signed value of at most `mag_bits` magnitude bits, log-uniform, either sign (or 0).
-    pub fn signed_log(&mut self, mag_bits: u32) -> i64 {
-        if self.next_u64() & 63 == 0 {
-            return 0;
-        }
-        let v = self.log_uniform(mag_bits) as i64;
-        if self.next_u64() & 1 == 0 {
-            v
-        } else {
-            -v
-        }
-    }
 }
 
 /// A generated set of vectors: the unit, its ports and one column of values per port.

@@ -44,6 +44,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
+pub use crate::rng::SplitMix64;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -135,25 +136,6 @@ pub struct McAlbedo {
     pub std_error: f64,
     /// Fraction of samples that produced a direction above the horizon.
     pub valid_fraction: f64,
-}
-
-/// The splitmix64 generator (Steele, Lea & Flood 2014): deterministic, seedable.
-#[derive(Clone, Copy, Debug)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1) with 53 random bits.
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
 }
 
 /// Unit direction from polar angle `theta_deg` (from `n`) and azimuth `phi_deg` (from `u`).

@@ -6,6 +6,7 @@
 
 use super::texture::height_image;
 use super::{shapes, Camera, Light, Material, RoughChoice, Scene, TextureImage};
+use crate::rng::hash_unit;
 use glam::DVec3;
 use std::f64::consts::TAU;
 
@@ -38,13 +39,6 @@ pub fn corrugated_height(size: u32) -> TextureImage {
     })
 }
 
-fn hash(mut x: u64) -> f64 {
-    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((x ^ (x >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
-
 /// Brushed metal: fine random streaks along s (height varies along t only, plus a weak
 /// variation along s): strongly anisotropic roughness.
 #[must_use]
@@ -55,7 +49,7 @@ pub fn brushed_height(size: u32) -> TextureImage {
         let (r0, fr) = (row.floor(), row - row.floor());
         let at = |r: f64| {
             let r = r.rem_euclid(f64::from(n)) as u64;
-            hash(r) * 0.8 + 0.2 * hash(r * 7919 + ((s * 4.0).floor() as u64))
+            hash_unit(r) * 0.8 + 0.2 * hash_unit(r * 7919 + ((s * 4.0).floor() as u64))
         };
         let w = fr * fr * (3.0 - 2.0 * fr);
         at(r0) * (1.0 - w) + at(r0 + 1.0) * w
@@ -67,9 +61,9 @@ pub fn brushed_height(size: u32) -> TextureImage {
 pub fn scratches_height(size: u32) -> TextureImage {
     let lines: Vec<[f64; 4]> = (0..48u64)
         .map(|i| {
-            let (x, y) = (hash(4 * i), hash(4 * i + 1));
-            let a = hash(4 * i + 2) * TAU;
-            let len = 0.1 + 0.35 * hash(4 * i + 3);
+            let (x, y) = (hash_unit(4 * i), hash_unit(4 * i + 1));
+            let a = hash_unit(4 * i + 2) * TAU;
+            let len = 0.1 + 0.35 * hash_unit(4 * i + 3);
             [x, y, a.cos() * len, a.sin() * len]
         })
         .collect();
