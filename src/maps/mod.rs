@@ -19,6 +19,7 @@ pub use prepared::{bump_sources, ndf_sources, BumpSource, Maps};
 pub const OFFSET_CHANNELS: u32 = 2;
 
 use crate::scene::TextureImage;
+use rayon::prelude::*;
 
 /// One float MIP level, RGBA in 0..1, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -224,8 +225,8 @@ pub fn quantize_unorm(x: f32, bits: u32) -> u16 {
     if x.is_nan() {
         return 0;
     }
-    let v = (f64::from(x) * max).round_ties_even().clamp(0.0, max);
-    v as u16
+    // Clamping before rounding is the same as after: both ends are integers.
+    crate::fixedpoint::round_ties_even_small((f64::from(x) * max).clamp(0.0, max)) as u16
 }
 
 /// Quantizes every level of `chain` to unsigned-normalized `texel_bits` (clamped to 1..=16),
@@ -244,7 +245,7 @@ pub fn quantize_chain(chain: &MipChain, texel_bits: u32) -> FixedMipChain {
                 height: l.height,
                 texels: l
                     .texels
-                    .iter()
+                    .par_iter()
                     .map(|t| t.map(|c| quantize_unorm(c, bits)))
                     .collect(),
             })

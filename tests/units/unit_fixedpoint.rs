@@ -78,3 +78,19 @@ fn unorm_round_trip() {
     assert_eq!(to_unorm(0.5, 8), 128);
     assert_eq!(to_unorm(2.5 / 255.0, 8), 2);
 }
+
+/// `round_ties_even_small` is `round_ties_even` on [0, 2^52): every quarter in [0, 2^22) (the
+/// unorm conversions' range and its ties), exhaustively, and 4M seeded doubles up to 2^52.
+#[test]
+fn round_ties_even_small_is_round_ties_even() {
+    use texsim::fixedpoint::round_ties_even_small;
+    for k in 0..(1u64 << 24) {
+        let y = k as f64 * 0.25;
+        assert_eq!(round_ties_even_small(y), y.round_ties_even(), "{y}");
+    }
+    let mut rng = Rng(0x5eed_0052);
+    for _ in 0..4_000_000 {
+        let y = (rng.next() >> 12) as f64 * rng.unit();
+        assert_eq!(round_ties_even_small(y), y.round_ties_even(), "{y}");
+    }
+}
