@@ -8,6 +8,7 @@ use image::{DynamicImage, ImageReader};
 
 use super::TextureImage;
 use crate::{Error, Result};
+use rayon::prelude::*;
 
 /// Largest accepted texture side, texels.
 pub const MAX_TEXTURE_SIDE: u32 = 16384;
@@ -85,9 +86,11 @@ pub fn hash2(x: u32, y: u32) -> u32 {
 /// clamped; alpha 255. With the Mesa colours and size 1024 this is `make_texture` exactly.
 #[must_use]
 pub fn noise_checker_rgba8(size: u32, light: [i32; 3], dark: [i32; 3]) -> Vec<[u8; 4]> {
-    let mut out = Vec::with_capacity(size as usize * size as usize);
-    for y in 0..size {
-        for x in 0..size {
+    let n = size as usize;
+    (0..n * n)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = ((i % n) as u32, (i / n) as u32);
             let check = ((x >> 3) ^ (y >> 3)) & 1;
             let c = if check == 1 { light } else { dark };
             let h = hash2(x, y);
@@ -96,10 +99,9 @@ pub fn noise_checker_rgba8(size: u32, light: [i32; 3], dark: [i32; 3]) -> Vec<[u
                 let n = ((h >> (8 * k)) & 63) as i32 - 32;
                 p[k] = (c[k] + n).clamp(0, 255) as u8;
             }
-            out.push(p);
-        }
-    }
-    out
+            p
+        })
+        .collect()
 }
 
 /// The Mesa anchor's next level: `(a+b+c+d+2) >> 2` per channel (`downsample` in the anchor).
@@ -107,10 +109,11 @@ pub fn noise_checker_rgba8(size: u32, light: [i32; 3], dark: [i32; 3]) -> Vec<[u
 pub fn downsample_rgba8(src: &[[u8; 4]], w: u32, h: u32) -> (u32, u32, Vec<[u8; 4]>) {
     let nw = if w > 1 { w / 2 } else { 1 };
     let nh = if h > 1 { h / 2 } else { 1 };
-    let mut d = Vec::with_capacity(nw as usize * nh as usize);
     let at = |x: u32, y: u32| src[y as usize * w as usize + x as usize];
-    for y in 0..nh {
-        for x in 0..nw {
+    let d = (0..nw as usize * nh as usize)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = ((i % nw as usize) as u32, (i / nw as usize) as u32);
             let (x0, x1) = (2 * x, if w > 1 { 2 * x + 1 } else { 2 * x });
             let (y0, y1) = (2 * y, if h > 1 { 2 * y + 1 } else { 2 * y });
             let (a, b, c, e) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
@@ -119,9 +122,9 @@ pub fn downsample_rgba8(src: &[[u8; 4]], w: u32, h: u32) -> (u32, u32, Vec<[u8; 
                 let s = u32::from(a[k]) + u32::from(b[k]) + u32::from(c[k]) + u32::from(e[k]);
                 p[k] = ((s + 2) >> 2) as u8;
             }
-            d.push(p);
-        }
-    }
+            p
+        })
+        .collect();
     (nw, nh, d)
 }
 
