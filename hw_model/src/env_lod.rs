@@ -6,13 +6,15 @@
 //! Inputs: the face coordinates (`face_coord_bits` = C fraction bits) of the pixel's
 //! reflection vector and of its helper samples (x+1, y), (x, y+1) projected on the pixel's
 //! face ([`crate::cube_face::project`]), the face size `N` (level-0 texels), and the
-//! roughness on the face: `width`, the footprint of `lambda_1` (face-coordinate units, C
-//! fraction bits), and `axes`, the two axes of the ellipse `D` carried to the face.
+//! roughness on the face: `axes`, the two axes of the ellipse `D` carried to the face
+//! (face-coordinate units, C fraction bits).
 //!
 //! - `none`: footprint assembly ([`crate::footprint::footprint`]) on the derivatives only
 //!   (with one probe: the isotropic LOD unit).
-//! - `lambda1`: the same footprint, its LOD raised to `lod(width)` when that is larger:
-//!   `max(log2 rho, log2 width)` (one more LOD evaluation and a compare).
+//! - `lambda1`: the same footprint, its LOD raised to that of the longer ellipse axis when
+//!   that is larger: `max(log2 rho, log2 max(|a_1|, |a_2|))` (one more evaluation of the LOD
+//!   unit, which takes the longer of two vectors, and a compare). The longer axis is within
+//!   `[lambda_1 / sqrt 2, lambda_1]` of the mapped ellipse's `lambda_1`: an isotropic width.
 //! - `ellipse`: the footprint of the union of the pixel's parallelogram and the ellipse,
 //!   bounded by two vectors: the major axis is the longest of the four (`dx`, `dy`, `axes`;
 //!   exact squared lengths, ties to the earlier), the minor has the largest length of the
@@ -37,10 +39,9 @@ use crate::fixed::{round_div_wide, SatCounter};
 use crate::footprint::{footprint, Footprint};
 use crate::lod::{lod, lod_cost};
 
-/// The roughness on the face: `lambda_1`'s width and the ellipse's axes (C fraction bits).
+/// The roughness on the face: the ellipse's two axes (C fraction bits).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FaceRoughness {
-    pub width: i64,
     pub axes: [[i64; 2]; 2],
 }
 
@@ -86,8 +87,10 @@ pub fn env_lod(
         EnvFilter::None => footprint(st, n, cb, probes, adaptive, lcfg, sat),
         EnvFilter::Lambda1 => {
             let mut fp = footprint(st, n, cb, probes, adaptive, lcfg, sat);
-            let w = rough.width.saturating_mul(i64::from(face_size));
-            let lw = lod([w, 0, 0, 0], cb, lcfg, sat);
+            let n = i64::from(face_size);
+            let [a, b] = rough.axes;
+            let d = [a[0], a[1], b[0], b[1]].map(|x| x.saturating_mul(n));
+            let lw = lod(d, cb, lcfg, sat);
             fp.lod = fp.lod.max(lw);
             fp
         }

@@ -67,10 +67,9 @@ pub fn project_f(r: DVec3, face: u8) -> [f64; 2] {
     [sc, tc].map(|c| ((c / ma + 1.0) * 0.5).clamp(-256.0, 256.0))
 }
 
-/// The roughness on the face in float: `lambda_1`'s width and the ellipse axes (face units).
+/// The roughness on the face in float: the ellipse's two axes (face units).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FaceRoughnessF {
-    pub width: f64,
     pub axes: [[f64; 2]; 2],
 }
 
@@ -89,7 +88,8 @@ pub fn env_lod_f(
         EnvFilter::None => footprint_f64(st, n, probes, adaptive),
         EnvFilter::Lambda1 => {
             let mut fp = footprint_f64(st, n, probes, adaptive);
-            let w = rough.width * f64::from(face_size);
+            let [a, b] = rough.axes;
+            let w = a[0].hypot(a[1]).max(b[0].hypot(b[1])) * f64::from(face_size);
             let lw = if w > 0.0 { w.log2().max(-32.0) } else { -32.0 };
             fp.lod = fp.lod.max(lw);
             fp
@@ -153,17 +153,10 @@ pub fn face_jacobian_f(r: DVec3, face: u8) -> [DVec3; 2] {
 /// first order): a slope `(du, dv)` of the surface tilts the normal by `dn = du t_u + dv t_v`,
 /// which turns the reflection by `dr = 2 ((dn . v) n + (n . v) dn)`, which moves the face
 /// coordinates by `J dr` ([`face_jacobian_f`]). The ellipse's axes are the columns of `D`
-/// (`[[d1, d2], [0, d3]]`, slopes) mapped so; `lambda_1` maps to the width `2 lambda_1 |J|`
-/// with `|J|` the larger row norm.
+/// (`[[d1, d2], [0, d3]]`, slopes) mapped so. (The stage uses the finite difference of the
+/// exact map instead, `env_fetch`; this first-order form is its small-roughness limit.)
 #[must_use]
-pub fn rough_on_face_f(
-    n: DVec3,
-    v: DVec3,
-    t: [DVec3; 2],
-    d: [f64; 3],
-    lambda1: f64,
-    face: u8,
-) -> FaceRoughnessF {
+pub fn rough_on_face_f(n: DVec3, v: DVec3, t: [DVec3; 2], d: [f64; 3], face: u8) -> FaceRoughnessF {
     let r = reflect_f(n, v);
     let j = face_jacobian_f(r, face);
     let nv = n.dot(v);
@@ -171,9 +164,7 @@ pub fn rough_on_face_f(
     let to_face = |dr: DVec3| [j[0].dot(dr), j[1].dot(dr)];
     let col0 = t[0] * d[0];
     let col1 = t[0] * d[1] + t[1] * d[2];
-    let jn = j[0].length().max(j[1].length());
     FaceRoughnessF {
-        width: 2.0 * lambda1 * jn,
         axes: [to_face(turn(col0)), to_face(turn(col1))],
     }
 }

@@ -249,11 +249,9 @@ fn env_lod_matches_float_twin() {
             [rng.range(-1.0, 1.0) * rs, rng.range(-1.0, 1.0) * rs],
         ];
         let fr = FaceRoughness {
-            width: (rs * one).round() as i64,
             axes: axes_f.map(|a| a.map(|x| (x * one).round() as i64)),
         };
         let frf = FaceRoughnessF {
-            width: fr.width as f64 / one,
             axes: fr.axes.map(|a| a.map(|x| x as f64 / one)),
         };
         let probes = 1u32 << (i % 4);
@@ -335,7 +333,6 @@ fn env_lod_hard_cases() {
         }
     }
     let rough = FaceRoughness {
-        width: 1 << (c - 6),
         axes: [[1 << (c - 5), 0], [0, 1 << (c - 9)]],
     };
     let none = env_lod(
@@ -371,8 +368,8 @@ fn env_lod_hard_cases() {
         &hw.lod,
         &mut sat,
     );
-    // 256 / 64 = 4 texels: lambda1 LOD = 2.
-    assert_eq!(l1.lod, 2 << 16);
+    // The longer axis: 256 / 32 = 8 texels: lambda1 LOD = 3.
+    assert_eq!(l1.lod, 3 << 16);
     assert!(none.lod < 0);
     // The ellipse: 8 texels along s, 0.5 across -> 8 probes along s, LOD log2(max(1, 0.5)) = 0.
     assert_eq!(el.probes, 8);
