@@ -224,6 +224,9 @@ pub struct HwConfig {
     /// The NDF mapping unit (absent in older files: the Texram-style default).
     #[serde(default)]
     pub ndf: crate::ndf::NdfConfig,
+    /// The environment-map units (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub env: crate::env_config::EnvConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -289,6 +292,7 @@ impl HwConfig {
             roughness: RoughnessConfig::texram16(),
             timing: TimingConfig::texram16(),
             ndf: crate::ndf::NdfConfig::texram16(),
+            env: crate::env_config::EnvConfig::texram16(),
         }
     }
 
@@ -399,6 +403,7 @@ impl HwConfig {
         self.roughness.validate()?;
         self.timing.validate()?;
         self.ndf.validate()?;
+        self.env.validate()?;
         Ok(())
     }
 }

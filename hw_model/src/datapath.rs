@@ -549,6 +549,26 @@ pub fn units(hw: &crate::HwConfig) -> Vec<UnitReport> {
         crate::aniso_phong::datapath(&hw.aniso_phong),
         g,
     ));
+    v.push(UnitReport::new(
+        "reflect",
+        crate::reflect::datapath(&sh.vector, &hw.env),
+        g,
+    ));
+    v.push(UnitReport::new(
+        "cube_face",
+        crate::cube_face::datapath(&hw.env, &hw.reciprocal),
+        g,
+    ));
+    v.push(UnitReport::new(
+        "env_lod.lambda1",
+        crate::env_lod::lambda1_datapath(&hw.lod),
+        g,
+    ));
+    v.push(UnitReport::new(
+        "env_lod.ellipse",
+        crate::env_lod::datapath(&hw.env),
+        g,
+    ));
     v
 }
 

@@ -12,6 +12,7 @@
 //! For texels that came from exact 16-bit data (`x = v / 65535`) and `bits == 16` this gives `v`
 //! back exactly.
 
+pub mod cube;
 mod prepared;
 pub use prepared::{bump_sources, ndf_sources, BumpSource, Maps};
 

@@ -16,6 +16,8 @@ pub mod bary;
 pub mod bump;
 pub mod bump_fetch;
 pub mod color;
+pub mod env;
+pub mod env_fetch;
 pub mod frame;
 pub mod lod;
 pub mod modulate;
@@ -100,6 +102,8 @@ pub struct Plan {
     pub rough: Option<rough::RoughPlan>,
     /// NDF mapping (with `bump` for the frame), for NDF materials.
     pub ndf: Option<ndf::NdfPlan>,
+    /// Environment map (with `bump` for the normal), for materials with `env`.
+    pub env: Option<env::EnvPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -173,6 +177,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             aniso: None,
             rough: None,
             ndf: None,
+            env: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -200,6 +205,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         aniso: None,
         rough: None,
         ndf: None,
+        env: None,
     }
 }
 

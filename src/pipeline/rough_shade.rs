@@ -219,7 +219,12 @@ pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
 
 /// Bilinear, wrapping sample of the two offset channels of a float level at `(u, v)`,
 /// decoded with range `2^offset_int_bits`.
-fn sample_offsets(l0: &crate::reference::LevelF, u: f64, v: f64, range: f64) -> [f64; 2] {
+pub(super) fn sample_offsets(
+    l0: &crate::reference::LevelF,
+    u: f64,
+    v: f64,
+    range: f64,
+) -> [f64; 2] {
     let (w, h) = (f64::from(l0.width), f64::from(l0.height));
     let fix = |x: f64| if x.is_finite() { x } else { 0.0 };
     let (x, y) = (fix(u) * w - 0.5, fix(v) * h - 0.5);

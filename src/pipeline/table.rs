@@ -9,8 +9,8 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_shade, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal, perturb,
-    phong, rough_fetch, rough_shade, texcoord, trilinear,
+    as_shade, bary, bump_fetch, color, env_fetch, frame, lod, modulate, ndf_fetch, ndf_shade,
+    normal, perturb, phong, rough_fetch, rough_shade, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -196,6 +196,12 @@ stage_table! {
     NdfShade "ndf-shade" {
         fixed: ndf_shade::fixed, float: ndf_shade::float, cost: ndf_shade::cost,
         lookups: no_lookups,
+    }
+    /// Environment-map materials: reflection, cube face, roughness-filtered footprint on
+    /// the face, `shade + ks * env`.
+    EnvFetch "env-fetch" {
+        fixed: env_fetch::fixed, float: env_fetch::float, cost: env_fetch::cost,
+        lookups: env_fetch::lookups,
     }
 }
 

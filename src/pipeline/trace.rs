@@ -34,8 +34,9 @@ pub struct TexelFootprint {
 }
 
 /// Most footprints one fragment can fetch: footprint assembly's 16 probes of two levels, the
-/// offset and roughness maps (two levels each) and four NDF maps (two levels each).
-pub const MAX_FOOTPRINTS: usize = 2 * hw_model::footprint::MAX_PROBES + 2 * 2 + 2 * 4;
+/// offset and roughness maps (two levels each), four NDF maps (two levels each) and the
+/// environment lookup's 16 probes of two levels.
+pub const MAX_FOOTPRINTS: usize = 4 * hw_model::footprint::MAX_PROBES + 2 * 2 + 2 * 4;
 
 /// The footprints of one fragment, in the order its stages fetched them.
 #[derive(Clone, Copy, Debug)]

@@ -147,6 +147,14 @@ pub fn render(
         rough_owned = mm;
         &rough_owned
     };
+    let env_sizes = crate::pipeline::env::resolve_plans(&mut geo.plans, hw, maps.float.len());
+    let env_owned;
+    let maps = if env_sizes.is_empty() {
+        maps
+    } else {
+        env_owned = crate::pipeline::env::env_maps(maps, &env_sizes, hw);
+        &env_owned
+    };
 
     let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
@@ -247,12 +255,14 @@ pub fn render(
     }
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
-    if opts.truth > 0 && (has_rough || has_ndf) {
+    let has_env = geo.plans.iter().any(|p| p.env.is_some());
+    if opts.truth > 0 && (has_rough || has_ndf || has_env) {
         let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
         // bump map (`rough::truth_plans`), NDF materials their supersampled finest normal
         // map (`ndf::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough::truth_plans(&geo.plans, opts.truth);
+        let tp = crate::pipeline::env::truth_plans(&tp, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
         let ndf_truth = crate::pipeline::ndf::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)

@@ -15,6 +15,7 @@ use glam::{DMat4, DVec3};
 
 pub mod as_scenes;
 mod catalogue;
+pub mod env_scenes;
 mod geometry;
 mod ndf_scenes;
 mod obj;
@@ -109,6 +110,34 @@ pub struct Material {
     /// NDF mapping (Olano and North 1997): the `bump` map's normals become moment maps,
     /// shaded by `ndf-fetch` and `ndf-shade` instead of the bump path's Blinn-Phong.
     pub ndf: bool,
+    /// Environment map of a bump material (`pipeline::env`): the reflection of the scene's
+    /// sky, weighted by `ks`, added to the shading result.
+    pub env: Option<EnvMaterial>,
+}
+
+/// A bump material's environment map (Schilling 1997, "balanced system").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvMaterial {
+    /// The filter: `None` = the hardware's `env_filter` (so `--vary env_filter=...` switches it).
+    pub filter: Option<hw_model::env_config::EnvFilter>,
+    /// Face size of the procedural sky cube (texels per side, a power of two).
+    pub size: u32,
+}
+
+impl EnvMaterial {
+    /// Parses an `env_filter` value: `hw`, `none`, `lambda1` or `ellipse`.
+    pub fn parse_filter(
+        s: &str,
+    ) -> std::result::Result<Option<hw_model::env_config::EnvFilter>, String> {
+        use hw_model::env_config::EnvFilter;
+        match s {
+            "hw" => Ok(None),
+            "none" => Ok(Some(EnvFilter::None)),
+            "lambda1" => Ok(Some(EnvFilter::Lambda1)),
+            "ellipse" => Ok(Some(EnvFilter::Ellipse)),
+            _ => Err(format!("'{s}' is not hw, none, lambda1 or ellipse")),
+        }
+    }
 }
 
 /// Which modified Blinn-Phong a roughness material uses.
@@ -213,6 +242,7 @@ impl Default for Material {
             roughness: None,
             brdf: None,
             ndf: false,
+            env: None,
         }
     }
 }

@@ -110,6 +110,12 @@ struct MaterialCfg {
     exponent_map: Option<String>,
     /// NDF mapping of the `bump` map (Olano and North 1997).
     ndf: Option<bool>,
+    /// Environment map of a bump material: `"sky"` (the procedural sky cube).
+    env_map: Option<String>,
+    /// Its filter: `hw` (default), `none`, `lambda1` or `ellipse`.
+    env_filter: Option<String>,
+    /// Face size of the sky cube (a power of two, 1..=2048; default 256).
+    env_size: Option<u32>,
 }
 
 /// The Ashikhmin-Shirley parameters of material `i` (defaults `nu = nv = 100`, `rs = 0.05`,
@@ -474,6 +480,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             shininess: m.shininess.unwrap_or(def.shininess),
             brdf: as_brdf(i, m, &tex_names)?,
             ndf: m.ndf.unwrap_or(def.ndf),
+            env: env_material(m, &f)?,
         });
     }
     let mut default_mat: Option<usize> = None;
@@ -676,4 +683,42 @@ fn build_camera(c: Option<&CameraCfg>, meshes: &[Mesh], w: u32, h: u32) -> Resul
         far,
         view_override: None,
     })
+}
+
+/// The `env_map`, `env_filter` and `env_size` keys of a material.
+fn env_material(
+    m: &MaterialCfg,
+    f: &dyn Fn(&str) -> String,
+) -> Result<Option<crate::scene::EnvMaterial>> {
+    let Some(src) = &m.env_map else {
+        if m.env_filter.is_some() || m.env_size.is_some() {
+            return Err(Error::field(
+                &f("env_map"),
+                "env_filter and env_size need env_map = \"sky\"",
+            ));
+        }
+        return Ok(None);
+    };
+    if src != "sky" {
+        return Err(Error::field(
+            &f("env_map"),
+            format!("'{src}' is not \"sky\" (the procedural sky cube)"),
+        ));
+    }
+    let filter = match &m.env_filter {
+        Some(s) => crate::scene::EnvMaterial::parse_filter(s)
+            .map_err(|e| Error::field(&f("env_filter"), e))?,
+        None => None,
+    };
+    let size = m.env_size.unwrap_or(256);
+    if !size.is_power_of_two() || size > crate::maps::cube::MAX_FACE_SIZE {
+        return Err(Error::field(
+            &f("env_size"),
+            format!(
+                "{size} is not a power of two in 1..={}",
+                crate::maps::cube::MAX_FACE_SIZE
+            ),
+        ));
+    }
+    Ok(Some(crate::scene::EnvMaterial { filter, size }))
 }

@@ -10,6 +10,7 @@ mod rng_common;
 mod bad_input_files;
 mod bad_input_validate;
 mod bump_scene;
+mod env_scene;
 mod report_images;
 mod report_metrics;
 mod report_output;

@@ -13,6 +13,7 @@ mod ndf_common;
 
 mod as_power;
 mod brdf_fixed;
+mod env_units;
 mod frames_config;
 mod frames_frame;
 mod frames_pixel;
