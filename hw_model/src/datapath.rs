@@ -549,6 +549,11 @@ pub fn units(hw: &crate::HwConfig) -> Vec<UnitReport> {
         crate::aniso_phong::datapath(&hw.aniso_phong),
         g,
     ));
+    v.push(UnitReport::new(
+        "multi_lobe",
+        crate::multi_lobe::datapath(&hw.multi_lobe, sh),
+        g,
+    ));
     v
 }
 
