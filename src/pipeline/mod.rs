@@ -17,6 +17,7 @@ pub mod bump;
 pub mod bump_fetch;
 pub mod color;
 pub mod frame;
+pub mod lobe_shade;
 pub mod lod;
 pub mod modulate;
 pub mod ndf;
@@ -100,6 +101,8 @@ pub struct Plan {
     pub rough: Option<rough::RoughPlan>,
     /// NDF mapping (with `bump` for the frame), for NDF materials.
     pub ndf: Option<ndf::NdfPlan>,
+    /// Multiple-surface lobes (with `bump` for the frame), for Fournier materials.
+    pub lobes: Option<lobe_shade::LobePlan>,
 }
 
 /// What the bump stages of one material need.
@@ -143,6 +146,9 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
     if let Some(p) = as_shade::plan_as(material, has_uvs) {
         return p;
     }
+    if let Some(p) = lobe_shade::plan_lobes(material, has_uvs) {
+        return p;
+    }
     if let (Some(map), true, Some(_)) = (bump_map, has_uvs, material.bump) {
         let mut stages = vec![StageKind::Bary, StageKind::Texcoord];
         if textured {
@@ -173,6 +179,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             aniso: None,
             rough: None,
             ndf: None,
+            lobes: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -200,6 +207,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         aniso: None,
         rough: None,
         ndf: None,
+        lobes: None,
     }
 }
 

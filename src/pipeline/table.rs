@@ -9,8 +9,8 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_shade, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal, perturb,
-    phong, rough_fetch, rough_shade, texcoord, trilinear,
+    as_shade, bary, bump_fetch, color, frame, lobe_shade, lod, modulate, ndf_fetch, ndf_shade,
+    normal, perturb, phong, rough_fetch, rough_shade, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -195,6 +195,11 @@ stage_table! {
     /// NDF materials: Sigma, its inverse, Mahalanobis distance, density, normalization, lights.
     NdfShade "ndf-shade" {
         fixed: ndf_shade::fixed, float: ndf_shade::float, cost: ndf_shade::cost,
+        lookups: no_lookups,
+    }
+    /// Fournier multiple surfaces: the sum of the lobes' Phong shadings over every light.
+    LobeShade "lobe-shade" {
+        fixed: lobe_shade::fixed, float: lobe_shade::float, cost: lobe_shade::cost,
         lookups: no_lookups,
     }
 }

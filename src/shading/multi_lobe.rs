@@ -6,6 +6,9 @@
 use super::reference::{normalize_or, perturb_normal, pow, FrameF};
 use glam::DVec3;
 
+/// The most lobes shaded (`hw_model::multi_lobe::MAX_LOBES`).
+const MAX_LOBES: usize = hw_model::multi_lobe::MAX_LOBES as usize;
+
 /// One lobe in float: slopes along the frame's `t_u`, `t_v`, amplitude, Phong exponent.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LobeF {
@@ -25,6 +28,8 @@ pub fn lobe_direction(fr: &FrameF, lobe: &LobeF) -> DVec3 {
 pub struct MultiLobeF {
     /// Sum over the lights, each light's colour and the sum clamped to [0, 1].
     pub color: [f64; 3],
+    /// Sum over the lights of each light's clamped colour, before the final clamp.
+    pub sum: [f64; 3],
     /// Lights with `l + v = 0`.
     pub h_zero: u32,
 }
@@ -43,8 +48,11 @@ pub fn shade(
     kd: [f64; 3],
     ks: [f64; 3],
 ) -> MultiLobeF {
-    let k = lobes.len().min(max_lobes);
-    let dirs: Vec<DVec3> = lobes[..k].iter().map(|l| lobe_direction(fr, l)).collect();
+    let k = lobes.len().min(max_lobes).min(MAX_LOBES);
+    let mut dirs = [DVec3::ZERO; MAX_LOBES];
+    for (d, l) in dirs.iter_mut().zip(&lobes[..k]) {
+        *d = lobe_direction(fr, l);
+    }
     let mut color = [0.0f64; 3];
     let mut h_zero = 0;
     for &(l, light) in lights {
@@ -54,7 +62,7 @@ pub fn shade(
         let h = normalize_or(sum, DVec3::ZERO).0;
         let mut d = 0.0;
         let mut s = 0.0;
-        for (n, lobe) in dirs.iter().zip(&lobes[..k]) {
+        for (n, lobe) in dirs[..k].iter().zip(&lobes[..k]) {
             let ndl = n.dot(l).clamp(0.0, 1.0);
             d += lobe.amp * ndl;
             if !hz && ndl > 0.0 {
@@ -67,6 +75,7 @@ pub fn shade(
     }
     MultiLobeF {
         color: color.map(|c| c.clamp(0.0, 1.0)),
+        sum: color,
         h_zero,
     }
 }

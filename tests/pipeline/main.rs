@@ -15,6 +15,7 @@ mod as_pipeline;
 mod bump_hard_cases;
 mod bump_pipeline;
 mod determinism;
+mod lobe_pipeline;
 mod ndf_pipeline;
 mod raster_parallel;
 mod raster_robust;
