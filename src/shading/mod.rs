@@ -4,6 +4,7 @@
 //! generation.
 
 pub mod bump;
+pub mod fournier_fit;
 pub mod multi_lobe;
 pub mod ndf;
 pub mod reference;
