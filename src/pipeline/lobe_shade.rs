@@ -90,6 +90,7 @@ const LIGHT_GROUP: usize = 8;
 
 /// Fixed twin: the frame (raw when `frame` ran fixed), the lobes quantized into the unit's
 /// formats, the multi-lobe unit over the lights, plus the ambient term, saturating.
+#[allow(clippy::needless_range_loop)]
 pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let (Some((bp, _)), Some(lp)) = (bump_of(px), &px.plan.lobes) else {
         return;

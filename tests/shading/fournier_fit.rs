@@ -19,7 +19,7 @@ fn cfg(k: usize) -> FitConfig {
 fn v_groove(w: u32, h: u32, a: f64) -> Vec<DVec3> {
     (0..w * h)
         .map(|i| {
-            let sx = if (i % w) % 2 == 0 { a } else { -a };
+            let sx = if (i % w) & 1 == 0 { a } else { -a };
             DVec3::new(sx.sin(), 0.0, sx.cos())
         })
         .collect()

@@ -2,6 +2,7 @@
 //! twin `texsim::shading::multi_lobe::shade`: the lobe sum exhaustively at 8 amplitude bits,
 //! 10^7 seeded evaluations against the stated bound, and the hard cases (exponent 0 and
 //! saturated, coincident lobes, lobes at the horizon, K above the limit, no lobes).
+#![allow(clippy::needless_range_loop)]
 
 use crate::rng_common::Rng;
 use glam::DVec3;
