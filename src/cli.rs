@@ -54,6 +54,9 @@ pub enum Command {
     /// Compare two images (a render against Mesa, a GPU capture, another simulator): match %,
     /// per-channel differences, histogram, error map, the pixels that differ most.
     Compare(CompareArgs),
+    /// Fit Fournier multiple-surface lobes (K vMF lobes per texel, EM) to a procedural normal
+    /// map at every MIP level: lobes, iterations, fallbacks, residual and time per level.
+    Fit(crate::fit_cmd::FitArgs),
 }
 
 /// Arguments of `texsim vectors`.
@@ -446,6 +449,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Cycles(a)) => cycles_cmd(&a),
         Some(Command::Vectors(a)) => vectors_cmd(&a),
         Some(Command::Compare(a)) => compare_cmd(&a),
+        Some(Command::Fit(a)) => {
+            print!("{}", crate::fit_cmd::fit_cmd(&a)?);
+            Ok(())
+        }
     }
 }
 

@@ -157,6 +157,7 @@ pub fn stage_unit(stage: &str) -> &'static str {
         "as-shade" => "aniso_phong",
         "rough-shade" => "roughness.shade",
         "ndf-shade" => "ndf",
+        "lobe-shade" => "multi_lobe",
         _ => "",
     }
 }

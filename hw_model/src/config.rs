@@ -227,6 +227,9 @@ pub struct HwConfig {
     /// The environment-map units (absent in older files: the Texram-style default).
     #[serde(default)]
     pub env: crate::env_config::EnvConfig,
+    /// The multi-lobe (Fournier multiple-surface) unit (absent in older files: the default).
+    #[serde(default)]
+    pub multi_lobe: crate::multi_lobe::MultiLobeConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -293,6 +296,7 @@ impl HwConfig {
             timing: TimingConfig::texram16(),
             ndf: crate::ndf::NdfConfig::texram16(),
             env: crate::env_config::EnvConfig::texram16(),
+            multi_lobe: crate::multi_lobe::MultiLobeConfig::texram16(),
         }
     }
 
@@ -404,6 +408,7 @@ impl HwConfig {
         self.timing.validate()?;
         self.ndf.validate()?;
         self.env.validate()?;
+        self.multi_lobe.validate()?;
         Ok(())
     }
 }

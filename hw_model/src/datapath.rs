@@ -569,6 +569,11 @@ pub fn units(hw: &crate::HwConfig) -> Vec<UnitReport> {
         crate::env_lod::datapath(&hw.env),
         g,
     ));
+    v.push(UnitReport::new(
+        "multi_lobe",
+        crate::multi_lobe::datapath(&hw.multi_lobe, sh),
+        g,
+    ));
     v
 }
 

@@ -22,6 +22,7 @@ pub mod frame;
 pub mod interpolator;
 pub mod lod;
 pub mod modulate;
+pub mod multi_lobe;
 pub mod ndf;
 pub mod pow;
 pub mod reciprocal;

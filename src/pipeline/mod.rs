@@ -19,6 +19,7 @@ pub mod color;
 pub mod env;
 pub mod env_fetch;
 pub mod frame;
+pub mod lobe_shade;
 pub mod lod;
 pub mod modulate;
 pub mod ndf;
@@ -104,6 +105,8 @@ pub struct Plan {
     pub ndf: Option<ndf::NdfPlan>,
     /// Environment map (with `bump` for the normal), for materials with `env`.
     pub env: Option<env::EnvPlan>,
+    /// Multiple-surface lobes (with `bump` for the frame), for Fournier materials.
+    pub lobes: Option<lobe_shade::LobePlan>,
 }
 
 /// What the bump stages of one material need.
@@ -147,6 +150,9 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
     if let Some(p) = as_shade::plan_as(material, has_uvs) {
         return p;
     }
+    if let Some(p) = lobe_shade::plan_lobes(material, has_uvs) {
+        return p;
+    }
     if let (Some(map), true, Some(_)) = (bump_map, has_uvs, material.bump) {
         let mut stages = vec![StageKind::Bary, StageKind::Texcoord];
         if textured {
@@ -178,6 +184,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             rough: None,
             ndf: None,
             env: None,
+            lobes: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -206,6 +213,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         rough: None,
         ndf: None,
         env: None,
+        lobes: None,
     }
 }
 

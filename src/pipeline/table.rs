@@ -9,7 +9,8 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_shade, bary, bump_fetch, color, env_fetch, frame, lod, modulate, ndf_fetch, ndf_shade,
+    as_shade, bary, bump_fetch, color, env_fetch, frame, lobe_shade, lod, modulate, ndf_fetch,
+    ndf_shade,
     normal, perturb, phong, rough_fetch, rough_shade, texcoord, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
@@ -202,6 +203,11 @@ stage_table! {
     EnvFetch "env-fetch" {
         fixed: env_fetch::fixed, float: env_fetch::float, cost: env_fetch::cost,
         lookups: env_fetch::lookups,
+    }
+    /// Fournier multiple surfaces: the sum of the lobes' Phong shadings over every light.
+    LobeShade "lobe-shade" {
+        fixed: lobe_shade::fixed, float: lobe_shade::float, cost: lobe_shade::cost,
+        lookups: no_lookups,
     }
 }
 

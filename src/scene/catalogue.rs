@@ -31,6 +31,9 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("ripple-sphere", "NDF mapping (Olano-North Fig. 1): a rippled sphere at three distances, highlight blurs and stretches with the MIP level, 480x320"),
     ("lod-pair", "NDF mapping (Olano-North Fig. 2): a wavy sphere at two polygon counts, per-vertex normals vs NDF map, 480x320"),
     ("foil", "NDF mapping: crumpled foil tile, shininess 256, 480x320"),
+    ("fournier-fig2", "Fournier multiple surfaces (Fig. 2): spheres with an anisotropic lobe pair and 2, 3 and 7 normals, 480x128"),
+    ("fournier-velvet", "Fournier multiple surfaces (Fig. 3): velvet lobes on a torus and a sphere, 320x240"),
+    ("fournier-silk", "Fournier multiple surfaces (Fig. 4): silk lobes on the same geometry, 320x240"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -54,6 +57,9 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "ripple-sphere" => super::ndf_scenes::ripple_sphere(),
         "lod-pair" => super::ndf_scenes::lod_pair(),
         "foil" => super::ndf_scenes::foil(),
+        "fournier-fig2" => super::lobe_scenes::fig2(),
+        "fournier-velvet" => super::lobe_scenes::velvet(),
+        "fournier-silk" => super::lobe_scenes::silk(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(

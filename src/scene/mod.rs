@@ -17,6 +17,7 @@ pub mod as_scenes;
 mod catalogue;
 pub mod env_scenes;
 mod geometry;
+pub mod lobe_scenes;
 mod ndf_scenes;
 mod obj;
 pub mod rough_scenes;
@@ -113,6 +114,55 @@ pub struct Material {
     /// Environment map of a bump material (`pipeline::env`): the reflection of the scene's
     /// sky, weighted by `ks`, added to the shading result.
     pub env: Option<EnvMaterial>,
+    /// Made-up multiple surface (Fournier 1992, sec. 3.4 and 4): the material's lobes, shaded
+    /// per pixel by `lobe-shade` (`pipeline::lobe_shade`) instead of Gouraud or Blinn-Phong.
+    pub lobes: Vec<MadeUpLobe>,
+}
+
+/// One lobe of a made-up multiple surface (Fournier 1992, eq. 12): its direction in the
+/// surface's local frame (`x` along the frame's `t_u`, `y` along `t_v`, `z` along the normal;
+/// any length, `z > 0`), amplitude `c_i` in `[0, 1]` and Phong exponent `n_i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MadeUpLobe {
+    pub direction: [f32; 3],
+    pub amplitude: f32,
+    pub exponent: u32,
+}
+
+/// Largest Phong exponent of a lobe (`2^16 - 1`, the widest `lobe_exp_bits`).
+pub const MAX_LOBE_EXPONENT: u32 = 65_535;
+
+impl MadeUpLobe {
+    /// Checks one lobe; the error names `field.direction` etc.
+    pub fn validate(&self, field: &str) -> crate::Result<()> {
+        let d = self.direction;
+        if !d.iter().all(|c| c.is_finite()) || d[2] <= 0.0 {
+            return Err(crate::Error::field(
+                &format!("{field}.direction"),
+                format!("{d:?} is not a finite direction above the surface (z > 0)"),
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.amplitude) {
+            return Err(crate::Error::field(
+                &format!("{field}.amplitude"),
+                format!("{} is not in [0, 1]", self.amplitude),
+            ));
+        }
+        if self.exponent > MAX_LOBE_EXPONENT {
+            return Err(crate::Error::field(
+                &format!("{field}.exponent"),
+                format!("{} is above {MAX_LOBE_EXPONENT}", self.exponent),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The slopes `(x / z, y / z)` of the direction: the lobe as a bump offset.
+    #[must_use]
+    pub fn slopes(&self) -> [f64; 2] {
+        let d = self.direction.map(f64::from);
+        [d[0] / d[2], d[1] / d[2]]
+    }
 }
 
 /// A bump material's environment map (Schilling 1997, "balanced system").
@@ -243,6 +293,7 @@ impl Default for Material {
             brdf: None,
             ndf: false,
             env: None,
+            lobes: Vec::new(),
         }
     }
 }

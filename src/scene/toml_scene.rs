@@ -116,6 +116,46 @@ struct MaterialCfg {
     env_filter: Option<String>,
     /// Face size of the sky cube (a power of two, 1..=2048; default 256).
     env_size: Option<u32>,
+    /// Made-up multiple surface (Fournier 1992): `[[materials.lobes]]` with `direction`,
+    /// `amplitude`, `exponent`.
+    lobes: Option<Vec<LobeCfg>>,
+}
+
+/// One `[[materials.lobes]]` entry.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LobeCfg {
+    /// Direction in the surface frame (`x` along `t_u`, `y` along `t_v`, `z` the normal).
+    direction: [f32; 3],
+    amplitude: Option<f32>,
+    exponent: Option<u32>,
+}
+
+/// The made-up lobes of material `i` (amplitude 1 and exponent 32 by default), at most
+/// `hw_model::multi_lobe::MAX_LOBES`.
+fn made_up_lobes(i: usize, m: &MaterialCfg) -> Result<Vec<crate::scene::MadeUpLobe>> {
+    let Some(cfgs) = &m.lobes else {
+        return Ok(Vec::new());
+    };
+    let max = hw_model::multi_lobe::MAX_LOBES as usize;
+    if cfgs.is_empty() || cfgs.len() > max {
+        return Err(Error::field(
+            &format!("materials[{i}].lobes"),
+            format!("{} lobes (a multiple surface has 1..={max})", cfgs.len()),
+        ));
+    }
+    cfgs.iter()
+        .enumerate()
+        .map(|(j, c)| {
+            let l = crate::scene::MadeUpLobe {
+                direction: c.direction,
+                amplitude: c.amplitude.unwrap_or(1.0),
+                exponent: c.exponent.unwrap_or(32),
+            };
+            l.validate(&format!("materials[{i}].lobes[{j}]"))?;
+            Ok(l)
+        })
+        .collect()
 }
 
 /// The Ashikhmin-Shirley parameters of material `i` (defaults `nu = nv = 100`, `rs = 0.05`,
@@ -481,6 +521,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             brdf: as_brdf(i, m, &tex_names)?,
             ndf: m.ndf.unwrap_or(def.ndf),
             env: env_material(m, &f)?,
+            lobes: made_up_lobes(i, m)?,
         });
     }
     let mut default_mat: Option<usize> = None;

@@ -12,6 +12,7 @@ mod brdf_albedo;
 mod brdf_props;
 mod brdf_sampling;
 mod brdf_spheres;
+mod fournier_fit;
 mod frames_bump;
 mod frames_tangents;
 mod ndf_maps;

@@ -1,0 +1,248 @@
+//! `lobe-shade`: a multiple surface (Fournier 1992, "Normal Distribution Functions and
+//! Multiple Surfaces", eqs. 11-12 and sec. 4) shaded per pixel as the sum of its lobes' Phong
+//! shadings, fixed (`hw_model::multi_lobe`) and float (`shading::multi_lobe::shade`).
+//!
+//! A made-up multiple-surface material (sec. 3.4: `[[materials.lobes]]` in a scene file, or
+//! the built-in `fournier-*` scenes) runs `bary` (+ `texcoord`, `lod`, `trilinear` when
+//! textured), `normal`, `frame` and `lobe-shade`: the bump stages' interpolation and the
+//! material's local frame supply `n`, `t_u`, `t_v` ("the normal vectors are defined in the
+//! surface local frame", sec. 4), and each lobe's direction `(x, y, z)` in that frame enters
+//! as the slopes `(x / z, y / z)`, decoded by the frame unit like a bump offset. Colour:
+//! `ambient kd + sum_lights light (kd D + ks S)` (the unit's `D`, `S`), saturating.
+//!
+//! The fixed twin quantizes the material's lobes into the unit's formats (`multi_lobe` config:
+//! slopes, amplitudes, exponents); the float twin uses them unquantized, so the stage's error
+//! includes the lobes' storage.
+
+use super::bump::{
+    bump_of, d3, fixed_eye, fixed_light, fixed_material, fixed_output, float_eye, float_light,
+    float_output, point_lights, raw3,
+};
+use super::stages::{Counters, Machine};
+use super::{BumpPlan, Frag, Plan, Px, StageKind};
+use crate::fixedpoint::to_raw;
+use crate::scene::{MadeUpLobe, Material};
+use crate::shading::multi_lobe::{shade, LobeF};
+use crate::shading::reference::FrameF;
+use glam::DVec3;
+use hw_model::blinn_phong::mac_cost;
+use hw_model::frame::Frame;
+use hw_model::multi_lobe::{
+    amp_format, multi_lobe_cost, multi_lobe_shade, slope_format, Lobe, LobeLight, MultiLobeInput,
+    MAX_LOBES,
+};
+use hw_model::rsqrt::rsqrt_cost;
+use hw_model::vector::normalize_cost;
+use hw_model::UnitCost;
+
+/// What the `lobe-shade` stage of one material needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobePlan {
+    /// The made-up lobes (at most [`MAX_LOBES`]).
+    pub lobes: Vec<MadeUpLobe>,
+}
+
+/// The plan of a made-up multiple-surface material (`None` for other materials): `bary`, the
+/// texture stages when textured, `normal`, `frame` (the material's frame kind, or the
+/// hardware's) and `lobe-shade`.
+#[must_use]
+pub fn plan_lobes(material: &Material, has_uvs: bool) -> Option<Plan> {
+    if material.lobes.is_empty() {
+        return None;
+    }
+    let textured = material.texture.is_some() && has_uvs;
+    let mut stages = vec![StageKind::Bary];
+    if textured {
+        stages.extend([StageKind::Texcoord, StageKind::Lod, StageKind::Trilinear]);
+    }
+    stages.extend([StageKind::Normal, StageKind::Frame, StageKind::LobeShade]);
+    let kd = material.kd.map(f64::from);
+    Some(Plan {
+        stages,
+        texture: if textured { material.texture } else { None },
+        const_color: [kd[0], kd[1], kd[2], 1.0],
+        derivatives: textured,
+        wrap: [material.wrap_s, material.wrap_t],
+        bump: Some(BumpPlan {
+            map: usize::MAX,
+            frame: material.frame,
+            main: material.main_direction,
+            kd,
+            ks: material.ks.map(f64::from),
+            shininess: material.shininess,
+        }),
+        aniso: None,
+        rough: None,
+        ndf: None,
+        lobes: Some(LobePlan {
+            lobes: material
+                .lobes
+                .iter()
+                .take(MAX_LOBES as usize)
+                .copied()
+                .collect(),
+        }),
+    })
+}
+
+/// Most lights passed to the unit at once (more are shaded in groups).
+const LIGHT_GROUP: usize = 8;
+
+/// Fixed twin: the frame (raw when `frame` ran fixed), the lobes quantized into the unit's
+/// formats, the multi-lobe unit over the lights, plus the ambient term, saturating.
+#[allow(clippy::needless_range_loop)]
+pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let (Some((bp, _)), Some(lp)) = (bump_of(px), &px.plan.lobes) else {
+        return;
+    };
+    let m = px.m;
+    let units = &m.units;
+    let cfg = &m.hw.multi_lobe;
+    let cb = units.cfg.shade.shade_color_bits;
+    let rnd = units.cfg.shade.shade_rounding;
+    let k = StageKind::LobeShade.index();
+    let mut sat = c.sat[k];
+    let bf = &frag.bump;
+    let (n, t_u, t_v, len) = if px.fixed(StageKind::Frame) {
+        (bf.fr_n_x, bf.fr_t_u_x, bf.fr_t_v_x, bf.fr_len_x)
+    } else {
+        (
+            raw3(&bf.fr_n, &m.vec_fmt, &mut sat),
+            raw3(&bf.fr_t_u, &m.vec_fmt, &mut sat),
+            raw3(&bf.fr_t_v, &m.vec_fmt, &mut sat),
+            bf.fr_len.map(|x| to_raw(x, &m.len_fmt, &mut sat)),
+        )
+    };
+    let frame = Frame {
+        n,
+        t_u,
+        t_v,
+        len_u: len[0],
+        len_v: len[1],
+        fallback: false,
+        zero_normal: false,
+    };
+    let sf = slope_format(cfg);
+    let af = amp_format(cfg);
+    let mut lobes = [Lobe::default(); MAX_LOBES as usize];
+    for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
+        let s = l.slopes();
+        *q = Lobe {
+            slope: [to_raw(s[0], &sf, &mut sat), to_raw(s[1], &sf, &mut sat)],
+            amp: to_raw(f64::from(l.amplitude), &af, &mut sat) as u64,
+            exponent: l.exponent,
+        };
+    }
+    let nl = lp.lobes.len().min(MAX_LOBES as usize);
+    let v = fixed_eye(m, bf, px.fixed(StageKind::Normal), &mut sat);
+    let (kd, ks, mut acc) = fixed_material(
+        bp,
+        m,
+        px.plan.texture.is_some(),
+        px.fixed(StageKind::Trilinear),
+        frag.texel_x,
+        frag.texel,
+        cb,
+        rnd,
+    );
+    for group in m.lights.chunks(LIGHT_GROUP) {
+        let mut ls = [LobeLight {
+            l: [0; 3],
+            color: [0; 3],
+        }; LIGHT_GROUP];
+        for (q, light) in ls.iter_mut().zip(group) {
+            *q = LobeLight {
+                l: fixed_light(m, bf, light, px.fixed(StageKind::Normal), &mut sat),
+                color: light.color_x,
+            };
+        }
+        let inp = MultiLobeInput {
+            frame: &frame,
+            lobes: &lobes[..nl],
+            lights: &ls[..group.len()],
+            v,
+            kd,
+            ks,
+        };
+        let out = multi_lobe_shade(&inp, cfg, units, &mut sat);
+        c.h_zero += u64::from(out.h_zero);
+        for ch in 0..3 {
+            acc[ch] += out.sum[ch];
+        }
+    }
+    fixed_output(acc, frag, &mut sat, cb);
+    c.sat[k] = sat;
+}
+
+/// Float twin: `shading::multi_lobe::shade` with the material's unquantized lobes.
+#[allow(clippy::needless_range_loop)]
+pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
+    let (Some((bp, _)), Some(lp)) = (bump_of(px), &px.plan.lobes) else {
+        return;
+    };
+    let m = px.m;
+    let bf = &frag.bump;
+    let fr = FrameF {
+        n: d3(&bf.fr_n),
+        t_u: d3(&bf.fr_t_u),
+        t_v: d3(&bf.fr_t_v),
+        len_u: bf.fr_len[0],
+        len_v: bf.fr_len[1],
+        fallback: false,
+        zero_normal: false,
+    };
+    let mut lobes = [LobeF::default(); MAX_LOBES as usize];
+    for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
+        *q = LobeF {
+            slope: l.slopes(),
+            amp: f64::from(l.amplitude),
+            exponent: l.exponent,
+        };
+    }
+    let nl = lp.lobes.len().min(MAX_LOBES as usize);
+    let v = float_eye(bf);
+    let mut kd = bp.kd;
+    if px.plan.texture.is_some() {
+        for ch in 0..3 {
+            kd[ch] *= frag.texel[ch];
+        }
+    }
+    let mut acc = [0.0f64; 3];
+    for ch in 0..3 {
+        acc[ch] = m.ambient[ch] * kd[ch];
+    }
+    for group in m.lights.chunks(LIGHT_GROUP) {
+        let mut ls = [(DVec3::ZERO, [0.0; 3]); LIGHT_GROUP];
+        for (q, light) in ls.iter_mut().zip(group) {
+            *q = (float_light(bf, light), light.color_f);
+        }
+        let out = shade(&fr, &lobes[..nl], nl, &ls[..group.len()], v, kd, bp.ks);
+        c.h_zero += u64::from(out.h_zero);
+        for ch in 0..3 {
+            acc[ch] += out.sum[ch];
+        }
+    }
+    float_output(acc, frag, c);
+}
+
+/// One invocation: the multi-lobe unit for the plan's K lobes and the scene's lights, the
+/// eye and point-light normalizations, the ambient multiply-add (+1 for the texture).
+#[must_use]
+pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
+    let (Some(_), Some(lp)) = (&plan.bump, &plan.lobes) else {
+        return UnitCost::default();
+    };
+    let u = &m.units;
+    let g = m.hw.timing.gate_levels_per_cycle;
+    let np = point_lights(m) as u32;
+    let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
+    let mac = mac_cost(&u.cfg, g);
+    let lights = m.lights.len() as u32;
+    let mut c = multi_lobe_cost(&m.hw.multi_lobe, u, lp.lobes.len() as u32, lights, g)
+        .plus(nz.times(1 + np))
+        .plus(mac);
+    if plan.texture.is_some() {
+        c = c.plus(mac);
+    }
+    c
+}
