@@ -40,6 +40,7 @@ pub mod budget;
 pub mod cli;
 pub mod compare;
 pub mod error;
+pub mod filters;
 pub mod fixedpoint;
 pub mod footprint_ref;
 pub mod hwconfig;

@@ -224,6 +224,9 @@ pub struct HwConfig {
     /// The NDF mapping unit (absent in older files: the Texram-style default).
     #[serde(default)]
     pub ndf: crate::ndf::NdfConfig,
+    /// The Toksvig exponent unit (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub toksvig: crate::toksvig::ToksvigConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -289,6 +292,7 @@ impl HwConfig {
             roughness: RoughnessConfig::texram16(),
             timing: TimingConfig::texram16(),
             ndf: crate::ndf::NdfConfig::texram16(),
+            toksvig: crate::toksvig::ToksvigConfig::texram16(),
         }
     }
 
@@ -399,6 +403,7 @@ impl HwConfig {
         self.roughness.validate()?;
         self.timing.validate()?;
         self.ndf.validate()?;
+        self.toksvig.validate()?;
         Ok(())
     }
 }

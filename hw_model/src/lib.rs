@@ -25,6 +25,7 @@ pub mod reciprocal;
 pub mod roughness;
 pub mod rsqrt;
 pub mod timing_config;
+pub mod toksvig;
 pub mod trilinear;
 pub mod vector;
 pub mod wrap;

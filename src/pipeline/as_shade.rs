@@ -112,6 +112,7 @@ pub fn plan_as(material: &Material, has_uvs: bool) -> Option<Plan> {
         }),
         rough: None,
         ndf: None,
+        toksvig: None,
     })
 }
 

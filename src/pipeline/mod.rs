@@ -31,6 +31,9 @@ pub mod rough_shade;
 pub mod stages;
 pub mod table;
 pub mod texcoord;
+pub mod toksvig;
+pub mod toksvig_fetch;
+pub mod toksvig_shade;
 pub mod trace;
 pub mod trilinear;
 
@@ -100,6 +103,8 @@ pub struct Plan {
     pub rough: Option<rough::RoughPlan>,
     /// NDF mapping (with `bump` for the frame), for NDF materials.
     pub ndf: Option<ndf::NdfPlan>,
+    /// Toksvig's exponent (with `bump`), for `bump_filter = "toksvig"` materials.
+    pub toksvig: Option<toksvig::ToksvigPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -173,6 +178,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             aniso: None,
             rough: None,
             ndf: None,
+            toksvig: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -200,6 +206,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         aniso: None,
         rough: None,
         ndf: None,
+        toksvig: None,
     }
 }
 
@@ -241,6 +248,8 @@ pub struct Frag {
     pub rough_x: [u32; 3],
     /// NDF stages.
     pub ndf: ndf::NdfFrag,
+    /// Toksvig fetch: the filtered Toksvig texel.
+    pub toksvig: toksvig::ToksvigFrag,
     /// The texel footprints the stages fetched (recorded only when `trace.on`).
     pub trace: trace::Trace,
 }

@@ -10,7 +10,7 @@
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
     as_shade, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal, perturb,
-    phong, rough_fetch, rough_shade, texcoord, trilinear,
+    phong, rough_fetch, rough_shade, texcoord, toksvig_fetch, toksvig_shade, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -185,6 +185,16 @@ stage_table! {
     /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
     RoughShade "rough-shade" {
         fixed: rough_shade::fixed, float: rough_shade::float, cost: rough_shade::cost,
+        lookups: no_lookups,
+    }
+    /// Toksvig materials: trilinear fetch of the Toksvig map at the bump fetch's LOD.
+    ToksvigFetch "toksvig-fetch" {
+        fixed: toksvig_fetch::fixed, float: toksvig_fetch::float, cost: toksvig_fetch::cost,
+        lookups: one_lookup,
+    }
+    /// Toksvig materials: adjusted exponent and scale, Blinn-Phong (replaces `phong`).
+    ToksvigShade "toksvig-shade" {
+        fixed: toksvig_shade::fixed, float: toksvig_shade::float, cost: toksvig_shade::cost,
         lookups: no_lookups,
     }
     /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).

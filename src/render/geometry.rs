@@ -99,6 +99,7 @@ impl Geometry {
                     p = crate::pipeline::ndf::with_ndf(p, first + 4 * j, mat.shininess, ne);
                 }
             }
+            crate::pipeline::toksvig::mark_plan(&mut p, mat);
             if let Some(bp) = &p.bump {
                 g.bump.resize(base as usize, BumpVertex::default());
                 g.bump.extend(bump_vertices(mesh, bp));

@@ -147,6 +147,15 @@ pub fn render(
         rough_owned = mm;
         &rough_owned
     };
+    let toksvig_sources = crate::pipeline::toksvig::resolve_plans(&mut geo.plans, maps.float.len());
+    let has_toksvig = !toksvig_sources.is_empty();
+    let toksvig_owned;
+    let maps = if has_toksvig {
+        toksvig_owned = crate::pipeline::toksvig::toksvig_maps(maps, &toksvig_sources, hw)?;
+        &toksvig_owned
+    } else {
+        maps
+    };
 
     let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
@@ -247,12 +256,13 @@ pub fn render(
     }
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
-    if opts.truth > 0 && (has_rough || has_ndf) {
+    if opts.truth > 0 && (has_rough || has_ndf || has_toksvig) {
         let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
         // bump map (`rough::truth_plans`), NDF materials their supersampled finest normal
         // map (`ndf::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough::truth_plans(&geo.plans, opts.truth);
+        let tp = crate::pipeline::toksvig::truth_plans(tp, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
         let ndf_truth = crate::pipeline::ndf::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)

@@ -109,6 +109,31 @@ pub struct Material {
     /// NDF mapping (Olano and North 1997): the `bump` map's normals become moment maps,
     /// shaded by `ndf-fetch` and `ndf-shade` instead of the bump path's Blinn-Phong.
     pub ndf: bool,
+    /// How a bump material's specular lobe accounts for the normals under the footprint
+    /// (TOML `bump_filter`): `plain` (the filtered bump map alone) or `toksvig` (Toksvig
+    /// 2005, `pipeline::toksvig`).
+    pub bump_filter: BumpFilter,
+}
+
+/// Specular filtering of a bump material beyond the filtered bump map.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BumpFilter {
+    /// The filtered bump map and the material's exponent (the baseline).
+    #[default]
+    Plain,
+    /// Toksvig's exponent from the length of the MIP-mapped average normal.
+    Toksvig,
+}
+
+impl BumpFilter {
+    /// Parses a TOML name; the error lists the names.
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "plain" => Ok(Self::Plain),
+            "toksvig" => Ok(Self::Toksvig),
+            _ => Err(format!("'{s}' is not plain or toksvig")),
+        }
+    }
 }
 
 /// Which modified Blinn-Phong a roughness material uses.
@@ -213,6 +238,7 @@ impl Default for Material {
             roughness: None,
             brdf: None,
             ndf: false,
+            bump_filter: BumpFilter::Plain,
         }
     }
 }

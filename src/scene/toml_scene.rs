@@ -110,6 +110,8 @@ struct MaterialCfg {
     exponent_map: Option<String>,
     /// NDF mapping of the `bump` map (Olano and North 1997).
     ndf: Option<bool>,
+    /// Specular filtering of a bump material: `plain` (default) or `toksvig`.
+    bump_filter: Option<String>,
 }
 
 /// The Ashikhmin-Shirley parameters of material `i` (defaults `nu = nv = 100`, `rs = 0.05`,
@@ -474,6 +476,11 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             shininess: m.shininess.unwrap_or(def.shininess),
             brdf: as_brdf(i, m, &tex_names)?,
             ndf: m.ndf.unwrap_or(def.ndf),
+            bump_filter: match &m.bump_filter {
+                Some(b) => crate::scene::BumpFilter::parse(b)
+                    .map_err(|e| Error::field(&f("bump_filter"), e))?,
+                None => def.bump_filter,
+            },
         });
     }
     let mut default_mat: Option<usize> = None;

@@ -8,3 +8,4 @@ pub mod ndf;
 pub mod reference;
 pub mod roughness;
 pub mod tangents;
+pub mod toksvig;
