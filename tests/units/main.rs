@@ -26,6 +26,7 @@ mod roughness_shade;
 mod roughness_unit;
 mod timing_footprint;
 mod timing_units;
+mod toksvig_unit;
 mod unit_bary_derivs;
 mod unit_cost;
 mod unit_fixed;
