@@ -9,6 +9,7 @@ mod cli_common;
 mod as_cli;
 mod bump_cli;
 mod cli;
+mod filters_cli;
 mod ndf_cli;
 mod roughness_cli;
 mod timing_cli;
