@@ -95,6 +95,14 @@ pub const METHODS: &[Method] = &[
         bytes_per_texel: |hw| offset_bytes(hw) + stored_texel_bytes(3, hw.trilinear.texel_bits),
     },
     Method {
+        name: "lean",
+        what: "Olano-Baker 2010 LEAN map: slope Gaussian from five moments",
+        truth: BLINN_TRUTH,
+        material: |m| set_bump(m, None, false, BumpFilter::Lean),
+        hw: no_hw,
+        bytes_per_texel: |hw| offset_bytes(hw) + stored_texel_bytes(3, hw.trilinear.texel_bits),
+    },
+    Method {
         name: "schilling",
         what: "Schilling 1997 roughness pyramid (directional variant)",
         truth: BLINN_TRUTH,

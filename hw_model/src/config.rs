@@ -227,6 +227,9 @@ pub struct HwConfig {
     /// The Toksvig exponent unit (absent in older files: the Texram-style default).
     #[serde(default)]
     pub toksvig: crate::toksvig::ToksvigConfig,
+    /// The LEAN mapping unit (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub lean: crate::lean::LeanConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -293,6 +296,7 @@ impl HwConfig {
             timing: TimingConfig::texram16(),
             ndf: crate::ndf::NdfConfig::texram16(),
             toksvig: crate::toksvig::ToksvigConfig::texram16(),
+            lean: crate::lean::LeanConfig::texram16(),
         }
     }
 
@@ -404,6 +408,7 @@ impl HwConfig {
         self.timing.validate()?;
         self.ndf.validate()?;
         self.toksvig.validate()?;
+        self.lean.validate()?;
         Ok(())
     }
 }

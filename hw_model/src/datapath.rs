@@ -549,6 +549,7 @@ pub fn units(hw: &crate::HwConfig) -> Vec<UnitReport> {
         crate::toksvig::datapath(&hw.toksvig, hw.trilinear.texel_bits),
         g,
     ));
+    v.push(UnitReport::new("lean", crate::lean::datapath(&hw.lean), g));
     v.push(UnitReport::new(
         "aniso_phong",
         crate::aniso_phong::datapath(&hw.aniso_phong),

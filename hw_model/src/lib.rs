@@ -17,6 +17,7 @@ pub mod fixed;
 pub mod footprint;
 pub mod frame;
 pub mod interpolator;
+pub mod lean;
 pub mod lod;
 pub mod modulate;
 pub mod ndf;

@@ -113,6 +113,7 @@ pub fn plan_as(material: &Material, has_uvs: bool) -> Option<Plan> {
         rough: None,
         ndf: None,
         toksvig: None,
+        lean: None,
     })
 }
 

@@ -17,6 +17,9 @@ pub mod bump;
 pub mod bump_fetch;
 pub mod color;
 pub mod frame;
+pub mod lean;
+pub mod lean_fetch;
+pub mod lean_shade;
 pub mod lod;
 pub mod modulate;
 pub mod ndf;
@@ -105,6 +108,8 @@ pub struct Plan {
     pub ndf: Option<ndf::NdfPlan>,
     /// Toksvig's exponent (with `bump`), for `bump_filter = "toksvig"` materials.
     pub toksvig: Option<toksvig::ToksvigPlan>,
+    /// LEAN mapping (with `bump`), for `bump_filter = "lean"` materials.
+    pub lean: Option<lean::LeanPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -179,6 +184,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             rough: None,
             ndf: None,
             toksvig: None,
+            lean: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -207,6 +213,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         rough: None,
         ndf: None,
         toksvig: None,
+        lean: None,
     }
 }
 
@@ -250,6 +257,8 @@ pub struct Frag {
     pub ndf: ndf::NdfFrag,
     /// Toksvig fetch: the filtered Toksvig texel.
     pub toksvig: toksvig::ToksvigFrag,
+    /// LEAN fetch: the filtered second-moment texel.
+    pub lean: lean::LeanFrag,
     /// The texel footprints the stages fetched (recorded only when `trace.on`).
     pub trace: trace::Trace,
 }

@@ -9,8 +9,9 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_shade, bary, bump_fetch, color, frame, lod, modulate, ndf_fetch, ndf_shade, normal, perturb,
-    phong, rough_fetch, rough_shade, texcoord, toksvig_fetch, toksvig_shade, trilinear,
+    as_shade, bary, bump_fetch, color, frame, lean_fetch, lean_shade, lod, modulate, ndf_fetch,
+    ndf_shade, normal, perturb, phong, rough_fetch, rough_shade, texcoord, toksvig_fetch,
+    toksvig_shade, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -195,6 +196,16 @@ stage_table! {
     /// Toksvig materials: adjusted exponent and scale, Blinn-Phong (replaces `phong`).
     ToksvigShade "toksvig-shade" {
         fixed: toksvig_shade::fixed, float: toksvig_shade::float, cost: toksvig_shade::cost,
+        lookups: no_lookups,
+    }
+    /// LEAN materials: trilinear fetch of the second-moment map at the bump fetch's LOD.
+    LeanFetch "lean-fetch" {
+        fixed: lean_fetch::fixed, float: lean_fetch::float, cost: lean_fetch::cost,
+        lookups: one_lookup,
+    }
+    /// LEAN materials: the slope Gaussian at the half vector per light (replaces `phong`).
+    LeanShade "lean-shade" {
+        fixed: lean_shade::fixed, float: lean_shade::float, cost: lean_shade::cost,
         lookups: no_lookups,
     }
     /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).

@@ -110,8 +110,8 @@ pub struct Material {
     /// shaded by `ndf-fetch` and `ndf-shade` instead of the bump path's Blinn-Phong.
     pub ndf: bool,
     /// How a bump material's specular lobe accounts for the normals under the footprint
-    /// (TOML `bump_filter`): `plain` (the filtered bump map alone) or `toksvig` (Toksvig
-    /// 2005, `pipeline::toksvig`).
+    /// (TOML `bump_filter`): `plain` (the filtered bump map alone), `toksvig` (Toksvig
+    /// 2005, `pipeline::toksvig`) or `lean` (Olano and Baker 2010, `pipeline::lean`).
     pub bump_filter: BumpFilter,
 }
 
@@ -123,6 +123,8 @@ pub enum BumpFilter {
     Plain,
     /// Toksvig's exponent from the length of the MIP-mapped average normal.
     Toksvig,
+    /// LEAN mapping: a Gaussian of the slopes from their filtered first and second moments.
+    Lean,
 }
 
 impl BumpFilter {
@@ -131,7 +133,8 @@ impl BumpFilter {
         match s {
             "plain" => Ok(Self::Plain),
             "toksvig" => Ok(Self::Toksvig),
-            _ => Err(format!("'{s}' is not plain or toksvig")),
+            "lean" => Ok(Self::Lean),
+            _ => Err(format!("'{s}' is not plain, toksvig or lean")),
         }
     }
 }

@@ -110,7 +110,7 @@ struct MaterialCfg {
     exponent_map: Option<String>,
     /// NDF mapping of the `bump` map (Olano and North 1997).
     ndf: Option<bool>,
-    /// Specular filtering of a bump material: `plain` (default) or `toksvig`.
+    /// Specular filtering of a bump material: `plain` (default), `toksvig` or `lean`.
     bump_filter: Option<String>,
 }
 

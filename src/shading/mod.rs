@@ -4,6 +4,7 @@
 //! generation.
 
 pub mod bump;
+pub mod lean;
 pub mod ndf;
 pub mod reference;
 pub mod roughness;

@@ -19,7 +19,7 @@ fn lake(filter: BumpFilter) -> Scene {
             m.bump_filter = filter;
             m.roughness = match filter {
                 BumpFilter::Plain => Some(RoughChoice::Variant(RoughVariant::None)),
-                BumpFilter::Toksvig => None,
+                _ => None,
             };
         }
     }

@@ -21,6 +21,7 @@ mod frames_rsqrt;
 mod frames_shade;
 mod frames_vector;
 mod hw_config;
+mod lean_unit;
 mod ndf_unit;
 mod roughness_shade;
 mod roughness_unit;
