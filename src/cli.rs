@@ -54,8 +54,8 @@ pub enum Command {
     /// Compare two images (a render against Mesa, a GPU capture, another simulator): match %,
     /// per-channel differences, histogram, error map, the pixels that differ most.
     Compare(CompareArgs),
-    /// Compare the bump-map filtering methods (plain bump map, Toksvig, Schilling's roughness
-    /// pyramid, Olano-North NDF with each normalization) on the same scenes and ground truth:
+    /// Compare the bump-map filtering methods (plain bump map, Toksvig, LEAN, Schilling's
+    /// roughness pyramid, Olano-North NDF with each normalization) on the same scenes and ground truth:
     /// model error, quantization error, bytes per texel, texels, issue and timing cycles per
     /// pixel; prints the table and writes filters.csv, filters.json and filters.md.
     Filters(FiltersArgs),
@@ -69,7 +69,7 @@ pub struct FiltersArgs {
     #[arg(long, value_delimiter = ',', required = true)]
     pub scene: Vec<String>,
     /// Methods to compare (comma list; default: all of `texsim::filters::METHODS`: plain,
-    /// toksvig, schilling, ndf-partial, ndf-map, ndf-projected, ndf-exact).
+    /// toksvig, lean, schilling, ndf-partial, ndf-map, ndf-projected, ndf-exact).
     #[arg(long, value_delimiter = ',')]
     pub method: Vec<String>,
     /// Override the image width and height of every scene.

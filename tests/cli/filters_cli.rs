@@ -6,9 +6,10 @@
 
 use crate::cli_common::{texsim, text, tmp};
 
-const METHODS: [&str; 7] = [
+const METHODS: [&str; 8] = [
     "plain",
     "toksvig",
+    "lean",
     "schilling",
     "ndf-partial",
     "ndf-map",
@@ -90,7 +91,7 @@ fn filters_table_shape_and_sanity() {
         assert!(tok["bytes_per_texel"].as_u64() > plain["bytes_per_texel"].as_u64());
         assert!(tok["issue_cycles_per_pixel"].as_f64() > plain["issue_cycles_per_pixel"].as_f64());
         let p = plain["model_mean"].as_f64().unwrap_or(0.0);
-        for m in ["toksvig", "schilling", "ndf-projected"] {
+        for m in ["toksvig", "lean", "schilling", "ndf-projected"] {
             if get(scene, m)["model_mean"].as_f64().unwrap_or(f64::MAX) < p {
                 beaten = true;
             }

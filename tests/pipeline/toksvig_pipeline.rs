@@ -19,7 +19,7 @@ fn lake(filter: BumpFilter) -> Scene {
             m.bump_filter = filter;
             m.roughness = match filter {
                 BumpFilter::Plain => Some(RoughChoice::Variant(RoughVariant::None)),
-                _ => None,
+                BumpFilter::Toksvig | BumpFilter::Lean => None,
             };
         }
     }
@@ -85,6 +85,42 @@ fn toksvig_stages_only_for_toksvig_materials_and_closer_to_truth() {
     let texels = |r: &Rendered| r.stats.stages.iter().map(|s| s.texels).sum::<u64>();
     assert_eq!(texels(&tok), 2 * texels(&plain));
     assert!(tok.stats.issue_cycles.total > plain.stats.issue_cycles.total);
+}
+
+/// LEAN (the same structure: `lean-fetch` after `bump-fetch`, `lean-shade` for `phong`) is
+/// within a few LSBs of its float twin and closer to the truth than the plain bump map.
+#[test]
+fn lean_stages_only_for_lean_materials_and_closer_to_truth() {
+    let plain = run(&lake(BumpFilter::Plain), 2);
+    let lean = run(&lake(BumpFilter::Lean), 2);
+    for k in [StageKind::LeanFetch, StageKind::LeanShade] {
+        assert_eq!(invocations(&plain, k), 0, "plain plans no {k}");
+        assert!(invocations(&lean, k) > 0, "lean plans {k}");
+    }
+    assert_eq!(invocations(&lean, StageKind::Phong), 0);
+    let q = lean.stats.error_8bit.as_ref().expect("reference");
+    assert!(
+        q.max_abs_lsb <= 3 && q.mean_abs_lsb < 0.1,
+        "quantization {q:?}"
+    );
+    let (mp, ml) = (
+        plain
+            .stats
+            .model_error
+            .as_ref()
+            .expect("truth")
+            .mean_abs_lsb,
+        lean.stats.model_error.as_ref().expect("truth").mean_abs_lsb,
+    );
+    assert!(ml < 0.9 * mp, "lean model error {ml} vs plain {mp}");
+    let (a, b) = (
+        run(&lake(BumpFilter::Lean), 1),
+        run(&lake(BumpFilter::Lean), 3),
+    );
+    assert!(
+        a.hw_image == b.hw_image && a.truth_image == b.truth_image,
+        "threads"
+    );
 }
 
 #[test]

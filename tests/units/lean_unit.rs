@@ -122,7 +122,9 @@ fn flat_map_is_the_base_lobe() {
             (fl - 1.0).abs() < 1e-4 && (fx - 1.0).abs() < 1e-3,
             "s {s}: {fx} {fl}"
         );
-        assert_eq!(sat.saturated, 0, "s {s}");
+        // The unorm centre code of M_uv is half an LSB off zero (Sigma_uv = 2^-16, not 0), so
+        // the normalization may reach 1 + 2^-20: clamped to 1, counted.
+        assert!(sat.saturated <= 1, "s {s}");
         // Off the normal: exp(-s tan^2 / 2), the Blinn-Phong-like base lobe.
         let t: f64 = 0.5 / f64::from(s).sqrt();
         let h = DVec3::new(t, 0.0, 1.0).normalize();
