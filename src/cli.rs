@@ -57,6 +57,41 @@ pub enum Command {
     /// Fit Fournier multiple-surface lobes (K vMF lobes per texel, EM) to a procedural normal
     /// map at every MIP level: lobes, iterations, fallbacks, residual and time per level.
     Fit(crate::fit_cmd::FitArgs),
+    /// Compare the bump-map filtering methods (plain bump map, Toksvig, LEAN, Schilling's
+    /// roughness pyramid, Olano-North NDF with each normalization) on the same scenes and ground truth:
+    /// model error, quantization error, bytes per texel, texels, issue and timing cycles per
+    /// pixel; prints the table and writes filters.csv, filters.json and filters.md.
+    Filters(FiltersArgs),
+}
+
+/// Arguments of `texsim filters`.
+#[derive(Args, Debug, Clone)]
+pub struct FiltersArgs {
+    /// Built-in scenes with bump materials (repeat the flag, or a comma list), e.g.
+    /// `--scene ripple-sphere --scene lake`.
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub scene: Vec<String>,
+    /// Methods to compare (comma list; default: all of `texsim::filters::METHODS`: plain,
+    /// toksvig, lean, schilling, ndf-partial, ndf-map, ndf-projected, ndf-exact).
+    #[arg(long, value_delimiter = ',')]
+    pub method: Vec<String>,
+    /// Override the image width and height of every scene.
+    #[arg(long)]
+    pub width: Option<u32>,
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Hardware preset or hw TOML file (default: each scene's, else texram16).
+    #[arg(long)]
+    pub hw: Option<String>,
+    /// Output directory.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Ground-truth sub-samples per pixel axis.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub truth: u32,
+    /// Skip the timing model (no cyc/px column; faster).
+    #[arg(long)]
+    pub no_cycles: bool,
 }
 
 /// Arguments of `texsim vectors`.
@@ -453,6 +488,7 @@ pub fn run(cli: Cli) -> Result<()> {
             print!("{}", crate::fit_cmd::fit_cmd(&a)?);
             Ok(())
         }
+        Some(Command::Filters(a)) => filters_cmd(&a),
     }
 }
 
@@ -1067,6 +1103,52 @@ fn compare_cmd(a: &CompareArgs) -> Result<()> {
 }
 
 /// One progress line on stderr: a finished phase and its wall time.
+fn filters_cmd(a: &FiltersArgs) -> Result<()> {
+    let methods: Vec<&crate::filters::Method> = if a.method.is_empty() {
+        crate::filters::METHODS.iter().collect()
+    } else {
+        a.method
+            .iter()
+            .map(|m| crate::filters::method(m).map_err(|e| e.context("--method")))
+            .collect::<Result<_>>()?
+    };
+    let opts = crate::filters::FilterOptions {
+        truth: a.truth,
+        timing: !a.no_cycles,
+    };
+    let mut rows = Vec::new();
+    for name in &a.scene {
+        let sa = SceneArgs {
+            scene: Some(name.clone()),
+            width: a.width,
+            height: a.height,
+            hw: a.hw.clone(),
+            ..SceneArgs::default_out()
+        };
+        let (sc, hw) = sa.load()?;
+        crate::budget::check_run(&sc, &hw, true, opts.timing)?;
+        let progress = |m: &str| eprintln!("[{name}] {m}");
+        rows.extend(crate::filters::compare_scene(
+            name, &sc, &hw, &methods, &opts, &progress,
+        )?);
+    }
+    print!("{}", crate::filters::text_table(&rows));
+    let mut out = OutputSet::new();
+    out.add("filters.csv", crate::filters::csv_table(&rows).into_bytes());
+    out.add(
+        "filters.json",
+        serde_json::to_vec_pretty(&rows).map_err(|e| Error::msg(e.to_string()))?,
+    );
+    out.add(
+        "filters.md",
+        crate::filters::markdown_table(&rows).into_bytes(),
+    );
+    for p in out.write_to(&a.out)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
 fn progress_line(phase: &str, ms: f64) {
     eprintln!("texsim:   {phase:<18} {ms:>9.1} ms");
 }

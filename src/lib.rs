@@ -41,6 +41,7 @@ pub mod cli;
 pub mod compare;
 pub mod error;
 pub mod fit_cmd;
+pub mod filters;
 pub mod fixedpoint;
 pub mod footprint_ref;
 pub mod hwconfig;

@@ -230,6 +230,12 @@ pub struct HwConfig {
     /// The multi-lobe (Fournier multiple-surface) unit (absent in older files: the default).
     #[serde(default)]
     pub multi_lobe: crate::multi_lobe::MultiLobeConfig,
+    /// The Toksvig exponent unit (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub toksvig: crate::toksvig::ToksvigConfig,
+    /// The LEAN mapping unit (absent in older files: the Texram-style default).
+    #[serde(default)]
+    pub lean: crate::lean::LeanConfig,
 }
 
 /// Names of the built-in presets, in the order `texsim hw list` shows them.
@@ -297,6 +303,8 @@ impl HwConfig {
             ndf: crate::ndf::NdfConfig::texram16(),
             env: crate::env_config::EnvConfig::texram16(),
             multi_lobe: crate::multi_lobe::MultiLobeConfig::texram16(),
+            toksvig: crate::toksvig::ToksvigConfig::texram16(),
+            lean: crate::lean::LeanConfig::texram16(),
         }
     }
 
@@ -409,6 +417,8 @@ impl HwConfig {
         self.ndf.validate()?;
         self.env.validate()?;
         self.multi_lobe.validate()?;
+        self.toksvig.validate()?;
+        self.lean.validate()?;
         Ok(())
     }
 }

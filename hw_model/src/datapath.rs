@@ -545,6 +545,12 @@ pub fn units(hw: &crate::HwConfig) -> Vec<UnitReport> {
         v.push(UnitReport::new("ndf", d, g));
     }
     v.push(UnitReport::new(
+        "toksvig",
+        crate::toksvig::datapath(&hw.toksvig, hw.trilinear.texel_bits),
+        g,
+    ));
+    v.push(UnitReport::new("lean", crate::lean::datapath(&hw.lean), g));
+    v.push(UnitReport::new(
         "aniso_phong",
         crate::aniso_phong::datapath(&hw.aniso_phong),
         g,

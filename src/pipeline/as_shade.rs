@@ -114,6 +114,8 @@ pub fn plan_as(material: &Material, has_uvs: bool) -> Option<Plan> {
         ndf: None,
         env: None,
         lobes: None,
+        toksvig: None,
+        lean: None,
     })
 }
 

@@ -20,6 +20,9 @@ pub mod env;
 pub mod env_fetch;
 pub mod frame;
 pub mod lobe_shade;
+pub mod lean;
+pub mod lean_fetch;
+pub mod lean_shade;
 pub mod lod;
 pub mod modulate;
 pub mod ndf;
@@ -34,6 +37,9 @@ pub mod rough_shade;
 pub mod stages;
 pub mod table;
 pub mod texcoord;
+pub mod toksvig;
+pub mod toksvig_fetch;
+pub mod toksvig_shade;
 pub mod trace;
 pub mod trilinear;
 
@@ -107,6 +113,10 @@ pub struct Plan {
     pub env: Option<env::EnvPlan>,
     /// Multiple-surface lobes (with `bump` for the frame), for Fournier materials.
     pub lobes: Option<lobe_shade::LobePlan>,
+    /// Toksvig's exponent (with `bump`), for `bump_filter = "toksvig"` materials.
+    pub toksvig: Option<toksvig::ToksvigPlan>,
+    /// LEAN mapping (with `bump`), for `bump_filter = "lean"` materials.
+    pub lean: Option<lean::LeanPlan>,
 }
 
 /// What the bump stages of one material need.
@@ -185,6 +195,8 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
             ndf: None,
             env: None,
             lobes: None,
+            toksvig: None,
+            lean: None,
         };
     }
     let mut stages = Vec::with_capacity(6);
@@ -214,6 +226,8 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
         ndf: None,
         env: None,
         lobes: None,
+        toksvig: None,
+        lean: None,
     }
 }
 
@@ -255,6 +269,10 @@ pub struct Frag {
     pub rough_x: [u32; 3],
     /// NDF stages.
     pub ndf: ndf::NdfFrag,
+    /// Toksvig fetch: the filtered Toksvig texel.
+    pub toksvig: toksvig::ToksvigFrag,
+    /// LEAN fetch: the filtered second-moment texel.
+    pub lean: lean::LeanFrag,
     /// The texel footprints the stages fetched (recorded only when `trace.on`).
     pub trace: trace::Trace,
 }

@@ -151,7 +151,7 @@ pub fn truth_plans(plans: &[Plan], k: u32) -> Vec<Plan> {
 }
 
 /// Level-0 offsets of offset map `map` as the trilinear unit sees them (decoded texels).
-fn decoded_offsets(chain: &MipChain, offset_int_bits: u32) -> (u32, u32, Vec<[f32; 2]>) {
+pub(crate) fn decoded_offsets(chain: &MipChain, offset_int_bits: u32) -> (u32, u32, Vec<[f32; 2]>) {
     let Some(l0) = chain.levels.first() else {
         return (1, 1, vec![[0.0; 2]]);
     };

@@ -94,6 +94,9 @@ pub struct Machine<'a> {
     pub aniso_roms: std::sync::OnceLock<hw_model::aniso_phong::AnisoPhongRoms>,
     /// The fixed NDF unit of `hw.ndf` (`None` for the float-only `exact` normalization).
     pub ndf: Option<hw_model::ndf::NdfUnit>,
+    /// The density unit of `lean-shade` (the NDF unit with the `gauss` density), built on first
+    /// use ([`Machine::lean_density`]).
+    pub lean_density: std::sync::OnceLock<Option<hw_model::ndf::NdfUnit>>,
     /// Ground-truth normal maps: when not empty, the float `ndf-shade` supersamples them.
     pub ndf_truth: &'a [super::ndf::NdfTruth],
 }
@@ -112,6 +115,21 @@ pub struct ShadeLight {
 }
 
 impl<'a> Machine<'a> {
+    /// The density unit of `lean-shade`: `hw.ndf` with the `gauss` density (`None` when its
+    /// widths are invalid).
+    pub fn lean_density(&self) -> Option<&hw_model::ndf::NdfUnit> {
+        self.lean_density
+            .get_or_init(|| {
+                let cfg = hw_model::ndf::NdfConfig {
+                    ndf_density: hw_model::ndf::NdfDensity::Gauss,
+                    ndf_norm: hw_model::ndf::NdfNorm::Partial,
+                    ..self.hw.ndf.clone()
+                };
+                hw_model::ndf::NdfUnit::new(&cfg, &self.hw.reciprocal, &self.hw.shading.rsqrt).ok()
+            })
+            .as_ref()
+    }
+
     /// Builds the units of `hw` over the prepared maps (`fixed[i]` quantizes `float[i]`).
     #[must_use]
     pub fn new(hw: &'a HwConfig, float: &'a [MipChain], fixed: &'a [FixedMipChain]) -> Self {
@@ -144,6 +162,7 @@ impl<'a> Machine<'a> {
             bump_attrs: &[],
             aniso_roms: std::sync::OnceLock::new(),
             ndf: super::ndf::ndf_unit(hw),
+            lean_density: std::sync::OnceLock::new(),
             ndf_truth: &[],
         }
     }

@@ -9,9 +9,9 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_shade, bary, bump_fetch, color, env_fetch, frame, lobe_shade, lod, modulate, ndf_fetch,
-    ndf_shade,
-    normal, perturb, phong, rough_fetch, rough_shade, texcoord, trilinear,
+    as_shade, bary, bump_fetch, color, env_fetch, frame, lean_fetch, lean_shade, lobe_shade, lod,
+    modulate, ndf_fetch, ndf_shade, normal, perturb, phong, rough_fetch, rough_shade, texcoord,
+    toksvig_fetch, toksvig_shade, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -186,6 +186,26 @@ stage_table! {
     /// Roughness materials: Blinn-Phong with the modified specular term (replaces `phong`).
     RoughShade "rough-shade" {
         fixed: rough_shade::fixed, float: rough_shade::float, cost: rough_shade::cost,
+        lookups: no_lookups,
+    }
+    /// Toksvig materials: trilinear fetch of the Toksvig map at the bump fetch's LOD.
+    ToksvigFetch "toksvig-fetch" {
+        fixed: toksvig_fetch::fixed, float: toksvig_fetch::float, cost: toksvig_fetch::cost,
+        lookups: one_lookup,
+    }
+    /// Toksvig materials: adjusted exponent and scale, Blinn-Phong (replaces `phong`).
+    ToksvigShade "toksvig-shade" {
+        fixed: toksvig_shade::fixed, float: toksvig_shade::float, cost: toksvig_shade::cost,
+        lookups: no_lookups,
+    }
+    /// LEAN materials: trilinear fetch of the second-moment map at the bump fetch's LOD.
+    LeanFetch "lean-fetch" {
+        fixed: lean_fetch::fixed, float: lean_fetch::float, cost: lean_fetch::cost,
+        lookups: one_lookup,
+    }
+    /// LEAN materials: the slope Gaussian at the half vector per light (replaces `phong`).
+    LeanShade "lean-shade" {
+        fixed: lean_shade::fixed, float: lean_shade::float, cost: lean_shade::cost,
         lookups: no_lookups,
     }
     /// NDF materials: LOD + three trilinear lookups of the moment maps (+1 normalization map).

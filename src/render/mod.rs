@@ -155,6 +155,24 @@ pub fn render(
         env_owned = crate::pipeline::env::env_maps(maps, &env_sizes, hw);
         &env_owned
     };
+    let toksvig_sources = crate::pipeline::toksvig::resolve_plans(&mut geo.plans, maps.float.len());
+    let has_toksvig = !toksvig_sources.is_empty();
+    let toksvig_owned;
+    let maps = if has_toksvig {
+        toksvig_owned = crate::pipeline::toksvig::toksvig_maps(maps, &toksvig_sources, hw)?;
+        &toksvig_owned
+    } else {
+        maps
+    };
+    let lean_sources = crate::pipeline::lean::resolve_plans(&mut geo.plans, maps.float.len());
+    let has_lean = !lean_sources.is_empty();
+    let lean_owned;
+    let maps = if has_lean {
+        lean_owned = crate::pipeline::lean::lean_maps(maps, &lean_sources, hw)?.0;
+        &lean_owned
+    } else {
+        maps
+    };
 
     let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
@@ -256,13 +274,15 @@ pub fn render(
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
     let has_env = geo.plans.iter().any(|p| p.env.is_some());
-    if opts.truth > 0 && (has_rough || has_ndf || has_env) {
+    if opts.truth > 0 && (has_rough || has_ndf || has_env || has_toksvig || has_lean) {
         let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
         // bump map (`rough::truth_plans`), NDF materials their supersampled finest normal
         // map (`ndf::NdfTruth`), all others are their own float reference.
         let tp = crate::pipeline::rough::truth_plans(&geo.plans, opts.truth);
         let tp = crate::pipeline::env::truth_plans(&tp, opts.truth);
+        let tp = crate::pipeline::toksvig::truth_plans(tp, opts.truth);
+        let tp = crate::pipeline::lean::truth_plans(tp, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
         let ndf_truth = crate::pipeline::ndf::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)

@@ -117,6 +117,10 @@ pub struct Material {
     /// Made-up multiple surface (Fournier 1992, sec. 3.4 and 4): the material's lobes, shaded
     /// per pixel by `lobe-shade` (`pipeline::lobe_shade`) instead of Gouraud or Blinn-Phong.
     pub lobes: Vec<MadeUpLobe>,
+    /// How a bump material's specular lobe accounts for the normals under the footprint
+    /// (TOML `bump_filter`): `plain` (the filtered bump map alone), `toksvig` (Toksvig
+    /// 2005, `pipeline::toksvig`) or `lean` (Olano and Baker 2010, `pipeline::lean`).
+    pub bump_filter: BumpFilter,
 }
 
 /// One lobe of a made-up multiple surface (Fournier 1992, eq. 12): its direction in the
@@ -186,6 +190,30 @@ impl EnvMaterial {
             "lambda1" => Ok(Some(EnvFilter::Lambda1)),
             "ellipse" => Ok(Some(EnvFilter::Ellipse)),
             _ => Err(format!("'{s}' is not hw, none, lambda1 or ellipse")),
+        }
+    }
+}
+
+/// Specular filtering of a bump material beyond the filtered bump map.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BumpFilter {
+    /// The filtered bump map and the material's exponent (the baseline).
+    #[default]
+    Plain,
+    /// Toksvig's exponent from the length of the MIP-mapped average normal.
+    Toksvig,
+    /// LEAN mapping: a Gaussian of the slopes from their filtered first and second moments.
+    Lean,
+}
+
+impl BumpFilter {
+    /// Parses a TOML name; the error lists the names.
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "plain" => Ok(Self::Plain),
+            "toksvig" => Ok(Self::Toksvig),
+            "lean" => Ok(Self::Lean),
+            _ => Err(format!("'{s}' is not plain, toksvig or lean")),
         }
     }
 }
@@ -294,6 +322,7 @@ impl Default for Material {
             ndf: false,
             env: None,
             lobes: Vec::new(),
+            bump_filter: BumpFilter::Plain,
         }
     }
 }

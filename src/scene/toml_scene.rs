@@ -119,6 +119,8 @@ struct MaterialCfg {
     /// Made-up multiple surface (Fournier 1992): `[[materials.lobes]]` with `direction`,
     /// `amplitude`, `exponent`.
     lobes: Option<Vec<LobeCfg>>,
+    /// Specular filtering of a bump material: `plain` (default), `toksvig` or `lean`.
+    bump_filter: Option<String>,
 }
 
 /// One `[[materials.lobes]]` entry.
@@ -522,6 +524,11 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             ndf: m.ndf.unwrap_or(def.ndf),
             env: env_material(m, &f)?,
             lobes: made_up_lobes(i, m)?,
+            bump_filter: match &m.bump_filter {
+                Some(b) => crate::scene::BumpFilter::parse(b)
+                    .map_err(|e| Error::field(&f("bump_filter"), e))?,
+                None => def.bump_filter,
+            },
         });
     }
     let mut default_mat: Option<usize> = None;

@@ -25,3 +25,4 @@ mod raster_watertight;
 mod render_pipeline;
 mod roughness_scene;
 mod timing_golden;
+mod toksvig_pipeline;
