@@ -33,6 +33,10 @@ pub enum Command {
     Scenes,
     /// Render once per setting of one or more HwConfig fields; print and write the table.
     Sweep(SweepArgs),
+    /// Find the narrowest machine (least area) that keeps every --scene within every
+    /// --budget: per-knob bisection, a greedy descent trading bits, a verified final run;
+    /// writes tune.json, tune.csv and tuned.toml (a hw file for --hw) into --out.
+    Tune(TuneArgs),
     /// Hardware configurations.
     Hw {
         #[command(subcommand)]
@@ -330,6 +334,38 @@ pub struct SweepArgs {
     pub truth: u32,
 }
 
+/// Arguments of `texsim tune`.
+#[derive(Args, Debug, Clone)]
+pub struct TuneArgs {
+    /// Built-in scene or scene file (TOML, OBJ); repeat for several: the budget must hold on
+    /// every one.
+    #[arg(long, required = true)]
+    pub scene: Vec<String>,
+    /// METRIC=LIMIT, repeatable, all must hold: max8=N (largest 8-bit channel error),
+    /// within1=P (percent of pixels within 1 LSB, at least), mean8=X (mean absolute error),
+    /// psnr8=DB (at least); against the float reference, or the truth with --truth.
+    #[arg(long, required = true)]
+    pub budget: Vec<String>,
+    /// Fields to search (leaf names or dotted paths, comma list or repeated); default: every
+    /// width and iteration count of the machine.
+    #[arg(long, value_delimiter = ',')]
+    pub knob: Vec<String>,
+    /// The widest machine (the knobs' upper bounds): a preset or a hw TOML file.
+    #[arg(long, default_value = "texram16")]
+    pub hw: String,
+    /// Render every scene at WxH (e.g. 320x240) instead of its own size.
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Compare the hardware against the ground truth (N x N sub-samples per pixel; --truth
+    /// alone: 16) instead of the float reference.
+    #[arg(long, default_value_t = 0, num_args = 0..=1, default_missing_value = "16",
+          value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub truth: u32,
+    /// Output directory.
+    #[arg(long, default_value = "out/tune")]
+    pub out: PathBuf,
+}
+
 #[derive(Args, Debug, Clone)]
 pub struct CyclesArgs {
     #[command(flatten)]
@@ -420,6 +456,7 @@ pub fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Some(Command::Sweep(a)) => sweep_cmd(&a),
+        Some(Command::Tune(a)) => crate::tune_cli::tune_cmd(&a),
         Some(Command::Hw {
             cmd: HwCmd::Show { preset },
         }) => {

@@ -55,6 +55,8 @@ pub mod scene;
 pub mod shading;
 pub mod summary;
 pub mod timing;
+pub mod tune;
+pub mod tune_cli;
 pub mod vectors;
 pub mod warnings;
 

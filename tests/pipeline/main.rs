@@ -23,3 +23,4 @@ mod raster_watertight;
 mod render_pipeline;
 mod roughness_scene;
 mod timing_golden;
+mod tune_search;
