@@ -309,6 +309,12 @@ pub struct RenderArgs {
     /// --truth.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub truth_samples: Option<u32>,
+    /// Range instrumentation: per stage and signal the least and largest value the float
+    /// reference computes, the values outside the declared format, and the integer bits each
+    /// signal needs; printed and written to summary.json (`stats.ranges`). An extra float
+    /// pass: without the flag nothing is counted.
+    #[arg(long)]
+    pub ranges: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -446,6 +452,7 @@ pub fn run(cli: Cli) -> Result<()> {
             no_cycles: false,
             truth: false,
             truth_samples: None,
+            ranges: false,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -576,6 +583,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
             0
         },
         progress: Some(progress_line),
+        ranges: a.ranges,
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
     let t = std::time::Instant::now();
@@ -611,6 +619,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let written = out.write_to(&a.scene.out)?;
     progress_line("writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
+    if let Some(rg) = &r.stats.ranges {
+        print!("{}", crate::render::ranges::table(rg, &r.stats.stages));
+    }
     for w in &r.stats.warnings {
         eprintln!("warning: {w}");
     }

@@ -253,6 +253,9 @@ pub struct TuneResult {
     pub base_area_ge: u64,
     /// The index into `trials` of the verified best point.
     pub best: usize,
+    /// Per knob: whether its least value changed some metric of some scene (false: the
+    /// scenes do not exercise it, so it went to its least value at no error).
+    pub exercised: Vec<bool>,
     /// The found machine (`name = "tuned"`).
     #[serde(skip)]
     pub machine: HwConfig,
@@ -689,6 +692,7 @@ pub fn tune(spec: &TuneSpec, progress: &mut dyn FnMut(&Trial)) -> Result<TuneRes
         grid_renders,
         base_area_ge: s.trials[base_t].area_ge,
         best: v,
+        exercised: sensitive,
         trials: s.trials,
         machine: found,
     })

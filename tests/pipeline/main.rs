@@ -16,6 +16,7 @@ mod bump_hard_cases;
 mod bump_pipeline;
 mod determinism;
 mod ndf_pipeline;
+mod range_instrumentation;
 mod raster_parallel;
 mod raster_robust;
 mod raster_rules;
