@@ -12,4 +12,5 @@ mod cli;
 mod ndf_cli;
 mod roughness_cli;
 mod timing_cli;
+mod tune_cli;
 mod vectors_cli;
