@@ -11,6 +11,7 @@ mod bump_cli;
 mod cli;
 mod ndf_cli;
 mod roughness_cli;
+mod sweep_usability;
 mod timing_cli;
 mod tune_cli;
 mod vectors_cli;
