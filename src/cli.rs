@@ -33,6 +33,13 @@ pub enum Command {
     Scenes,
     /// Render once per setting of one or more HwConfig fields; print and write the table.
     Sweep(SweepArgs),
+    /// Find the narrowest machine (least area) that keeps every --scene within every
+    /// --budget: per-knob bisection, a greedy descent trading bits, a verified final run;
+    /// writes tune.json, tune.csv and tuned.toml (a hw file for --hw) into --out.
+    Tune(TuneArgs),
+    /// Join the shards of a sweep (`sweep --shard K/N`) into one sweep.json, sweep.csv and
+    /// table, in grid order; every shard and every grid row must be present once.
+    Merge(MergeArgs),
     /// Hardware configurations.
     Hw {
         #[command(subcommand)]
@@ -343,6 +350,12 @@ pub struct RenderArgs {
     /// --truth.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub truth_samples: Option<u32>,
+    /// Range instrumentation: per stage and signal the least and largest value the float
+    /// reference computes, the values outside the declared format, and the integer bits each
+    /// signal needs; printed and written to summary.json (`stats.ranges`). An extra float
+    /// pass: without the flag nothing is counted.
+    #[arg(long)]
+    pub ranges: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -366,6 +379,65 @@ pub struct SweepArgs {
     #[arg(long, default_value_t = 0, num_args = 0..=1, default_missing_value = "16",
           value_parser = clap::value_parser!(u32).range(0..=64))]
     pub truth: u32,
+    /// Ground-truth sub-samples per pixel axis, as on `render` (`--truth --truth-samples 4`
+    /// is `--truth 4`); only with --truth.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub truth_samples: Option<u32>,
+    /// Stages every row runs in float (as on `render`).
+    #[arg(long, value_delimiter = ',')]
+    pub float: Vec<String>,
+    /// Run only this stage in fixed point in every row (all others float): how the swept
+    /// field changes the error of that stage alone (as on `render`).
+    #[arg(long, conflicts_with = "float")]
+    pub isolate: Option<String>,
+    /// Render only shard K of N (K in 1..=N): grid rows K-1, K-1+N, ...; writes
+    /// sweep-shard-K-of-N.json and .csv into --out for `texsim merge`. `--shard N` takes K
+    /// from a Slurm array: SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN (default 0) + 1.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+}
+
+/// Arguments of `texsim merge`.
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// Shard files (sweep-shard-K-of-N.json) or directories holding them.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output directory of sweep.json and sweep.csv [default: the first shard's directory].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Arguments of `texsim tune`.
+#[derive(Args, Debug, Clone)]
+pub struct TuneArgs {
+    /// Built-in scene or scene file (TOML, OBJ); repeat for several: the budget must hold on
+    /// every one.
+    #[arg(long, required = true)]
+    pub scene: Vec<String>,
+    /// METRIC=LIMIT, repeatable, all must hold: max8=N (largest 8-bit channel error),
+    /// within1=P (percent of pixels within 1 LSB, at least), mean8=X (mean absolute error),
+    /// psnr8=DB (at least); against the float reference, or the truth with --truth.
+    #[arg(long, required = true)]
+    pub budget: Vec<String>,
+    /// Fields to search (leaf names or dotted paths, comma list or repeated); default: every
+    /// width and iteration count of the machine.
+    #[arg(long, value_delimiter = ',')]
+    pub knob: Vec<String>,
+    /// The widest machine (the knobs' upper bounds): a preset or a hw TOML file.
+    #[arg(long, default_value = "texram16")]
+    pub hw: String,
+    /// Render every scene at WxH (e.g. 320x240) instead of its own size.
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Compare the hardware against the ground truth (N x N sub-samples per pixel; --truth
+    /// alone: 16) instead of the float reference.
+    #[arg(long, default_value_t = 0, num_args = 0..=1, default_missing_value = "16",
+          value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub truth: u32,
+    /// Output directory.
+    #[arg(long, default_value = "out/tune")]
+    pub out: PathBuf,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -448,6 +520,7 @@ pub fn run(cli: Cli) -> Result<()> {
             no_cycles: false,
             truth: false,
             truth_samples: None,
+            ranges: false,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -458,6 +531,8 @@ pub fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Some(Command::Sweep(a)) => sweep_cmd(&a),
+        Some(Command::Tune(a)) => crate::tune_cli::tune_cmd(&a),
+        Some(Command::Merge(a)) => merge_cmd(&a),
         Some(Command::Hw {
             cmd: HwCmd::Show { preset },
         }) => {
@@ -527,12 +602,17 @@ impl SceneArgs {
 }
 
 fn impls_from(a: &RenderArgs) -> Result<StageImpls> {
-    if let Some(s) = &a.isolate {
+    stage_impls(a.isolate.as_deref(), &a.float)
+}
+
+/// The twins of `--isolate STAGE` or `--float A,B` (render and sweep).
+fn stage_impls(isolate: Option<&str>, float: &[String]) -> Result<StageImpls> {
+    if let Some(s) = isolate {
         let k = StageKind::parse(s).map_err(|e| e.context("--isolate"))?;
         return Ok(StageImpls::FLOAT.with(k, Impl::Fixed));
     }
     let mut im = StageImpls::FIXED;
-    for s in &a.float {
+    for s in float {
         let k = StageKind::parse(s).map_err(|e| e.context("--float"))?;
         im = im.with(k, Impl::Float);
     }
@@ -582,6 +662,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
             0
         },
         progress: Some(progress_line),
+        ranges: a.ranges,
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
     let t = std::time::Instant::now();
@@ -617,6 +698,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let written = out.write_to(&a.scene.out)?;
     progress_line("writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
+    if let Some(rg) = &r.stats.ranges {
+        print!("{}", crate::render::ranges::table(rg, &r.stats.stages));
+    }
     for w in &r.stats.warnings {
         eprintln!("warning: {w}");
     }
@@ -792,6 +876,45 @@ pub fn parse_axis(s: &str) -> Result<Axis> {
     Ok(Axis { field, values })
 }
 
+/// Refuses axes that would overwrite each other: a `hw` axis after another axis (it
+/// replaces the whole machine, so the earlier axis's values would be lost and its rows
+/// identical), a second `hw` axis, or two axes on the same field.
+pub fn check_axes(base: &HwConfig, axes: &[Axis]) -> Result<()> {
+    let fields = hwconfig::fields(base);
+    let path = |name: &str| -> String {
+        let name = if name == "frame" { "frame_kind" } else { name };
+        fields
+            .iter()
+            .find(|(p, _)| p == name || p.rsplit('.').next() == Some(name))
+            .map_or_else(|| name.to_string(), |(p, _)| p.clone())
+    };
+    for (i, ax) in axes.iter().enumerate() {
+        if ax.field == "hw" && i > 0 {
+            return Err(Error::field(
+                "--vary",
+                format!(
+                    "'hw' comes after --vary {}: it replaces the whole machine and would overwrite that axis (its rows would be identical); give --vary hw=... first",
+                    axes[i - 1].field
+                ),
+            ));
+        }
+        for prev in &axes[..i] {
+            if ax.field != "hw" && path(&prev.field) == path(&ax.field) {
+                return Err(Error::field(
+                    "--vary",
+                    format!(
+                        "'{}' and '{}' both set {}: the later axis would overwrite the earlier one",
+                        prev.field,
+                        ax.field,
+                        path(&ax.field)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Most values of one `--vary` range.
 pub const MAX_AXIS_VALUES: u64 = 4097;
 
@@ -828,13 +951,39 @@ pub fn grid(axes: &[Axis]) -> Result<Vec<Vec<(String, String)>>> {
 }
 
 fn sweep_cmd(a: &SweepArgs) -> Result<()> {
+    if a.truth_samples.is_some() && a.truth == 0 {
+        return Err(Error::field(
+            "--truth-samples",
+            "only means something with --truth (add --truth, or drop --truth-samples)",
+        ));
+    }
+    let truth = a.truth_samples.unwrap_or(a.truth);
+    let impls = stage_impls(a.isolate.as_deref(), &a.float)?;
     let (sc, base) = a.scene.load()?;
     let axes: Vec<Axis> = a
         .vary
         .iter()
         .map(|s| parse_axis(s))
         .collect::<Result<_>>()?;
-    let settings = grid(&axes)?;
+    check_axes(&base, &axes)?;
+    let shard = a
+        .shard
+        .as_deref()
+        .map(|s| {
+            crate::sweep_shard::Shard::parse(
+                s,
+                std::env::var("SLURM_ARRAY_TASK_ID").ok().as_deref(),
+                std::env::var("SLURM_ARRAY_TASK_MIN").ok().as_deref(),
+            )
+        })
+        .transpose()?;
+    let grid_total = grid_rows(&axes);
+    let (grid_index, settings): (Vec<u64>, Vec<_>) = grid(&axes)?
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| (i as u64, r))
+        .filter(|(i, _)| shard.map_or(true, |s| s.owns(*i)))
+        .unzip();
     // Validate every setting before rendering anything.
     let configs: Vec<HwConfig> = settings
         .iter()
@@ -855,6 +1004,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     }
     let mut maps = Maps::new(&sc, base.trilinear.texel_bits);
     let mut rows = Vec::with_capacity(configs.len());
+    let mut worst_pixels = Vec::with_capacity(configs.len());
     for (i, (cfg, set)) in configs.iter().zip(&settings).enumerate() {
         let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
         eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
@@ -862,7 +1012,8 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
         let opts = RenderOptions {
             timing,
-            truth: a.truth,
+            truth,
+            hw_impls: impls,
             ..RenderOptions::default()
         };
         let r = render(&sc, &maps, cfg, &opts)?;
@@ -870,6 +1021,19 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             eprintln!("  warning: {w}");
         }
         let row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        let worst = r
+            .ref_image
+            .as_ref()
+            .and_then(|re| crate::sweep_shard::worst_pixel(&r.hw_image, re, &r.mask));
+        if let Some(w) = &worst {
+            if w.error_lsb > 0 {
+                eprintln!(
+                    "  worst pixel ({}, {}): {} LSB, hw {:?} vs reference {:?}",
+                    w.x, w.y, w.error_lsb, w.hw, w.reference
+                );
+            }
+        }
+        worst_pixels.push(worst);
         let varies_frame = set
             .iter()
             .any(|(f, _)| f == "frame" || f == "frame_kind" || f.ends_with(".frame_kind"));
@@ -897,26 +1061,66 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let table = crate::summary::sweep_table(&rows);
     print!("{table}");
     let mut out = OutputSet::new();
-    out.add("sweep.csv", crate::summary::sweep_csv(&rows)?.into_bytes());
+    let csv_name = shard.map_or_else(|| "sweep.csv".to_string(), |s| s.file("csv"));
+    out.add(&csv_name, crate::summary::sweep_csv(&rows)?.into_bytes());
     // Each row carries its provenance and the full configuration it ran on.
     let prov = crate::provenance::Provenance::of_process();
     let json_rows = rows
         .iter()
         .zip(&configs)
-        .map(|(row, cfg)| {
+        .zip(worst_pixels.iter().zip(&grid_index))
+        .map(|((row, cfg), (worst, gi))| {
             let mut v = serde_json::to_value(row).map_err(|e| Error::msg(e.to_string()))?;
             if let Some(o) = v.as_object_mut() {
                 o.insert("hw_config".into(), serde_json::json!(cfg));
                 o.insert("provenance".into(), serde_json::json!(&prov));
+                o.insert("worst_pixel".into(), serde_json::json!(worst));
+                if shard.is_some() {
+                    o.insert("grid_index".into(), serde_json::json!(gi));
+                }
             }
             Ok(v)
         })
         .collect::<Result<Vec<_>>>()?;
+    let json = match shard {
+        None => serde_json::to_vec_pretty(&json_rows),
+        Some(s) => serde_json::to_vec_pretty(&serde_json::json!({
+            "shard": s.index,
+            "shards": s.count,
+            "grid_rows": grid_total,
+            "rows": json_rows,
+        })),
+    }
+    .map_err(|e| Error::msg(e.to_string()))?;
     out.add(
-        "sweep.json",
-        serde_json::to_vec_pretty(&json_rows).map_err(|e| Error::msg(e.to_string()))?,
+        &shard.map_or_else(|| "sweep.json".to_string(), |s| s.file("json")),
+        json,
     );
     for p in out.write_to(&a.scene.out)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn merge_cmd(a: &MergeArgs) -> Result<()> {
+    let files = crate::sweep_shard::shard_files(&a.inputs)?;
+    let m = crate::sweep_shard::merge(&files)?;
+    print!("{}", crate::summary::sweep_table(&m.rows));
+    let mut out = OutputSet::new();
+    out.add(
+        "sweep.csv",
+        crate::summary::sweep_csv(&m.rows)?.into_bytes(),
+    );
+    out.add(
+        "sweep.json",
+        serde_json::to_vec_pretty(&m.json_rows).map_err(|e| Error::msg(e.to_string()))?,
+    );
+    let dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| crate::sweep_shard::default_out(&files));
+    println!("merged {} shard files, {} rows", files.len(), m.rows.len());
+    for p in out.write_to(&dir)? {
         println!("wrote {}", p.display());
     }
     Ok(())

@@ -57,7 +57,10 @@ pub mod rng;
 pub mod scene;
 pub mod shading;
 pub mod summary;
+pub mod sweep_shard;
 pub mod timing;
+pub mod tune;
+pub mod tune_cli;
 pub mod vectors;
 pub mod warnings;
 

@@ -170,7 +170,7 @@ fn imp_name(i: crate::pipeline::Impl) -> &'static str {
 }
 
 /// One unit's cost in a sweep row: critical path (gate levels), latency (cycles), area (GE).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct UnitCost {
     pub delay: u32,
     pub latency: u32,
@@ -178,7 +178,7 @@ pub struct UnitCost {
 }
 
 /// One row of a sweep: the settings, the error against the reference, the cost.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct SweepRow {
     pub settings: Vec<(String, String)>,
     pub error_8bit: Option<ErrorMetrics>,

@@ -13,6 +13,7 @@
 //! measured); maps come prepared from [`crate::maps`], visibility from [`crate::raster`].
 
 mod geometry;
+pub mod ranges;
 mod shading;
 mod stats;
 
@@ -66,6 +67,8 @@ pub struct RenderOptions {
     /// Called once per finished phase (setup, raster, hardware shading, reference shading,
     /// ground truth) with its name and wall time in ms (`texsim render` prints them).
     pub progress: Option<fn(&str, f64)>,
+    /// Also run the range-instrumented float pass ([`ranges`]): `RenderStats::ranges`.
+    pub ranges: bool,
 }
 
 impl Default for RenderOptions {
@@ -77,6 +80,7 @@ impl Default for RenderOptions {
             timing: false,
             truth: 0,
             progress: None,
+            ranges: false,
         }
     }
 }
@@ -271,6 +275,7 @@ pub fn render(
         e16 = Some(compare(&hw_image, &img, 16, Some(&mask)));
         ref_image = Some(img);
     }
+    let ranges = opts.ranges.then(|| ranges::measure(&inp));
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
     let has_env = geo.plans.iter().any(|p| p.env.is_some());
@@ -402,6 +407,7 @@ pub fn render(
             error_8bit: e8,
             error_16bit: e16,
             roughness,
+            ranges,
             warnings: {
                 warnings.extend(crate::warnings::depth_warning(
                     scene,

@@ -120,7 +120,7 @@ pub(super) struct ShadeInput<'a> {
 /// shaded fragment (a no-op closure compiles to the plain loop; the timing model records its
 /// events through it, from the footprints the stages traced when `trace`).
 #[allow(clippy::too_many_arguments)]
-fn shade_row(
+pub(super) fn shade_row(
     inp: &ShadeInput,
     progs: &[Program],
     y: usize,

@@ -191,6 +191,10 @@ pub struct RenderStats {
     /// the hardware against the float reference (quantization), 8-bit LSBs.
     pub model_error: Option<ErrorMetrics>,
     pub quantization_error: Option<ErrorMetrics>,
+    /// `render --ranges`: per stage and signal, the range the float reference computes
+    /// (`render::ranges`); absent without it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ranges: Option<Vec<super::ranges::SignalRange>>,
     /// Results that are valid but probably not what was meant (`crate::warnings`).
     pub warnings: Vec<String>,
 }

@@ -20,7 +20,7 @@ pub const HISTOGRAM_BUCKETS: [(&str, u32); 8] = [
 ];
 
 /// Comparison of two images (see the module docs for definitions).
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ErrorMetrics {
     /// Pixels compared (inside the mask and inside both images).
     pub pixels: u64,

@@ -13,5 +13,7 @@ mod fournier_cli;
 mod filters_cli;
 mod ndf_cli;
 mod roughness_cli;
+mod sweep_usability;
 mod timing_cli;
+mod tune_cli;
 mod vectors_cli;

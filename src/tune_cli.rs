@@ -1,0 +1,287 @@
+//! `texsim tune` on the command line: parses the arguments, prints every trial as it is
+//! rendered and the verified result, writes tune.json, tune.csv and tuned.toml.
+
+use crate::cli::TuneArgs;
+use crate::report::OutputSet;
+use crate::scene::{self, Scene};
+use crate::tune::{tune, Budget, Trial, TuneResult, TuneSpec};
+use crate::{hwconfig, Error, Result};
+use std::fmt::Write;
+use std::path::Path;
+
+/// Parses `WxH`.
+pub fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let bad = || Error::field("--size", format!("'{s}' is not WxH (e.g. 320x240)"));
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// A built-in scene by name, else a scene file.
+fn load_scene(name: &str, size: Option<(u32, u32)>) -> Result<Scene> {
+    let p = Path::new(name);
+    let mut sc = if p.is_file() {
+        scene::load(p)?
+    } else {
+        scene::builtin(name).map_err(|e| e.context("--scene"))?
+    };
+    if let Some((w, h)) = size {
+        sc.width = w;
+        sc.height = h;
+    }
+    scene::validate(&sc)?;
+    Ok(sc)
+}
+
+/// The knobs of `values` that differ from `from`, as `field=value`.
+fn changed(knobs: &[crate::tune::Knob], values: &[u32], from: &[u32]) -> String {
+    let v: Vec<String> = knobs
+        .iter()
+        .zip(values.iter().zip(from))
+        .filter(|(_, (v, f))| v != f)
+        .map(|(k, (v, _))| format!("{}={v}", leaf(&k.field)))
+        .collect();
+    if v.is_empty() {
+        "-".into()
+    } else {
+        v.join(" ")
+    }
+}
+
+fn leaf(path: &str) -> &str {
+    path.rsplit('.').next().unwrap_or(path)
+}
+
+/// One trial: phase, verdict, area, budget load, errors per scene, then the knobs that
+/// differ from `from` (the previous trial's values; the base for the first).
+fn trial_line(knobs: &[crate::tune::Knob], t: &Trial, from: &[u32]) -> String {
+    let errs: Vec<String> = t
+        .scenes
+        .iter()
+        .map(|e| {
+            format!(
+                "{} max8 {} mean8 {:.4} within1 {:.2}%",
+                e.scene, e.max8, e.mean8, e.within1_pct
+            )
+        })
+        .collect();
+    format!(
+        "#{:<4} {:<8} {:<4} area {:>8} GE  load {:>7.3}  {}  | {}",
+        t.index,
+        t.phase,
+        if t.meets { "ok" } else { "miss" },
+        t.area_ge,
+        t.load(),
+        errs.join("; "),
+        changed(knobs, &t.values, from)
+    )
+}
+
+/// The trials as CSV: index, phase, meets, complete, area, total bits, every knob's value,
+/// then per scene its metrics and budget load.
+pub fn tune_csv(r: &TuneResult) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let err = |e: csv::Error| Error::msg(format!("tune.csv: {e}"));
+    let mut head: Vec<String> = [
+        "index",
+        "phase",
+        "meets",
+        "complete",
+        "area_ge",
+        "total_bits",
+    ]
+    .iter()
+    .map(|s| (*s).to_string())
+    .collect();
+    head.extend(r.knobs.iter().map(|k| k.field.clone()));
+    for sc in &r.scenes {
+        for m in ["max8", "mean8", "within1_pct", "psnr8_db", "load"] {
+            head.push(format!("{sc}.{m}"));
+        }
+    }
+    w.write_record(&head).map_err(err)?;
+    for t in &r.trials {
+        let mut rec = vec![
+            t.index.to_string(),
+            t.phase.to_string(),
+            t.meets.to_string(),
+            t.complete.to_string(),
+            t.area_ge.to_string(),
+            t.total_bits.to_string(),
+        ];
+        rec.extend(t.values.iter().map(ToString::to_string));
+        for sc in &r.scenes {
+            match t.scenes.iter().find(|e| &e.scene == sc) {
+                Some(e) => rec.extend([
+                    e.max8.to_string(),
+                    e.mean8.to_string(),
+                    e.within1_pct.to_string(),
+                    e.psnr8_db.map_or_else(String::new, |p| p.to_string()),
+                    e.load.to_string(),
+                ]),
+                None => rec.extend(std::iter::repeat(String::new()).take(5)),
+            }
+        }
+        w.write_record(&rec).map_err(err)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::msg(format!("tune.csv: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| Error::msg(format!("tune.csv: {e}")))
+}
+
+/// The closing report: renders against the grid, the verified row, the found widths.
+pub fn summary_text(r: &TuneResult, texram16_area: u64) -> String {
+    let mut o = String::new();
+    let best = r.best_trial();
+    let budgets: Vec<String> = r.budgets.iter().map(Budget::label).collect();
+    let _ = writeln!(
+        o,
+        "budget {} (hardware vs {}) on {}",
+        budgets.join(", "),
+        if r.against == "truth" {
+            "ground truth"
+        } else {
+            "float reference"
+        },
+        r.scenes.join(", ")
+    );
+    let _ = writeln!(
+        o,
+        "renders: {} used for {} trials; the full grid of {} knobs is {} points = {} renders",
+        r.renders,
+        r.trials.len(),
+        r.knobs.len(),
+        big(r.grid_points),
+        big(r.grid_renders)
+    );
+    let hi: Vec<u32> = r.knobs.iter().map(|k| k.hi).collect();
+    let _ = writeln!(
+        o,
+        "verified (knobs vs base): {}",
+        trial_line(&r.knobs, best, &hi)
+    );
+    let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
+    let _ = writeln!(
+        o,
+        "area {} GE = {:.1}% of the base machine ({} GE), {:.1}% of texram16 ({} GE)",
+        best.area_ge,
+        pct(best.area_ge, r.base_area_ge),
+        r.base_area_ge,
+        pct(best.area_ge, texram16_area),
+        texram16_area
+    );
+    let _ = writeln!(
+        o,
+        "{:<34} {:>6} {:>6} {:>6}",
+        "knob", "found", "base", "least"
+    );
+    for (k, v) in r.knobs.iter().zip(&best.values) {
+        let _ = writeln!(
+            o,
+            "{:<34} {:>6} {:>6} {:>6}{}",
+            k.field,
+            v,
+            k.hi,
+            k.lo,
+            if *v == k.hi { "" } else { "  *" }
+        );
+    }
+    o
+}
+
+/// A count, in scientific notation when large.
+fn big(n: f64) -> String {
+    if n >= 1e9 {
+        format!("{n:.2e}")
+    } else {
+        format!("{n:.0}")
+    }
+}
+
+/// Runs `texsim tune`.
+pub fn tune_cmd(a: &TuneArgs) -> Result<()> {
+    let size = a.size.as_deref().map(parse_size).transpose()?;
+    let budgets = a
+        .budget
+        .iter()
+        .map(|b| Budget::parse(b))
+        .collect::<Result<Vec<_>>>()?;
+    let base = hwconfig::resolve(&a.hw).map_err(|e| e.context("--hw"))?;
+    let scenes = a
+        .scene
+        .iter()
+        .map(|s| load_scene(s, size))
+        .collect::<Result<Vec<_>>>()?;
+    for sc in &scenes {
+        crate::budget::check_run(sc, &base, true, true)?;
+        for w in &sc.warnings {
+            eprintln!("warning: scene '{}': {w}", sc.name);
+        }
+    }
+    let spec = TuneSpec {
+        scenes,
+        base,
+        budgets,
+        knobs: a.knob.clone(),
+        truth: a.truth,
+    };
+    let knobs = if spec.knobs.is_empty() {
+        crate::tune::default_knobs(&spec.base)?
+    } else {
+        spec.knobs
+            .iter()
+            .map(|n| crate::tune::knob(&spec.base, n))
+            .collect::<Result<Vec<_>>>()?
+    };
+    eprintln!(
+        "texsim: tuning {} knobs on {} scene(s) from '{}'",
+        knobs.len(),
+        spec.scenes.len(),
+        spec.base.name
+    );
+    let start = std::time::Instant::now();
+    let mut prev: Vec<u32> = knobs.iter().map(|k| k.hi).collect();
+    println!("trials (knobs that differ from the previous trial):");
+    let mut print = |t: &Trial| {
+        println!("{}", trial_line(&knobs, t, &prev));
+        prev.clone_from(&t.values);
+    };
+    let r = tune(&spec, &mut print)?;
+    let texram16_area =
+        hw_model::datapath::total_area(&hw_model::datapath::units(&hw_model::HwConfig::texram16()));
+    print!("{}", summary_text(&r, texram16_area));
+    eprintln!("texsim: tune took {:.1} s", start.elapsed().as_secs_f64());
+    let mut out = OutputSet::new();
+    let mut json = serde_json::to_value(&r).map_err(|e| Error::msg(e.to_string()))?;
+    if let Some(o) = json.as_object_mut() {
+        o.insert("texram16_area_ge".into(), serde_json::json!(texram16_area));
+        o.insert("hw_config".into(), serde_json::json!(&r.machine));
+        o.insert(
+            "provenance".into(),
+            serde_json::json!(crate::provenance::Provenance::of_process()),
+        );
+    }
+    out.add(
+        "tune.json",
+        serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
+    );
+    out.add("tune.csv", tune_csv(&r)?.into_bytes());
+    let budgets: Vec<String> = r.budgets.iter().map(Budget::label).collect();
+    let toml = format!(
+        "# texsim tune: least area meeting {} on {} (vs {}); use with --hw tuned.toml\n{}",
+        budgets.join(", "),
+        r.scenes.join(", "),
+        r.against,
+        hwconfig::to_toml(&r.machine)
+    );
+    out.add("tuned.toml", toml.into_bytes());
+    for p in out.write_to(&a.out)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,130 @@
+//! `texsim tune` and `texsim render --ranges` as users run them.
+
+use crate::cli_common::{texsim, text, tmp};
+
+#[test]
+fn tune_writes_its_trials_and_a_machine_render_accepts() {
+    let d = tmp("tune");
+    let o = texsim(
+        &[
+            "tune",
+            "--scene",
+            "demo",
+            "--budget",
+            "max8=1",
+            "--knob",
+            "weight_bits,texel_bits,lod_frac_bits",
+            "--size",
+            "48x36",
+            "--out",
+            "t",
+        ],
+        &d,
+    );
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("renders: "))
+        .unwrap_or_else(|| panic!("no renders line: {out}"));
+    // "renders: R used for T trials; the full grid of 3 knobs is P points = G renders"
+    let num = |after: &str| -> f64 {
+        let rest = &line[line.find(after).expect(after) + after.len()..];
+        rest.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    let renders = num("renders: ");
+    let grid = num("points = ");
+    // weight_bits 0..=16, texel_bits 1..=16, lod_frac_bits 0..=16.
+    assert_eq!(grid, 17.0 * 16.0 * 17.0, "{line}");
+    assert!(renders > 0.0 && renders < grid / 10.0, "{line}");
+    assert!(out.contains("verified (knobs vs base): #"), "{out}");
+    for f in ["tune.json", "tune.csv", "tuned.toml"] {
+        assert!(d.join("t").join(f).is_file(), "{f}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("t/tune.json")).unwrap()).unwrap();
+    assert_eq!(json["renders"].as_f64(), Some(renders));
+    let best = &json["trials"][json["best"].as_u64().unwrap() as usize];
+    assert_eq!(best["phase"], "verify");
+    assert_eq!(best["meets"], true);
+    let csv = std::fs::read_to_string(d.join("t/tune.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        json["trials"].as_array().unwrap().len() + 1
+    );
+    // The found machine renders within the budget.
+    let r = texsim(
+        &[
+            "render",
+            "--scene",
+            "demo",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--hw",
+            "t/tuned.toml",
+            "--no-cycles",
+            "--out",
+            "r",
+        ],
+        &d,
+    );
+    assert!(r.status.success(), "{}", text(&r));
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("r/summary.json")).unwrap()).unwrap();
+    assert_eq!(s["hw_config"]["name"], "tuned");
+    assert!(s["stats"]["error_8bit"]["max_abs_lsb"].as_u64().unwrap() <= 1);
+}
+
+#[test]
+fn tune_bad_budget_and_knob_fail_with_the_flag_named() {
+    let d = tmp("tune-bad");
+    for (args, want) in [
+        (vec!["--budget", "max9=1"], "--budget"),
+        (
+            vec!["--budget", "max8=1", "--knob", "weight_bit"],
+            "weight_bits",
+        ),
+        (vec!["--budget", "max8=1", "--size", "48"], "--size"),
+    ] {
+        let mut a = vec!["tune", "--scene", "demo"];
+        a.extend(args);
+        let o = texsim(&a, &d);
+        assert!(!o.status.success());
+        assert!(text(&o).contains(want), "{}", text(&o));
+    }
+}
+
+#[test]
+fn render_ranges_prints_and_writes_the_bits_needed() {
+    let d = tmp("ranges");
+    let o = texsim(
+        &[
+            "render",
+            "--scene",
+            "bumps",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--ranges",
+            "--no-cycles",
+            "--out",
+            "o",
+        ],
+        &d,
+    );
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(out.contains("signal ranges"), "{out}");
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("o/summary.json")).unwrap()).unwrap();
+    let rows = s["stats"]["ranges"].as_array().expect("stats.ranges");
+    let perturb = rows
+        .iter()
+        .find(|r| r["signal"] == "normal")
+        .expect("perturbed normal");
+    assert!(perturb["int_bits_needed"].as_u64().unwrap() <= 1);
+    assert!(perturb["max"].as_f64().unwrap() <= 1.0 + 1e-9);
+}
