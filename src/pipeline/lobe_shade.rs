@@ -74,6 +74,9 @@ pub fn plan_lobes(material: &Material, has_uvs: bool) -> Option<Plan> {
         aniso: None,
         rough: None,
         ndf: None,
+        env: None,
+        toksvig: None,
+        lean: None,
         lobes: Some(LobePlan {
             lobes: material
                 .lobes
