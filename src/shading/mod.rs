@@ -6,8 +6,8 @@
 pub mod bump;
 pub mod env;
 pub mod fournier_fit;
-pub mod multi_lobe;
 pub mod lean;
+pub mod multi_lobe;
 pub mod ndf;
 pub mod reference;
 pub mod roughness;
