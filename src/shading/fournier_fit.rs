@@ -427,3 +427,46 @@ pub fn fit_pyramid(
     }
     Ok(levels)
 }
+
+/// The stored lobes of a texel fit in the multi-lobe unit's formats (`hw_model::multi_lobe`):
+/// per lobe its slopes `(x / z, y / z)` in the slope format, its amplitude in the amplitude
+/// format and its exponent rounded to an integer, saturating at `2^lobe_exp_bits - 1` (every
+/// saturation counted in `sat`); `s` is the material's Phong exponent of the conversion.
+#[must_use]
+pub fn quantize_fit(
+    fit: &TexelFit,
+    s: f64,
+    cfg: &hw_model::multi_lobe::MultiLobeConfig,
+    sat: &mut hw_model::SatCounter,
+) -> Vec<hw_model::multi_lobe::Lobe> {
+    use crate::fixedpoint::to_raw;
+    use hw_model::multi_lobe::{amp_format, max_exponent, slope_format, Lobe};
+    let sf = slope_format(cfg);
+    let af = amp_format(cfg);
+    let n_max = f64::from(max_exponent(cfg));
+    fit.lobes
+        .iter()
+        .map(|l| {
+            let p = l.to_phong(s);
+            let d = p.direction;
+            let z = d.z.max(1e-9);
+            let e = p.exponent.round();
+            if e > n_max {
+                sat.saturated += 1;
+            }
+            Lobe {
+                slope: [to_raw(d.x / z, &sf, sat), to_raw(d.y / z, &sf, sat)],
+                amp: to_raw(p.amplitude, &af, sat) as u64,
+                exponent: e.clamp(0.0, n_max) as u32,
+            }
+        })
+        .collect()
+}
+
+/// Bytes per texel of K stored lobes (two slopes, amplitude, exponent per lobe), rounded up.
+#[must_use]
+pub fn bytes_per_texel(k: usize, cfg: &hw_model::multi_lobe::MultiLobeConfig) -> u32 {
+    let slope = 1 + cfg.lobe_slope_int_bits + cfg.lobe_slope_frac_bits;
+    let bits = 2 * slope + 1 + cfg.lobe_amp_bits + cfg.lobe_exp_bits;
+    (k as u32 * bits).div_ceil(8)
+}
