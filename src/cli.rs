@@ -305,6 +305,10 @@ pub struct RenderArgs {
     /// --truth.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub truth_samples: Option<u32>,
+    /// Skip the LDR-FLIP comparison (hardware vs reference: `flip` in summary.json, flip.png),
+    /// which costs about as much as the reference pass.
+    #[arg(long)]
+    pub no_flip: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -328,6 +332,10 @@ pub struct SweepArgs {
     #[arg(long, default_value_t = 0, num_args = 0..=1, default_missing_value = "16",
           value_parser = clap::value_parser!(u32).range(0..=64))]
     pub truth: u32,
+    /// Also compute LDR-FLIP (hardware vs reference) per setting: the flip_mean and flip_p99
+    /// columns (about as costly as the reference pass of each row).
+    #[arg(long)]
+    pub flip: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -410,6 +418,7 @@ pub fn run(cli: Cli) -> Result<()> {
             no_cycles: false,
             truth: false,
             truth_samples: None,
+            no_flip: false,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -547,12 +556,24 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     if a.truth {
         truth_outputs(&sc, &maps, &hw, &mut r, &mut out)?;
     }
+    let t_flip = std::time::Instant::now();
+    let flip = r
+        .ref_image
+        .as_ref()
+        .filter(|_| !a.no_flip)
+        .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)));
+    if let Some(f) = &flip {
+        out.add("flip.png", crate::flip::error_map_png(f, Some(&r.mask))?);
+        progress_line("FLIP", elapsed_ms(t_flip));
+    }
+    let flip_stats = flip.as_ref().map(|f| &f.stats);
     let prov = crate::provenance::Provenance::of_process();
     let json = serde_json::json!({
         "provenance": &prov,
         "scene": &r.stats.scene,
         "hw_config": &hw,
         "stats": &r.stats,
+        "flip": flip_stats,
         "warnings": &sc.warnings,
     });
     out.add(
@@ -574,6 +595,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let written = out.write_to(&a.scene.out)?;
     progress_line("writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
+    if let Some(f) = flip_stats {
+        println!("{}", crate::summary::flip_line(f));
+    }
     for w in &r.stats.warnings {
         eprintln!("warning: {w}");
     }
@@ -601,6 +625,7 @@ pub const RENDER_OUTPUTS: &[&str] = &[
     "ref.png",
     "ref16.png",
     "error.png",
+    "flip.png",
     "sheet.png",
     "truth.png",
     "baseline.png",
@@ -826,7 +851,13 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         for w in &r.stats.warnings {
             eprintln!("  warning: {w}");
         }
-        let row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        row.flip = r
+            .ref_image
+            .as_ref()
+            .filter(|_| a.flip)
+            .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)))
+            .map(|f| f.stats);
         let varies_frame = set
             .iter()
             .any(|(f, _)| f == "frame" || f == "frame_kind" || f.ends_with(".frame_kind"));

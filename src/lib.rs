@@ -41,6 +41,7 @@ pub mod cli;
 pub mod compare;
 pub mod error;
 pub mod fixedpoint;
+pub mod flip;
 pub mod footprint_ref;
 pub mod hwconfig;
 pub mod maps;

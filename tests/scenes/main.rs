@@ -7,6 +7,7 @@
 mod bad_input_files;
 mod bad_input_validate;
 mod bump_scene;
+mod report_flip;
 mod report_images;
 mod report_metrics;
 mod report_output;
