@@ -882,6 +882,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         }
         rows.push(row);
     }
+    crate::pareto::mark_sweep(&mut rows);
     let table = crate::summary::sweep_table(&rows);
     print!("{table}");
     let mut out = OutputSet::new();

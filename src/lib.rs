@@ -41,6 +41,7 @@ pub mod cli;
 pub mod compare;
 pub mod error;
 pub mod fixedpoint;
+pub mod pareto;
 pub mod flip;
 pub mod footprint_ref;
 pub mod hwconfig;

@@ -227,6 +227,10 @@ pub struct SweepRow {
     pub offset_clamped: u64,
     /// LDR-FLIP of the hardware image against the reference (`crate::flip`), set by the sweep.
     pub flip: Option<crate::flip::FlipStats>,
+    /// On the Pareto front of mean 8-bit error vs `area_ge` (`crate::pareto::mark_sweep`).
+    pub pareto_area: bool,
+    /// On the Pareto front of mean 8-bit error vs `cycles` (`None` when a row has no cycles).
+    pub pareto_cycles: Option<bool>,
 }
 
 impl SweepRow {
@@ -284,6 +288,8 @@ impl SweepRow {
             zero_normal: s.bump.zero_normal,
             offset_clamped: s.bump.offset_clamped,
             flip: None,
+            pareto_area: false,
+            pareto_cycles: None,
         }
     }
 }
@@ -510,6 +516,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     if bump {
         head.push(BUMP_HEADER[0].into());
     }
+    head.push("pareto".into());
     grid.push(head);
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
@@ -525,6 +532,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
             let [used, ..] = bump_cells(r);
             line.push(used);
         }
+        line.push(crate::pareto::mark(r).into());
         grid.push(line);
     }
     let ncol = grid[0].len();
@@ -550,7 +558,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 
 /// Columns of `sweep.csv` after the swept fields: the names of `sweep.json`'s row fields
 /// (nested metrics joined with a dot).
-pub const CSV_COLUMNS: [&str; 30] = [
+pub const CSV_COLUMNS: [&str; 32] = [
     "error_8bit.max_abs_lsb",
     "error_8bit.mean_abs_lsb",
     "error_8bit.rmse_lsb",
@@ -581,6 +589,8 @@ pub const CSV_COLUMNS: [&str; 30] = [
     "ref_ms",
     "flip.mean",
     "flip.p99",
+    "pareto_area",
+    "pareto_cycles",
 ];
 
 /// The cells of [`CSV_COLUMNS`] for one row: full precision, empty where the JSON has `null`
@@ -623,6 +633,8 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
         r.ref_ms.to_string(),
         opt(r.flip.as_ref().map(|f| f.mean)),
         opt(r.flip.as_ref().map(|f| f.p99)),
+        r.pareto_area.to_string(),
+        opt(r.pareto_cycles),
     ]
 }
 

@@ -797,6 +797,7 @@ fn sweep_csv_uses_the_json_names_and_empty_cells() {
                     assert!((x - y).abs() <= 1e-12 * y.abs(), "{col}: {x} vs {y}");
                 }
                 serde_json::Value::String(s) => assert_eq!(cell, s, "{col}"),
+                serde_json::Value::Bool(b) => assert_eq!(cell, b.to_string(), "{col}"),
                 other => panic!("{col}: {other} is not a JSON row field"),
             }
         }

@@ -7,7 +7,11 @@
 mod bad_input_files;
 mod bad_input_validate;
 mod bump_scene;
+#[path = "../rng_common/mod.rs"]
+mod rng_common;
+
 mod report_flip;
+mod report_pareto;
 mod report_images;
 mod report_metrics;
 mod report_output;
