@@ -567,6 +567,32 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         progress_line("FLIP", elapsed_ms(t_flip));
     }
     let flip_stats = flip.as_ref().map(|f| &f.stats);
+    let mut rep_row = crate::summary::SweepRow::new(Vec::new(), &r.stats);
+    rep_row.flip = flip_stats.cloned();
+    crate::pareto::mark_sweep(std::slice::from_mut(&mut rep_row));
+    let mut row = report::html::sweep_report_row(&rep_row);
+    row.strip = report::html::render_strip(
+        &r.hw_image,
+        r.ref_image.as_ref(),
+        r.truth_image.as_ref(),
+        &r.mask,
+        flip.as_ref(),
+    )?;
+    let page = report::html::HtmlReport {
+        title: format!("texsim render: {} on {}", sc.name, hw.name),
+        subtitle: format!(
+            "{}x{}, {} triangles, {} covered pixels",
+            sc.width,
+            sc.height,
+            sc.triangle_count(),
+            r.stats.covered_pixels
+        ),
+        rows: vec![row],
+        tables: vec![("Summary".into(), crate::summary::text(&r.stats))],
+        ranges: None,
+        hw_config: hwconfig::to_toml(&hw),
+    };
+    out.add("report.html", report::html::html(&page)?.into_bytes());
     let prov = crate::provenance::Provenance::of_process();
     let json = serde_json::json!({
         "provenance": &prov,
@@ -631,6 +657,7 @@ pub const RENDER_OUTPUTS: &[&str] = &[
     "baseline.png",
     "summary.json",
     "timings.json",
+    "report.html",
 ];
 
 /// Writes truth.png and fills the baseline error: the same scene with every roughness material
@@ -837,6 +864,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     }
     let mut maps = Maps::new(&sc, base.trilinear.texel_bits);
     let mut rows = Vec::with_capacity(configs.len());
+    let mut strips: Vec<Vec<(String, Vec<u8>)>> = Vec::with_capacity(configs.len());
     for (i, (cfg, set)) in configs.iter().zip(&settings).enumerate() {
         let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
         eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
@@ -852,12 +880,19 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             eprintln!("  warning: {w}");
         }
         let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
-        row.flip = r
+        let flip = r
             .ref_image
             .as_ref()
             .filter(|_| a.flip)
-            .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)))
-            .map(|f| f.stats);
+            .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)));
+        row.flip = flip.as_ref().map(|f| f.stats.clone());
+        strips.push(report::html::render_strip(
+            &r.hw_image,
+            r.ref_image.as_ref(),
+            r.truth_image.as_ref(),
+            &r.mask,
+            flip.as_ref(),
+        )?);
         let varies_frame = set
             .iter()
             .any(|(f, _)| f == "frame" || f == "frame_kind" || f.ends_with(".frame_kind"));
@@ -881,6 +916,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             eprintln!("  no cycles: {why}");
         }
         rows.push(row);
+        keep_report_strips(&mut rows, &mut strips);
     }
     crate::pareto::mark_sweep(&mut rows);
     let table = crate::summary::sweep_table(&rows);
@@ -905,10 +941,48 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         "sweep.json",
         serde_json::to_vec_pretty(&json_rows).map_err(|e| Error::msg(e.to_string()))?,
     );
+    let page = report::html::HtmlReport {
+        title: format!("texsim sweep: {} on {}", sc.name, base.name),
+        subtitle: format!(
+            "{}x{}; {} settings: {}",
+            sc.width,
+            sc.height,
+            rows.len(),
+            a.vary.join(" ")
+        ),
+        rows: rows
+            .iter()
+            .zip(strips)
+            .map(|(r, strip)| report::html::ReportRow {
+                strip,
+                ..report::html::sweep_report_row(r)
+            })
+            .collect(),
+        tables: vec![("Sweep table".into(), table)],
+        ranges: None,
+        hw_config: hwconfig::to_toml(&base),
+    };
+    out.add("report.html", report::html::html(&page)?.into_bytes());
     for p in out.write_to(&a.scene.out)? {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Bounds the image strips a sweep keeps for report.html: once more than twice
+/// `MAX_STRIPS` rows hold one, the rows past the first `MAX_STRIPS` that are off the Pareto
+/// fronts so far drop theirs (a dominated row stays dominated as rows are added).
+fn keep_report_strips(rows: &mut [crate::summary::SweepRow], strips: &mut [Vec<(String, Vec<u8>)>]) {
+    let max = report::html::MAX_STRIPS;
+    if strips.iter().filter(|s| !s.is_empty()).count() <= 2 * max {
+        return;
+    }
+    crate::pareto::mark_sweep(rows);
+    for (i, (r, s)) in rows.iter().zip(strips.iter_mut()).enumerate() {
+        if i >= max && !r.pareto_area && r.pareto_cycles != Some(true) {
+            s.clear();
+        }
+    }
 }
 
 fn brdf_model(p: &BrdfParams) -> Result<crate::brdf::ashikhmin_shirley::AshikhminShirley> {
