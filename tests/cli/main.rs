@@ -10,6 +10,7 @@ mod as_cli;
 mod bump_cli;
 mod cli;
 mod ndf_cli;
+mod report_cli;
 mod roughness_cli;
 mod timing_cli;
 mod vectors_cli;
