@@ -972,7 +972,10 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
 /// Bounds the image strips a sweep keeps for report.html: once more than twice
 /// `MAX_STRIPS` rows hold one, the rows past the first `MAX_STRIPS` that are off the Pareto
 /// fronts so far drop theirs (a dominated row stays dominated as rows are added).
-fn keep_report_strips(rows: &mut [crate::summary::SweepRow], strips: &mut [Vec<(String, Vec<u8>)>]) {
+fn keep_report_strips(
+    rows: &mut [crate::summary::SweepRow],
+    strips: &mut [Vec<(String, Vec<u8>)>],
+) {
     let max = report::html::MAX_STRIPS;
     if strips.iter().filter(|s| !s.is_empty()).count() <= 2 * max {
         return;

@@ -64,7 +64,7 @@ pub fn flip(test: &Image, reference: &Image, mask: Option<&[bool]>) -> Option<Fl
     let mut pooled: Vec<f32> = map
         .iter()
         .enumerate()
-        .filter(|(i, _)| mask.map_or(true, |m| m.get(*i).copied().unwrap_or(false)))
+        .filter(|(i, _)| mask.is_none_or(|m| m.get(*i).copied().unwrap_or(false)))
         .map(|(_, &v)| if v.is_finite() { v } else { 1.0 })
         .collect();
     if pooled.is_empty() {
@@ -100,7 +100,7 @@ pub fn error_map_rgba8(f: &Flip, mask: Option<&[bool]>) -> Vec<u8> {
     rgb.chunks_exact(3)
         .enumerate()
         .flat_map(|(i, p)| {
-            if mask.map_or(true, |m| m.get(i).copied().unwrap_or(false)) {
+            if mask.is_none_or(|m| m.get(i).copied().unwrap_or(false)) {
                 [p[0], p[1], p[2], 255]
             } else {
                 let [r, g, b] = crate::report::MASKED_RGB;

@@ -157,10 +157,7 @@ pub fn render_strip(
         let heat = heatmap(hw, rf, 8, Some(mask));
         let (w, h) = (heat.width(), heat.height());
         // The heatmap is opaque: its premultiplied bytes are its straight ones.
-        s.push((
-            "error (8-bit LSB)".into(),
-            thumbnail(heat.data(), w, h)?,
-        ));
+        s.push(("error (8-bit LSB)".into(), thumbnail(heat.data(), w, h)?));
     }
     if let Some(f) = flip {
         let rgba = crate::flip::error_map_rgba8(f, Some(mask));
@@ -226,7 +223,7 @@ struct Pt {
 const CW: f64 = 440.0;
 const CH: f64 = 270.0;
 const ML: f64 = 62.0;
-const MR: f64 = 14.0;
+const MR: f64 = 30.0;
 const MT: f64 = 12.0;
 const MB: f64 = 44.0;
 
@@ -263,7 +260,11 @@ fn chart(
     };
     let (y0, y1) = {
         let (lo, hi) = span(pts.iter().map(|p| p.y));
-        let y0 = if pts.iter().all(|p| p.y >= 0.0) { 0.0 } else { lo };
+        let y0 = if pts.iter().all(|p| p.y >= 0.0) {
+            0.0
+        } else {
+            lo
+        };
         (y0, hi.max(y0 + 1e-9))
     };
     let sx = |x: f64| ML + (x - x0) / (x1 - x0) * (CW - ML - MR);
@@ -304,8 +305,17 @@ fn chart(
             }
         }
         None => {
-            for k in 0..=4 {
-                let x = x0 + (x1 - x0) * f64::from(k) / 4.0;
+            // A knob's own values when few (integers: its widths), else five even ticks.
+            let mut xs: Vec<f64> = pts.iter().map(|p| p.x).collect();
+            xs.sort_by(f64::total_cmp);
+            xs.dedup();
+            let own = !front && xs.len() <= 12 && xs.iter().all(|x| x.fract() == 0.0);
+            if !own {
+                xs = (0..=4)
+                    .map(|k| x0 + (x1 - x0) * f64::from(k) / 4.0)
+                    .collect();
+            }
+            for x in xs {
                 let _ = write!(
                     s,
                     r#"<text class="tick" x="{:.1}" y="{}" text-anchor="middle">{}</text>"#,
@@ -551,7 +561,11 @@ fn rows_table(rows: &[ReportRow]) -> String {
             opt(r.cycles)
         );
         for m in &metric_names {
-            let v = r.metrics.iter().find(|(n, _)| n == *m).and_then(|(_, v)| *v);
+            let v = r
+                .metrics
+                .iter()
+                .find(|(n, _)| n == *m)
+                .and_then(|(_, v)| *v);
             let _ = write!(s, "<td>{}</td>", opt(v));
         }
         s.push_str("</tr>");
@@ -571,7 +585,10 @@ pub fn html(rep: &HtmlReport) -> Result<String> {
                 "cost-cycles" => "cycles".to_string(),
                 _ => {
                     let ki: usize = id.trim_start_matches("knob-").parse().unwrap_or(0);
-                    format!("knob:{}", knobs(&rep.rows).get(ki).cloned().unwrap_or_default())
+                    format!(
+                        "knob:{}",
+                        knobs(&rep.rows).get(ki).cloned().unwrap_or_default()
+                    )
                 }
             };
             serde_json::json!({ "id": id, "key": key })
@@ -593,9 +610,9 @@ pub fn html(rep: &HtmlReport) -> Result<String> {
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>\n",
         esc(&rep.title)
     );
-    let _ = write!(
+    let _ = writeln!(
         s,
-        "<h1>{}</h1><p>{}</p><p id=\"texsim-check\" data-ok=\"pending\">charts not checked (script did not run)</p><div id=\"texsim-errors\"></div>\n",
+        "<h1>{}</h1><p>{}</p><p id=\"texsim-check\" data-ok=\"pending\">charts not checked (script did not run)</p><div id=\"texsim-errors\"></div>",
         esc(&rep.title),
         esc(&rep.subtitle)
     );
@@ -630,7 +647,11 @@ pub fn html(rep: &HtmlReport) -> Result<String> {
     }
     for i in with_strip {
         let r = &rep.rows[i];
-        let _ = write!(s, "<h3>#{i} {}</h3><div class=\"strip\">", esc(&label(r, i)));
+        let _ = write!(
+            s,
+            "<h3>#{i} {}</h3><div class=\"strip\">",
+            esc(&label(r, i))
+        );
         for (cap, png) in &r.strip {
             let b64 = base64::engine::general_purpose::STANDARD.encode(png);
             let _ = write!(

@@ -63,7 +63,9 @@ fn console_lines(log: &str) -> Vec<&str> {
 
 /// The text of the element with `id` (up to its first child tag or end tag).
 fn element_text<'a>(dom: &'a str, id: &str) -> &'a str {
-    let start = dom.find(&format!("id=\"{id}\"")).unwrap_or_else(|| panic!("no #{id}"));
+    let start = dom
+        .find(&format!("id=\"{id}\""))
+        .unwrap_or_else(|| panic!("no #{id}"));
     let open_end = start + dom[start..].find('>').unwrap() + 1;
     let close = open_end + dom[open_end..].find('<').unwrap();
     &dom[open_end..close]
@@ -89,12 +91,23 @@ fn chart_points(dom: &str, id: &str) -> usize {
 fn check_report(page: &Path, profile: &Path) -> serde_json::Value {
     let html = std::fs::read_to_string(page).unwrap();
     // Self-contained: no external resource.
-    for bad in ["src=\"http", "href=\"http", "<link", "<script src", "@import", "url(http"] {
+    for bad in [
+        "src=\"http",
+        "href=\"http",
+        "<link",
+        "<script src",
+        "@import",
+        "url(http",
+    ] {
         assert!(!html.contains(bad), "report.html refers outside: {bad}");
     }
     let json = page_json(&html);
     let (dom, log) = chromium_dump(page, profile);
-    assert!(console_lines(&log).is_empty(), "console: {:?}", console_lines(&log));
+    assert!(
+        console_lines(&log).is_empty(),
+        "console: {:?}",
+        console_lines(&log)
+    );
     assert_eq!(element_text(&dom, "texsim-errors"), "", "script errors");
     let check = element_text(&dom, "texsim-check");
     assert!(check.starts_with("ok: "), "page check: {check}");
@@ -109,11 +122,7 @@ fn check_report(page: &Path, profile: &Path) -> serde_json::Value {
             .filter(|r| {
                 !r["error"].is_null()
                     && match key.strip_prefix("knob:") {
-                        Some(k) => r["settings"]
-                            .as_array()
-                            .unwrap()
-                            .iter()
-                            .any(|s| s[0] == k),
+                        Some(k) => r["settings"].as_array().unwrap().iter().any(|s| s[0] == k),
                         None => !r[key].is_null(),
                     }
             })
@@ -139,14 +148,28 @@ fn sweep_and_render_reports_render_in_chromium() {
     let d = tmp("chromium");
     let o = texsim(
         &[
-            "sweep", "--scene", "sphere", "--width", "64", "--height", "48", "--vary",
-            "weight_bits=2..5", "--vary", "texel_bits=6,8", "--flip", "--out", "s",
+            "sweep",
+            "--scene",
+            "sphere",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--vary",
+            "weight_bits=2..5",
+            "--vary",
+            "texel_bits=6,8",
+            "--flip",
+            "--out",
+            "s",
         ],
         &d,
     );
     assert!(o.status.success(), "{}", text(&o));
     let o = texsim(
-        &["render", "--scene", "sphere", "--width", "64", "--height", "48", "--out", "r"],
+        &[
+            "render", "--scene", "sphere", "--width", "64", "--height", "48", "--out", "r",
+        ],
         &d,
     );
     assert!(o.status.success(), "{}", text(&o));
@@ -164,7 +187,11 @@ fn sweep_and_render_reports_render_in_chromium() {
         .collect();
     assert_eq!(charts, ["knob-0", "knob-1", "cost-area", "cost-cycles"]);
     let html = std::fs::read_to_string(d.join("s/report.html")).unwrap();
-    assert_eq!(html.matches("data:image/png;base64,").count(), 8 * 4, "strips");
+    assert_eq!(
+        html.matches("data:image/png;base64,").count(),
+        8 * 4,
+        "strips"
+    );
     check_report(&d.join("r/report.html"), &d.join("profile-r"));
 
     // The harness sees a broken page: a console message and an uncaught error.
@@ -183,7 +210,9 @@ fn sweep_and_render_reports_render_in_chromium() {
 fn flip_and_pareto_in_the_outputs() {
     let d = tmp("flippareto");
     let o = texsim(
-        &["render", "--scene", "sphere", "--width", "64", "--height", "48", "--out", "r"],
+        &[
+            "render", "--scene", "sphere", "--width", "64", "--height", "48", "--out", "r",
+        ],
         &d,
     );
     assert!(o.status.success(), "{}", text(&o));
@@ -196,8 +225,16 @@ fn flip_and_pareto_in_the_outputs() {
     assert!(d.join("r/flip.png").is_file());
     let o = texsim(
         &[
-            "render", "--scene", "sphere", "--width", "64", "--height", "48", "--no-flip",
-            "--out", "n",
+            "render",
+            "--scene",
+            "sphere",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--no-flip",
+            "--out",
+            "n",
         ],
         &d,
     );
@@ -209,14 +246,27 @@ fn flip_and_pareto_in_the_outputs() {
 
     let o = texsim(
         &[
-            "sweep", "--scene", "sphere", "--width", "48", "--height", "36", "--vary",
-            "weight_bits=2..6", "--flip", "--out", "s",
+            "sweep",
+            "--scene",
+            "sphere",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--vary",
+            "weight_bits=2..6",
+            "--flip",
+            "--out",
+            "s",
         ],
         &d,
     );
     assert!(o.status.success(), "{}", text(&o));
     let table = String::from_utf8_lossy(&o.stdout);
-    assert!(table.contains("flip_mean") && table.contains("pareto"), "{table}");
+    assert!(
+        table.contains("flip_mean") && table.contains("pareto"),
+        "{table}"
+    );
     let rows: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("s/sweep.json")).unwrap()).unwrap();
     let rows = rows.as_array().unwrap();
@@ -239,5 +289,8 @@ fn flip_and_pareto_in_the_outputs() {
     assert!(rows.iter().any(|r| r["pareto_area"] == true));
     let csv = std::fs::read_to_string(d.join("s/sweep.csv")).unwrap();
     let head = csv.lines().next().unwrap();
-    assert!(head.contains("flip.mean") && head.contains("pareto_area"), "{head}");
+    assert!(
+        head.contains("flip.mean") && head.contains("pareto_area"),
+        "{head}"
+    );
 }

@@ -11,10 +11,10 @@ mod bump_scene;
 mod rng_common;
 
 mod report_flip;
-mod report_pareto;
 mod report_images;
 mod report_metrics;
 mod report_output;
+mod report_pareto;
 mod scene_anchor_coverage;
 mod scene_load;
 mod scene_mip;

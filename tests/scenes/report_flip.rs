@@ -38,7 +38,11 @@ fn flip_grows_with_the_difference_and_stays_in_0_1() {
     let mut last = 0.0;
     for delta in [512u16, 4096, 16384, 40000] {
         let f = flip(&gradient(delta), &reference, None).unwrap();
-        assert!(f.stats.mean > last, "delta {delta}: {} <= {last}", f.stats.mean);
+        assert!(
+            f.stats.mean > last,
+            "delta {delta}: {} <= {last}",
+            f.stats.mean
+        );
         assert!(f.stats.max <= 1.0 && f.stats.p99 <= f.stats.max);
         assert!(f.stats.mean <= f.stats.max);
         assert!(f.map.iter().all(|v| (0.0..=1.0).contains(v)));
@@ -61,7 +65,12 @@ fn the_mask_selects_the_pooled_pixels_and_p99_is_a_nearest_rank() {
     let left: Vec<bool> = (0..64 * 48).map(|i| i % 64 < 32).collect();
     let f = flip(&test, &reference, Some(&left)).unwrap();
     assert_eq!(f.stats.pixels, 32 * 48);
-    assert!(f.stats.mean < all.stats.mean / 2.0, "{} vs {}", f.stats.mean, all.stats.mean);
+    assert!(
+        f.stats.mean < all.stats.mean / 2.0,
+        "{} vs {}",
+        f.stats.mean,
+        all.stats.mean
+    );
     let mut pooled: Vec<f32> = all
         .map
         .iter()

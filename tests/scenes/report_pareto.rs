@@ -10,9 +10,9 @@ fn brute(p: &[(f64, f64)]) -> Vec<bool> {
     p.iter()
         .map(|&a| {
             finite(a)
-                && !p.iter().any(|&b| {
-                    finite(b) && b.0 <= a.0 && b.1 <= a.1 && (b.0 < a.0 || b.1 < a.1)
-                })
+                && !p
+                    .iter()
+                    .any(|&b| finite(b) && b.0 <= a.0 && b.1 <= a.1 && (b.0 < a.0 || b.1 < a.1))
         })
         .collect()
 }
