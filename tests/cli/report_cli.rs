@@ -294,3 +294,40 @@ fn flip_and_pareto_in_the_outputs() {
         "{head}"
     );
 }
+
+/// FLIP (summary.json's `flip`, flip.png) is bit-identical at 1 and 2 threads.
+#[test]
+fn flip_outputs_are_identical_at_any_thread_count() {
+    let d = tmp("flipthreads");
+    for n in ["1", "2"] {
+        let out = format!("t{n}");
+        let o = texsim(
+            &[
+                "--threads",
+                n,
+                "render",
+                "--scene",
+                "demo",
+                "--width",
+                "96",
+                "--height",
+                "72",
+                "--out",
+                &out,
+            ],
+            &d,
+        );
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    let a = std::fs::read(d.join("t1/flip.png")).unwrap();
+    let b = std::fs::read(d.join("t2/flip.png")).unwrap();
+    assert!(a == b, "flip.png differs between 1 and 2 threads");
+    // summary.json's provenance holds the command line: compare the measurements.
+    let json = |dir: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(d.join(dir).join("summary.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (json("t1"), json("t2"));
+    assert!(a["flip"]["mean"].as_f64().unwrap() > 0.0);
+    assert_eq!(a["flip"], b["flip"]);
+    assert_eq!(a["stats"], b["stats"]);
+}
