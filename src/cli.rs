@@ -552,7 +552,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let mut r = render(&sc, &maps, &hw, &opts)?;
     let t = std::time::Instant::now();
     let mut out = OutputSet::new();
-    stage_images(&r, a.png16, &mut out)?;
+    let error_map = stage_images(&r, a.png16, &mut out)?;
     if a.truth {
         truth_outputs(&sc, &maps, &hw, &mut r, &mut out)?;
     }
@@ -576,6 +576,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         r.ref_image.as_ref(),
         r.truth_image.as_ref(),
         &r.mask,
+        error_map.as_ref(),
         flip.as_ref(),
     )?;
     let page = report::html::HtmlReport {
@@ -725,7 +726,13 @@ fn truth_outputs(
     Ok(())
 }
 
-fn stage_images(r: &Rendered, png16: bool, out: &mut OutputSet) -> Result<()> {
+/// Adds the images of a render; returns the error map (for report.html), when there is a
+/// reference.
+fn stage_images(
+    r: &Rendered,
+    png16: bool,
+    out: &mut OutputSet,
+) -> Result<Option<tiny_skia::Pixmap>> {
     out.add("hw.png", report::encode_png8(&r.hw_image)?);
     if png16 {
         out.add("hw16.png", report::encode_png16(&r.hw_image)?);
@@ -745,8 +752,9 @@ fn stage_images(r: &Rendered, png16: bool, out: &mut OutputSet) -> Result<()> {
         ]);
         out.add("error.png", report::encode_pixmap(&heat)?);
         out.add("sheet.png", report::encode_pixmap(&sheet)?);
+        return Ok(Some(heat));
     }
-    Ok(())
+    Ok(None)
 }
 
 /// One `--vary` axis: a field and its values.
@@ -891,6 +899,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             r.ref_image.as_ref(),
             r.truth_image.as_ref(),
             &r.mask,
+            None,
             flip.as_ref(),
         )?);
         let varies_frame = set

@@ -132,12 +132,14 @@ pub fn thumbnail(rgba: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
 }
 
 /// The strip of one render: hardware, reference, truth (when rendered), the 8-bit LSB error
-/// map and the FLIP map (when given).
+/// map (`error_map` when the caller has it, else computed: `heatmap(hw, reference, 8, mask)`)
+/// and the FLIP map (when given).
 pub fn render_strip(
     hw: &Image,
     reference: Option<&Image>,
     truth: Option<&Image>,
     mask: &[bool],
+    error_map: Option<&tiny_skia::Pixmap>,
     flip: Option<&crate::flip::Flip>,
 ) -> Result<Vec<(String, Vec<u8>)>> {
     let mut s = vec![(
@@ -154,7 +156,14 @@ pub fn render_strip(
         s.push(("truth".into(), thumbnail(&t.to_rgba8(), t.width, t.height)?));
     }
     if let Some(rf) = reference {
-        let heat = heatmap(hw, rf, 8, Some(mask));
+        let computed;
+        let heat = match error_map {
+            Some(m) => m,
+            None => {
+                computed = heatmap(hw, rf, 8, Some(mask));
+                &computed
+            }
+        };
         let (w, h) = (heat.width(), heat.height());
         // The heatmap is opaque: its premultiplied bytes are its straight ones.
         s.push(("error (8-bit LSB)".into(), thumbnail(heat.data(), w, h)?));
