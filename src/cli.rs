@@ -356,6 +356,10 @@ pub struct RenderArgs {
     /// pass: without the flag nothing is counted.
     #[arg(long)]
     pub ranges: bool,
+    /// Skip the LDR-FLIP comparison (hardware vs reference: `flip` in summary.json, flip.png),
+    /// which costs about as much as the reference pass.
+    #[arg(long)]
+    pub no_flip: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -395,6 +399,10 @@ pub struct SweepArgs {
     /// from a Slurm array: SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN (default 0) + 1.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
+    /// Also compute LDR-FLIP (hardware vs reference) per setting: the flip_mean and flip_p99
+    /// columns (about as costly as the reference pass of each row).
+    #[arg(long)]
+    pub flip: bool,
 }
 
 /// Arguments of `texsim merge`.
@@ -521,6 +529,7 @@ pub fn run(cli: Cli) -> Result<()> {
             truth: false,
             truth_samples: None,
             ranges: false,
+            no_flip: false,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -667,16 +676,55 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let mut r = render(&sc, &maps, &hw, &opts)?;
     let t = std::time::Instant::now();
     let mut out = OutputSet::new();
-    stage_images(&r, a.png16, &mut out)?;
+    let error_map = stage_images(&r, a.png16, &mut out)?;
     if a.truth {
         truth_outputs(&sc, &maps, &hw, &mut r, &mut out)?;
     }
+    let t_flip = std::time::Instant::now();
+    let flip = r
+        .ref_image
+        .as_ref()
+        .filter(|_| !a.no_flip)
+        .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)));
+    if let Some(f) = &flip {
+        out.add("flip.png", crate::flip::error_map_png(f, Some(&r.mask))?);
+        progress_line("FLIP", elapsed_ms(t_flip));
+    }
+    let flip_stats = flip.as_ref().map(|f| &f.stats);
+    let mut rep_row = crate::summary::SweepRow::new(Vec::new(), &r.stats);
+    rep_row.flip = flip_stats.cloned();
+    crate::pareto::mark_sweep(std::slice::from_mut(&mut rep_row));
+    let mut row = report::html::sweep_report_row(&rep_row);
+    row.strip = report::html::render_strip(
+        &r.hw_image,
+        r.ref_image.as_ref(),
+        r.truth_image.as_ref(),
+        &r.mask,
+        error_map.as_ref(),
+        flip.as_ref(),
+    )?;
+    let page = report::html::HtmlReport {
+        title: format!("texsim render: {} on {}", sc.name, hw.name),
+        subtitle: format!(
+            "{}x{}, {} triangles, {} covered pixels",
+            sc.width,
+            sc.height,
+            sc.triangle_count(),
+            r.stats.covered_pixels
+        ),
+        rows: vec![row],
+        tables: vec![("Summary".into(), crate::summary::text(&r.stats))],
+        ranges: None,
+        hw_config: hwconfig::to_toml(&hw),
+    };
+    out.add("report.html", report::html::html(&page)?.into_bytes());
     let prov = crate::provenance::Provenance::of_process();
     let json = serde_json::json!({
         "provenance": &prov,
         "scene": &r.stats.scene,
         "hw_config": &hw,
         "stats": &r.stats,
+        "flip": flip_stats,
         "warnings": &sc.warnings,
     });
     out.add(
@@ -700,6 +748,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     print!("{}", crate::summary::text(&r.stats));
     if let Some(rg) = &r.stats.ranges {
         print!("{}", crate::render::ranges::table(rg, &r.stats.stages));
+    }
+    if let Some(f) = flip_stats {
+        println!("{}", crate::summary::flip_line(f));
     }
     for w in &r.stats.warnings {
         eprintln!("warning: {w}");
@@ -728,11 +779,13 @@ pub const RENDER_OUTPUTS: &[&str] = &[
     "ref.png",
     "ref16.png",
     "error.png",
+    "flip.png",
     "sheet.png",
     "truth.png",
     "baseline.png",
     "summary.json",
     "timings.json",
+    "report.html",
 ];
 
 /// Writes truth.png and fills the baseline error: the same scene with every roughness material
@@ -800,7 +853,13 @@ fn truth_outputs(
     Ok(())
 }
 
-fn stage_images(r: &Rendered, png16: bool, out: &mut OutputSet) -> Result<()> {
+/// Adds the images of a render; returns the error map (for report.html), when there is a
+/// reference.
+fn stage_images(
+    r: &Rendered,
+    png16: bool,
+    out: &mut OutputSet,
+) -> Result<Option<tiny_skia::Pixmap>> {
     out.add("hw.png", report::encode_png8(&r.hw_image)?);
     if png16 {
         out.add("hw16.png", report::encode_png16(&r.hw_image)?);
@@ -820,8 +879,9 @@ fn stage_images(r: &Rendered, png16: bool, out: &mut OutputSet) -> Result<()> {
         ]);
         out.add("error.png", report::encode_pixmap(&heat)?);
         out.add("sheet.png", report::encode_pixmap(&sheet)?);
+        return Ok(Some(heat));
     }
-    Ok(())
+    Ok(None)
 }
 
 /// One `--vary` axis: a field and its values.
@@ -1005,6 +1065,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let mut maps = Maps::new(&sc, base.trilinear.texel_bits);
     let mut rows = Vec::with_capacity(configs.len());
     let mut worst_pixels = Vec::with_capacity(configs.len());
+    let mut strips: Vec<Vec<(String, Vec<u8>)>> = Vec::with_capacity(configs.len());
     for (i, (cfg, set)) in configs.iter().zip(&settings).enumerate() {
         let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
         eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
@@ -1020,7 +1081,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         for w in &r.stats.warnings {
             eprintln!("  warning: {w}");
         }
-        let row = crate::summary::SweepRow::new(set.clone(), &r.stats);
+        let mut row = crate::summary::SweepRow::new(set.clone(), &r.stats);
         let worst = r
             .ref_image
             .as_ref()
@@ -1034,6 +1095,20 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             }
         }
         worst_pixels.push(worst);
+        let flip = r
+            .ref_image
+            .as_ref()
+            .filter(|_| a.flip)
+            .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)));
+        row.flip = flip.as_ref().map(|f| f.stats.clone());
+        strips.push(report::html::render_strip(
+            &r.hw_image,
+            r.ref_image.as_ref(),
+            r.truth_image.as_ref(),
+            &r.mask,
+            None,
+            flip.as_ref(),
+        )?);
         let varies_frame = set
             .iter()
             .any(|(f, _)| f == "frame" || f == "frame_kind" || f.ends_with(".frame_kind"));
@@ -1057,7 +1132,9 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             eprintln!("  no cycles: {why}");
         }
         rows.push(row);
+        keep_report_strips(&mut rows, &mut strips);
     }
+    crate::pareto::mark_sweep(&mut rows);
     let table = crate::summary::sweep_table(&rows);
     print!("{table}");
     let mut out = OutputSet::new();
@@ -1096,6 +1173,28 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         &shard.map_or_else(|| "sweep.json".to_string(), |s| s.file("json")),
         json,
     );
+    let page = report::html::HtmlReport {
+        title: format!("texsim sweep: {} on {}", sc.name, base.name),
+        subtitle: format!(
+            "{}x{}; {} settings: {}",
+            sc.width,
+            sc.height,
+            rows.len(),
+            a.vary.join(" ")
+        ),
+        rows: rows
+            .iter()
+            .zip(strips)
+            .map(|(r, strip)| report::html::ReportRow {
+                strip,
+                ..report::html::sweep_report_row(r)
+            })
+            .collect(),
+        tables: vec![("Sweep table".into(), table)],
+        ranges: None,
+        hw_config: hwconfig::to_toml(&base),
+    };
+    out.add("report.html", report::html::html(&page)?.into_bytes());
     for p in out.write_to(&a.scene.out)? {
         println!("wrote {}", p.display());
     }
@@ -1124,6 +1223,25 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Bounds the image strips a sweep keeps for report.html: once more than twice
+/// `MAX_STRIPS` rows hold one, the rows past the first `MAX_STRIPS` that are off the Pareto
+/// fronts so far drop theirs (a dominated row stays dominated as rows are added).
+fn keep_report_strips(
+    rows: &mut [crate::summary::SweepRow],
+    strips: &mut [Vec<(String, Vec<u8>)>],
+) {
+    let max = report::html::MAX_STRIPS;
+    if strips.iter().filter(|s| !s.is_empty()).count() <= 2 * max {
+        return;
+    }
+    crate::pareto::mark_sweep(rows);
+    for (i, (r, s)) in rows.iter().zip(strips.iter_mut()).enumerate() {
+        if i >= max && !r.pareto_area && r.pareto_cycles != Some(true) {
+            s.clear();
+        }
+    }
 }
 
 fn brdf_model(p: &BrdfParams) -> Result<crate::brdf::ashikhmin_shirley::AshikhminShirley> {

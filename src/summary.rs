@@ -226,6 +226,12 @@ pub struct SweepRow {
     pub frame_fallback: u64,
     pub zero_normal: u64,
     pub offset_clamped: u64,
+    /// LDR-FLIP of the hardware image against the reference (`crate::flip`), set by the sweep.
+    pub flip: Option<crate::flip::FlipStats>,
+    /// On the Pareto front of mean 8-bit error vs `area_ge` (`crate::pareto::mark_sweep`).
+    pub pareto_area: bool,
+    /// On the Pareto front of mean 8-bit error vs `cycles` (`None` when a row has no cycles).
+    pub pareto_cycles: Option<bool>,
 }
 
 impl SweepRow {
@@ -282,6 +288,9 @@ impl SweepRow {
             frame_fallback: s.bump.frame_fallback,
             zero_normal: s.bump.zero_normal,
             offset_clamped: s.bump.offset_clamped,
+            flip: None,
+            pareto_area: false,
+            pareto_cycles: None,
         }
     }
 }
@@ -362,6 +371,26 @@ fn cells(r: &SweepRow) -> Vec<String> {
             .map_or("-".into(), |e| format!("{:.4}", e.mean_abs_lsb)),
         format!("{:.1}", r.hw_ms),
     ]
+}
+
+/// Columns of FLIP (present when any row has FLIP: `sweep --flip`).
+const FLIP_HEADER: [&str; 2] = ["flip_mean", "flip_p99"];
+
+fn flip_cells(r: &SweepRow) -> [String; 2] {
+    let f = r.flip.as_ref();
+    [
+        f.map_or("-".into(), |f| format!("{:.4}", f.mean)),
+        f.map_or("-".into(), |f| format!("{:.4}", f.p99)),
+    ]
+}
+
+/// The terminal line of a render's FLIP statistics.
+#[must_use]
+pub fn flip_line(f: &crate::flip::FlipStats) -> String {
+    format!(
+        "FLIP (LDR, hardware vs reference, {:.0} px/degree, {} covered px): mean {:.4}  p99 {:.4}  max {:.4}",
+        f.pixels_per_degree, f.pixels, f.mean, f.p99, f.max
+    )
 }
 
 /// Units whose cost (delay, latency or area) differs from the first row's in some row, in
@@ -481,9 +510,14 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     for (u, f) in &changed {
         head.push(format!("{}:{u}", f.short()));
     }
+    let flipped = rows.iter().any(|r| r.flip.is_some());
+    if flipped {
+        head.extend(FLIP_HEADER.iter().map(|s| s.to_string()));
+    }
     if bump {
         head.push(BUMP_HEADER[0].into());
     }
+    head.push("pareto".into());
     grid.push(head);
     for r in rows {
         let mut line: Vec<String> = r.settings.iter().map(|(_, v)| v.clone()).collect();
@@ -492,10 +526,14 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
             let c = r.unit_cost.get(u);
             line.push(c.map_or_else(|| "-".into(), |c| f.of(c).to_string()));
         }
+        if flipped {
+            line.extend(flip_cells(r));
+        }
         if bump {
             let [used, ..] = bump_cells(r);
             line.push(used);
         }
+        line.push(crate::pareto::mark(r).into());
         grid.push(line);
     }
     let ncol = grid[0].len();
@@ -521,7 +559,7 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
 
 /// Columns of `sweep.csv` after the swept fields: the names of `sweep.json`'s row fields
 /// (nested metrics joined with a dot).
-pub const CSV_COLUMNS: [&str; 28] = [
+pub const CSV_COLUMNS: [&str; 32] = [
     "error_8bit.max_abs_lsb",
     "error_8bit.mean_abs_lsb",
     "error_8bit.rmse_lsb",
@@ -550,6 +588,10 @@ pub const CSV_COLUMNS: [&str; 28] = [
     "offset_clamped",
     "hw_ms",
     "ref_ms",
+    "flip.mean",
+    "flip.p99",
+    "pareto_area",
+    "pareto_cycles",
 ];
 
 /// The cells of [`CSV_COLUMNS`] for one row: full precision, empty where the JSON has `null`
@@ -590,6 +632,10 @@ fn csv_cells(r: &SweepRow) -> Vec<String> {
         r.offset_clamped.to_string(),
         r.hw_ms.to_string(),
         r.ref_ms.to_string(),
+        opt(r.flip.as_ref().map(|f| f.mean)),
+        opt(r.flip.as_ref().map(|f| f.p99)),
+        r.pareto_area.to_string(),
+        opt(r.pareto_cycles),
     ]
 }
 

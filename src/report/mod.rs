@@ -10,6 +10,7 @@
 mod draw;
 pub mod font;
 mod heatmap;
+pub mod html;
 mod metrics;
 mod output;
 mod png;

@@ -93,7 +93,8 @@ fn no_arguments_renders_the_demo_into_out() {
 }
 
 /// A render removes the outputs an earlier render left that it does not produce itself (and
-/// nothing else): a full run writes every name of `RENDER_OUTPUTS`, a reduced one leaves two.
+/// nothing else): a full run writes every name of `RENDER_OUTPUTS`, a reduced one leaves two
+/// (and writes its own report.html).
 #[test]
 fn render_removes_its_own_stale_outputs_only() {
     let d = tmp("stale");
@@ -141,6 +142,7 @@ fn render_removes_its_own_stale_outputs_only() {
             "cycles.json",
             "hw.png",
             "notes.txt",
+            "report.html",
             "summary.json",
             "timings.json"
         ]
@@ -797,6 +799,7 @@ fn sweep_csv_uses_the_json_names_and_empty_cells() {
                     assert!((x - y).abs() <= 1e-12 * y.abs(), "{col}: {x} vs {y}");
                 }
                 serde_json::Value::String(s) => assert_eq!(cell, s, "{col}"),
+                serde_json::Value::Bool(b) => assert_eq!(cell, b.to_string(), "{col}"),
                 other => panic!("{col}: {other} is not a JSON row field"),
             }
         }

@@ -12,6 +12,7 @@ mod cli;
 mod filters_cli;
 mod fournier_cli;
 mod ndf_cli;
+mod report_cli;
 mod roughness_cli;
 mod sweep_usability;
 mod timing_cli;
