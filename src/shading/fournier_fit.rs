@@ -157,13 +157,6 @@ pub struct LevelFit {
     pub seconds: f64,
 }
 
-fn splitmix64(s: u64) -> u64 {
-    let mut z = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// `log C(kappa)` of the vMF density on the 2-sphere, `C = kappa / (4 pi sinh kappa)`.
 fn log_norm(kappa: f64) -> f64 {
     if kappa < 1e-6 {
@@ -211,7 +204,8 @@ const SAME: f64 = 1e-12;
 
 /// Deterministic centres: a seeded first normal, then farthest points.
 fn initial_centres(normals: &[DVec3], k: usize, seed: u64) -> Vec<DVec3> {
-    let mut c = vec![normals[(splitmix64(seed) % normals.len() as u64) as usize]];
+    let mut c =
+        vec![normals[(crate::rng::SplitMix64(seed).next_u64() % normals.len() as u64) as usize]];
     while c.len() < k {
         let (best, cos) = normals
             .iter()

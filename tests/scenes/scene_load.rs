@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use crate::rng_common::Rng;
 use glam::{DMat4, DVec3, DVec4};
 use texsim::scene::{
     self, builtin, decode_texture, fit_camera, load, load_obj, smooth_normals, validate, Mesh,
@@ -24,20 +25,6 @@ fn temp_dir(tag: &str) -> PathBuf {
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
-}
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[test]
@@ -286,7 +273,7 @@ fn smooth_normals_area_weighted() {
 
 #[test]
 fn fit_camera_contains_random_meshes() {
-    let mut rng = SplitMix(11);
+    let mut rng = Rng(11);
     for case in 0..200 {
         let c = DVec3::new(
             rng.unit() * 200.0 - 100.0,

@@ -2,25 +2,12 @@
 //! quantization (lossless for exact 16-bit data, round-half-even), and the Mesa W1/W2 texture
 //! hashes (FNV-1a-64 of the 8-bit bytes, as `mesa_anchor.c` prints them).
 
+use crate::rng_common::Rng;
 use texsim::maps::{build_mip_chain, chain_sizes, quantize_chain, quantize_unorm};
 use texsim::scene::texture::mesa_levels_rgba8;
 use texsim::scene::{builtin, TextureImage};
 
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
-
-fn random_texture(rng: &mut SplitMix, w: u32, h: u32) -> TextureImage {
+fn random_texture(rng: &mut Rng, w: u32, h: u32) -> TextureImage {
     let texels = (0..w * h)
         .map(|_| std::array::from_fn(|_| rng.below(65536) as u16))
         .collect();
@@ -40,7 +27,7 @@ fn chain_sizes_pot_and_npot() {
     assert_eq!(chain_sizes(5, 3), vec![(5, 3), (2, 1), (1, 1)]);
     assert_eq!(chain_sizes(7, 1), vec![(7, 1), (3, 1), (1, 1)]);
     assert_eq!(chain_sizes(1, 1), vec![(1, 1)]);
-    let mut rng = SplitMix(7);
+    let mut rng = Rng(7);
     for _ in 0..2000 {
         let (w, h) = (1 + rng.below(5000) as u32, 1 + rng.below(5000) as u32);
         let s = chain_sizes(w, h);
@@ -96,7 +83,7 @@ fn model_next(src: &[Vec<f64>], w: usize, h: usize, ch: usize) -> (Vec<Vec<f64>>
 
 #[test]
 fn box_filter_matches_independent_model() {
-    let mut rng = SplitMix(42);
+    let mut rng = Rng(42);
     for case in 0..60 {
         let (w, h) = if case < 4 {
             ([1, 2, 3, 4][case], [4, 3, 2, 1][case])
@@ -185,7 +172,7 @@ fn quantize_lossless_for_exact_16_bit_data() {
 
 #[test]
 fn quantize_rounds_half_even_to_n_bits() {
-    let mut rng = SplitMix(99);
+    let mut rng = Rng(99);
     for bits in 1..=16u32 {
         let max = (1u64 << bits) - 1;
         for _ in 0..20000 {
@@ -259,7 +246,7 @@ fn mesa_texture_hashes_match_the_anchor() {
 
 #[test]
 fn prebuilt_levels_are_used_only_when_consistent() {
-    let mut rng = SplitMix(5);
+    let mut rng = Rng(5);
     let mut tex = random_texture(&mut rng, 4, 4);
     let l1 = vec![[1000u16, 2000, 3000, 4000]; 4];
     // Level 2 has a wrong size: from there on the chain is box-filtered.

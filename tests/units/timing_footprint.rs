@@ -3,6 +3,7 @@
 //! (renders, N x texels, deterministic, less blur than plain trilinear on the receding plane
 //! against a supersampled image), and the adaptive probe count (`aniso_adaptive`).
 
+use crate::rng_common::Rng;
 use hw_model::config::LodConfig;
 use hw_model::fixed::{round_shift_right, SatCounter};
 use hw_model::footprint::{footprint, footprint_filter, probe_offset};
@@ -15,16 +16,8 @@ use texsim::pipeline::{StageImpls, StageKind};
 use texsim::render::{render, Maps, RenderOptions};
 use texsim::scene;
 
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-fn signed(s: &mut u64, bits: u32) -> i64 {
-    let r = splitmix(s);
+fn signed(s: &mut Rng, bits: u32) -> i64 {
+    let r = s.next();
     let b = (r >> 8) % (bits as u64 + 1);
     let mag = (r >> 16) & ((1u64 << b) - 1);
     if r & 1 == 1 {
@@ -38,7 +31,7 @@ const FRAC: u32 = 24;
 
 #[test]
 fn lod_and_offsets_match_the_f64_twin() {
-    let mut s = 42u64;
+    let mut s = Rng(42);
     for f in [4u32, 8, 16] {
         let cfg = LodConfig {
             lod_frac_bits: f,
@@ -54,12 +47,9 @@ fn lod_and_offsets_match_the_f64_twin() {
                 [base[0] + signed(&mut s, 22), base[1] + signed(&mut s, 22)],
                 [base[0] + signed(&mut s, 22), base[1] + signed(&mut s, 22)],
             ];
-            let size = (
-                1u32 << (splitmix(&mut s) % 12),
-                1u32 << (splitmix(&mut s) % 12),
-            );
-            let cap = 1u32 << (splitmix(&mut s) % 5);
-            let adaptive = splitmix(&mut s) & 1 == 0;
+            let size = (1u32 << (s.next() % 12), 1u32 << (s.next() % 12));
+            let cap = 1u32 << (s.next() % 5);
+            let adaptive = s.next() & 1 == 0;
             let mut sat = SatCounter::default();
             let fx = footprint(&uv, size, FRAC, cap, adaptive, &cfg, &mut sat);
             let uvf = uv.map(|p| p.map(|x| x as f64 / f64::from(1u32 << FRAC) / 1.0));
@@ -106,10 +96,10 @@ fn lod_and_offsets_match_the_f64_twin() {
     }
 }
 
-fn level_data(s: &mut u64, w: u32, h: u32) -> Vec<[u16; 4]> {
+fn level_data(s: &mut Rng, w: u32, h: u32) -> Vec<[u16; 4]> {
     (0..w * h)
         .map(|_| {
-            let r = splitmix(s);
+            let r = s.next();
             [
                 r as u16,
                 (r >> 16) as u16,
@@ -122,7 +112,7 @@ fn level_data(s: &mut u64, w: u32, h: u32) -> Vec<[u16; 4]> {
 
 #[test]
 fn one_probe_is_plain_trilinear_and_the_average_rounds_once() {
-    let mut s = 9u64;
+    let mut s = Rng(9);
     let hw = HwConfig::texram16();
     let data: Vec<Vec<[u16; 4]>> = (0..6)
         .map(|l| level_data(&mut s, 32 >> l, 32 >> l))

@@ -2,20 +2,13 @@
 //! (2x2 footprints conflict-free under the tiled interleave, counted conflicts otherwise) and
 //! the DRAM open-page model, on hand-built event streams.
 
+use crate::rng_common::Rng;
 use hw_model::timing_config::BankInterleave;
 use hw_model::{HwConfig, UnitCost};
 use texsim::pipeline::StageKind;
 use texsim::timing::events::{FrameEvents, PixelEvent, PlanTiming, TexelFootprint, TextureLayout};
 use texsim::timing::model::{bank_of, footprint_conflicts};
 use texsim::timing::{simulate, Cache};
-
-fn splitmix(s: &mut u64) -> u64 {
-    *s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    let mut z = *s;
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 #[test]
 fn lru_cache_hand_cases() {
@@ -41,13 +34,13 @@ fn lru_cache_hand_cases() {
 
 #[test]
 fn lru_cache_matches_a_list_model() {
-    let mut seed = 7u64;
+    let mut seed = Rng(7);
     for ways in [1usize, 2, 4, 8] {
         let sets = 4u64;
         let mut c = Cache::new(sets, ways);
         let mut model: Vec<Vec<u64>> = vec![vec![]; sets as usize];
         for _ in 0..20000 {
-            let k = splitmix(&mut seed) % 64;
+            let k = seed.next() % 64;
             let set = &mut model[(k % sets) as usize];
             let hit = if let Some(p) = set.iter().position(|&x| x == k) {
                 set.remove(p);
@@ -77,13 +70,13 @@ fn fp(x0: u32, y0: u32, w: u32, h: u32) -> TexelFootprint {
 
 #[test]
 fn tiled_interleave_makes_2x2_conflict_free() {
-    let mut seed = 1u64;
+    let mut seed = Rng(1);
     for banks in [4u32, 8, 16, 64] {
         for _ in 0..20000 {
-            let w = 1u32 << (1 + splitmix(&mut seed) % 10);
-            let h = 1u32 << (1 + splitmix(&mut seed) % 10);
-            let x = (splitmix(&mut seed) % u64::from(w)) as u32;
-            let y = (splitmix(&mut seed) % u64::from(h)) as u32;
+            let w = 1u32 << (1 + seed.next() % 10);
+            let h = 1u32 << (1 + seed.next() % 10);
+            let x = (seed.next() % u64::from(w)) as u32;
+            let y = (seed.next() % u64::from(h)) as u32;
             assert_eq!(
                 footprint_conflicts(&fp(x, y, w, h), w, banks, BankInterleave::Tiled),
                 0,
