@@ -29,10 +29,12 @@
 //! clamped below 128 as in the NDF unit. Integers only: no NaN or infinity can arise.
 //!
 //! ERROR BOUND (against the float twin `texsim::shading::lean::lean_f` on the same quantized
-//! inputs, asserted in `tests/units/lean_unit.rs`): `|D - D_f| <= 2^-12` for
-//! `s <= 2^12` and `G >= 24`: the decoded moments err by `2^-(G+1)`, the cancellation
-//! `M - B B^T` by `2^(2R - G + 2)` relative to `1/s`, the density by the NDF unit's bound, the
-//! normalization by `2^-29` relative.
+//! inputs, asserted in `tests/units/lean_unit.rs`): `|D - D_f| <= 2^-12` at texram16 widths
+//! (`G = 24`, `E = 2`, 16-bit texels, `F = 14` half vectors, `P = 16`) for `s <= 4096`. The
+//! terms: the decoded moments err by `2^-(G+1)`; `M - B B^T` cancels to an error of about
+//! `2^(2R - G + 1)` against a variance of at least `1/s`; the slope `h~` errs by the half
+//! vector's `2^-F` over `h_n`; the density by the NDF unit's Gauss bound; the normalization by
+//! `2^-29` relative. Measured over 10^7 seeded cases: 2.07e-4.
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;

@@ -23,7 +23,7 @@ pub fn lean_f(b: [f64; 2], m: [f64; 3], h: DVec3, shininess: u32) -> f64 {
         cuv = 0.0;
         det = cuu * cvv;
     }
-    if !(h.z > 0.0) {
+    if h.z.is_nan() || h.z <= 0.0 {
         return 0.0;
     }
     let x0 = (h.x / h.z).clamp(-256.0, 256.0) - b0;

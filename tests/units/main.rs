@@ -1,7 +1,7 @@
 //! Integration tests of the bit-accurate units (`hw_model`) against exact integer models and
 //! their float twins: fixed-point rounding and conversion, reciprocal, interpolator, LOD, wrap,
 //! filter, modulate, the shading units (vector, rsqrt, pow, frames, Blinn-Phong,
-//! Ashikhmin-Shirley, roughness, NDF), footprint assembly, the timing model's parts, and the
+//! Ashikhmin-Shirley, roughness, NDF, Toksvig, LEAN), footprint assembly, the timing model's parts, and the
 //! hardware configurations.
 //!
 //! One file per module below; run one with `cargo test --test units unit_lod::`.
