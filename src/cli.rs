@@ -326,8 +326,9 @@ pub struct SweepArgs {
     pub scene: SceneArgs,
     /// FIELD=A..B (inclusive integer range) or FIELD=v1,v2,... ; FIELD is any HwConfig field
     /// name (`texsim hw show texram16`), or `hw` to switch the whole machine (presets or files;
-    /// give it first, later axes edit it). Several --vary make a grid.
-    #[arg(long, required = true)]
+    /// give it first, later axes edit it). Several --vary make a grid. Or give a sweep plan
+    /// (a TOML file with `vary = [...]`) as INPUT: `texsim sweep plan.toml`.
+    #[arg(long)]
     pub vary: Vec<String>,
     /// Run the timing model per setting: each row's cycles, texture and DRAM bytes. This is
     /// the default; the flag is kept so that older command lines work.
@@ -908,6 +909,13 @@ pub fn grid(axes: &[Axis]) -> Result<Vec<Vec<(String, String)>>> {
 }
 
 fn sweep_cmd(a: &SweepArgs) -> Result<()> {
+    let a = &crate::sweep_plan::apply(a)?;
+    if a.vary.is_empty() {
+        return Err(Error::field(
+            "--vary",
+            "give at least one --vary FIELD=A..B, or a sweep plan file (texsim sweep plan.toml)",
+        ));
+    }
     if a.truth_samples.is_some() && a.truth == 0 {
         return Err(Error::field(
             "--truth-samples",
