@@ -32,6 +32,13 @@ pub enum Command {
     /// List the built-in scenes.
     Scenes,
     /// Render once per setting of one or more HwConfig fields; print and write the table.
+    ///
+    /// Columns: quant_* compare the hardware with the float reference (the quantization
+    /// error; error_8bit.* and error_16bit.* in sweep.csv and sweep.json), model_* the float
+    /// reference with the ground truth (--truth; model_error.*); sat: saturations and wraps;
+    /// cycles, cyc/px, tex_bytes, dram_bytes: the timing model; area_ge, max_lat and
+    /// area:UNIT, delay:UNIT, lat:UNIT: the datapath cost model. sweep.json also holds each
+    /// row's worst pixel (location, hardware and reference values).
     Sweep(SweepArgs),
     /// Find the narrowest machine (least area) that keeps every --scene within every
     /// --budget: per-knob bisection, a greedy descent trading bits, a verified final run;
