@@ -954,7 +954,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         .into_iter()
         .enumerate()
         .map(|(i, r)| (i as u64, r))
-        .filter(|(i, _)| shard.map_or(true, |s| s.owns(*i)))
+        .filter(|(i, _)| shard.is_none_or(|s| s.owns(*i)))
         .unzip();
     // Validate every setting before rendering anything.
     let configs: Vec<HwConfig> = settings
@@ -977,9 +977,19 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let mut maps = Maps::new(&sc, base.trilinear.texel_bits);
     let mut rows = Vec::with_capacity(configs.len());
     let mut worst_pixels = Vec::with_capacity(configs.len());
+    let sweep_start = std::time::Instant::now();
     for (i, (cfg, set)) in configs.iter().zip(&settings).enumerate() {
         let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
-        eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
+        let elapsed = sweep_start.elapsed().as_secs_f64();
+        let eta = if i == 0 {
+            String::new()
+        } else {
+            format!(
+                " (elapsed {elapsed:.1} s, ETA {:.1} s)",
+                elapsed / i as f64 * (configs.len() - i) as f64
+            )
+        };
+        eprintln!("[{}/{}] {}{eta}", i + 1, configs.len(), label.join(" "));
         maps.ensure_texel_bits(cfg.trilinear.texel_bits);
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
         let opts = RenderOptions {
