@@ -32,6 +32,13 @@ pub enum Command {
     /// List the built-in scenes.
     Scenes,
     /// Render once per setting of one or more HwConfig fields; print and write the table.
+    ///
+    /// Columns: quant_* compare the hardware with the float reference (the quantization
+    /// error; error_8bit.* and error_16bit.* in sweep.csv and sweep.json), model_* the float
+    /// reference with the ground truth (--truth; model_error.*); sat: saturations and wraps;
+    /// cycles, cyc/px, tex_bytes, dram_bytes: the timing model; area_ge, max_lat and
+    /// area:UNIT, delay:UNIT, lat:UNIT: the datapath cost model. sweep.json also holds each
+    /// row's worst pixel (location, hardware and reference values).
     Sweep(SweepArgs),
     /// Find the narrowest machine (least area) that keeps every --scene within every
     /// --budget: per-knob bisection, a greedy descent trading bits, a verified final run;
@@ -368,8 +375,9 @@ pub struct SweepArgs {
     pub scene: SceneArgs,
     /// FIELD=A..B (inclusive integer range) or FIELD=v1,v2,... ; FIELD is any HwConfig field
     /// name (`texsim hw show texram16`), or `hw` to switch the whole machine (presets or files;
-    /// give it first, later axes edit it). Several --vary make a grid.
-    #[arg(long, required = true)]
+    /// give it first, later axes edit it). Several --vary make a grid. Or give a sweep plan
+    /// (a TOML file with `vary = [...]`) as INPUT: `texsim sweep plan.toml`.
+    #[arg(long)]
     pub vary: Vec<String>,
     /// Run the timing model per setting: each row's cycles, texture and DRAM bytes. This is
     /// the default; the flag is kept so that older command lines work.
@@ -1011,6 +1019,13 @@ pub fn grid(axes: &[Axis]) -> Result<Vec<Vec<(String, String)>>> {
 }
 
 fn sweep_cmd(a: &SweepArgs) -> Result<()> {
+    let a = &crate::sweep_plan::apply(a)?;
+    if a.vary.is_empty() {
+        return Err(Error::field(
+            "--vary",
+            "give at least one --vary FIELD=A..B, or a sweep plan file (texsim sweep plan.toml)",
+        ));
+    }
     if a.truth_samples.is_some() && a.truth == 0 {
         return Err(Error::field(
             "--truth-samples",
@@ -1042,7 +1057,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         .into_iter()
         .enumerate()
         .map(|(i, r)| (i as u64, r))
-        .filter(|(i, _)| shard.map_or(true, |s| s.owns(*i)))
+        .filter(|(i, _)| shard.is_none_or(|s| s.owns(*i)))
         .unzip();
     // Validate every setting before rendering anything.
     let configs: Vec<HwConfig> = settings
@@ -1066,9 +1081,19 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     let mut rows = Vec::with_capacity(configs.len());
     let mut worst_pixels = Vec::with_capacity(configs.len());
     let mut strips: Vec<Vec<(String, Vec<u8>)>> = Vec::with_capacity(configs.len());
+    let sweep_start = std::time::Instant::now();
     for (i, (cfg, set)) in configs.iter().zip(&settings).enumerate() {
         let label: Vec<String> = set.iter().map(|(f, v)| format!("{f}={v}")).collect();
-        eprintln!("[{}/{}] {}", i + 1, configs.len(), label.join(" "));
+        let elapsed = sweep_start.elapsed().as_secs_f64();
+        let eta = if i == 0 {
+            String::new()
+        } else {
+            format!(
+                " (elapsed {elapsed:.1} s, ETA {:.1} s)",
+                elapsed / i as f64 * (configs.len() - i) as f64
+            )
+        };
+        eprintln!("[{}/{}] {}{eta}", i + 1, configs.len(), label.join(" "));
         maps.ensure_texel_bits(cfg.trilinear.texel_bits);
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
         let opts = RenderOptions {

@@ -59,6 +59,7 @@ pub mod rng;
 pub mod scene;
 pub mod shading;
 pub mod summary;
+pub mod sweep_plan;
 pub mod sweep_shard;
 pub mod timing;
 pub mod tune;

@@ -324,14 +324,17 @@ fn bump_cells(r: &SweepRow) -> [String; 4] {
     ]
 }
 
+/// The terminal table's error columns: `quant_*` compare the hardware with the float
+/// reference (quantization error; `error_8bit.*` / `error_16bit.*` in the CSV and JSON),
+/// `model_*` the float reference with the ground truth (`model_error.*`).
 const HEADER: [&str; 18] = [
-    "max8",
-    "mean8",
-    "rmse8",
-    "psnr8_db",
-    "exact8_%",
-    "max16",
-    "rmse16",
+    "quant_max8",
+    "quant_mean8",
+    "quant_rmse8",
+    "quant_psnr8_db",
+    "quant_exact8_%",
+    "quant_max16",
+    "quant_rmse16",
     "sat",
     "cycles",
     "cyc/px",

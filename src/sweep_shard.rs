@@ -108,7 +108,7 @@ pub fn worst_pixel(hw: &Image, reference: &Image, mask: &[bool]) -> Option<Worst
             .map(|c| quantize(a[c], 8).abs_diff(quantize(b[c], 8)))
             .max()
             .unwrap_or(0);
-        if best.map_or(true, |(_, b)| e > b) {
+        if best.is_none_or(|(_, b)| e > b) {
             best = Some((i, e));
         }
     }

@@ -421,7 +421,13 @@ impl Search<'_> {
                 match &r.truth_image {
                     Some(t) => compare(&r.hw_image, t, 8, Some(&r.mask)),
                     None => {
-                        return Err(Error::msg(format!("scene '{}': no ground truth", sc.name)))
+                        return Err(Error::field(
+                            "--truth",
+                            format!(
+                                "scene '{}' has no roughness or NDF material, so its ground truth is its float reference: drop --truth",
+                                sc.name
+                            ),
+                        ))
                     }
                 }
             } else {

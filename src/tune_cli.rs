@@ -123,7 +123,7 @@ pub fn tune_csv(r: &TuneResult) -> Result<String> {
                     e.psnr8_db.map_or_else(String::new, |p| p.to_string()),
                     e.load.to_string(),
                 ]),
-                None => rec.extend(std::iter::repeat(String::new()).take(5)),
+                None => rec.extend(std::iter::repeat_n(String::new(), 5)),
             }
         }
         w.write_record(&rec).map_err(err)?;

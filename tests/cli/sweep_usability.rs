@@ -188,3 +188,39 @@ fn shards_merge_into_the_unsharded_table() {
         assert!(text(&o).contains("--shard"), "{bad}: {}", text(&o));
     }
 }
+
+#[test]
+fn a_sweep_plan_file_runs_and_the_command_line_adds_to_it() {
+    let d = tmp("plan");
+    std::fs::write(
+        d.join("plan.toml"),
+        "scene = \"demo\"\nwidth = 48\nheight = 36\nvary = [\"weight_bits=2..3\"]\nno_cycles = true\nout = \"p\"\n",
+    )
+    .unwrap();
+    let o = texsim(&["sweep", "plan.toml", "--vary", "texel_bits=6,8"], &d);
+    assert!(o.status.success(), "{}", text(&o));
+    let rows = json(&d.join("p/sweep.json"));
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    assert_eq!(rows[1]["settings"][0][0], "weight_bits");
+    assert_eq!(
+        rows[1]["settings"][1],
+        serde_json::json!(["texel_bits", "8"])
+    );
+    assert!(rows[0]["cycles"].is_null(), "no_cycles from the plan");
+    std::fs::write(
+        d.join("bad.toml"),
+        "vary = [\"weight_bits=2\"]\nbogus = 1\n",
+    )
+    .unwrap();
+    let o = texsim(&["sweep", "bad.toml"], &d);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o).contains("bad.toml") && text(&o).contains("bogus"),
+        "{}",
+        text(&o)
+    );
+    let o = texsim(&["sweep", "--scene", "demo"], &d);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o).contains("--vary"), "{}", text(&o));
+}

@@ -87,6 +87,10 @@ fn tune_bad_budget_and_knob_fail_with_the_flag_named() {
             "weight_bits",
         ),
         (vec!["--budget", "max8=1", "--size", "48"], "--size"),
+        (
+            vec!["--budget", "max8=1", "--size", "32x24", "--truth", "2"],
+            "drop --truth",
+        ),
     ] {
         let mut a = vec!["tune", "--scene", "demo"];
         a.extend(args);
