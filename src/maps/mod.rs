@@ -219,6 +219,7 @@ pub fn build_mip_chain(tex: &TextureImage) -> MipChain {
 }
 
 /// Quantizes one value in 0..1 to `bits` bits (module doc rule).
+#[inline]
 #[must_use]
 pub fn quantize_unorm(x: f32, bits: u32) -> u16 {
     let bits = bits.clamp(1, 16);

@@ -57,7 +57,7 @@ const KIND: StageKind = StageKind::EnvFetch;
 const CLAMP: [WrapMode; 2] = [WrapMode::ClampToEdge; 2];
 
 /// Fixed twin (module doc). A ground-truth plan runs the float twin.
-#[allow(clippy::too_many_lines)]
+#[allow(clippy::too_many_lines, clippy::needless_range_loop)]
 pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let (Some(ep), Some((_, ba))) = (px.plan.env.as_ref(), bump_of(px)) else {
         return;
@@ -237,6 +237,7 @@ fn filter_traced(
 }
 
 /// Float twin (module doc), or the ground truth.
+#[allow(clippy::needless_range_loop)]
 pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let (Some(ep), Some((bp, ba))) = (px.plan.env.as_ref(), bump_of(px)) else {
         return;
@@ -342,6 +343,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
 
 /// Ground truth: the mean over `k x k` sub-samples of the level-0 face texel (bilinear) seen
 /// along the reflection of the finest perturbed normal.
+#[allow(clippy::needless_range_loop)]
 fn truth(px: &Px, frag: &Frag, ep: &super::env::EnvPlan, n: DVec3, v: DVec3) -> [f64; 3] {
     let m = px.m;
     let Some(bp) = px.plan.bump.as_ref() else {

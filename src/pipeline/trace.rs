@@ -34,9 +34,11 @@ pub struct TexelFootprint {
 }
 
 /// Most footprints one fragment can fetch: footprint assembly's 16 probes of two levels, the
-/// offset and roughness maps (two levels each), four NDF maps (two levels each) and the
-/// environment lookup's 16 probes of two levels.
-pub const MAX_FOOTPRINTS: usize = 4 * hw_model::footprint::MAX_PROBES + 2 * 2 + 2 * 4;
+/// offset and roughness maps (two levels each) and four NDF maps (two levels each). An
+/// environment material's lookups (`env-fetch`: `aniso_probes` probes of two levels, after
+/// its bump and roughness maps) fit too, unless it is also textured with 16 probes (not
+/// supported: 4 x 16 + 4 footprints exceed the trace).
+pub const MAX_FOOTPRINTS: usize = 2 * hw_model::footprint::MAX_PROBES + 2 * 2 + 2 * 4;
 
 /// The footprints of one fragment, in the order its stages fetched them.
 #[derive(Clone, Copy, Debug)]

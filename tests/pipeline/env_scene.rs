@@ -33,7 +33,7 @@ fn run(sc: &Scene, hw: &HwConfig, opts: &RenderOptions) -> Rendered {
     render(sc, &maps, hw, opts).expect("render")
 }
 
-fn stage<'a>(r: &'a Rendered, k: StageKind) -> &'a texsim::render::StageStats {
+fn stage(r: &Rendered, k: StageKind) -> &texsim::render::StageStats {
     r.stats
         .stages
         .iter()
@@ -135,10 +135,6 @@ fn only_env_materials_run_env_fetch_and_timing_sees_it() {
     );
 }
 
-fn finite(img: &Image) -> bool {
-    img.px.iter().all(|p| p.iter().all(|&c| c <= 65535))
-}
-
 /// The rippled chrome sphere (normals parallel to the view at its centre, grazing reflections
 /// at its rim, every cube edge and corner in view) and 1x1 faces render without panics, with
 /// the hardware within a few LSB of the float twin, every filter (1x1 faces: but for pixels
@@ -158,7 +154,8 @@ fn chrome_sphere_and_tiny_faces_are_stable() {
             hw.env.env_filter = filter;
             hw.trilinear.aniso_probes = 4;
             let r = run(&s, &hw, &RenderOptions::default());
-            assert!(finite(&r.hw_image));
+            // Every float carrier finite (hardware and reference passes).
+            assert_eq!(r.stats.bump.ref_nonfinite, 0);
             let e8 = r.stats.error_8bit.as_ref().expect("error vs float");
             println!(
                 "{filter:?} size {size}: max {} within 1 LSB {:.2}%",
