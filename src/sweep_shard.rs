@@ -239,8 +239,21 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
             .collect();
         table.push(row);
     }
+    // A shard's Pareto marks are over its own rows: the front is recomputed over the grid.
+    crate::pareto::mark_sweep(&mut table);
+    let json_rows = all
+        .into_iter()
+        .zip(&table)
+        .map(|((_, mut r), row)| {
+            if let Some(o) = r.as_object_mut() {
+                o.insert("pareto_area".into(), row.pareto_area.into());
+                o.insert("pareto_cycles".into(), row.pareto_cycles.into());
+            }
+            r
+        })
+        .collect();
     Ok(Merged {
-        json_rows: all.into_iter().map(|(_, r)| r).collect(),
+        json_rows,
         rows: table,
     })
 }
