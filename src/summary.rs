@@ -38,7 +38,7 @@ pub fn text(s: &RenderStats) -> String {
     }
     let _ = writeln!(
         o,
-        "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
+        "{:<13} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
         "stage",
         "impl",
         "invocations",
@@ -61,7 +61,7 @@ pub fn text(s: &RenderStats) -> String {
         let cost = s.datapath.unit(uname);
         let _ = writeln!(
             o,
-            "{:<11} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
+            "{:<13} {:<6} {:>12} {:>10} {:>8} {:>12} {:>13} {:>12} {:>12}  {:<24} {:>7} {:>9}",
             st.stage.name(),
             if st.invocations == 0 {
                 "-"
@@ -161,6 +161,7 @@ pub fn stage_unit(stage: &str) -> &'static str {
         "rough-shade" => "roughness.shade",
         "ndf-shade" => "ndf",
         "lobe-shade" => "multi_lobe",
+        "env-fetch" => "cube_face",
         _ => "",
     }
 }

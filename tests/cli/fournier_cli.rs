@@ -57,6 +57,6 @@ fn fournier_scene_renders() {
     );
     assert!(o.status.success(), "{}", text(&o));
     let t = text(&o);
-    assert!(t.contains("lobe-shade  fixed"), "{t}");
+    assert!(t.contains("lobe-shade    fixed"), "{t}");
     assert!(d.join("o/hw.png").exists() && d.join("o/ref.png").exists());
 }
