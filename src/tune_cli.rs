@@ -194,6 +194,77 @@ pub fn summary_text(r: &TuneResult, texram16_area: u64) -> String {
     o
 }
 
+/// report.html of a tune run: every complete trial as a setting (the knobs that differ from
+/// the base machine, its worst mean and max 8-bit error over the scenes, its area), the Pareto
+/// front of error against area, the summary and the found machine.
+pub fn tune_report(r: &TuneResult, summary: &str) -> Result<String> {
+    use crate::report::html::{html, HtmlReport, ReportRow};
+    let hi: Vec<u32> = r.knobs.iter().map(|k| k.hi).collect();
+    // Only the knobs some trial moved: the others would each be a chart of one value.
+    let moved: Vec<usize> = (0..r.knobs.len())
+        .filter(|&i| r.trials.iter().any(|t| t.values[i] != hi[i]))
+        .collect();
+    let trials: Vec<&Trial> = r.trials.iter().filter(|t| t.complete).collect();
+    let worst = |t: &Trial, f: fn(&crate::tune::SceneError) -> f64| {
+        t.scenes.iter().map(f).fold(f64::NAN, f64::max)
+    };
+    let points: Vec<(f64, f64)> = trials
+        .iter()
+        .map(|t| (worst(t, |e| e.mean8), t.area_ge as f64))
+        .collect();
+    let front = crate::pareto::front(&points);
+    let rows = trials
+        .iter()
+        .zip(front)
+        .map(|(t, on_front)| ReportRow {
+            settings: moved
+                .iter()
+                .map(|&i| (leaf(&r.knobs[i].field).to_string(), t.values[i].to_string()))
+                .collect(),
+            error: Some(worst(t, |e| e.mean8)).filter(|e| e.is_finite()),
+            metrics: vec![
+                ("max8".into(), Some(worst(t, |e| f64::from(e.max8)))),
+                (
+                    "within1_pct".into(),
+                    Some(
+                        t.scenes
+                            .iter()
+                            .map(|e| e.within1_pct)
+                            .fold(f64::NAN, f64::min),
+                    ),
+                ),
+                ("load".into(), Some(t.load())),
+                ("meets".into(), Some(if t.meets { 1.0 } else { 0.0 })),
+            ],
+            area_ge: Some(t.area_ge as f64),
+            cycles: None,
+            pareto_area: on_front,
+            pareto_cycles: None,
+            strip: Vec::new(),
+        })
+        .collect();
+    let budgets: Vec<String> = r.budgets.iter().map(Budget::label).collect();
+    html(&HtmlReport {
+        title: format!(
+            "texsim tune: {} on {}",
+            budgets.join(", "),
+            r.scenes.join(", ")
+        ),
+        subtitle: format!(
+            "{} trials, {} renders (full grid: {} renders); error = the worst scene's mean 8-bit \
+             error vs the {}",
+            r.trials.len(),
+            r.renders,
+            big(r.grid_renders),
+            r.against
+        ),
+        rows,
+        tables: vec![("Tune result".into(), summary.to_string())],
+        ranges: None,
+        hw_config: hwconfig::to_toml(&r.machine),
+    })
+}
+
 /// A count, in scientific notation when large.
 fn big(n: f64) -> String {
     if n >= 1e9 {
@@ -254,7 +325,8 @@ pub fn tune_cmd(a: &TuneArgs) -> Result<()> {
     let r = tune(&spec, &mut print)?;
     let texram16_area =
         hw_model::datapath::total_area(&hw_model::datapath::units(&hw_model::HwConfig::texram16()));
-    print!("{}", summary_text(&r, texram16_area));
+    let summary = summary_text(&r, texram16_area);
+    print!("{summary}");
     eprintln!("texsim: tune took {:.1} s", start.elapsed().as_secs_f64());
     let mut out = OutputSet::new();
     let mut json = serde_json::to_value(&r).map_err(|e| Error::msg(e.to_string()))?;
@@ -280,6 +352,7 @@ pub fn tune_cmd(a: &TuneArgs) -> Result<()> {
         hwconfig::to_toml(&r.machine)
     );
     out.add("tuned.toml", toml.into_bytes());
+    out.add("report.html", tune_report(&r, &summary)?.into_bytes());
     for p in out.write_to(&a.out)? {
         println!("wrote {}", p.display());
     }

@@ -611,8 +611,9 @@ pub fn html(rep: &HtmlReport) -> Result<String> {
     });
     let json = serde_json::to_string(&data)
         .map_err(|e| Error::msg(format!("report.html: {e}")))?
-        // Inside <script>: no "</" may end the element early (JSON allows "<\/").
-        .replace("</", "<\\/");
+        // Inside <script>: no "</" may end the element early. `<` only occurs inside JSON
+        // strings, where "\u003c" is the same character.
+        .replace('<', "\\u003c");
     let mut s = String::new();
     let _ = write!(
         s,

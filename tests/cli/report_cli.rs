@@ -71,7 +71,7 @@ fn element_text<'a>(dom: &'a str, id: &str) -> &'a str {
     &dom[open_end..close]
 }
 
-/// The JSON the page embeds (`<script id="texsim-data">`), with `<\/` unescaped by the parser.
+/// The JSON the page embeds (`<script id="texsim-data">`; `<` is escaped as `\u003c`).
 fn page_json(html: &str) -> serde_json::Value {
     let t = element_text(html, "texsim-data");
     serde_json::from_str(t).expect("page JSON")
@@ -193,6 +193,42 @@ fn sweep_and_render_reports_render_in_chromium() {
         "strips"
     );
     check_report(&d.join("r/report.html"), &d.join("profile-r"));
+    // A tune run's report: every complete trial a point, its charts per moved knob and the
+    // area chart with the front.
+    let o = texsim(
+        &[
+            "tune",
+            "--scene",
+            "sphere",
+            "--size",
+            "64x48",
+            "--budget",
+            "max8=2",
+            "--knob",
+            "weight_bits,texel_bits",
+            "--out",
+            "t",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let tj = check_report(&d.join("t/report.html"), &d.join("profile-t"));
+    let tune: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("t/tune.json")).unwrap()).unwrap();
+    let complete = tune["trials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|t| t["complete"] == true)
+        .count();
+    assert_eq!(tj["rows"].as_array().unwrap().len(), complete);
+    let tcharts: Vec<&str> = tj["charts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["id"].as_str().unwrap())
+        .collect();
+    assert!(tcharts.contains(&"cost-area"), "{tcharts:?}");
 
     // The harness sees a broken page: a console message and an uncaught error.
     let bad = html.replace(
