@@ -433,7 +433,8 @@ pub struct TuneArgs {
     pub scene: Vec<String>,
     /// METRIC=LIMIT, repeatable, all must hold: max8=N (largest 8-bit channel error),
     /// within1=P (percent of pixels within 1 LSB, at least), mean8=X (mean absolute error),
-    /// psnr8=DB (at least); against the float reference, or the truth with --truth.
+    /// psnr8=DB (at least), flip_mean=F, flip_p99=F (LDR-FLIP, 0..1); against the float
+    /// reference, or the truth with --truth.
     #[arg(long, required = true)]
     pub budget: Vec<String>,
     /// Fields to search (leaf names or dotted paths, comma list or repeated); default: every

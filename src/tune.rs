@@ -40,15 +40,21 @@ pub enum Metric {
     Mean8,
     /// PSNR in dB (`psnr8`; identical images: infinite).
     Psnr8,
+    /// Mean LDR-FLIP over the covered pixels (`flip_mean`, in [0, 1]; `crate::flip`).
+    FlipMean,
+    /// 99th percentile of the per-pixel LDR-FLIP (`flip_p99`).
+    FlipP99,
 }
 
 impl Metric {
     /// Every metric with its budget name.
-    pub const ALL: [(Self, &'static str); 4] = [
+    pub const ALL: [(Self, &'static str); 6] = [
         (Self::Max8, "max8"),
         (Self::Within1, "within1"),
         (Self::Mean8, "mean8"),
         (Self::Psnr8, "psnr8"),
+        (Self::FlipMean, "flip_mean"),
+        (Self::FlipP99, "flip_p99"),
     ];
 
     /// The budget name (`max8`, ...).
@@ -66,14 +72,23 @@ impl Metric {
         matches!(self, Self::Within1 | Self::Psnr8)
     }
 
-    /// The metric's value in `e` (`f64::INFINITY` for the PSNR of identical images).
+    /// True for the FLIP metrics (a render computes FLIP only when a budget uses one).
     #[must_use]
-    pub fn of(self, e: &ErrorMetrics) -> f64 {
+    pub fn is_flip(self) -> bool {
+        matches!(self, Self::FlipMean | Self::FlipP99)
+    }
+
+    /// The metric's value in `e` and `flip` (`f64::INFINITY` for the PSNR of identical
+    /// images; NaN for a FLIP metric without FLIP, which no budget meets).
+    #[must_use]
+    pub fn of(self, e: &ErrorMetrics, flip: Option<&crate::flip::FlipStats>) -> f64 {
         match self {
             Self::Max8 => f64::from(e.max_abs_lsb),
             Self::Within1 => e.pct_within_1lsb,
             Self::Mean8 => e.mean_abs_lsb,
             Self::Psnr8 => e.psnr_db.unwrap_or(f64::INFINITY),
+            Self::FlipMean => flip.map_or(f64::NAN, |f| f.mean),
+            Self::FlipP99 => flip.map_or(f64::NAN, |f| f.p99),
         }
     }
 }
@@ -86,8 +101,9 @@ pub struct Budget {
 }
 
 impl Budget {
-    /// Parses `METRIC=LIMIT` (`max8=1`, `within1=99.5`, `mean8=0.1`, `psnr8=45`; `mean` and
-    /// `psnr` are accepted for `mean8` and `psnr8`).
+    /// Parses `METRIC=LIMIT` (`max8=1`, `within1=99.5`, `mean8=0.1`, `psnr8=45`,
+    /// `flip_mean=0.01`, `flip_p99=0.05`; `mean` and `psnr` are accepted for `mean8` and
+    /// `psnr8`).
     pub fn parse(s: &str) -> Result<Self> {
         let names: Vec<&str> = Metric::ALL.iter().map(|(_, n)| *n).collect();
         let (m, v) = s.split_once('=').ok_or_else(|| {
@@ -118,13 +134,19 @@ impl Budget {
                 format!("'{}' in '{s}' is not a number", v.trim()),
             )
         })?;
-        if !limit.is_finite() || limit < 0.0 || (metric == Metric::Within1 && limit > 100.0) {
+        if !limit.is_finite()
+            || limit < 0.0
+            || (metric == Metric::Within1 && limit > 100.0)
+            || (metric.is_flip() && limit > 1.0)
+        {
             return Err(Error::field(
                 "--budget",
                 format!(
                     "{m}={limit} is out of range (a finite value >= 0{})",
                     if metric == Metric::Within1 {
                         ", at most 100"
+                    } else if metric.is_flip() {
+                        ", at most 1"
                     } else {
                         ""
                     }
@@ -148,8 +170,13 @@ impl Budget {
                 used / allowed
             }
         };
+        if value.is_nan() {
+            return f64::INFINITY;
+        }
         match self.metric {
-            Metric::Max8 | Metric::Mean8 => ratio(value, self.limit),
+            Metric::Max8 | Metric::Mean8 | Metric::FlipMean | Metric::FlipP99 => {
+                ratio(value, self.limit)
+            }
             Metric::Within1 => ratio(100.0 - value, 100.0 - self.limit),
             Metric::Psnr8 => {
                 if value.is_infinite() {
@@ -202,6 +229,9 @@ pub struct SceneError {
     pub within1_pct: f64,
     /// `None`: identical images.
     pub psnr8_db: Option<f64>,
+    /// LDR-FLIP mean and 99th percentile (computed only when a budget uses FLIP).
+    pub flip_mean: Option<f64>,
+    pub flip_p99: Option<f64>,
     /// The largest budget load ([`Budget::load`]) on this scene.
     pub load: f64,
 }
@@ -436,10 +466,22 @@ impl Search<'_> {
                     .clone()
                     .ok_or_else(|| Error::msg(format!("scene '{}': no reference", sc.name)))?
             };
+            let flip = if spec.budgets.iter().any(|b| b.metric.is_flip()) {
+                let target = if spec.truth > 0 {
+                    r.truth_image.as_ref()
+                } else {
+                    r.ref_image.as_ref()
+                };
+                target
+                    .and_then(|t| crate::flip::flip(&r.hw_image, t, Some(&r.mask)))
+                    .map(|f| f.stats)
+            } else {
+                None
+            };
             let load = spec
                 .budgets
                 .iter()
-                .map(|b| b.load(b.metric.of(&e)))
+                .map(|b| b.load(b.metric.of(&e, flip.as_ref())))
                 .fold(0.0, f64::max);
             scenes.push(SceneError {
                 scene: sc.name.clone(),
@@ -447,6 +489,8 @@ impl Search<'_> {
                 mean8: e.mean_abs_lsb,
                 within1_pct: e.pct_within_1lsb,
                 psnr8_db: e.psnr_db,
+                flip_mean: flip.as_ref().map(|f| f.mean),
+                flip_p99: flip.as_ref().map(|f| f.p99),
                 load,
             });
             if !full && load > 1.0 {

@@ -106,7 +106,17 @@ fn budgets_parse_and_bad_ones_name_the_flag() {
     assert!(p.load(f64::INFINITY) == 0.0 && p.load(39.0) > 1.0 && p.load(41.0) <= 1.0);
     let m = Budget::parse("max8=0").expect("zero");
     assert!(m.load(0.0) <= 1.0 && m.load(1.0) > 1.0);
-    for bad in ["max8", "max9=1", "max8=x", "within1=101", "mean8=-1"] {
+    let f = Budget::parse("flip_mean=0.01").expect("flip");
+    assert_eq!(f.metric, Metric::FlipMean);
+    assert!(f.load(0.005) <= 1.0 && f.load(0.02) > 1.0 && f.load(f64::NAN).is_infinite());
+    for bad in [
+        "max8",
+        "max9=1",
+        "max8=x",
+        "within1=101",
+        "mean8=-1",
+        "flip_p99=1.5",
+    ] {
         let e = Budget::parse(bad).unwrap_err().to_string();
         assert!(e.contains("--budget"), "{bad}: {e}");
     }
@@ -120,4 +130,22 @@ fn budgets_parse_and_bad_ones_name_the_flag() {
         (k.field.as_str(), k.lo, k.hi),
         ("trilinear.weight_bits", 0, 16)
     );
+}
+
+/// A FLIP budget: the search computes FLIP per scene and the verified machine meets it,
+/// cheaper than texram16.
+#[test]
+fn a_flip_budget_is_met_by_the_verified_machine() {
+    let sp = spec(
+        vec![small("demo", 80, 60)],
+        "flip_mean=0.01",
+        &["weight_bits", "texel_bits", "color_bits"],
+    );
+    let r = tune(&sp, &mut |_t: &Trial| {}).expect("tune");
+    let best = r.best_trial();
+    assert!(best.meets);
+    let f = best.scenes[0].flip_mean.expect("FLIP computed");
+    assert!(f <= 0.01, "{f}");
+    assert!(best.area_ge < area(&hw_model::HwConfig::texram16()));
+    assert!(r.trials.iter().any(|t| !t.meets), "the budget binds");
 }
