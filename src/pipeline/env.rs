@@ -9,9 +9,9 @@
 
 use super::{Plan, StageKind};
 use crate::maps::cube::cube_chains;
+use crate::maps::cube::env_sampler;
 use crate::maps::{quantize_chain, Maps};
-use crate::scene::Material;
-use crate::shading::env::sky_f;
+use crate::scene::{EnvSource, Material, TextureImage};
 use hw_model::config::HwConfig;
 use hw_model::env_config::EnvFilter;
 
@@ -22,8 +22,10 @@ pub struct EnvPlan {
     pub choice: Option<EnvFilter>,
     /// The resolved filter.
     pub filter: EnvFilter,
-    /// Face size of the sky cube.
+    /// Face size of the cube.
     pub size: u32,
+    /// Where its texels come from.
+    pub source: EnvSource,
     /// Index of the cube's first face chain (+X; the six faces are consecutive).
     pub map: usize,
     /// Ground-truth sub-samples per axis; 0 = the model.
@@ -45,6 +47,7 @@ pub fn mark_plan(plan: &mut Plan, material: &Material) {
             choice: e.filter,
             filter: EnvFilter::None,
             size: e.size,
+            source: e.source,
             map: usize::MAX,
             truth_samples: 0,
             d_scale_q16: 1 << 16,
@@ -53,10 +56,10 @@ pub fn mark_plan(plan: &mut Plan, material: &Material) {
 }
 
 /// Resolves every environment plan's filter against `hw`, numbers its cube (one per distinct
-/// face size, from `first_map`) and appends `env-fetch` as the plan's last stage. Returns
-/// the face sizes of the cubes to build, in order.
-pub fn resolve_plans(plans: &mut [Plan], hw: &HwConfig, first_map: usize) -> Vec<u32> {
-    let mut sizes: Vec<u32> = Vec::new();
+/// face size and source, from `first_map`) and appends `env-fetch` as the plan's last stage.
+/// Returns the cubes to build (face size, source), in order.
+pub fn resolve_plans(plans: &mut [Plan], hw: &HwConfig, first_map: usize) -> Vec<(u32, EnvSource)> {
+    let mut sizes: Vec<(u32, EnvSource)> = Vec::new();
     for plan in plans.iter_mut() {
         let Some(ep) = plan.env.as_mut() else {
             continue;
@@ -67,8 +70,9 @@ pub fn resolve_plans(plans: &mut [Plan], hw: &HwConfig, first_map: usize) -> Vec
             .as_ref()
             .map_or(1, |b| hw.roughness.exponent(b.shininess).max(1));
         ep.d_scale_q16 = (65536.0 / f64::from(exponent).sqrt()).round() as i64;
-        let k = sizes.iter().position(|&s| s == ep.size).unwrap_or_else(|| {
-            sizes.push(ep.size);
+        let key = (ep.size, ep.source);
+        let k = sizes.iter().position(|&s| s == key).unwrap_or_else(|| {
+            sizes.push(key);
             sizes.len() - 1
         });
         ep.map = first_map + 6 * k;
@@ -78,13 +82,18 @@ pub fn resolve_plans(plans: &mut [Plan], hw: &HwConfig, first_map: usize) -> Vec
     sizes
 }
 
-/// `maps` with the sky cubes of `sizes` appended (six float chains each and their
-/// quantization to `texel_bits`).
+/// `maps` with the cubes of `cubes` appended (six float chains each and their quantization
+/// to `texel_bits`); image sources are the scene's `textures`.
 #[must_use]
-pub fn env_maps(maps: &Maps, sizes: &[u32], hw: &HwConfig) -> Maps {
+pub fn env_maps(
+    maps: &Maps,
+    cubes: &[(u32, EnvSource)],
+    hw: &HwConfig,
+    textures: &[TextureImage],
+) -> Maps {
     let mut out = maps.clone();
-    for &n in sizes {
-        for c in cube_chains(n, sky_f) {
+    for &(n, source) in cubes {
+        for c in cube_chains(n, &*env_sampler(source, textures)) {
             out.fixed.push(quantize_chain(&c, hw.trilinear.texel_bits));
             out.float.push(c);
         }

@@ -156,7 +156,7 @@ pub fn render(
     let maps = if env_sizes.is_empty() {
         maps
     } else {
-        env_owned = crate::pipeline::env::env_maps(maps, &env_sizes, hw);
+        env_owned = crate::pipeline::env::env_maps(maps, &env_sizes, hw, &scene.textures);
         &env_owned
     };
     let toksvig_sources = crate::pipeline::toksvig::resolve_plans(&mut geo.plans, maps.float.len());

@@ -6,12 +6,13 @@
 
 use super::geometry::{fit_camera, fit_light};
 use super::texture::ripples_height;
-use super::{shapes, EnvMaterial, Material, RoughChoice, Scene};
+use super::{shapes, EnvMaterial, EnvSource, Material, RoughChoice, Scene};
 
 /// The sky cube of the built-in scenes: 256 texels per face, the hardware's filter.
 const SKY: EnvMaterial = EnvMaterial {
     filter: None,
     size: 256,
+    source: EnvSource::Sky,
 };
 
 /// Shininess of the mirrors: a base roughness `1/sqrt(1024)` (1/32 slope) in the D map.

@@ -174,8 +174,22 @@ impl MadeUpLobe {
 pub struct EnvMaterial {
     /// The filter: `None` = the hardware's `env_filter` (so `--vary env_filter=...` switches it).
     pub filter: Option<hw_model::env_config::EnvFilter>,
-    /// Face size of the procedural sky cube (texels per side, a power of two).
+    /// Face size of the cube (texels per side, a power of two).
     pub size: u32,
+    /// Where the cube's texels come from.
+    pub source: EnvSource,
+}
+
+/// Where an environment map's texels come from (`maps::cube::env_sampler`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvSource {
+    /// The procedural sky (`shading::env::sky_f`).
+    Sky,
+    /// An equirectangular (latitude-longitude, 2:1) image: the scene texture of this index.
+    Equirect(usize),
+    /// Six square face images in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), each in OpenGL's face
+    /// orientation (OpenGL 4.6 Table 8.19): scene texture indices.
+    Faces([usize; 6]),
 }
 
 impl EnvMaterial {

@@ -110,8 +110,10 @@ struct MaterialCfg {
     exponent_map: Option<String>,
     /// NDF mapping of the `bump` map (Olano and North 1997).
     ndf: Option<bool>,
-    /// Environment map of a bump material: `"sky"` (the procedural sky cube).
-    env_map: Option<String>,
+    /// Environment map of a bump material: `"sky"` (the procedural sky cube), one image file
+    /// (equirectangular 2:1 or a horizontal cross 4:3) or six face files (+x, -x, +y, -y,
+    /// +z, -z).
+    env_map: Option<EnvMapCfg>,
     /// Its filter: `hw` (default), `none`, `lambda1` or `ellipse`.
     env_filter: Option<String>,
     /// Face size of the sky cube (a power of two, 1..=2048; default 256).
@@ -522,7 +524,7 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
             shininess: m.shininess.unwrap_or(def.shininess),
             brdf: as_brdf(i, m, &tex_names)?,
             ndf: m.ndf.unwrap_or(def.ndf),
-            env: env_material(m, &f)?,
+            env: env_material(m, &f, &base, &mut textures)?,
             lobes: made_up_lobes(i, m)?,
             bump_filter: match &m.bump_filter {
                 Some(b) => crate::scene::BumpFilter::parse(b)
@@ -734,31 +736,130 @@ fn build_camera(c: Option<&CameraCfg>, meshes: &[Mesh], w: u32, h: u32) -> Resul
 }
 
 /// The `env_map`, `env_filter` and `env_size` keys of a material.
+/// An `env_map` value: `"sky"`, one image file, or six face files.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum EnvMapCfg {
+    One(String),
+    Six(Vec<String>),
+}
+
+/// Decodes an environment image (a texture file) for `field`, appends it to `textures` and
+/// returns its index.
+fn env_image(
+    base: &Path,
+    file: &str,
+    field: &str,
+    textures: &mut Vec<TextureImage>,
+) -> Result<usize> {
+    let t =
+        decode_texture(&resolve(base, file)).map_err(|e| e.context(format!("field '{field}'")))?;
+    textures.push(t);
+    Ok(textures.len() - 1)
+}
+
+/// Checks that six faces are square, of one power-of-two size up to the cube limit; returns it.
+fn face_size(faces: &[&TextureImage], field: &str) -> Result<u32> {
+    let n = faces[0].width;
+    for t in faces {
+        if t.width != t.height || t.width != n {
+            return Err(Error::field(
+                field,
+                format!(
+                    "face '{}' is {}x{}: the six faces must be square and of one size ({n}x{n})",
+                    t.name, t.width, t.height
+                ),
+            ));
+        }
+    }
+    if !n.is_power_of_two() || n > crate::maps::cube::MAX_FACE_SIZE {
+        return Err(Error::field(
+            field,
+            format!(
+                "faces of {n}x{n}: a face side must be a power of two in 1..={}",
+                crate::maps::cube::MAX_FACE_SIZE
+            ),
+        ));
+    }
+    Ok(n)
+}
+
 fn env_material(
     m: &MaterialCfg,
     f: &dyn Fn(&str) -> String,
+    base: &Path,
+    textures: &mut Vec<TextureImage>,
 ) -> Result<Option<crate::scene::EnvMaterial>> {
+    use crate::scene::EnvSource;
     let Some(src) = &m.env_map else {
         if m.env_filter.is_some() || m.env_size.is_some() {
             return Err(Error::field(
                 &f("env_map"),
-                "env_filter and env_size need env_map = \"sky\"",
+                "env_filter and env_size need env_map (\"sky\", an image file or six face files)",
             ));
         }
         return Ok(None);
     };
-    if src != "sky" {
-        return Err(Error::field(
-            &f("env_map"),
-            format!("'{src}' is not \"sky\" (the procedural sky cube)"),
-        ));
-    }
+    let field = f("env_map");
+    let (source, own_size) = match src {
+        EnvMapCfg::One(s) if s == "sky" => (EnvSource::Sky, None),
+        EnvMapCfg::One(file) => {
+            let i = env_image(base, file, &field, textures)?;
+            let (w, h) = (textures[i].width, textures[i].height);
+            if w == 2 * h {
+                (EnvSource::Equirect(i), None)
+            } else if 3 * w == 4 * h && w % 4 == 0 {
+                let faces = crate::maps::cube::split_cross(&textures[i]);
+                let n = face_size(&faces.iter().collect::<Vec<_>>(), &field)?;
+                let first = textures.len();
+                textures.extend(faces);
+                (
+                    EnvSource::Faces(std::array::from_fn(|k| first + k)),
+                    Some(n),
+                )
+            } else {
+                return Err(Error::field(
+                    &field,
+                    format!(
+                        "'{file}' is {w}x{h}: an environment image is equirectangular (2:1) or a horizontal cross (4:3)"
+                    ),
+                ));
+            }
+        }
+        EnvMapCfg::Six(files) => {
+            if files.len() != 6 {
+                return Err(Error::field(
+                    &field,
+                    format!(
+                        "{} files: a cube is six faces (+x, -x, +y, -y, +z, -z)",
+                        files.len()
+                    ),
+                ));
+            }
+            let mut ix = [0usize; 6];
+            for (k, file) in files.iter().enumerate() {
+                ix[k] = env_image(base, file, &format!("{field}[{k}]"), textures)?;
+            }
+            let faces: Vec<&TextureImage> = ix.iter().map(|&i| &textures[i]).collect();
+            let n = face_size(&faces, &field)?;
+            (EnvSource::Faces(ix), Some(n))
+        }
+    };
     let filter = match &m.env_filter {
         Some(s) => crate::scene::EnvMaterial::parse_filter(s)
             .map_err(|e| Error::field(&f("env_filter"), e))?,
         None => None,
     };
-    let size = m.env_size.unwrap_or(256);
+    let size = match (own_size, m.env_size) {
+        (Some(n), Some(s)) if s != n => {
+            return Err(Error::field(
+                &f("env_size"),
+                format!("{s}: the faces of env_map are {n}x{n} (leave env_size out)"),
+            ))
+        }
+        (Some(n), _) => n,
+        (None, s) => s.unwrap_or(256),
+    };
     if !size.is_power_of_two() || size > crate::maps::cube::MAX_FACE_SIZE {
         return Err(Error::field(
             &f("env_size"),
@@ -768,5 +869,9 @@ fn env_material(
             ),
         ));
     }
-    Ok(Some(crate::scene::EnvMaterial { filter, size }))
+    Ok(Some(crate::scene::EnvMaterial {
+        filter,
+        size,
+        source,
+    }))
 }
