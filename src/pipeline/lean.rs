@@ -9,13 +9,18 @@
 //! BRDF) gets these stages; any other costs nothing extra. Its ground truth is the roughness
 //! stages' (the box-filtered mean of plain Blinn-Phong over sub-samples of the finest offsets).
 
-use super::rough::{decoded_offsets, RoughPlan};
+use super::rough::{decoded_offsets, resolve_extra_map, truth_as_rough, ExtraMapStages};
 use super::{BumpPlan, Plan, Px, StageKind};
 use crate::maps::Maps;
-use crate::scene::{BumpFilter, Material, RoughChoice};
+use crate::scene::{BumpFilter, Material};
 use crate::shading::lean::{lean_mip_chain, quantize_lean_chain};
 use hw_model::config::HwConfig;
-use hw_model::roughness::RoughVariant;
+
+/// The LEAN stages: the fetch after `bump-fetch`, the shade instead of `phong`.
+const STAGES: ExtraMapStages = ExtraMapStages {
+    fetch: StageKind::LeanFetch,
+    shade: StageKind::LeanShade,
+};
 
 /// What the LEAN stages of one material need.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,33 +62,9 @@ pub(super) fn lean_of<'a>(px: &Px<'a>) -> Option<(&'a BumpPlan, &'a LeanPlan)> {
 /// returned offset-map indices) and sets the stages: `lean-fetch` after `bump-fetch`,
 /// `lean-shade` instead of `phong`.
 pub fn resolve_plans(plans: &mut [Plan], first_map: usize) -> Vec<usize> {
-    let mut sources: Vec<usize> = Vec::new();
-    for plan in plans.iter_mut() {
-        let Some(bp) = &plan.bump else { continue };
-        let offset_map = bp.map;
-        let Some(tp) = plan.lean.as_mut() else {
-            continue;
-        };
-        let k = sources
-            .iter()
-            .position(|&s| s == offset_map)
-            .unwrap_or_else(|| {
-                sources.push(offset_map);
-                sources.len() - 1
-            });
-        tp.map = first_map + k;
-        let mut stages = Vec::with_capacity(plan.stages.len() + 1);
-        for &s in &plan.stages {
-            match s {
-                StageKind::BumpFetch => stages.extend([s, StageKind::LeanFetch]),
-                StageKind::Phong => stages.push(StageKind::LeanShade),
-                StageKind::LeanFetch | StageKind::LeanShade => {}
-                _ => stages.push(s),
-            }
-        }
-        plan.stages = stages;
-    }
-    sources
+    resolve_extra_map(plans, first_map, STAGES, |p| {
+        p.lean.as_mut().map(|t| &mut t.map)
+    })
 }
 
 /// `maps` with the moment maps of offset maps `sources` appended (float chains and their
@@ -112,24 +93,5 @@ pub fn lean_maps(maps: &Maps, sources: &[usize], hw: &HwConfig) -> crate::Result
 /// truth mode (`rough-shade` supersampling plain Blinn-Phong, `k` sub-samples per axis).
 #[must_use]
 pub fn truth_plans(plans: Vec<Plan>, k: u32) -> Vec<Plan> {
-    plans
-        .into_iter()
-        .map(|mut p| {
-            if p.lean.take().is_some() {
-                p.rough = Some(RoughPlan {
-                    choice: RoughChoice::Variant(RoughVariant::None),
-                    variant: RoughVariant::None,
-                    map: usize::MAX,
-                    truth_samples: k.max(1),
-                });
-                p.stages.retain(|&s| s != StageKind::LeanFetch);
-                for s in &mut p.stages {
-                    if *s == StageKind::LeanShade {
-                        *s = StageKind::RoughShade;
-                    }
-                }
-            }
-            p
-        })
-        .collect()
+    truth_as_rough(plans, k, STAGES, |p| p.lean.take().is_some())
 }

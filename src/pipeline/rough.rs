@@ -197,3 +197,80 @@ pub fn rough_maps(
     }
     Ok((out, clamped))
 }
+
+/// The two stages of a bump-map filter that reads one more map per offset map (Toksvig,
+/// LEAN): its fetch runs after `bump-fetch`, its shade instead of `phong`.
+#[derive(Clone, Copy)]
+pub(super) struct ExtraMapStages {
+    pub fetch: StageKind,
+    pub shade: StageKind,
+}
+
+/// Numbers the extra maps of the plans whose `slot` is set (the map index it holds) from
+/// `first_map`, one per distinct offset map, and sets their stages. Returns the offset maps,
+/// in the order of the extra maps.
+pub(super) fn resolve_extra_map(
+    plans: &mut [Plan],
+    first_map: usize,
+    st: ExtraMapStages,
+    slot: fn(&mut Plan) -> Option<&mut usize>,
+) -> Vec<usize> {
+    let mut sources: Vec<usize> = Vec::new();
+    for plan in plans.iter_mut() {
+        let Some(offset_map) = plan.bump.as_ref().map(|b| b.map) else {
+            continue;
+        };
+        let Some(map) = slot(plan) else { continue };
+        let k = sources
+            .iter()
+            .position(|&s| s == offset_map)
+            .unwrap_or_else(|| {
+                sources.push(offset_map);
+                sources.len() - 1
+            });
+        *map = first_map + k;
+        let mut stages = Vec::with_capacity(plan.stages.len() + 1);
+        for &s in &plan.stages {
+            match s {
+                StageKind::BumpFetch => stages.extend([s, st.fetch]),
+                StageKind::Phong => stages.push(st.shade),
+                s if s == st.fetch || s == st.shade => {}
+                _ => stages.push(s),
+            }
+        }
+        plan.stages = stages;
+    }
+    sources
+}
+
+/// The ground truth of such a filter's plans (`take` clears the filter's plan and says whether
+/// there was one): a roughness plan of variant `none` in truth mode (`rough-shade`
+/// supersampling plain Blinn-Phong, `k` sub-samples per axis), so the filter, the plain bump
+/// map and the roughness pyramid are measured against one truth.
+pub(super) fn truth_as_rough(
+    plans: Vec<Plan>,
+    k: u32,
+    st: ExtraMapStages,
+    take: fn(&mut Plan) -> bool,
+) -> Vec<Plan> {
+    plans
+        .into_iter()
+        .map(|mut p| {
+            if take(&mut p) {
+                p.rough = Some(RoughPlan {
+                    choice: RoughChoice::Variant(RoughVariant::None),
+                    variant: RoughVariant::None,
+                    map: usize::MAX,
+                    truth_samples: k.max(1),
+                });
+                p.stages.retain(|&s| s != st.fetch);
+                for s in &mut p.stages {
+                    if *s == st.shade {
+                        *s = StageKind::RoughShade;
+                    }
+                }
+            }
+            p
+        })
+        .collect()
+}

@@ -12,13 +12,18 @@
 //! Blinn-Phong over sub-samples of the finest offsets, `rough-shade` in truth mode), so
 //! Toksvig, the plain bump map and the roughness pyramid are measured against one truth.
 
-use super::rough::{decoded_offsets, RoughPlan};
+use super::rough::{decoded_offsets, resolve_extra_map, truth_as_rough, ExtraMapStages};
 use super::{BumpPlan, Plan, Px, StageKind};
 use crate::maps::Maps;
-use crate::scene::{BumpFilter, Material, RoughChoice};
+use crate::scene::{BumpFilter, Material};
 use crate::shading::toksvig::{quantize_toksvig_chain, toksvig_mip_chain};
 use hw_model::config::HwConfig;
-use hw_model::roughness::RoughVariant;
+
+/// The Toksvig stages: the fetch after `bump-fetch`, the shade instead of `phong`.
+const STAGES: ExtraMapStages = ExtraMapStages {
+    fetch: StageKind::ToksvigFetch,
+    shade: StageKind::ToksvigShade,
+};
 
 /// What the Toksvig stages of one material need.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,33 +65,9 @@ pub(super) fn toksvig_of<'a>(px: &Px<'a>) -> Option<(&'a BumpPlan, &'a ToksvigPl
 /// returned offset-map indices) and sets the stages: `toksvig-fetch` after `bump-fetch`,
 /// `toksvig-shade` instead of `phong`.
 pub fn resolve_plans(plans: &mut [Plan], first_map: usize) -> Vec<usize> {
-    let mut sources: Vec<usize> = Vec::new();
-    for plan in plans.iter_mut() {
-        let Some(bp) = &plan.bump else { continue };
-        let offset_map = bp.map;
-        let Some(tp) = plan.toksvig.as_mut() else {
-            continue;
-        };
-        let k = sources
-            .iter()
-            .position(|&s| s == offset_map)
-            .unwrap_or_else(|| {
-                sources.push(offset_map);
-                sources.len() - 1
-            });
-        tp.map = first_map + k;
-        let mut stages = Vec::with_capacity(plan.stages.len() + 1);
-        for &s in &plan.stages {
-            match s {
-                StageKind::BumpFetch => stages.extend([s, StageKind::ToksvigFetch]),
-                StageKind::Phong => stages.push(StageKind::ToksvigShade),
-                StageKind::ToksvigFetch | StageKind::ToksvigShade => {}
-                _ => stages.push(s),
-            }
-        }
-        plan.stages = stages;
-    }
-    sources
+    resolve_extra_map(plans, first_map, STAGES, |p| {
+        p.toksvig.as_mut().map(|t| &mut t.map)
+    })
 }
 
 /// `maps` with the Toksvig maps of offset maps `sources` appended (float chains and their
@@ -112,24 +93,5 @@ pub fn toksvig_maps(maps: &Maps, sources: &[usize], hw: &HwConfig) -> crate::Res
 /// truth mode (`rough-shade` supersampling plain Blinn-Phong, `k` sub-samples per axis).
 #[must_use]
 pub fn truth_plans(plans: Vec<Plan>, k: u32) -> Vec<Plan> {
-    plans
-        .into_iter()
-        .map(|mut p| {
-            if p.toksvig.take().is_some() {
-                p.rough = Some(RoughPlan {
-                    choice: RoughChoice::Variant(RoughVariant::None),
-                    variant: RoughVariant::None,
-                    map: usize::MAX,
-                    truth_samples: k.max(1),
-                });
-                p.stages.retain(|&s| s != StageKind::ToksvigFetch);
-                for s in &mut p.stages {
-                    if *s == StageKind::ToksvigShade {
-                        *s = StageKind::RoughShade;
-                    }
-                }
-            }
-            p
-        })
-        .collect()
+    truth_as_rough(plans, k, STAGES, |p| p.toksvig.take().is_some())
 }

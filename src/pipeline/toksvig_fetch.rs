@@ -4,11 +4,9 @@
 
 use super::stages::{Counters, Machine};
 use super::toksvig::toksvig_of;
-use super::trace::{trace_float_fetch, trilinear_traced, Lookup};
+use super::trace::{fetch_at_uv_lod, fetch_at_uv_lod_f64};
 use super::{Frag, Plan, Px, StageKind};
-use crate::fixedpoint::{from_unorm, to_raw};
-use crate::reference::{lod_f64, trilinear_f64};
-use hw_model::lod::lod;
+use crate::fixedpoint::from_unorm;
 use hw_model::trilinear::trilinear_cost;
 use hw_model::UnitCost;
 
@@ -17,46 +15,10 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let Some((_, tp)) = toksvig_of(px) else {
         return;
     };
-    let m = px.m;
-    let hw = m.hw;
-    let t = tp.map;
-    let Some(l0) = m.tex_float.get(t).and_then(|l| l.first()) else {
+    let Some(r) = fetch_at_uv_lod(px, frag, c, StageKind::ToksvigFetch, tp.map) else {
         return;
     };
-    let sat = &mut c.sat[StageKind::ToksvigFetch.index()];
-    let (w, h) = (l0.width, l0.height);
-    let fb = m.uv_fmt.frac_bits;
-    let uv = if px.fixed(StageKind::Texcoord) {
-        frag.uv_x
-    } else {
-        frag.uv.map(|s| s.map(|x| to_raw(x, &m.uv_fmt, sat)))
-    };
-    let d = [
-        (uv[1][0] - uv[0][0]) * i64::from(w),
-        (uv[1][1] - uv[0][1]) * i64::from(h),
-        (uv[2][0] - uv[0][0]) * i64::from(w),
-        (uv[2][1] - uv[0][1]) * i64::from(h),
-    ];
-    let l = lod(d, fb, &hw.lod, sat);
-    let [u, v] = uv[0];
-    let at = Lookup {
-        stage: StageKind::ToksvigFetch,
-        lookup: 0,
-        tex: t,
-    };
-    let r = trilinear_traced(
-        &m.tex_fixed[t],
-        u,
-        v,
-        fb,
-        l,
-        hw.lod.lod_frac_bits,
-        px.plan.wrap,
-        &hw.trilinear,
-        &mut frag.trace,
-        at,
-    );
-    let tb = hw.trilinear.texel_bits;
+    let tb = px.m.hw.trilinear.texel_bits;
     frag.toksvig.texel_x = [0, 1, 2].map(|i| u32::from(r[i]));
     frag.toksvig.texel = frag.toksvig.texel_x.map(|x| from_unorm(x, tb));
 }
@@ -66,27 +28,10 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let Some((_, tp)) = toksvig_of(px) else {
         return;
     };
-    let m = px.m;
-    let t = tp.map;
-    let Some(l0) = m.tex_float.get(t).and_then(|l| l.first()) else {
+    let Some(r) = fetch_at_uv_lod_f64(px, frag, StageKind::ToksvigFetch, tp.map) else {
         return;
     };
-    let uv = &frag.uv;
-    let (wf, hf) = (f64::from(l0.width), f64::from(l0.height));
-    let l = lod_f64([
-        (uv[1][0] - uv[0][0]) * wf,
-        (uv[1][1] - uv[0][1]) * hf,
-        (uv[2][0] - uv[0][0]) * wf,
-        (uv[2][1] - uv[0][1]) * hf,
-    ]);
-    let r = trilinear_f64(&m.tex_float[t], uv[0][0], uv[0][1], l, px.plan.wrap);
     frag.toksvig.texel = [r[0], r[1], r[2]];
-    let at = Lookup {
-        stage: StageKind::ToksvigFetch,
-        lookup: 0,
-        tex: t,
-    };
-    trace_float_fetch(m, frag, px.fixed(StageKind::Texcoord), px.plan.wrap, at, 1);
 }
 
 /// One invocation: one trilinear lookup (the LOD unit's share is counted as in `rough-fetch`:

@@ -193,3 +193,69 @@ pub fn trace_float_fetch(
         let _ = trilinear_traced(levels, u, v, fb, l, lfb, wrap, hw, &mut frag.trace, at);
     }
 }
+
+/// One lookup of texture `t` for `stage` at the LOD of the pixel's texture-coordinate
+/// derivatives on the map's level-0 size: the fixed LOD unit, then the traced trilinear unit.
+/// A Float `texcoord` producer's carriers are rounded into the coordinate format. The maps
+/// fetched beside the bump map (D, Toksvig, LEAN moments) share it. `None`: no such texture.
+pub fn fetch_at_uv_lod(
+    px: &super::Px,
+    frag: &mut super::Frag,
+    c: &mut super::stages::Counters,
+    stage: StageKind,
+    t: usize,
+) -> Option<[u16; 4]> {
+    let m = px.m;
+    let hw = m.hw;
+    let l0 = m.tex_float.get(t).and_then(|l| l.first())?;
+    let sat = &mut c.sat[stage.index()];
+    let fb = m.uv_fmt.frac_bits;
+    let uv = if px.fixed(StageKind::Texcoord) {
+        frag.uv_x
+    } else {
+        frag.uv
+            .map(|s| s.map(|x| crate::fixedpoint::to_raw(x, &m.uv_fmt, sat)))
+    };
+    let d = super::stages::texel_derivs(&uv, l0.width, l0.height);
+    let l = hw_model::lod::lod(d, fb, &hw.lod, sat);
+    let [u, v] = uv[0];
+    let at = Lookup {
+        stage,
+        lookup: 0,
+        tex: t,
+    };
+    Some(trilinear_traced(
+        &m.tex_fixed[t],
+        u,
+        v,
+        fb,
+        l,
+        hw.lod.lod_frac_bits,
+        px.plan.wrap,
+        &hw.trilinear,
+        &mut frag.trace,
+        at,
+    ))
+}
+
+/// The float twin of [`fetch_at_uv_lod`]: exact LOD and trilinear filter of the float map
+/// (under timing, the footprints the hardware fetches for the rounded coordinates).
+pub fn fetch_at_uv_lod_f64(
+    px: &super::Px,
+    frag: &mut super::Frag,
+    stage: StageKind,
+    t: usize,
+) -> Option<[f64; 4]> {
+    let m = px.m;
+    let l0 = m.tex_float.get(t).and_then(|l| l.first())?;
+    let uv = &frag.uv;
+    let l = crate::reference::lod_f64(super::stages::texel_derivs_f64(uv, l0.width, l0.height));
+    let r = crate::reference::trilinear_f64(&m.tex_float[t], uv[0][0], uv[0][1], l, px.plan.wrap);
+    let at = Lookup {
+        stage,
+        lookup: 0,
+        tex: t,
+    };
+    trace_float_fetch(m, frag, px.fixed(StageKind::Texcoord), px.plan.wrap, at, 1);
+    Some(r)
+}
