@@ -7,7 +7,7 @@ use super::rough_scenes::{flat_scene, sun};
 use super::texture::height_image;
 use super::{Camera, LobeCount, Material, Scene, TextureImage};
 
-/// V-grooves along `s`, `period` texels wide: heights rise and fall linearly, so the offsets
+/// V-grooves across `s` (ridges along `t`), `period` texels wide: heights rise and fall linearly, so the offsets
 /// take two slopes of opposite sign (and, at the ridges and valleys, the central difference
 /// between them).
 #[must_use]
@@ -24,8 +24,9 @@ pub fn vgroove_height(size: u32, period: u32) -> TextureImage {
 }
 
 /// `two-slope`: a 40 x 40 plane of V-grooves (20 tiles of 16 grooves, 8 texels each), seen
-/// from 1.5 units above it towards the horizon, lit by a low sun from the side: near the
-/// viewer the grooves are resolved, far away every pixel covers many of them.
+/// from 1.5 units above it towards the horizon, lit by a low sun straight ahead: near the
+/// viewer the grooves are resolved, far away every pixel covers many of them, and the two
+/// slopes reflect the sun in two glitter paths left and right of the centre.
 #[must_use]
 pub fn two_slope() -> Scene {
     let material = Material {
@@ -51,7 +52,7 @@ pub fn two_slope() -> Scene {
             far: 100.0,
             view_override: None,
         },
-        sun(25.0, 40.0, [1.0, 0.95, 0.9]),
+        sun(20.0, 0.0, [1.0, 0.95, 0.9]),
         material,
         vgroove_height(128, 8),
         [0.2, 0.22, 0.25, 1.0],
