@@ -241,3 +241,17 @@ fn toml_fournier_lobes_key() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The run budget counts the lobe maps (K pyramids per bump-map texel) and K lookups per pixel
+/// of the timing events before anything is allocated.
+#[test]
+fn budget_counts_the_lobe_maps() {
+    use texsim::budget::{max_lookups, RunNeed, BYTES_PER_LOBE_TEXEL};
+    let s = two_slope();
+    let t = &s.textures[0];
+    let texels = u64::from(t.width) * u64::from(t.height);
+    let (one, eight) = (with_lobes(1), with_lobes(8));
+    let d = RunNeed::of(&s, &eight, true, true).texels - RunNeed::of(&s, &one, true, true).texels;
+    assert_eq!(d, 7 * texels * BYTES_PER_LOBE_TEXEL);
+    assert_eq!(max_lookups(&s, &eight), max_lookups(&s, &one) + 7);
+}
