@@ -37,6 +37,9 @@ pub const BYTES_PER_TRIANGLE: u64 = 256;
 /// quantized (8 B) MIP chains (4/3 of level 0 each) and the working copies while they are
 /// built.
 pub const BYTES_PER_TEXEL: u64 = 48;
+/// Bytes per bump-map texel and fitted Fournier lobe (`pipeline::lobe_fit`): its float (16 B)
+/// and stored (8 B) lobe pyramids (4/3 of level 0 each).
+pub const BYTES_PER_LOBE_TEXEL: u64 = 32;
 /// Bytes per pixel of a render: visibility buffer and depth, the hardware image, coverage
 /// mask, its PNG...
 pub const BYTES_PER_PIXEL: u64 = 32;
@@ -196,9 +199,20 @@ impl RunNeed {
             .iter()
             .map(|t| u64::from(t.width) * u64::from(t.height))
             .fold(0u64, u64::saturating_add);
+        // Fitted Fournier lobes: K float and stored lobe pyramids per bump map texel.
+        let lobe_texels = scene
+            .materials
+            .iter()
+            .filter_map(|m| {
+                let t = scene.textures.get(m.bump?)?;
+                let k = u64::from(m.fournier_lobes?.resolve(hw));
+                Some(mul(u64::from(t.width) * u64::from(t.height), k))
+            })
+            .fold(0u64, u64::saturating_add);
         Self {
             triangles: mul(scene.triangle_count() as u64, BYTES_PER_TRIANGLE),
-            texels: mul(texels, BYTES_PER_TEXEL),
+            texels: mul(texels, BYTES_PER_TEXEL)
+                .saturating_add(mul(lobe_texels, BYTES_PER_LOBE_TEXEL)),
             framebuffer: mul(
                 pixels,
                 BYTES_PER_PIXEL
@@ -280,7 +294,8 @@ impl RunNeed {
 }
 
 /// Texture lookups per pixel of the scene's most demanding material on `hw` (at least 1):
-/// its texture (`aniso_probes` each), bump and roughness maps, NDF moment maps, exponent map.
+/// its texture (`aniso_probes` each), bump and roughness maps, NDF moment maps, exponent map,
+/// fitted Fournier lobe maps (one each).
 #[must_use]
 pub fn max_lookups(scene: &Scene, hw: &HwConfig) -> u32 {
     scene
@@ -300,7 +315,10 @@ pub fn max_lookups(scene: &Scene, hw: &HwConfig) -> u32 {
                 0
             };
             let exp = u32::from(m.brdf.is_some_and(|b| b.exponent_map.is_some()));
-            tex + bump + rough + ndf + exp
+            let lobes = m
+                .fournier_lobes
+                .map_or(0, |c| c.resolve(hw).min(hw.multi_lobe.lobe_max_lobes));
+            tex + bump + rough + ndf + exp + lobes
         })
         .max()
         .unwrap_or(0)

@@ -4,19 +4,19 @@
 //!
 //! [`METHODS`] is the one list of methods: a row says how a bump material and the hardware
 //! are set for the method and how many bytes a texel of its maps occupies. Adding a method
-//! (e.g. Fournier's multi-lobe NDF) is one entry.
+//! is one entry (the Fournier rows `fournier-K` are four).
 //!
 //! Every scene is rendered once per method with the reference and the ground truth
-//! (`RenderOptions::truth`): the plain bump map, Toksvig and Schilling's roughness pyramid are
-//! measured against the box-filtered mean of plain Blinn-Phong over the finest offsets
-//! (`pipeline::rough` truth mode); the Olano-North rows against the mean of the exactly
+//! (`RenderOptions::truth`): the plain bump map, Toksvig, LEAN, Schilling's roughness pyramid
+//! and the fitted Fournier lobes are measured against the box-filtered mean of plain
+//! Blinn-Phong over the finest offsets (`pipeline::rough` truth mode); the Olano-North rows against the mean of the exactly
 //! normalized base lobes of the finest normals (`pipeline::ndf::NdfTruth`, the same normals,
 //! the von Mises-Fisher lobe `exp(s (n.h - 1))` in place of `(n.h)^s`; the two truths differ by
 //! the lobe shape, below 1/s in angle).
 
 use crate::maps::Maps;
 use crate::render::{render, RenderOptions};
-use crate::scene::{BumpFilter, Material, RoughChoice, Scene};
+use crate::scene::{BumpFilter, LobeCount, Material, RoughChoice, Scene};
 use crate::summary::SweepRow;
 use hw_model::ndf::NdfNorm;
 use hw_model::roughness::RoughVariant;
@@ -63,6 +63,18 @@ fn set_bump(m: &mut Material, rough: Option<RoughChoice>, ndf: bool, f: BumpFilt
     m.roughness = rough;
     m.ndf = ndf;
     m.bump_filter = f;
+    m.fournier_lobes = None;
+}
+
+/// Fournier lobes fitted per texel (`pipeline::lobe_fit`), `k` of them.
+fn set_lobes(m: &mut Material, k: u32) {
+    set_bump(m, None, false, BumpFilter::Plain);
+    m.fournier_lobes = Some(LobeCount::Lobes(k));
+}
+
+/// The lobe maps replace the offset map: K maps of four 16-bit channels (`lobe_fit`).
+fn lobe_bytes(k: u32) -> u32 {
+    k * stored_texel_bytes(4, 16)
 }
 
 fn ndf_norm(hw: &mut HwConfig, n: NdfNorm) {
@@ -151,6 +163,38 @@ pub const METHODS: &[Method] = &[
         material: |m| set_bump(m, None, true, BumpFilter::Plain),
         hw: |hw| ndf_norm(hw, NdfNorm::Exact),
         bytes_per_texel: ndf_bytes,
+    },
+    Method {
+        name: "fournier-1",
+        what: "Fournier 1992 lobes fitted per texel (EM, vMF), K = 1, nearest level",
+        truth: BLINN_TRUTH,
+        material: |m| set_lobes(m, 1),
+        hw: no_hw,
+        bytes_per_texel: |_| lobe_bytes(1),
+    },
+    Method {
+        name: "fournier-2",
+        what: "Fournier 1992 lobes fitted per texel (EM, vMF), K = 2, nearest level",
+        truth: BLINN_TRUTH,
+        material: |m| set_lobes(m, 2),
+        hw: no_hw,
+        bytes_per_texel: |_| lobe_bytes(2),
+    },
+    Method {
+        name: "fournier-4",
+        what: "Fournier 1992 lobes fitted per texel (EM, vMF), K = 4, nearest level",
+        truth: BLINN_TRUTH,
+        material: |m| set_lobes(m, 4),
+        hw: no_hw,
+        bytes_per_texel: |_| lobe_bytes(4),
+    },
+    Method {
+        name: "fournier-8",
+        what: "Fournier 1992 lobes fitted per texel (EM, vMF), K = 8, nearest level",
+        truth: BLINN_TRUTH,
+        material: |m| set_lobes(m, 8),
+        hw: no_hw,
+        bytes_per_texel: |_| lobe_bytes(8),
     },
 ];
 

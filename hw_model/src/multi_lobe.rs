@@ -72,6 +72,14 @@ pub struct MultiLobeConfig {
     pub lobe_rounding: Rounding,
     /// Cycles of the amplitude multiply-accumulate of one lobe.
     pub lobe_mac_cycles: Cycles,
+    /// Lobes fitted per texel to the bump map of a `fournier_lobes = "hw"` material
+    /// (`texsim::pipeline::lobe_fit`). 1..=8.
+    #[serde(default = "default_fournier_lobes")]
+    pub fournier_lobes: u32,
+}
+
+fn default_fournier_lobes() -> u32 {
+    2
 }
 
 impl MultiLobeConfig {
@@ -87,6 +95,7 @@ impl MultiLobeConfig {
             lobe_exp_bits: 11,
             lobe_rounding: Rounding::HalfEven,
             lobe_mac_cycles: Cycles::Derived,
+            fournier_lobes: default_fournier_lobes(),
         }
     }
 
@@ -112,6 +121,12 @@ impl MultiLobeConfig {
         )?;
         range("multi_lobe.lobe_amp_bits", self.lobe_amp_bits, 2, 16)?;
         range("multi_lobe.lobe_exp_bits", self.lobe_exp_bits, 1, 16)?;
+        range(
+            "multi_lobe.fournier_lobes",
+            self.fournier_lobes,
+            1,
+            MAX_LOBES,
+        )?;
         Ok(())
     }
 }

@@ -18,6 +18,7 @@ use super::bump::{
     bump_of, d3, fixed_eye, fixed_light, fixed_material, fixed_output, float_eye, float_light,
     float_output, point_lights, raw3,
 };
+use super::lobe_fit::{decode_lobe, float_lobe};
 use super::stages::{Counters, Machine};
 use super::{BumpPlan, Frag, Plan, Px, StageKind};
 use crate::fixedpoint::to_raw;
@@ -28,8 +29,8 @@ use glam::DVec3;
 use hw_model::blinn_phong::mac_cost;
 use hw_model::frame::Frame;
 use hw_model::multi_lobe::{
-    amp_format, multi_lobe_cost, multi_lobe_shade, slope_format, Lobe, LobeLight, MultiLobeInput,
-    MAX_LOBES,
+    amp_format, max_exponent, multi_lobe_cost, multi_lobe_shade, slope_format, Lobe, LobeLight,
+    MultiLobeInput, MAX_LOBES,
 };
 use hw_model::rsqrt::rsqrt_cost;
 use hw_model::vector::normalize_cost;
@@ -40,6 +41,9 @@ use hw_model::UnitCost;
 pub struct LobePlan {
     /// The made-up lobes (at most [`MAX_LOBES`]).
     pub lobes: Vec<MadeUpLobe>,
+    /// Lobes fitted to the bump map (`pipeline::lobe_fit`), fetched per pixel by `lobe-fetch`
+    /// (then `lobes` is empty).
+    pub fitted: Option<super::lobe_fit::FittedLobes>,
 }
 
 /// The plan of a made-up multiple-surface material (`None` for other materials): `bary`, the
@@ -84,6 +88,7 @@ pub fn plan_lobes(material: &Material, has_uvs: bool) -> Option<Plan> {
                 .take(MAX_LOBES as usize)
                 .copied()
                 .collect(),
+            fitted: None,
         }),
     })
 }
@@ -128,15 +133,33 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let sf = slope_format(cfg);
     let af = amp_format(cfg);
     let mut lobes = [Lobe::default(); MAX_LOBES as usize];
-    for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
-        let s = l.slopes();
-        *q = Lobe {
-            slope: [to_raw(s[0], &sf, &mut sat), to_raw(s[1], &sf, &mut sat)],
-            amp: to_raw(f64::from(l.amplitude), &af, &mut sat) as u64,
-            exponent: l.exponent,
-        };
-    }
-    let nl = lp.lobes.len().min(MAX_LOBES as usize);
+    let nl = if lp.fitted.is_some() {
+        let lf = &frag.lobe;
+        let nl = usize::from(lf.count).min(MAX_LOBES as usize);
+        for j in 0..nl {
+            lobes[j] = if px.fixed(StageKind::LobeFetch) {
+                decode_lobe(lf.texel_x[j])
+            } else {
+                let t = lf.texel[j].map(f64::from);
+                Lobe {
+                    slope: [to_raw(t[0], &sf, &mut sat), to_raw(t[1], &sf, &mut sat)],
+                    amp: to_raw(t[2], &af, &mut sat) as u64,
+                    exponent: t[3].round().clamp(0.0, f64::from(max_exponent(cfg))) as u32,
+                }
+            };
+        }
+        nl
+    } else {
+        for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
+            let s = l.slopes();
+            *q = Lobe {
+                slope: [to_raw(s[0], &sf, &mut sat), to_raw(s[1], &sf, &mut sat)],
+                amp: to_raw(f64::from(l.amplitude), &af, &mut sat) as u64,
+                exponent: l.exponent,
+            };
+        }
+        lp.lobes.len().min(MAX_LOBES as usize)
+    };
     let v = fixed_eye(m, bf, px.fixed(StageKind::Normal), &mut sat);
     let (kd, ks, mut acc) = fixed_material(
         bp,
@@ -195,14 +218,35 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
         zero_normal: false,
     };
     let mut lobes = [LobeF::default(); MAX_LOBES as usize];
-    for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
-        *q = LobeF {
-            slope: l.slopes(),
-            amp: f64::from(l.amplitude),
-            exponent: l.exponent,
-        };
-    }
-    let nl = lp.lobes.len().min(MAX_LOBES as usize);
+    let nl = if lp.fitted.is_some() {
+        let lf = &frag.lobe;
+        let nl = usize::from(lf.count).min(MAX_LOBES as usize);
+        let cfg = &m.hw.multi_lobe;
+        for j in 0..nl {
+            lobes[j] = if px.fixed(StageKind::LobeFetch) {
+                let q = decode_lobe(lf.texel_x[j]);
+                let sf = slope_format(cfg).frac_bits;
+                let af = amp_format(cfg).frac_bits;
+                LobeF {
+                    slope: q.slope.map(|x| x as f64 / f64::from(sf).exp2()),
+                    amp: q.amp as f64 / f64::from(af).exp2(),
+                    exponent: q.exponent,
+                }
+            } else {
+                float_lobe(lf.texel[j])
+            };
+        }
+        nl
+    } else {
+        for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
+            *q = LobeF {
+                slope: l.slopes(),
+                amp: f64::from(l.amplitude),
+                exponent: l.exponent,
+            };
+        }
+        lp.lobes.len().min(MAX_LOBES as usize)
+    };
     let v = float_eye(bf);
     let mut kd = bp.kd;
     if px.plan.texture.is_some() {
@@ -241,7 +285,11 @@ pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
     let nz = normalize_cost(&u.cfg.vector, rsqrt_cost(&u.cfg.rsqrt, g), g);
     let mac = mac_cost(&u.cfg, g);
     let lights = m.lights.len() as u32;
-    let mut c = multi_lobe_cost(&m.hw.multi_lobe, u, lp.lobes.len() as u32, lights, g)
+    let k = lp
+        .fitted
+        .as_ref()
+        .map_or(lp.lobes.len() as u32, |f| f.lobes);
+    let mut c = multi_lobe_cost(&m.hw.multi_lobe, u, k, lights, g)
         .plus(nz.times(1 + np))
         .plus(mac);
     if plan.texture.is_some() {

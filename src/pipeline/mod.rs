@@ -22,6 +22,8 @@ pub mod frame;
 pub mod lean;
 pub mod lean_fetch;
 pub mod lean_shade;
+pub mod lobe_fetch;
+pub mod lobe_fit;
 pub mod lobe_shade;
 pub mod lod;
 pub mod modulate;
@@ -273,6 +275,8 @@ pub struct Frag {
     pub toksvig: toksvig::ToksvigFrag,
     /// LEAN fetch: the filtered second-moment texel.
     pub lean: lean::LeanFrag,
+    /// Lobe fetch: the fetched lobe texels of a fitted-lobe material.
+    pub lobe: lobe_fit::LobeFrag,
     /// The texel footprints the stages fetched (recorded only when `trace.on`).
     pub trace: trace::Trace,
 }

@@ -9,9 +9,9 @@
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
-    as_shade, bary, bump_fetch, color, env_fetch, frame, lean_fetch, lean_shade, lobe_shade, lod,
-    modulate, ndf_fetch, ndf_shade, normal, perturb, phong, rough_fetch, rough_shade, texcoord,
-    toksvig_fetch, toksvig_shade, trilinear,
+    as_shade, bary, bump_fetch, color, env_fetch, frame, lean_fetch, lean_shade, lobe_fetch,
+    lobe_shade, lod, modulate, ndf_fetch, ndf_shade, normal, perturb, phong, rough_fetch,
+    rough_shade, texcoord, toksvig_fetch, toksvig_shade, trilinear,
 };
 use super::{Frag, Impl, Plan, StageImpls};
 use crate::raster::ScreenTri;
@@ -223,6 +223,11 @@ stage_table! {
     EnvFetch "env-fetch" {
         fixed: env_fetch::fixed, float: env_fetch::float, cost: env_fetch::cost,
         lookups: env_fetch::lookups,
+    }
+    /// Fitted Fournier lobes: the nearest level's texel of the K lobe maps (K lookups).
+    LobeFetch "lobe-fetch" {
+        fixed: lobe_fetch::fixed, float: lobe_fetch::float, cost: lobe_fetch::cost,
+        lookups: lobe_fetch::lookups,
     }
     /// Fournier multiple surfaces: the sum of the lobes' Phong shadings over every light.
     LobeShade "lobe-shade" {

@@ -102,6 +102,7 @@ impl Geometry {
             crate::pipeline::env::mark_plan(&mut p, mat);
             crate::pipeline::toksvig::mark_plan(&mut p, mat);
             crate::pipeline::lean::mark_plan(&mut p, mat);
+            crate::pipeline::lobe_fit::mark_plan(&mut p, mat);
             if let Some(bp) = &p.bump {
                 g.bump.resize(base as usize, BumpVertex::default());
                 g.bump.extend(bump_vertices(mesh, bp));

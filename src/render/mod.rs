@@ -177,6 +177,16 @@ pub fn render(
     } else {
         maps
     };
+    let lobe_sources =
+        crate::pipeline::lobe_fit::resolve_plans(&mut geo.plans, hw, maps.float.len());
+    let has_fitted_lobes = !lobe_sources.is_empty();
+    let lobes_owned;
+    let maps = if has_fitted_lobes {
+        lobes_owned = crate::pipeline::lobe_fit::lobe_maps(maps, &lobe_sources, hw)?.0;
+        &lobes_owned
+    } else {
+        maps
+    };
 
     let mut warnings: Vec<String> = Vec::new();
     let mut opts = opts.clone();
@@ -279,7 +289,9 @@ pub fn render(
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
     let has_env = geo.plans.iter().any(|p| p.env.is_some());
-    if opts.truth > 0 && (has_rough || has_ndf || has_env || has_toksvig || has_lean) {
+    if opts.truth > 0
+        && (has_rough || has_ndf || has_env || has_toksvig || has_lean || has_fitted_lobes)
+    {
         let t_truth = Instant::now();
         // One float pass over every material: roughness materials shade their supersampled
         // bump map (`rough::truth_plans`), NDF materials their supersampled finest normal
@@ -288,6 +300,7 @@ pub fn render(
         let tp = crate::pipeline::env::truth_plans(&tp, opts.truth);
         let tp = crate::pipeline::toksvig::truth_plans(tp, opts.truth);
         let tp = crate::pipeline::lean::truth_plans(tp, opts.truth);
+        let tp = crate::pipeline::lobe_fit::truth_plans(tp, opts.truth);
         let saved = std::mem::replace(&mut geo.plans, tp);
         let ndf_truth = crate::pipeline::ndf::truth_maps(maps, scene, &geo.plans, opts.truth);
         let mt = Machine::new(hw, &maps.float, &maps.fixed)

@@ -34,6 +34,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("fournier-fig2", "Fournier multiple surfaces (Fig. 2): spheres with an anisotropic lobe pair and 2, 3 and 7 normals, 480x128"),
     ("fournier-velvet", "Fournier multiple surfaces (Fig. 3): velvet lobes on a torus and a sphere, 320x240"),
     ("fournier-silk", "Fournier multiple surfaces (Fig. 4): silk lobes on the same geometry, 320x240"),
+    ("two-slope", "Fournier lobes fitted to a bump map: fine V-grooves (two slopes per far texel) receding, fournier_lobes = hw, 320x200"),
 ];
 
 /// A built-in scene by name; an unknown name is an error listing the known ones.
@@ -60,6 +61,7 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "fournier-fig2" => super::lobe_scenes::fig2(),
         "fournier-velvet" => super::lobe_scenes::velvet(),
         "fournier-silk" => super::lobe_scenes::silk(),
+        "two-slope" => super::fit_scenes::two_slope(),
         other => {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
             return Err(Error::msg(format!(

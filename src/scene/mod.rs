@@ -16,6 +16,7 @@ use glam::{DMat4, DVec3};
 pub mod as_scenes;
 mod catalogue;
 pub mod env_scenes;
+pub mod fit_scenes;
 mod geometry;
 pub mod lobe_scenes;
 mod ndf_scenes;
@@ -121,6 +122,41 @@ pub struct Material {
     /// (TOML `bump_filter`): `plain` (the filtered bump map alone), `toksvig` (Toksvig
     /// 2005, `pipeline::toksvig`) or `lean` (Olano and Baker 2010, `pipeline::lean`).
     pub bump_filter: BumpFilter,
+    /// Fournier lobes fitted to the bump map per texel and MIP level (TOML `fournier_lobes`,
+    /// `pipeline::lobe_fit`): shaded by `lobe-fetch` and `lobe-shade` instead of `phong`;
+    /// `None`: not fitted.
+    pub fournier_lobes: Option<LobeCount>,
+}
+
+/// How many Fournier lobes a bump material's fit has per texel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LobeCount {
+    /// The hardware's `multi_lobe.fournier_lobes` (so `--vary fournier_lobes=...` switches it).
+    Hw,
+    /// K lobes, 1..=8.
+    Lobes(u32),
+}
+
+impl LobeCount {
+    /// Parses a `fournier_lobes` value: `hw` or an integer 1..=8.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        if s.trim() == "hw" {
+            return Ok(Self::Hw);
+        }
+        match s.trim().parse::<u32>() {
+            Ok(k) if (1..=8).contains(&k) => Ok(Self::Lobes(k)),
+            _ => Err(format!("'{s}' is not hw or a lobe count 1..=8")),
+        }
+    }
+
+    /// The lobe count on the hardware `hw`.
+    #[must_use]
+    pub fn resolve(self, hw: &hw_model::config::HwConfig) -> u32 {
+        match self {
+            Self::Hw => hw.multi_lobe.fournier_lobes,
+            Self::Lobes(k) => k,
+        }
+    }
 }
 
 /// One lobe of a made-up multiple surface (Fournier 1992, eq. 12): its direction in the
@@ -337,6 +373,7 @@ impl Default for Material {
             env: None,
             lobes: Vec::new(),
             bump_filter: BumpFilter::Plain,
+            fournier_lobes: None,
         }
     }
 }

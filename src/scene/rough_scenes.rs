@@ -97,7 +97,7 @@ fn rough_material(name: &str, kd: [f32; 3], ks: f32, shininess: u32, scale: f32)
     }
 }
 
-fn sun(elev_deg: f64, azimuth_deg: f64, color: [f32; 3]) -> Light {
+pub(super) fn sun(elev_deg: f64, azimuth_deg: f64, color: [f32; 3]) -> Light {
     let (e, a) = (elev_deg.to_radians(), azimuth_deg.to_radians());
     // Direction the light travels: from the sun (elevation e, at azimuth a from -z) down.
     let d = DVec3::new(a.sin() * e.cos(), -e.sin(), a.cos() * e.cos()).normalize();
@@ -108,7 +108,7 @@ fn sun(elev_deg: f64, azimuth_deg: f64, color: [f32; 3]) -> Light {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn flat_scene(
+pub(super) fn flat_scene(
     name: &str,
     size: (u32, u32),
     plane: (f32, f32),

@@ -123,6 +123,8 @@ struct MaterialCfg {
     lobes: Option<Vec<LobeCfg>>,
     /// Specular filtering of a bump material: `plain` (default), `toksvig` or `lean`.
     bump_filter: Option<String>,
+    /// Fournier lobes fitted to the bump map: `"hw"` or a count 1..=8.
+    fournier_lobes: Option<toml::Value>,
 }
 
 /// One `[[materials.lobes]]` entry.
@@ -530,6 +532,19 @@ fn build(path: &Path, cfg: SceneFile) -> Result<Scene> {
                 Some(b) => crate::scene::BumpFilter::parse(b)
                     .map_err(|e| Error::field(&f("bump_filter"), e))?,
                 None => def.bump_filter,
+            },
+            fournier_lobes: match &m.fournier_lobes {
+                None => def.fournier_lobes,
+                Some(v) => {
+                    let text = match v {
+                        toml::Value::String(t) => t.clone(),
+                        other => other.to_string(),
+                    };
+                    Some(
+                        crate::scene::LobeCount::parse(&text)
+                            .map_err(|e| Error::field(&f("fournier_lobes"), e))?,
+                    )
+                }
             },
         });
     }

@@ -6,7 +6,7 @@
 
 use crate::cli_common::{texsim, text, tmp};
 
-const METHODS: [&str; 8] = [
+const METHODS: [&str; 12] = [
     "plain",
     "toksvig",
     "lean",
@@ -15,6 +15,10 @@ const METHODS: [&str; 8] = [
     "ndf-map",
     "ndf-projected",
     "ndf-exact",
+    "fournier-1",
+    "fournier-2",
+    "fournier-4",
+    "fournier-8",
 ];
 
 #[test]
@@ -90,6 +94,21 @@ fn filters_table_shape_and_sanity() {
         assert_eq!(tok["texels_per_pixel"].as_f64(), Some(16.0), "{tok}");
         assert!(tok["bytes_per_texel"].as_u64() > plain["bytes_per_texel"].as_u64());
         assert!(tok["issue_cycles_per_pixel"].as_f64() > plain["issue_cycles_per_pixel"].as_f64());
+        // Fitted lobes: one single-level lookup (4 texels) per lobe, cost rising with K.
+        let lobes: Vec<&serde_json::Value> =
+            ["fournier-1", "fournier-2", "fournier-4", "fournier-8"]
+                .iter()
+                .map(|m| get(scene, m))
+                .collect();
+        for (r, k) in lobes.iter().zip([1.0, 2.0, 4.0, 8.0]) {
+            assert_eq!(r["texels_per_pixel"].as_f64(), Some(4.0 * k), "{r}");
+        }
+        for w in lobes.windows(2) {
+            assert!(
+                w[1]["issue_cycles_per_pixel"].as_f64() > w[0]["issue_cycles_per_pixel"].as_f64()
+            );
+            assert!(w[1]["bytes_per_texel"].as_u64() > w[0]["bytes_per_texel"].as_u64());
+        }
         let p = plain["model_mean"].as_f64().unwrap_or(0.0);
         for m in ["toksvig", "lean", "schilling", "ndf-projected"] {
             if get(scene, m)["model_mean"].as_f64().unwrap_or(f64::MAX) < p {

@@ -60,3 +60,58 @@ fn fournier_scene_renders() {
     assert!(t.contains("lobe-shade    fixed"), "{t}");
     assert!(d.join("o/hw.png").exists() && d.join("o/ref.png").exists());
 }
+
+/// The command: `texsim sweep --scene two-slope --truth --vary fournier_lobes=1,2,4,8`
+/// (at 96 x 64) gives the model error against the supersampled truth falling with K (K = 4 and
+/// 8 agree: no texel of the V-grooves has more than four distinct normals) and the cost rising.
+#[test]
+fn two_slope_sweep_model_error_falls_with_k() {
+    let d = tmp("two-slope");
+    let o = texsim(
+        &[
+            "sweep",
+            "--scene",
+            "two-slope",
+            "--truth",
+            "--vary",
+            "fournier_lobes=1,2,4,8",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--out",
+            "s",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = std::fs::read_to_string(d.join("s/sweep.csv")).expect("csv");
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).expect(name);
+    let (k, model, cyc) = (
+        col("fournier_lobes"),
+        col("model_error.mean_abs_lsb"),
+        col("cycles"),
+    );
+    let rows: Vec<[f64; 3]> = lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            [k, model, cyc].map(|i| c[i].parse::<f64>().expect(c[i]))
+        })
+        .collect();
+    assert_eq!(rows.len(), 4, "{csv}");
+    assert_eq!(
+        rows.iter().map(|r| r[0]).collect::<Vec<_>>(),
+        [1.0, 2.0, 4.0, 8.0]
+    );
+    assert!(rows[1][1] < 0.8 * rows[0][1], "{csv}");
+    assert!(
+        rows[2][1] < rows[1][1] && rows[3][1] <= rows[2][1] + 1e-9,
+        "{csv}"
+    );
+    assert!(
+        rows.windows(2).all(|w| w[1][2] > w[0][2]),
+        "cycles rise with K: {csv}"
+    );
+}

@@ -16,6 +16,7 @@ mod bump_hard_cases;
 mod bump_pipeline;
 mod determinism;
 mod env_scene;
+mod lobe_fit_pipeline;
 mod lobe_pipeline;
 mod ndf_pipeline;
 mod range_instrumentation;

@@ -364,6 +364,30 @@ const EVERY_SCENE: &[Row] = &[
         0,
         0,
     ),
+    (
+        "two-slope",
+        "texram16",
+        111827,
+        8752,
+        103075,
+        94324,
+        "memory",
+        102912,
+        63232,
+        63232,
+    ),
+    (
+        "two-slope",
+        "d3d11",
+        40214,
+        8752,
+        31462,
+        22541,
+        "memory",
+        27448,
+        63232,
+        300,
+    ),
 ];
 
 fn config(spec: &str) -> hw_model::HwConfig {
