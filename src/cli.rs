@@ -549,7 +549,7 @@ pub fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Some(Command::Sweep(a)) => sweep_cmd(&a),
-        Some(Command::Tune(a)) => crate::tune_cli::tune_cmd(&a),
+        Some(Command::Tune(a)) => tune_cmd(&a),
         Some(Command::Merge(a)) => merge_cmd(&a),
         Some(Command::Hw {
             cmd: HwCmd::Show { preset },
@@ -1499,4 +1499,96 @@ fn filters_cmd(a: &FiltersArgs) -> Result<()> {
 
 fn progress_line(phase: &str, ms: f64) {
     eprintln!("texsim:   {phase:<18} {ms:>9.1} ms");
+}
+
+/// Runs `texsim tune`.
+fn tune_cmd(a: &TuneArgs) -> Result<()> {
+    let size = a
+        .size
+        .as_deref()
+        .map(crate::tune_cli::parse_size)
+        .transpose()?;
+    let budgets = a
+        .budget
+        .iter()
+        .map(|b| crate::tune::Budget::parse(b))
+        .collect::<Result<Vec<_>>>()?;
+    let base = hwconfig::resolve(&a.hw).map_err(|e| e.context("--hw"))?;
+    let scenes = a
+        .scene
+        .iter()
+        .map(|s| crate::tune_cli::load_scene(s, size))
+        .collect::<Result<Vec<_>>>()?;
+    for sc in &scenes {
+        crate::budget::check_run(sc, &base, true, true)?;
+        for w in &sc.warnings {
+            eprintln!("warning: scene '{}': {w}", sc.name);
+        }
+    }
+    let spec = crate::tune::TuneSpec {
+        scenes,
+        base,
+        budgets,
+        knobs: a.knob.clone(),
+        truth: a.truth,
+    };
+    let knobs = if spec.knobs.is_empty() {
+        crate::tune::default_knobs(&spec.base)?
+    } else {
+        spec.knobs
+            .iter()
+            .map(|n| crate::tune::knob(&spec.base, n))
+            .collect::<Result<Vec<_>>>()?
+    };
+    eprintln!(
+        "texsim: tuning {} knobs on {} scene(s) from '{}'",
+        knobs.len(),
+        spec.scenes.len(),
+        spec.base.name
+    );
+    let start = std::time::Instant::now();
+    let mut prev: Vec<u32> = knobs.iter().map(|k| k.hi).collect();
+    println!("trials (knobs that differ from the previous trial):");
+    let mut print = |t: &crate::tune::Trial| {
+        println!("{}", crate::tune_cli::trial_line(&knobs, t, &prev));
+        prev.clone_from(&t.values);
+    };
+    let r = crate::tune::tune(&spec, &mut print)?;
+    let texram16_area =
+        hw_model::datapath::total_area(&hw_model::datapath::units(&hw_model::HwConfig::texram16()));
+    let summary = crate::tune_cli::summary_text(&r, texram16_area);
+    print!("{summary}");
+    eprintln!("texsim: tune took {:.1} s", start.elapsed().as_secs_f64());
+    let mut out = OutputSet::new();
+    let mut json = serde_json::to_value(&r).map_err(|e| Error::msg(e.to_string()))?;
+    if let Some(o) = json.as_object_mut() {
+        o.insert("texram16_area_ge".into(), serde_json::json!(texram16_area));
+        o.insert("hw_config".into(), serde_json::json!(&r.machine));
+        o.insert(
+            "provenance".into(),
+            serde_json::json!(crate::provenance::Provenance::of_process()),
+        );
+    }
+    out.add(
+        "tune.json",
+        serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
+    );
+    out.add("tune.csv", crate::tune_cli::tune_csv(&r)?.into_bytes());
+    let budgets: Vec<String> = r.budgets.iter().map(crate::tune::Budget::label).collect();
+    let toml = format!(
+        "# texsim tune: least area meeting {} on {} (vs {}); use with --hw tuned.toml\n{}",
+        budgets.join(", "),
+        r.scenes.join(", "),
+        r.against,
+        hwconfig::to_toml(&r.machine)
+    );
+    out.add("tuned.toml", toml.into_bytes());
+    out.add(
+        "report.html",
+        crate::tune_cli::tune_report(&r, &summary)?.into_bytes(),
+    );
+    for p in out.write_to(&a.out)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
 }

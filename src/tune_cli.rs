@@ -1,10 +1,8 @@
-//! `texsim tune` on the command line: parses the arguments, prints every trial as it is
-//! rendered and the verified result, writes tune.json, tune.csv and tuned.toml.
+//! What `texsim tune` shows and writes: the trial lines, the closing summary, tune.csv and
+//! report.html, the argument parsing. The command itself (which prints) is `cli::tune_cmd`.
 
-use crate::cli::TuneArgs;
-use crate::report::OutputSet;
 use crate::scene::{self, Scene};
-use crate::tune::{tune, Budget, Trial, TuneResult, TuneSpec};
+use crate::tune::{Budget, Trial, TuneResult};
 use crate::{hwconfig, Error, Result};
 use std::fmt::Write;
 use std::path::Path;
@@ -22,7 +20,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
 }
 
 /// A built-in scene by name, else a scene file.
-fn load_scene(name: &str, size: Option<(u32, u32)>) -> Result<Scene> {
+pub fn load_scene(name: &str, size: Option<(u32, u32)>) -> Result<Scene> {
     let p = Path::new(name);
     let mut sc = if p.is_file() {
         scene::load(p)?
@@ -58,7 +56,7 @@ fn leaf(path: &str) -> &str {
 
 /// One trial: phase, verdict, area, budget load, errors per scene, then the knobs that
 /// differ from `from` (the previous trial's values; the base for the first).
-fn trial_line(knobs: &[crate::tune::Knob], t: &Trial, from: &[u32]) -> String {
+pub fn trial_line(knobs: &[crate::tune::Knob], t: &Trial, from: &[u32]) -> String {
     let errs: Vec<String> = t
         .scenes
         .iter()
@@ -272,89 +270,4 @@ fn big(n: f64) -> String {
     } else {
         format!("{n:.0}")
     }
-}
-
-/// Runs `texsim tune`.
-pub fn tune_cmd(a: &TuneArgs) -> Result<()> {
-    let size = a.size.as_deref().map(parse_size).transpose()?;
-    let budgets = a
-        .budget
-        .iter()
-        .map(|b| Budget::parse(b))
-        .collect::<Result<Vec<_>>>()?;
-    let base = hwconfig::resolve(&a.hw).map_err(|e| e.context("--hw"))?;
-    let scenes = a
-        .scene
-        .iter()
-        .map(|s| load_scene(s, size))
-        .collect::<Result<Vec<_>>>()?;
-    for sc in &scenes {
-        crate::budget::check_run(sc, &base, true, true)?;
-        for w in &sc.warnings {
-            eprintln!("warning: scene '{}': {w}", sc.name);
-        }
-    }
-    let spec = TuneSpec {
-        scenes,
-        base,
-        budgets,
-        knobs: a.knob.clone(),
-        truth: a.truth,
-    };
-    let knobs = if spec.knobs.is_empty() {
-        crate::tune::default_knobs(&spec.base)?
-    } else {
-        spec.knobs
-            .iter()
-            .map(|n| crate::tune::knob(&spec.base, n))
-            .collect::<Result<Vec<_>>>()?
-    };
-    eprintln!(
-        "texsim: tuning {} knobs on {} scene(s) from '{}'",
-        knobs.len(),
-        spec.scenes.len(),
-        spec.base.name
-    );
-    let start = std::time::Instant::now();
-    let mut prev: Vec<u32> = knobs.iter().map(|k| k.hi).collect();
-    println!("trials (knobs that differ from the previous trial):");
-    let mut print = |t: &Trial| {
-        println!("{}", trial_line(&knobs, t, &prev));
-        prev.clone_from(&t.values);
-    };
-    let r = tune(&spec, &mut print)?;
-    let texram16_area =
-        hw_model::datapath::total_area(&hw_model::datapath::units(&hw_model::HwConfig::texram16()));
-    let summary = summary_text(&r, texram16_area);
-    print!("{summary}");
-    eprintln!("texsim: tune took {:.1} s", start.elapsed().as_secs_f64());
-    let mut out = OutputSet::new();
-    let mut json = serde_json::to_value(&r).map_err(|e| Error::msg(e.to_string()))?;
-    if let Some(o) = json.as_object_mut() {
-        o.insert("texram16_area_ge".into(), serde_json::json!(texram16_area));
-        o.insert("hw_config".into(), serde_json::json!(&r.machine));
-        o.insert(
-            "provenance".into(),
-            serde_json::json!(crate::provenance::Provenance::of_process()),
-        );
-    }
-    out.add(
-        "tune.json",
-        serde_json::to_vec_pretty(&json).map_err(|e| Error::msg(e.to_string()))?,
-    );
-    out.add("tune.csv", tune_csv(&r)?.into_bytes());
-    let budgets: Vec<String> = r.budgets.iter().map(Budget::label).collect();
-    let toml = format!(
-        "# texsim tune: least area meeting {} on {} (vs {}); use with --hw tuned.toml\n{}",
-        budgets.join(", "),
-        r.scenes.join(", "),
-        r.against,
-        hwconfig::to_toml(&r.machine)
-    );
-    out.add("tuned.toml", toml.into_bytes());
-    out.add("report.html", tune_report(&r, &summary)?.into_bytes());
-    for p in out.write_to(&a.out)? {
-        println!("wrote {}", p.display());
-    }
-    Ok(())
 }
