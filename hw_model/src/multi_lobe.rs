@@ -4,8 +4,15 @@
 //! of the K traditional Phong shadings ("a sum of Phong peaks"):
 //!
 //! `colour = sum_lights light * (kd D + ks S)`, `D = sum_i c_i max(0, N_i . l)`,
-//! `S = sum_i c_i max(0, N_i . h)^(n_i)` (no specular term of lobe `i` where `N_i . l <= 0`,
-//! as in [`crate::blinn_phong`]), `h = (l + v) / |l + v|`.
+//! `S = sum_i w_i max(0, N_i . h)^(n_i)` (no specular term of lobe `i` where `N_i . l <= 0`,
+//! as in [`crate::blinn_phong`]), `h = (l + v) / |l + v|`. The specular weight `w_i` is `c_i`
+//! for made-up lobes; for lobes fitted to a bump map (von Mises-Fisher lobes of weight
+//! `alpha_i = c_i` and concentration `kappa_i` seen through the material's `(N . h)^s`,
+//! `texsim::shading::fournier_fit`) it is the conversion's peak `alpha_i kappa_i / (kappa_i +
+//! s) = c_i n_i / s` (the stored exponent is `n_i = kappa_i s / (kappa_i + s)`): the unit
+//! takes the material's reciprocal `2^R / s` ([`shininess_recip`], `R =`
+//! [`recip_frac_bits`]) and weights the specular sum by `n_i` exactly, so one stored amplitude
+//! gives both the diffuse weight `alpha_i` and the specular one.
 //!
 //! Storage and decoding: a lobe's direction is two tangent-plane slopes `(p, q)` (signed
 //! `lobe_slope_int_bits`.`lobe_slope_frac_bits`), decoded exactly as a bump offset: requantized
@@ -16,9 +23,9 @@
 //! ones saturate, counted; the power unit saturates again at `pow_exponent_bits`). At most
 //! `lobe_max_lobes` lobes are shaded; extra lobes are dropped and flagged.
 //!
-//! Rounding: the `K` products `c_i (N_i . l)` and `c_i x_i^(n_i)` are summed exactly and each
-//! sum leaves through one `round_shift_right` (to `F = vector_frac_bits` and `P =
-//! pow_frac_bits`); the colour is [`crate::blinn_phong::lit_color`] (one exact division per
+//! Rounding: the `K` products `c_i (N_i . l)` and `c_i x_i^(n_i)` (fitted: `c_i n_i x_i^(n_i)`,
+//! then times the reciprocal) are summed exactly and each sum leaves through one
+//! `round_shift_right` (to `F = vector_frac_bits` and `P = pow_frac_bits`); the colour is [`crate::blinn_phong::lit_color`] (one exact division per
 //! channel, saturating at 1.0) and the lights' colours add saturating at 1.0 (counted).
 //!
 //! ERROR BOUND (absolute, per channel, colours in [0, 1]; against the float twin
@@ -27,8 +34,10 @@
 //! 2^-F` the decoded direction's error per component (the frame unit's bound, lengths 1),
 //! `d_l = 2^-F + sqrt(3) e_N` the error of `N_i . l` and `d_h = 2.5 * 2^-F + sqrt(3) e_N` that
 //! of `N_i . h` (as in `blinn_phong.rs`, plus the direction's error), per light:
-//! `light * (kd (sum_i c_i d_l + 2^-(F+1)) + ks (sum_i c_i (E_i + W_i + T_i) + 2^-(P+1))) +
-//! 1 / (2^C - 1)`, summed over the lights, where `x_i = N_i . h` (float), `W_i = min(1, x_i +
+//! `light * (kd (sum_i c_i d_l + 2^-(F+1)) + ks (sum_i w_i (E_i + W_i + T_i) + Q + 2^-(P+1)))
+//! + 1 / (2^C - 1)`, summed over the lights, where `w_i` is the specular weight (`c_i`, or
+//! `c_i n_i / s` for fitted lobes), `Q = 0` for made-up lobes and `Q = sum_i c_i n_i
+//! 2^-(R+1)` for fitted ones (the reciprocal's rounding), `x_i = N_i . h` (float), `W_i = min(1, x_i +
 //! d_h)^n_i - max(0, x_i - d_h)^n_i` (the power's spread over its input error), `E_i` the power
 //! unit's bound (`pow.rs`) at `min(1, x_i + d_h)`, and `T_i = min(1, x_i + d_h)^n_i` where
 //! `N_i . l < d_l` (at a lobe's terminator its specular term may switch), else 0. A saturated
@@ -41,7 +50,7 @@ use crate::blinn_phong::{
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Cycles, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
+use crate::fixed::{round_div_wide, round_shift_right_wide, Format, Rounding, SatCounter};
 use crate::frame::{perturb_datapath, perturb_normal, Frame};
 use crate::pow::pow_cost;
 use crate::rsqrt::{range, rsqrt_cost};
@@ -76,6 +85,23 @@ pub struct MultiLobeConfig {
     /// (`texsim::pipeline::lobe_fit`). 1..=8.
     #[serde(default = "default_fournier_lobes")]
     pub fournier_lobes: u32,
+    /// How fitted lobes combine two MIP levels (`texsim::pipeline::lobe_fetch`): the nearest
+    /// level, or both levels shaded and their colours blended by the LOD fraction.
+    #[serde(default)]
+    pub lobe_level_mix: LevelMix,
+}
+
+/// How the fitted lobes of two MIP levels are combined (lobe parameters do not average
+/// linearly, so never by filtering the lobes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LevelMix {
+    /// The LOD rounded to the nearest level: K lookups, one multi-lobe shading.
+    #[default]
+    Nearest,
+    /// The two levels around the LOD: 2K lookups, two multi-lobe shadings, the colours blended
+    /// by the LOD fraction (one lerp per channel).
+    Blend,
 }
 
 fn default_fournier_lobes() -> u32 {
@@ -96,6 +122,7 @@ impl MultiLobeConfig {
             lobe_rounding: Rounding::HalfEven,
             lobe_mac_cycles: Cycles::Derived,
             fournier_lobes: default_fournier_lobes(),
+            lobe_level_mix: LevelMix::Nearest,
         }
     }
 
@@ -191,6 +218,25 @@ pub struct MultiLobeInput<'a> {
     pub v: Vec3x,
     pub kd: [u64; 3],
     pub ks: [u64; 3],
+    /// Fitted lobes: the material's [`shininess_recip`] (each lobe's specular weight is then
+    /// `c_i n_i / s`); `None` for made-up lobes (weight `c_i`).
+    pub spec_recip: Option<u64>,
+}
+
+/// Fraction bits `R = lobe_exp_bits + P + 2` of the reciprocal of a fitted material's Phong
+/// exponent (`P = pow_frac_bits`): its rounding adds at most `c_i n_i 2^-(R+1) <= c_i
+/// 2^-(P+3)` per lobe.
+#[must_use]
+pub fn recip_frac_bits(cfg: &MultiLobeConfig, sh: &ShadingConfig) -> u32 {
+    cfg.lobe_exp_bits.clamp(1, 16) + sh.pow.pow_frac_bits.clamp(8, 24) + 2
+}
+
+/// The reciprocal `round(2^R / s)` of a fitted material's Phong exponent `s` (at least 1), a
+/// per-material constant set up with the material (as `kd`, `ks`).
+#[must_use]
+pub fn shininess_recip(s: u32, cfg: &MultiLobeConfig, sh: &ShadingConfig) -> u64 {
+    let r = recip_frac_bits(cfg, sh);
+    round_div_wide(1i128 << r, i128::from(s.max(1)), cfg.lobe_rounding) as u64
 }
 
 /// Result of one multi-lobe evaluation.
@@ -234,6 +280,18 @@ pub fn lobe_sum(terms: &[(u64, i64)], amp_bits: u32, mode: Rounding) -> i64 {
     round_shift_right_wide(acc, amp_bits, mode)
 }
 
+/// `r sum_i w_i t_i`, summed exactly and rounded once by `shift` bits (the fitted lobes'
+/// specular sum: `w_i = c_i n_i`, `r` the reciprocal of the material's exponent). ERROR: at most
+/// 1/2 ulp from the exact product.
+#[must_use]
+pub fn fitted_spec_sum(terms: &[(u64, i64)], r: u64, shift: u32, mode: Rounding) -> i64 {
+    let acc: i128 = terms
+        .iter()
+        .map(|&(w, t)| i128::from(w) * i128::from(t))
+        .sum();
+    round_shift_right_wide(acc * i128::from(r), shift, mode)
+}
+
 /// One multi-lobe evaluation over every light (see the module doc for the formula).
 #[must_use]
 pub fn multi_lobe_shade(
@@ -267,6 +325,14 @@ pub fn multi_lobe_shade(
     let mut sum = [0u64; 3];
     let mut h_zero = 0u32;
     let x_fmt = Format::unsigned(1, p, vc.vector_rounding);
+    // Specular weights: c_i, or c_i n_i (exact) for fitted lobes, scaled by the reciprocal.
+    let r_bits = recip_frac_bits(cfg, &units.cfg);
+    let mut spec_w = amps;
+    if inp.spec_recip.is_some() {
+        for i in 0..k {
+            spec_w[i] = amps[i] * u64::from(exps[i]);
+        }
+    }
     for light in inp.lights {
         let hsum = [
             light.l[0] + inp.v[0],
@@ -292,10 +358,13 @@ pub fn multi_lobe_shade(
                 let x = x_fmt.requantize(ndh, f, sat);
                 units.pow.pow(x as u64, exps[i], sat) as i64
             };
-            spec[i] = (amps[i], s);
+            spec[i] = (spec_w[i], s);
         }
         let d = lobe_sum(&diffuse[..k], a, cfg.lobe_rounding);
-        let s = lobe_sum(&spec[..k], a, cfg.lobe_rounding);
+        let s = match inp.spec_recip {
+            None => lobe_sum(&spec[..k], a, cfg.lobe_rounding),
+            Some(r) => fitted_spec_sum(&spec[..k], r, a + r_bits, cfg.lobe_rounding),
+        };
         let bp = BlinnPhongInput {
             n: [0; 3],
             l: light.l,
@@ -353,6 +422,50 @@ pub fn datapath(cfg: &MultiLobeConfig, sh: &ShadingConfig) -> Datapath {
         .then(crate::pow::datapath(&sh.pow))
         .then(accumulate_datapath(cfg, sh))
         .then(shade_datapath(sh))
+}
+
+/// The fitted lobes' specular weighting (`spec_recip`): per lobe the exact weight `c_i n_i`
+/// (a `(A + 1) x E` multiplier, once per lobe), per light the specular sum times the
+/// reciprocal (a `(A + 1 + E + P + 4) x R` multiplier).
+#[must_use]
+pub fn fitted_weight_datapath(cfg: &MultiLobeConfig, sh: &ShadingConfig) -> [Datapath; 2] {
+    let a = cfg.lobe_amp_bits + 1;
+    let e = cfg.lobe_exp_bits;
+    let p = sh.pow.pow_frac_bits + 1;
+    [
+        Datapath::new().stage(
+            Stage::new("lobe specular weight")
+                .then(Component::Multiplier { a, b: e })
+                .cycles(cfg.lobe_mac_cycles),
+        ),
+        Datapath::new().stage(
+            Stage::new("lobe specular scale")
+                .then(Component::Multiplier {
+                    a: a + e + p + 3,
+                    b: recip_frac_bits(cfg, sh),
+                })
+                .cycles(cfg.lobe_mac_cycles),
+        ),
+    ]
+}
+
+/// Extra cost of fitted lobes over [`multi_lobe_cost`] (see [`fitted_weight_datapath`]).
+#[must_use]
+pub fn fitted_weight_cost(
+    cfg: &MultiLobeConfig,
+    sh: &ShadingConfig,
+    lobes: u32,
+    lights: u32,
+    gate_levels_per_cycle: u32,
+) -> UnitCost {
+    let k = lobes.min(cfg.lobe_max_lobes.clamp(1, MAX_LOBES));
+    let [weight, scale] = fitted_weight_datapath(cfg, sh);
+    let op = |d: Datapath| UnitCost {
+        ops: 1,
+        cycles: d.latency(gate_levels_per_cycle),
+        texels: 0,
+    };
+    op(weight).times(k).plus(op(scale).times(lights))
 }
 
 /// Cost of one pixel with `lobes` lobes and `lights` lights: per lobe its decode (madd +

@@ -9,19 +9,24 @@
 //! filter, or Ashikhmin-Shirley BRDF) gets these stages; any other costs nothing extra.
 //!
 //! - Fit: per texel and MIP level, K lobes fitted to the finest offsets under the texel
-//!   (`shading::fournier_fit::fit_pyramid`, every level from the finest map), as normals
+//!   (`shading::fournier_fit::fit_pyramid`, every level from the finest map; through the
+//!   in-process cache `fit_pyramid_cached`, so a sweep fits each map once), as normals
 //!   `normalize(f_u, f_v, 1)` of the offset space (the frame the perturbation decodes offsets
 //!   in; exact where the frame is orthonormal with unit lengths), under the material's Phong
 //!   exponent.
 //! - Storage: lobe `j` of every texel is map `map + j`, one texel `[p, q, c, n]` per lobe
 //!   (`quantize_fit`: slopes `p = x / z`, `q = y / z` in the slope format stored offset-binary,
-//!   amplitude, exponent), four 16-bit channels; a texel with fewer lobes has zero amplitudes.
+//!   the lobe's weight `alpha` as amplitude, exponent `n`; the multi-lobe unit's specular
+//!   weight is `alpha n / s`), four 16-bit channels; a texel with fewer lobes has zero
+//!   amplitudes.
 //!   The amplitude channel holds at most `2^16 - 1`: at `lobe_amp_bits = 16` an amplitude of
 //!   exactly 1.0 (a flat texel) is stored `1 - 2^-16`. The float chains hold the unquantized
 //!   `[p, q, c, n]` (the float reference's lobes).
-//! - Between MIP levels: the nearest level and the nearest texel (lobes do not average
-//!   linearly, so no bilinear or trilinear blend of lobe parameters): one single-level lookup
-//!   per lobe at the texel's centre (weights 0), whose footprint the timing model sees.
+//! - Between MIP levels (`multi_lobe.lobe_level_mix`): the nearest level and the nearest texel
+//!   (lobes do not average linearly, so no bilinear or trilinear blend of lobe parameters): one
+//!   single-level lookup per lobe at the texel's centre (weights 0), whose footprint the timing
+//!   model sees; or `blend`: the two levels around the LOD, each its nearest texel, both shaded
+//!   and the colours blended by the LOD fraction (2K lookups, two shadings).
 //! - Ground truth: the roughness stages' (supersampled plain Blinn-Phong of the finest
 //!   offsets, `rough-shade` in truth mode), as for Toksvig and LEAN.
 
@@ -30,12 +35,13 @@ use super::{BumpPlan, Plan, Px, StageKind};
 use crate::maps::Maps;
 use crate::maps::{FixedLevel, FixedMipChain, MipChain, MipLevel, TexelFormat};
 use crate::scene::{BumpFilter, LobeCount, Material};
-use crate::shading::fournier_fit::{fit_pyramid, quantize_fit, FitConfig, LevelFit};
+use crate::shading::fournier_fit::{fit_pyramid_cached, quantize_fit, FitConfig, LevelFit};
 use crate::shading::multi_lobe::LobeF;
 use glam::DVec3;
 use hw_model::config::HwConfig;
 use hw_model::multi_lobe::{Lobe, MAX_LOBES};
 use hw_model::roughness::RoughVariant;
+use std::sync::Arc;
 
 /// What the fitted-lobe stages of one material need.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,12 +58,19 @@ pub struct FittedLobes {
 }
 
 /// Per-fragment signals of `lobe-fetch`: the fetched lobe texels (raw and float) and their
-/// number.
+/// number; with `lobe_level_mix = "blend"` also the coarser level's texels and its weight.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct LobeFrag {
     pub texel_x: [[u16; 4]; MAX_LOBES as usize],
     pub texel: [[f32; 4]; MAX_LOBES as usize],
     pub count: u8,
+    /// Blend: the coarser level's texels were fetched (`coarse_x` fixed, `coarse` float).
+    pub blend: bool,
+    pub coarse_x: [[u16; 4]; MAX_LOBES as usize],
+    pub coarse: [[f32; 4]; MAX_LOBES as usize],
+    /// Weight of the coarser level: raw (`lod_frac_bits` fraction bits) and float.
+    pub weight_x: u32,
+    pub weight: f64,
 }
 
 /// Marks the bump plan of a `fournier_lobes` material (after the other bump planners: a plan
@@ -180,7 +193,9 @@ pub fn float_lobe(t: [f32; 4]) -> LobeF {
 #[derive(Clone, Debug)]
 pub struct LobeMapStats {
     pub source: LobeSource,
-    pub levels: Vec<LevelFit>,
+    pub levels: Arc<Vec<LevelFit>>,
+    /// The fit came from the in-process cache (`fournier_fit::fit_pyramid_cached`).
+    pub cached: bool,
 }
 
 /// `maps` with the lobe maps of `sources` appended (K float chains and their stored
@@ -216,12 +231,12 @@ pub fn lobe_maps(
             shininess: f64::from(src.shininess.max(1)),
             ..FitConfig::default()
         };
-        let levels = fit_pyramid(&normals, w, h, &fc)?;
+        let (levels, cached) = fit_pyramid_cached(&normals, w, h, &fc)?;
         let s = fc.shininess;
         for j in 0..src.lobes as usize {
             let mut float = Vec::with_capacity(levels.len());
             let mut fixed = Vec::with_capacity(levels.len());
-            for lv in &levels {
+            for lv in levels.iter() {
                 let mut ft = Vec::with_capacity(lv.texels.len());
                 let mut xt = Vec::with_capacity(lv.texels.len());
                 for t in &lv.texels {
@@ -229,7 +244,7 @@ pub fn lobe_maps(
                     let stored = quantize_fit(t, s, cfg, &mut sat);
                     match (t.lobes.get(j), stored.get(j)) {
                         (Some(l), Some(q)) => {
-                            let p = l.to_phong(s);
+                            let p = l.to_stored(s);
                             let z = p.direction.z.max(1e-9);
                             ft.push([
                                 (p.direction.x / z) as f32,
@@ -269,6 +284,7 @@ pub fn lobe_maps(
         stats.push(LobeMapStats {
             source: src,
             levels,
+            cached,
         });
     }
     Ok((out, stats))

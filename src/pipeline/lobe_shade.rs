@@ -10,6 +10,9 @@
 //! as the slopes `(x / z, y / z)`, decoded by the frame unit like a bump offset. Colour:
 //! `ambient kd + sum_lights light (kd D + ks S)` (the unit's `D`, `S`), saturating.
 //!
+//! Fitted lobes (`lobe-fetch`): the stored amplitude is the lobe's weight `alpha`, its
+//! specular weight `alpha n / s` (the unit's `spec_recip`, `s` the material's exponent).
+//!
 //! The fixed twin quantizes the material's lobes into the unit's formats (`multi_lobe` config:
 //! slopes, amplitudes, exponents); the float twin uses them unquantized, so the stage's error
 //! includes the lobes' storage.
@@ -27,12 +30,15 @@ use crate::shading::multi_lobe::{shade, LobeF};
 use crate::shading::reference::FrameF;
 use glam::DVec3;
 use hw_model::blinn_phong::mac_cost;
+use hw_model::datapath::{Component, Datapath, Stage};
+use hw_model::fixed::Format;
 use hw_model::frame::Frame;
 use hw_model::multi_lobe::{
-    amp_format, max_exponent, multi_lobe_cost, multi_lobe_shade, slope_format, Lobe, LobeLight,
-    MultiLobeInput, MAX_LOBES,
+    amp_format, fitted_weight_cost, max_exponent, multi_lobe_cost, multi_lobe_shade,
+    shininess_recip, slope_format, LevelMix, Lobe, LobeLight, MultiLobeInput, MAX_LOBES,
 };
 use hw_model::rsqrt::rsqrt_cost;
+use hw_model::trilinear::lerp;
 use hw_model::vector::normalize_cost;
 use hw_model::UnitCost;
 
@@ -132,23 +138,41 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     };
     let sf = slope_format(cfg);
     let af = amp_format(cfg);
-    let mut lobes = [Lobe::default(); MAX_LOBES as usize];
-    let nl = if lp.fitted.is_some() {
-        let lf = &frag.lobe;
-        let nl = usize::from(lf.count).min(MAX_LOBES as usize);
-        for j in 0..nl {
-            lobes[j] = if px.fixed(StageKind::LobeFetch) {
-                decode_lobe(lf.texel_x[j])
+    let fetched_fixed = px.fixed(StageKind::LobeFetch);
+    let lf = &frag.lobe;
+    let wb = m.hw.lod.lod_frac_bits.min(30);
+    // The lobes of one fetched level (fixed texels, or the float ones quantized).
+    let fitted_lobes = |tx: &[[u16; 4]; MAX_LOBES as usize],
+                        tf: &[[f32; 4]; MAX_LOBES as usize],
+                        sat: &mut hw_model::SatCounter| {
+        let mut lobes = [Lobe::default(); MAX_LOBES as usize];
+        for j in 0..usize::from(lf.count).min(MAX_LOBES as usize) {
+            lobes[j] = if fetched_fixed {
+                decode_lobe(tx[j])
             } else {
-                let t = lf.texel[j].map(f64::from);
+                let t = tf[j].map(f64::from);
                 Lobe {
-                    slope: [to_raw(t[0], &sf, &mut sat), to_raw(t[1], &sf, &mut sat)],
-                    amp: to_raw(t[2], &af, &mut sat) as u64,
+                    slope: [to_raw(t[0], &sf, sat), to_raw(t[1], &sf, sat)],
+                    amp: to_raw(t[2], &af, sat) as u64,
                     exponent: t[3].round().clamp(0.0, f64::from(max_exponent(cfg))) as u32,
                 }
             };
         }
-        nl
+        lobes
+    };
+    let mut lobes = [Lobe::default(); MAX_LOBES as usize];
+    let mut coarse = None;
+    let nl = if lp.fitted.is_some() {
+        lobes = fitted_lobes(&lf.texel_x, &lf.texel, &mut sat);
+        if lf.blend {
+            let w = if fetched_fixed {
+                lf.weight_x
+            } else {
+                to_raw(lf.weight, &Format::unsigned(1, wb, rnd), &mut sat) as u32
+            };
+            coarse = Some((fitted_lobes(&lf.coarse_x, &lf.coarse, &mut sat), w));
+        }
+        usize::from(lf.count).min(MAX_LOBES as usize)
     } else {
         for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
             let s = l.slopes();
@@ -160,6 +184,10 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         }
         lp.lobes.len().min(MAX_LOBES as usize)
     };
+    let spec_recip = lp
+        .fitted
+        .as_ref()
+        .map(|_| shininess_recip(bp.shininess, cfg, &units.cfg));
     let v = fixed_eye(m, bf, px.fixed(StageKind::Normal), &mut sat);
     let (kd, ks, mut acc) = fixed_material(
         bp,
@@ -171,6 +199,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         cb,
         rnd,
     );
+    let mut acc_coarse = acc;
     for group in m.lights.chunks(LIGHT_GROUP) {
         let mut ls = [LobeLight {
             l: [0; 3],
@@ -182,18 +211,35 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
                 color: light.color_x,
             };
         }
-        let inp = MultiLobeInput {
+        let mut inp = MultiLobeInput {
             frame: &frame,
             lobes: &lobes[..nl],
             lights: &ls[..group.len()],
             v,
             kd,
             ks,
+            spec_recip,
         };
         let out = multi_lobe_shade(&inp, cfg, units, &mut sat);
         c.h_zero += u64::from(out.h_zero);
         for ch in 0..3 {
             acc[ch] += out.sum[ch];
+        }
+        if let Some((cl, _)) = &coarse {
+            inp.lobes = &cl[..nl];
+            let out = multi_lobe_shade(&inp, cfg, units, &mut sat);
+            for ch in 0..3 {
+                acc_coarse[ch] += out.sum[ch];
+            }
+        }
+    }
+    if let Some((_, w)) = coarse {
+        // Both levels' colours (saturated, counted), blended by the LOD fraction.
+        let max = (1u64 << cb) - 1;
+        for ch in 0..3 {
+            let (a, b) = (acc[ch], acc_coarse[ch]);
+            sat.saturated += u64::from(a > max) + u64::from(b > max);
+            acc[ch] = u64::from(lerp(a.min(max) as u32, b.min(max) as u32, w, wb, rnd));
         }
     }
     fixed_output(acc, frag, &mut sat, cb);
@@ -217,14 +263,16 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
         fallback: false,
         zero_normal: false,
     };
-    let mut lobes = [LobeF::default(); MAX_LOBES as usize];
-    let nl = if lp.fitted.is_some() {
-        let lf = &frag.lobe;
-        let nl = usize::from(lf.count).min(MAX_LOBES as usize);
-        let cfg = &m.hw.multi_lobe;
-        for j in 0..nl {
-            lobes[j] = if px.fixed(StageKind::LobeFetch) {
-                let q = decode_lobe(lf.texel_x[j]);
+    let lf = &frag.lobe;
+    let cfg = &m.hw.multi_lobe;
+    let fetched_fixed = px.fixed(StageKind::LobeFetch);
+    // The lobes of one fetched level (float texels, or the fixed ones decoded).
+    let fitted_lobes = |tx: &[[u16; 4]; MAX_LOBES as usize],
+                        tf: &[[f32; 4]; MAX_LOBES as usize]| {
+        let mut lobes = [LobeF::default(); MAX_LOBES as usize];
+        for j in 0..usize::from(lf.count).min(MAX_LOBES as usize) {
+            lobes[j] = if fetched_fixed {
+                let q = decode_lobe(tx[j]);
                 let sf = slope_format(cfg).frac_bits;
                 let af = amp_format(cfg).frac_bits;
                 LobeF {
@@ -233,10 +281,24 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
                     exponent: q.exponent,
                 }
             } else {
-                float_lobe(lf.texel[j])
+                float_lobe(tf[j])
             };
         }
-        nl
+        lobes
+    };
+    let mut lobes = [LobeF::default(); MAX_LOBES as usize];
+    let mut coarse = None;
+    let nl = if lp.fitted.is_some() {
+        lobes = fitted_lobes(&lf.texel_x, &lf.texel);
+        if lf.blend {
+            let w = if fetched_fixed {
+                f64::from(lf.weight_x) / f64::from(m.hw.lod.lod_frac_bits.min(30)).exp2()
+            } else {
+                lf.weight
+            };
+            coarse = Some((fitted_lobes(&lf.coarse_x, &lf.coarse), w));
+        }
+        usize::from(lf.count).min(MAX_LOBES as usize)
     } else {
         for (q, l) in lobes.iter_mut().zip(&lp.lobes) {
             *q = LobeF {
@@ -247,6 +309,7 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
         }
         lp.lobes.len().min(MAX_LOBES as usize)
     };
+    let fitted_shininess = lp.fitted.as_ref().map(|_| f64::from(bp.shininess.max(1)));
     let v = float_eye(bf);
     let mut kd = bp.kd;
     if px.plan.texture.is_some() {
@@ -258,18 +321,62 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
     for ch in 0..3 {
         acc[ch] = m.ambient[ch] * kd[ch];
     }
+    let mut acc_coarse = acc;
     for group in m.lights.chunks(LIGHT_GROUP) {
         let mut ls = [(DVec3::ZERO, [0.0; 3]); LIGHT_GROUP];
         for (q, light) in ls.iter_mut().zip(group) {
             *q = (float_light(bf, light), light.color_f);
         }
-        let out = shade(&fr, &lobes[..nl], nl, &ls[..group.len()], v, kd, bp.ks);
+        let lights = &ls[..group.len()];
+        let out = shade(
+            &fr,
+            &lobes[..nl],
+            nl,
+            lights,
+            v,
+            kd,
+            bp.ks,
+            fitted_shininess,
+        );
         c.h_zero += u64::from(out.h_zero);
         for ch in 0..3 {
             acc[ch] += out.sum[ch];
         }
+        if let Some((cl, _)) = &coarse {
+            let out = shade(&fr, &cl[..nl], nl, lights, v, kd, bp.ks, fitted_shininess);
+            for ch in 0..3 {
+                acc_coarse[ch] += out.sum[ch];
+            }
+        }
+    }
+    if let Some((_, w)) = coarse {
+        for ch in 0..3 {
+            let (a, b) = (acc[ch].clamp(0.0, 1.0), acc_coarse[ch].clamp(0.0, 1.0));
+            acc[ch] = a + (b - a) * w;
+        }
     }
     float_output(acc, frag, c);
+}
+
+/// The colour blend of two levels: one lerp per channel (`trilinear::lerp`: a multiply by
+/// the LOD fraction and an add).
+fn level_blend_cost(m: &Machine) -> UnitCost {
+    let g = m.hw.timing.gate_levels_per_cycle;
+    let cb = m.units.cfg.shade.shade_color_bits;
+    let wb = m.hw.lod.lod_frac_bits.min(30);
+    let d = Datapath::new().stage(
+        Stage::new("level blend")
+            .then(Component::Multiplier {
+                a: cb + 1,
+                b: wb + 1,
+            })
+            .then(Component::Adder { width: cb + wb + 1 }),
+    );
+    UnitCost {
+        ops: 3,
+        cycles: d.latency(g),
+        texels: 0,
+    }
 }
 
 /// One invocation: the multi-lobe unit for the plan's K lobes and the scene's lights, the
@@ -292,6 +399,15 @@ pub fn cost(m: &Machine, plan: &Plan) -> UnitCost {
     let mut c = multi_lobe_cost(&m.hw.multi_lobe, u, k, lights, g)
         .plus(nz.times(1 + np))
         .plus(mac);
+    if lp.fitted.is_some() {
+        c = c.plus(fitted_weight_cost(&m.hw.multi_lobe, &u.cfg, k, lights, g));
+        if m.hw.multi_lobe.lobe_level_mix == LevelMix::Blend {
+            // The coarser level's shading and the colour blend.
+            let second = multi_lobe_cost(&m.hw.multi_lobe, u, k, lights, g)
+                .plus(fitted_weight_cost(&m.hw.multi_lobe, &u.cfg, k, lights, g));
+            c = c.plus(second).plus(level_blend_cost(m));
+        }
+    }
     if plan.texture.is_some() {
         c = c.plus(mac);
     }

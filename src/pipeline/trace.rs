@@ -37,8 +37,11 @@ pub struct TexelFootprint {
 /// offset and roughness maps (two levels each) and four NDF maps (two levels each). An
 /// environment material's lookups (`env-fetch`: `aniso_probes` probes of two levels, after
 /// its bump and roughness maps) fit too, unless it is also textured with 16 probes (not
-/// supported: 4 x 16 + 4 footprints exceed the trace).
-pub const MAX_FOOTPRINTS: usize = 2 * hw_model::footprint::MAX_PROBES + 2 * 2 + 2 * 4;
+/// supported: 4 x 16 + 4 footprints exceed the trace). A fitted-lobe material's texture (16
+/// probes of two levels) and its lobe maps blended between two levels (2 x 8 single-level
+/// lookups) fit as well.
+pub const MAX_FOOTPRINTS: usize =
+    2 * hw_model::footprint::MAX_PROBES + 2 * hw_model::multi_lobe::MAX_LOBES as usize;
 
 /// The footprints of one fragment, in the order its stages fetched them.
 #[derive(Clone, Copy, Debug)]

@@ -9,7 +9,9 @@
 //! seen through the Phong specular `(n.h)^s` is, for large `kappa` and `s`,
 //! `alpha kappa / (kappa + s) (mu.h)^(kappa s / (kappa + s))` (the product of two vMF
 //! exponentials integrated over the sphere; `exp(k (x - 1)) ~ x^k` near the peak): amplitude
-//! `c = alpha kappa / (kappa + s)`, exponent `n = kappa s / (kappa + s)`. Fournier's own fit
+//! `c = alpha kappa / (kappa + s)`, exponent `n = kappa s / (kappa + s)`. A lobe is stored
+//! as `alpha` and `n` ([`VmfLobe::to_stored`]): `alpha` weights its diffuse term and the
+//! multi-lobe unit forms the specular weight `c = alpha n / s`. Fournier's own fit
 //! is a non-linear least-squares one; this is the EM form, which the issue accepts.
 //!
 //! - Initialization (seeded, deterministic): the first centre is the normal at index
@@ -32,6 +34,7 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// Most lobes per texel.
@@ -124,6 +127,18 @@ impl VmfLobe {
             direction: self.mu,
             amplitude,
             exponent,
+        }
+    }
+
+    /// The stored form under the specular exponent `s`: direction, the mixture weight `alpha`
+    /// as amplitude (the diffuse weight) and the Phong exponent `n` of [`Self::to_phong`]; the
+    /// specular weight `alpha kappa / (kappa + s)` is `alpha n / s`, which the multi-lobe unit
+    /// forms from the stored `alpha` and `n` (`hw_model::multi_lobe`, fitted lobes).
+    #[must_use]
+    pub fn to_stored(&self, s: f64) -> PhongLobe {
+        PhongLobe {
+            amplitude: self.weight,
+            ..self.to_phong(s)
         }
     }
 }
@@ -422,9 +437,110 @@ pub fn fit_pyramid(
     Ok(levels)
 }
 
+/// One cached fit: its key (the map's normals bit for bit, its size, every fit parameter) and
+/// the levels.
+struct CachedFit {
+    normals: Vec<[u64; 3]>,
+    size: (u32, u32),
+    cfg: [u64; 5],
+    levels: Arc<Vec<LevelFit>>,
+    bytes: u64,
+}
+
+/// The fits kept in this process, oldest first, and their bytes.
+static FIT_CACHE: Mutex<(Vec<CachedFit>, u64)> = Mutex::new((Vec::new(), 0));
+
+/// The fit parameters as bits (the cache key's part).
+fn cfg_key(cfg: &FitConfig) -> [u64; 5] {
+    [
+        cfg.lobes as u64,
+        u64::from(cfg.max_iterations),
+        cfg.tolerance.to_bits(),
+        cfg.seed,
+        cfg.shininess.to_bits(),
+    ]
+}
+
+/// Bytes held by a cached fit of `normals` (its key and its levels' texel fits and lobes).
+fn fit_bytes(normals: usize, levels: &[LevelFit]) -> u64 {
+    let texels: usize = levels
+        .iter()
+        .flat_map(|l| &l.texels)
+        .map(|t| {
+            std::mem::size_of::<TexelFit>() + t.lobes.capacity() * std::mem::size_of::<VmfLobe>()
+        })
+        .sum();
+    (normals * std::mem::size_of::<[u64; 3]>()
+        + levels.len() * std::mem::size_of::<LevelFit>()
+        + texels) as u64
+}
+
+/// The fit cache's capacity: an eighth of the run's memory limit (`crate::budget`); a fit
+/// larger than that is not kept.
+#[must_use]
+pub fn fit_cache_capacity() -> u64 {
+    crate::budget::max_memory() / 8
+}
+
+/// [`fit_pyramid`] through an in-process cache: a fit of the same normals (bit for bit), size
+/// and parameters is returned from the cache (`true`) instead of being redone, so a sweep that
+/// varies no fit input fits once. The fit is deterministic, so a cached result equals a new
+/// one (but for the levels' wall times, those of the first fit). The cache holds at most
+/// [`fit_cache_capacity`] bytes, dropping the oldest fits first.
+pub fn fit_pyramid_cached(
+    normals: &[DVec3],
+    w: u32,
+    h: u32,
+    cfg: &FitConfig,
+) -> crate::Result<(Arc<Vec<LevelFit>>, bool)> {
+    let key: Vec<[u64; 3]> = normals
+        .iter()
+        .map(|n| [n.x.to_bits(), n.y.to_bits(), n.z.to_bits()])
+        .collect();
+    let ck = cfg_key(cfg);
+    {
+        let cache = FIT_CACHE
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some(c) = cache
+            .0
+            .iter()
+            .find(|c| c.size == (w, h) && c.cfg == ck && c.normals == key)
+        {
+            return Ok((Arc::clone(&c.levels), true));
+        }
+    }
+    let levels = Arc::new(fit_pyramid(normals, w, h, cfg)?);
+    let bytes = fit_bytes(key.len(), &levels);
+    let cap = fit_cache_capacity();
+    if bytes <= cap {
+        let mut cache = FIT_CACHE
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let (entries, held) = &mut *cache;
+        while *held + bytes > cap && !entries.is_empty() {
+            *held -= entries.remove(0).bytes;
+        }
+        if !entries
+            .iter()
+            .any(|c| c.size == (w, h) && c.cfg == ck && c.normals == key)
+        {
+            entries.push(CachedFit {
+                normals: key,
+                size: (w, h),
+                cfg: ck,
+                levels: Arc::clone(&levels),
+                bytes,
+            });
+            *held += bytes;
+        }
+    }
+    Ok((levels, false))
+}
+
 /// The stored lobes of a texel fit in the multi-lobe unit's formats (`hw_model::multi_lobe`):
-/// per lobe its slopes `(x / z, y / z)` in the slope format, its amplitude in the amplitude
-/// format and its exponent rounded to an integer, saturating at `2^lobe_exp_bits - 1` (every
+/// per lobe ([`VmfLobe::to_stored`]) its slopes `(x / z, y / z)` in the slope format, its
+/// weight `alpha` in the amplitude format and its exponent rounded to an integer, saturating at `2^lobe_exp_bits - 1` (every
 /// saturation counted in `sat`); `s` is the material's Phong exponent of the conversion.
 #[must_use]
 pub fn quantize_fit(
@@ -441,7 +557,7 @@ pub fn quantize_fit(
     fit.lobes
         .iter()
         .map(|l| {
-            let p = l.to_phong(s);
+            let p = l.to_stored(s);
             let d = p.direction;
             let z = d.z.max(1e-9);
             let e = p.exponent.round();

@@ -36,7 +36,8 @@ pub struct MultiLobeF {
 
 /// Twin of `hw_model::multi_lobe::multi_lobe_shade` for the first `max_lobes` lobes: per light
 /// `light * (kd sum_i c_i max(0, N_i.l) + ks sum_i c_i max(0, N_i.h)^n_i)`, no specular term of
-/// lobe `i` where `N_i.l <= 0` or `l + v = 0`.
+/// lobe `i` where `N_i.l <= 0` or `l + v = 0`. With `fitted_shininess = Some(s)` (lobes fitted
+/// to a bump map) lobe `i`'s specular weight is `c_i n_i / s` instead of `c_i`.
 #[must_use]
 #[allow(clippy::too_many_arguments)]
 pub fn shade(
@@ -47,6 +48,7 @@ pub fn shade(
     v: DVec3,
     kd: [f64; 3],
     ks: [f64; 3],
+    fitted_shininess: Option<f64>,
 ) -> MultiLobeF {
     let k = lobes.len().min(max_lobes).min(MAX_LOBES);
     let mut dirs = [DVec3::ZERO; MAX_LOBES];
@@ -66,7 +68,10 @@ pub fn shade(
             let ndl = n.dot(l).clamp(0.0, 1.0);
             d += lobe.amp * ndl;
             if !hz && ndl > 0.0 {
-                s += lobe.amp * pow(n.dot(h).clamp(0.0, 1.0), lobe.exponent);
+                let w = fitted_shininess.map_or(lobe.amp, |sh| {
+                    lobe.amp * f64::from(lobe.exponent) / sh.max(1.0)
+                });
+                s += w * pow(n.dot(h).clamp(0.0, 1.0), lobe.exponent);
             }
         }
         for ch in 0..3 {

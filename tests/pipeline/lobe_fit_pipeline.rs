@@ -134,7 +134,7 @@ fn k1_stores_the_single_moments_lobe() {
                     .flat_map(|y| (tx * f..((tx + 1) * f).min(*w)).map(move |x| (x, y)))
                     .map(|(x, y)| normals[(y * w + x) as usize])
                     .collect();
-                let p = moments_lobe(&under).to_phong(sh);
+                let p = moments_lobe(&under).to_stored(sh);
                 let d = p.direction / p.direction.z;
                 let t = lv.texels[(ty * lv.width + tx) as usize];
                 let want = [d.x, d.y, p.amplitude, p.exponent];

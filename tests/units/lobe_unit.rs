@@ -9,8 +9,8 @@ use glam::DVec3;
 use hw_model::blinn_phong::{ShadingConfig, ShadingUnits};
 use hw_model::frame::Frame;
 use hw_model::multi_lobe::{
-    lobe_direction, lobe_sum, multi_lobe_cost, multi_lobe_shade, Lobe, LobeLight, MultiLobeConfig,
-    MultiLobeInput,
+    fitted_spec_sum, lobe_direction, lobe_sum, multi_lobe_cost, multi_lobe_shade, recip_frac_bits,
+    shininess_recip, Lobe, LobeLight, MultiLobeConfig, MultiLobeInput,
 };
 use hw_model::{Rounding, SatCounter};
 use rayon::prelude::*;
@@ -94,20 +94,24 @@ struct Case {
     v: [i64; 3],
     kd: [u64; 3],
     ks: [u64; 3],
+    /// Fitted lobes: the material's exponent `s` (specular weights `c_i n_i / s`).
+    fitted: Option<u32>,
 }
 
 fn random_case(g: &mut Rng, lf: u32) -> Case {
     let frame = random_frame(g, lf);
     let n = frame.1.n;
     let k = 1 + g.below(8) as usize;
+    // One case in two: fitted lobes under an exponent s in 1..=2047, lobe exponents <= s.
+    let fitted = (g.below(2) == 0).then(|| (g.range(0.0, 11.0).exp2() as u32).clamp(1, 2047));
     let lobes = (0..k)
         .map(|_| Lobe {
             slope: [0; 2].map(|_: i64| (g.range(-2.0, 2.0) * 4096.0).round() as i64),
             amp: g.below(1 << 14),
-            exponent: if g.below(8) == 0 {
-                g.below(4) as u32
-            } else {
-                g.range(0.0, 10.0).exp2() as u32
+            exponent: match fitted {
+                Some(s) => g.below(u64::from(s) + 1) as u32,
+                None if g.below(8) == 0 => g.below(4) as u32,
+                None => g.range(0.0, 10.0).exp2() as u32,
             },
         })
         .collect();
@@ -140,6 +144,7 @@ fn random_case(g: &mut Rng, lf: u32) -> Case {
         v: vq,
         kd: col(g),
         ks: col(g),
+        fitted,
     }
 }
 
@@ -153,6 +158,7 @@ fn check(c: &Case, u: &ShadingUnits, cfg: &MultiLobeConfig, idx: u64) -> f64 {
         v: c.v,
         kd: c.kd,
         ks: c.ks,
+        spec_recip: c.fitted.map(|s| shininess_recip(s, cfg, &u.cfg)),
     };
     let out = multi_lobe_shade(&inp, cfg, u, &mut sat);
     let cu = 1.0 / ((1u64 << C) - 1) as f64;
@@ -172,7 +178,9 @@ fn check(c: &Case, u: &ShadingUnits, cfg: &MultiLobeConfig, idx: u64) -> f64 {
         .map(|l| (r::from_vec3x(&l.l, F), fc(l.color)))
         .collect();
     let vd = r::from_vec3x(&c.v, F);
-    let want = shade(&c.frame.1, &lf, 8, &lights, vd, fc(c.kd), fc(c.ks));
+    let fs = c.fitted.map(f64::from);
+    let want = shade(&c.frame.1, &lf, 8, &lights, vd, fc(c.kd), fc(c.ks), fs);
+    let r_ulp = (-f64::from(recip_frac_bits(cfg, &u.cfg))).exp2();
     assert_eq!(want.h_zero, out.h_zero, "case {idx}");
     let ulp = (-f64::from(F)).exp2();
     let e_n = 2.5 * ulp;
@@ -196,7 +204,11 @@ fn check(c: &Case, u: &ShadingUnits, cfg: &MultiLobeConfig, idx: u64) -> f64 {
             let lo = (x - d_h).max(0.0);
             let w = hi.powf(s) - lo.powf(s);
             let t = if ndl < d_l { hi.powf(s) } else { 0.0 };
-            bs += lobe.amp * (pow_bound(hi, s) + w + t);
+            let (weight, q) = match fs {
+                Some(sh) => (lobe.amp * s / sh, lobe.amp * s * r_ulp / 2.0),
+                None => (lobe.amp, 0.0),
+            };
+            bs += weight * (pow_bound(hi, s) + w + t) + q;
         }
         for ch in 0..3 {
             bound[ch] += light[ch] * (fc(c.kd)[ch] * bd + fc(c.ks)[ch] * bs);
@@ -218,7 +230,8 @@ fn check(c: &Case, u: &ShadingUnits, cfg: &MultiLobeConfig, idx: u64) -> f64 {
 }
 
 /// 10^7 seeded evaluations (K = 1..8 lobes, 1..3 lights, exponents 0..1024, slopes in
-/// [-2, 2], `l = -v` once in 64) within the module's bound; chunks are seeded by index, so
+/// [-2, 2], `l = -v` once in 64; one case in two fitted lobes, specular weights `c_i n_i / s`
+/// for an exponent `s` in 1..=2047) within the module's bound; chunks are seeded by index, so
 /// the result does not depend on the thread count.
 #[test]
 fn multi_lobe_matches_twin_within_bound() {
@@ -278,6 +291,7 @@ fn eval(
         v,
         kd: [20000; 3],
         ks: [40000; 3],
+        spec_recip: None,
     };
     multi_lobe_shade(&inp, cfg, &units(), sat)
 }
@@ -327,6 +341,7 @@ fn exponent_zero_and_saturated() {
         v,
         kd: [0; 3],
         ks: [65535; 3],
+        spec_recip: None,
     };
     let out = multi_lobe_shade(&inp, &cfg, &units(), &mut sat);
     assert!(out.color.iter().all(|&c| c.abs_diff(32768) <= 1), "{out:?}");
@@ -352,6 +367,7 @@ fn exponent_zero_and_saturated() {
             v,
             kd: [20000; 3],
             ks: [0; 3],
+            spec_recip: None,
         };
         multi_lobe_shade(&inp, &cfg, &units(), &mut sat)
     };
@@ -440,4 +456,79 @@ fn config_validation_names_the_field() {
     c = MultiLobeConfig::texram16();
     c.lobe_amp_bits = 1;
     assert_eq!(c.validate().unwrap_err().field, "multi_lobe.lobe_amp_bits");
+}
+
+/// Fitted lobes: a lobe at the material's own exponent (`n = s`: a von Mises-Fisher lobe of
+/// coincident normals) has specular weight `c` exactly, so with `s` a power of two (an exact
+/// reciprocal) it shades bit-identically to the made-up lobe; at `n < s` its specular term
+/// falls as `n / s` while the diffuse term keeps the weight `c`. The scaled sum is rounded once.
+#[test]
+fn fitted_lobe_weights() {
+    let cfg = MultiLobeConfig::texram16();
+    let u = units();
+    let (fr, _, lights, v) = one_light_case(vec![]);
+    let mut sat = SatCounter::default();
+    let run = |lobes: &[Lobe], recip: Option<u64>, kd, ks, sat: &mut SatCounter| {
+        let inp = MultiLobeInput {
+            frame: &fr,
+            lobes,
+            lights: &lights,
+            v,
+            kd,
+            ks,
+            spec_recip: recip,
+        };
+        multi_lobe_shade(&inp, &cfg, &u, sat).color
+    };
+    let mut g = Rng(77);
+    for _ in 0..2000 {
+        let s = 1u32 << g.below(11);
+        let lobe = Lobe {
+            slope: [0; 2].map(|_: i64| g.below(4096) as i64 - 2048),
+            amp: g.below(1 << 16),
+            exponent: s,
+        };
+        let recip = Some(shininess_recip(s, &cfg, &u.cfg));
+        let (kd, ks) = ([30000; 3], [50000; 3]);
+        assert_eq!(
+            run(&[lobe], recip, kd, ks, &mut sat),
+            run(&[lobe], None, kd, ks, &mut sat)
+        );
+    }
+    let lobe = |exponent| Lobe {
+        slope: [0, 0],
+        amp: 1 << 15,
+        exponent,
+    };
+    let recip = Some(shininess_recip(64, &cfg, &u.cfg));
+    let diffuse = |n| {
+        run(
+            &[lobe(n)],
+            recip,
+            [65535; 3],
+            [0; 3],
+            &mut SatCounter::default(),
+        )
+    };
+    assert_eq!(
+        diffuse(64),
+        diffuse(4),
+        "the diffuse weight is c at every n"
+    );
+    let spec = |n| {
+        run(
+            &[lobe(n)],
+            recip,
+            [0; 3],
+            [65535; 3],
+            &mut SatCounter::default(),
+        )[0]
+    };
+    assert!(
+        spec(4) < spec(16) && spec(16) < spec(64),
+        "specular weight c n / s"
+    );
+    // One rounding of the scaled sum: 3 x 1 x 1 / 2^2 = 0.75 -> 1; per term 0.25 -> 0 each.
+    assert_eq!(fitted_spec_sum(&[(1, 1); 3], 1, 2, Rounding::HalfEven), 1);
+    assert_eq!(fitted_spec_sum(&[(1, 1)], 1, 2, Rounding::HalfEven), 0);
 }
