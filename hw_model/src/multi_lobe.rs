@@ -34,10 +34,10 @@
 //! 2^-F` the decoded direction's error per component (the frame unit's bound, lengths 1),
 //! `d_l = 2^-F + sqrt(3) e_N` the error of `N_i . l` and `d_h = 2.5 * 2^-F + sqrt(3) e_N` that
 //! of `N_i . h` (as in `blinn_phong.rs`, plus the direction's error), per light:
-//! `light * (kd (sum_i c_i d_l + 2^-(F+1)) + ks (sum_i w_i (E_i + W_i + T_i) + Q + 2^-(P+1)))
-//! + 1 / (2^C - 1)`, summed over the lights, where `w_i` is the specular weight (`c_i`, or
-//! `c_i n_i / s` for fitted lobes), `Q = 0` for made-up lobes and `Q = sum_i c_i n_i
-//! 2^-(R+1)` for fitted ones (the reciprocal's rounding), `x_i = N_i . h` (float), `W_i = min(1, x_i +
+//! `light * (kd (sum_i c_i d_l + 2^-(F+1)) + ks (sum_i w_i (E_i + W_i + T_i) + Q + 2^-(P+1))) +
+//! 1 / (2^C - 1)`, summed over the lights, where `w_i` is the specular weight (`c_i`, or `c_i
+//! n_i / s` for fitted lobes), `Q = 0` for made-up lobes and `Q = sum_i c_i n_i 2^-(R+1)` for
+//! fitted ones (the reciprocal's rounding), `x_i = N_i . h` (float), `W_i = min(1, x_i +
 //! d_h)^n_i - max(0, x_i - d_h)^n_i` (the power's spread over its input error), `E_i` the power
 //! unit's bound (`pow.rs`) at `min(1, x_i + d_h)`, and `T_i = min(1, x_i + d_h)^n_i` where
 //! `N_i . l < d_l` (at a lobe's terminator its specular term may switch), else 0. A saturated

@@ -72,7 +72,7 @@ fn fetch_level(
     };
     let u = texel_centre(uv[0], fb, lv.width);
     let v = texel_centre(uv[1], fb, lv.height);
-    for j in 0..fetched(fl.lobes, m.hw) {
+    for (j, texel) in out.iter_mut().enumerate().take(fetched(fl.lobes, m.hw)) {
         let Some(levels) = m.tex_fixed.get(fl.map + j) else {
             break;
         };
@@ -81,7 +81,7 @@ fn fetch_level(
             lookup: first + j as u32,
             tex: fl.map + j,
         };
-        out[j] = trilinear_traced(
+        *texel = trilinear_traced(
             levels,
             u,
             v,

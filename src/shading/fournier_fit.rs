@@ -470,9 +470,7 @@ fn fit_bytes(normals: usize, levels: &[LevelFit]) -> u64 {
             std::mem::size_of::<TexelFit>() + t.lobes.capacity() * std::mem::size_of::<VmfLobe>()
         })
         .sum();
-    (normals * std::mem::size_of::<[u64; 3]>()
-        + levels.len() * std::mem::size_of::<LevelFit>()
-        + texels) as u64
+    (normals * std::mem::size_of::<[u64; 3]>() + std::mem::size_of_val(levels) + texels) as u64
 }
 
 /// The fit cache's capacity: an eighth of the run's memory limit (`crate::budget`); a fit

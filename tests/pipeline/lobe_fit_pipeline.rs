@@ -268,8 +268,8 @@ fn blending_two_levels_costs_twice_the_lookups_and_lowers_the_error() {
     let tex = |r: &Rendered| r.stats.stages.iter().map(|s| s.texels).sum::<u64>();
     for k in [1, 2] {
         let near = run_on(&s, &with_lobes(k), StageImpls::FIXED, 2);
-        let hw = texsim::hwconfig::set_field(&with_lobes(k), "lobe_level_mix", "blend")
-            .expect("blend");
+        let hw =
+            texsim::hwconfig::set_field(&with_lobes(k), "lobe_level_mix", "blend").expect("blend");
         let blend = run_on(&s, &hw, StageImpls::FIXED, 2);
         assert_eq!(tex(&blend), 2 * tex(&near), "K = {k}: two levels per lobe");
         assert!(blend.stats.issue_cycles.total > near.stats.issue_cycles.total);
