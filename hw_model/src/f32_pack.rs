@@ -7,7 +7,8 @@
 //! underflow (subnormal operands and results are exact IEEE), overflow to infinity, and NaN
 //! results as SSE produces them: an operation with a NaN operand returns its first NaN
 //! operand quieted, an invalid operation (inf - inf, 0 x inf, 0/0, inf/inf) the default NaN
-//! `0xFFC0_0000`. Mesa llvmpipe runs its setup and shaders with DAZ and FTZ set
+//! `0xFFC0_0000` (the tests check NaN-ness only: the host compiler may commute operands).
+//! Mesa llvmpipe runs its setup and shaders with DAZ and FTZ set
 //! (`util_fpstate_set_denorms_to_zero`); that differs from this policy only when an operand
 //! or a result is below 2^-126 in magnitude.
 
