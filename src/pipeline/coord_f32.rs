@@ -16,13 +16,17 @@
 //!   level-0 size, squared and summed per direction, the larger, `lp_build_fast_log2` (the
 //!   exponent minus one plus the mantissa in [1, 2)) times 1/2, floored to `lod_frac_bits`.
 //!
-//! The vertices enter as the float32 roundings of texsim's (f64) window positions, `1/w` and
-//! texture coordinates: llvmpipe's own float32 vertex transform and clipper are not modelled.
+//! The vertices of a triangle the clipper left whole come from [`vertex_transform`] (the
+//! vertex program and viewport transform in binary32); those of a clipped triangle are
+//! texsim's (f64) window positions, `1/w` and texture coordinates rounded to binary32:
+//! llvmpipe's float32 clipper (`draw_pipe_clip.c`) is not modelled.
 
-use super::stages::{texcoord_offset, Counters, Machine};
+use super::stages::{texcoord_offset, Counters, Machine, TriAttrs};
 use super::{Frag, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::raster::ScreenTri;
+use crate::render::Geometry;
+use glam::DMat4;
 use hw_model::f32_add::{add, sub};
 use hw_model::f32_convert::{from_i32, to_i32_trunc};
 use hw_model::f32_div::div;
@@ -182,18 +186,78 @@ pub fn quad_lod(p: &Planes, qx: i64, qy: i64, width: u32, height: u32, frac_bits
     i64::from(floor_i32(mul(lod, scale)))
 }
 
-/// The vertices of `px`'s triangle in llvmpipe's order, rounded to binary32.
+/// The vertices of `px`'s triangle in llvmpipe's order.
 fn vertices(px: &Px) -> [Vertex; 3] {
-    let (tri, a) = (px.tri, px.a);
-    llvmpipe_order(tri).map(|k| {
-        let f = |x: f64| (x as f32).to_bits();
-        [
-            f(tri.xy_f[k][0]),
-            f(tri.xy_f[k][1]),
-            f(a.inv_w_f[k]),
-            f(a.uv_f[k][0]),
-            f(a.uv_f[k][1]),
-        ]
+    llvmpipe_order(px.tri).map(|k| px.a.f32_verts[k])
+}
+
+/// The view-projection matrix as binary32 (row-major `m[row][col]`).
+fn matrix_f32(vp: &DMat4) -> [[u32; 4]; 4] {
+    let c = vp.to_cols_array_2d();
+    std::array::from_fn(|r| std::array::from_fn(|k| (c[k][r] as f32).to_bits()))
+}
+
+/// llvmpipe's vertex transform of object position `p`: the clip position `MVP p` in
+/// binary32 (the fixed-function vertex program's `MUL` then three `MAD`s, each a product
+/// and a sum rounded on their own: fusing them measured worse), then the draw module's
+/// viewport transform: `1/w` by a division, `x (1/w) scale + translate` with a fused
+/// multiply-add (for a power-of-two half size the product is exact and fusing changes
+/// nothing). `mvp` is texsim's view-projection rounded to binary32, not Mesa's own float32
+/// product of the `glFrustum`/`glRotated`/`glTranslated` matrices. Returns window x, y (y
+/// down) and `1/w`.
+#[must_use]
+pub fn vertex_transform(mvp: &[[u32; 4]; 4], p: [f32; 3], width: u32, height: u32) -> [u32; 3] {
+    let pos = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits(), ONE];
+    let clip: [u32; 4] = std::array::from_fn(|r| {
+        let m = &mvp[r];
+        let t = mul(pos[0], m[0]);
+        let t = add(mul(pos[1], m[1]), t);
+        let t = add(mul(pos[2], m[2]), t);
+        add(mul(pos[3], m[3]), t)
+    });
+    let oow = div(ONE, clip[3]);
+    let half_w = from_i32(width as i32 / 2);
+    let half_h = from_i32(height as i32 / 2);
+    let vp = |v: u32, scale: u32, trans: u32| fma(mul(v, oow), scale, trans);
+    [
+        vp(clip[0], half_w, half_w),
+        vp(clip[1], half_h ^ 0x8000_0000, half_h),
+        oow,
+    ]
+}
+
+/// The vertices of screen triangle `tri` as llvmpipe's setup reads them, in `tri`'s order:
+/// for a triangle the clipper left whole, each source vertex through [`vertex_transform`] with
+/// its texture coordinates; for a clipped one (llvmpipe's float32 clipper is not modelled)
+/// texsim's window position, `1/w` and coordinates rounded to binary32.
+#[must_use]
+pub fn llvmpipe_vertices(
+    tri: &ScreenTri,
+    a: &TriAttrs,
+    geo: &Geometry,
+    width: u32,
+    height: u32,
+) -> [Vertex; 3] {
+    let f = |x: f64| (x as f32).to_bits();
+    let d = &geo.draws[tri.src as usize];
+    let mvp = matrix_f32(&geo.view_projection);
+    std::array::from_fn(|k| {
+        let b = tri.src_bary[k];
+        let src = (0..3).find(|&j| b[j] == 1.0 && b.iter().filter(|&&x| x == 0.0).count() == 2);
+        match src {
+            Some(j) => {
+                let vi = d.v[j] as usize;
+                let [x, y, w] = vertex_transform(&mvp, geo.object[vi], width, height);
+                [x, y, w, f(geo.uv[vi][0]), f(geo.uv[vi][1])]
+            }
+            None => [
+                f(tri.xy_f[k][0]),
+                f(tri.xy_f[k][1]),
+                f(a.inv_w_f[k]),
+                f(a.uv_f[k][0]),
+                f(a.uv_f[k][1]),
+            ],
+        }
     })
 }
 

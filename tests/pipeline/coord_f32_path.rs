@@ -3,7 +3,9 @@
 //! (`mul_add` for the fused multiply-adds): bit for bit on random triangles and pixels.
 
 use crate::rng_common::Rng;
-use texsim::pipeline::coord_f32::{coords_at, fast_log2, quad_lod, setup, Plane, Planes, Vertex};
+use texsim::pipeline::coord_f32::{
+    coords_at, fast_log2, quad_lod, setup, vertex_transform, Plane, Planes, Vertex,
+};
 
 /// Host `f32` twin of `coord_f32::setup` (`lp_state_setup.c`).
 fn setup_host(v: [[f32; 5]; 3]) -> [[f32; 3]; 3] {
@@ -127,5 +129,40 @@ fn fast_log2_matches_host() {
                 "{x:#x}"
             );
         }
+    }
+}
+
+/// Host `f32` twin of `coord_f32::vertex_transform`: `MVP p` as a product and three
+/// product-plus-sum steps, `1/w`, `x (1/w) scale + translate` fused.
+fn vertex_host(m: &[[f32; 4]; 4], p: [f32; 3], w: u32, h: u32) -> [f32; 3] {
+    let pos = [p[0], p[1], p[2], 1.0];
+    let clip: [f32; 4] = std::array::from_fn(|r| {
+        let t = pos[0] * m[r][0];
+        let t = pos[1] * m[r][1] + t;
+        let t = pos[2] * m[r][2] + t;
+        pos[3] * m[r][3] + t
+    });
+    let oow = 1.0 / clip[3];
+    let (hw, hh) = ((w / 2) as f32, (h / 2) as f32);
+    [
+        (clip[0] * oow).mul_add(hw, hw),
+        (clip[1] * oow).mul_add(-hh, hh),
+        oow,
+    ]
+}
+
+#[test]
+fn vertex_transform_matches_host_f32() {
+    let mut r = Rng(0x7E57);
+    for _ in 0..200_000 {
+        let m: [[f32; 4]; 4] =
+            std::array::from_fn(|_| std::array::from_fn(|_| r.range(-3.0, 3.0) as f32));
+        let p: [f32; 3] = std::array::from_fn(|_| r.range(-300.0, 300.0) as f32);
+        let want = vertex_host(&m, p, 1024, 768);
+        if want.iter().any(|x| !x.is_finite()) {
+            continue;
+        }
+        let got = vertex_transform(&m.map(|row| row.map(f32::to_bits)), p, 1024, 768);
+        assert_eq!(got, want.map(f32::to_bits), "{m:?} {p:?}");
     }
 }
