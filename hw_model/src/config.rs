@@ -118,6 +118,15 @@ pub struct InterpConfig {
     /// Absent in older files: 0.
     #[serde(default)]
     pub attr_subpixel_bits: u32,
+    /// Arithmetic of the texture coordinates and their LOD: `fixed` (the barycentric
+    /// interpolator and LOD unit above) or `float32` (Mesa llvmpipe's IEEE binary32 path,
+    /// bit for bit: plane equations from its triangle setup, `a0 + dadx x + dady y` by fused
+    /// multiply-adds, `s/w` times `1 / (1/w)`, the LOD from the 2x2 quad's float32
+    /// differences and `lp_build_fast_log2`; the `hw_model::f32_*` units). `float32` needs
+    /// `lod.lod_per_quad = true` and `lod.lod_log2 = "piecewise-linear"`. Absent in older
+    /// files: `fixed`.
+    #[serde(default)]
+    pub coord_arith: CoordArith,
     /// Cycles to form the perspective-correct barycentrics of one fragment (excl. reciprocal).
     pub bary_cycles: Cycles,
     /// Cycles per interpolated scalar attribute.
@@ -144,6 +153,17 @@ pub struct LodConfig {
     /// `false`.
     #[serde(default)]
     pub lod_per_quad: bool,
+}
+
+/// The arithmetic of the texture-coordinate path (`interp.coord_arith`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CoordArith {
+    /// Fixed point: exact-edge barycentrics, the interpolator and the LOD unit.
+    #[default]
+    Fixed,
+    /// IEEE binary32 as Mesa 22.3 llvmpipe computes it (`src/pipeline/coord_f32.rs`).
+    Float32,
 }
 
 /// How the LOD unit forms `log2` of the squared footprint length.
@@ -270,6 +290,7 @@ impl HwConfig {
                 texcoord_overflow: Overflow::Saturate,
                 texcoord_reduce: true,
                 attr_subpixel_bits: 0,
+                coord_arith: CoordArith::Fixed,
                 bary_cycles: Cycles::Derived,
                 attr_cycles: Cycles::Derived,
             },
@@ -346,10 +367,11 @@ impl HwConfig {
     }
 
     /// Mesa llvmpipe's 8-bit AoS texture path (Mesa 22.3, `lp_bld_sample_aos.c`,
-    /// `lp_bld_sample.c`): 8-bit texels, coordinates rounded to 8 sub-texel bits, lerps
-    /// `a + ((b - a) w + 128) >> 8` (pmulhrsw), LOD per 2x2 quad from finite differences
-    /// with the piecewise-linear `lp_build_fast_log2`, level fraction truncated to 8 bits;
-    /// coverage on 8 sub-pixel bits, the attribute setup from positions on 16.
+    /// `lp_bld_sample.c`): 8-bit texels, coordinates rounded to 8 sub-texel bits to nearest
+    /// even (`lp_build_iround`), lerps `a + ((b - a) w + 128) >> 8` (pmulhrsw), LOD per 2x2
+    /// quad from finite differences with the piecewise-linear `lp_build_fast_log2`, level
+    /// fraction truncated to 8 bits; coverage on 8 sub-pixel bits; the texture coordinates
+    /// and LOD in llvmpipe's float32 arithmetic (`interp.coord_arith = "float32"`).
     #[must_use]
     pub fn llvmpipe() -> Self {
         let mut c = Self::texram16();
@@ -358,11 +380,12 @@ impl HwConfig {
         c.trilinear.texel_bits = 8;
         c.trilinear.weight_bits = 8;
         c.trilinear.filter_rounding = Rounding::HalfUp;
-        c.trilinear.weight_rounding = Rounding::HalfUp;
+        c.trilinear.weight_rounding = Rounding::HalfEven;
         c.lod.lod_frac_bits = 8;
         c.lod.lod_log2 = LodLog2::PiecewiseLinear;
         c.lod.lod_per_quad = true;
         c.interp.attr_subpixel_bits = 16;
+        c.interp.coord_arith = CoordArith::Float32;
         c
     }
 
@@ -399,6 +422,16 @@ impl HwConfig {
         check("interp.texcoord_int_bits", i.texcoord_int_bits, 1, 16)?;
         check("interp.attr_subpixel_bits", i.attr_subpixel_bits, 0, 16)?;
         check("lod.lod_frac_bits", self.lod.lod_frac_bits, 0, 16)?;
+        if i.coord_arith == CoordArith::Float32
+            && !(self.lod.lod_per_quad && self.lod.lod_log2 == LodLog2::PiecewiseLinear)
+        {
+            return Err(ConfigError {
+                field: "interp.coord_arith".into(),
+                what: "float32 (llvmpipe's path) needs lod.lod_per_quad = true and \
+                       lod.lod_log2 = \"piecewise-linear\""
+                    .into(),
+            });
+        }
         let t = &self.trilinear;
         check("trilinear.weight_bits", t.weight_bits, 0, 16)?;
         check("trilinear.texel_bits", t.texel_bits, 1, 16)?;

@@ -580,6 +580,16 @@ pub fn units(hw: &crate::HwConfig) -> Vec<UnitReport> {
         crate::multi_lobe::datapath(&hw.multi_lobe, sh),
         g,
     ));
+    // The IEEE binary32 units of the float32 coordinate path (`interp.coord_arith`).
+    v.push(UnitReport::new("f32_add", crate::f32_add::datapath(), g));
+    v.push(UnitReport::new("f32_mul", crate::f32_mul::datapath(), g));
+    v.push(UnitReport::new("f32_div", crate::f32_div::datapath(), g));
+    v.push(UnitReport::new("f32_fma", crate::f32_fma::datapath(), g));
+    v.push(UnitReport::new(
+        "f32_convert",
+        crate::f32_convert::datapath(),
+        g,
+    ));
     v
 }
 

@@ -6,12 +6,16 @@ use super::texcoord::quantize_uv;
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
 use crate::reference::lod_mode_f64;
+use hw_model::config::CoordArith;
 use hw_model::lod::lod_cost;
 use hw_model::UnitCost;
 
 /// Fixed twin: squared lengths, bit-serial log2.
 pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let m = px.m;
+    if m.hw.interp.coord_arith == CoordArith::Float32 && px.fixed(StageKind::Texcoord) {
+        return super::coord_f32::lod(px, frag, c);
+    }
     let Some(l0) = px.plan.texture.and_then(|t| m.tex_float[t].first()) else {
         return;
     };

@@ -16,6 +16,7 @@ pub mod bary;
 pub mod bump;
 pub mod bump_fetch;
 pub mod color;
+pub mod coord_f32;
 pub mod env;
 pub mod env_fetch;
 pub mod frame;

@@ -5,6 +5,7 @@ use super::stages::{column, column_f, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::reference::interpolate_f64;
+use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
 use hw_model::interpolator::{interpolate, interpolate_cost};
 use hw_model::UnitCost;
@@ -12,6 +13,9 @@ use hw_model::UnitCost;
 /// Fixed twin: two interpolations per sample.
 pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let m = px.m;
+    if m.hw.interp.coord_arith == CoordArith::Float32 {
+        return super::coord_f32::texcoord(px, frag, c);
+    }
     let bb = m.hw.interp.bary_bits;
     let fb = m.uv_fmt.frac_bits;
     let raw_bary = px.fixed(StageKind::Bary);

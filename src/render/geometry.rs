@@ -8,12 +8,17 @@ use crate::scene::{Light, Scene};
 use crate::scene::{MainDirection, Mesh};
 use crate::shading::reference as fref;
 use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
-use glam::DVec3;
+use glam::{DMat4, DVec3};
 
 /// Host-side geometry: clip-space vertices, Gouraud vertex colours, texture coordinates, the
 /// triangles to draw and the plan of each mesh.
 pub struct Geometry {
     pub clip: Vec<[f64; 4]>,
+    /// Object-space positions as the scene gives them (float32), for llvmpipe's float32
+    /// vertex transform (`interp.coord_arith = "float32"`).
+    pub object: Vec<[f32; 3]>,
+    /// The view-projection matrix the clip positions come from.
+    pub view_projection: DMat4,
     pub color: Vec<[f64; 3]>,
     pub uv: Vec<[f64; 2]>,
     /// Per-vertex bump data: empty unless some plan is bump mapped (then one per vertex;
@@ -38,6 +43,8 @@ impl Geometry {
         let n: usize = scene.meshes.iter().map(|m| m.positions.len()).sum();
         let mut g = Geometry {
             clip: Vec::with_capacity(n),
+            object: Vec::with_capacity(n),
+            view_projection: vp,
             color: Vec::with_capacity(n),
             uv: Vec::with_capacity(n),
             draws: Vec::with_capacity(scene.triangle_count()),
@@ -66,6 +73,7 @@ impl Geometry {
             let base = g.clip.len() as u32;
             let kd = DVec3::from(mat.kd.map(f64::from));
             for (vi, p) in mesh.positions.iter().enumerate() {
+                g.object.push(*p);
                 let p = DVec3::from(p.map(f64::from));
                 g.clip.push((vp * p.extend(1.0)).to_array());
                 let c = if mat.lit {

@@ -4,11 +4,13 @@
 
 use super::Geometry;
 use crate::pipeline::bump::{BumpAttrs, BumpVertex};
+use crate::pipeline::coord_f32;
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
 use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
+use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
 use rayon::prelude::*;
 
@@ -92,7 +94,10 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             let mut sat = SatCounter::default();
             let plan = geo.draw_plan[t.src as usize];
             let wrap = geo.plans[plan as usize].wrap;
-            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
+            let mut a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
+            if m.hw.interp.coord_arith == CoordArith::Float32 {
+                a.f32_verts = coord_f32::llvmpipe_vertices(t, &a, geo, setup.width, setup.height);
+            }
             (a, sat)
         })
         .collect();

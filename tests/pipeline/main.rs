@@ -14,6 +14,7 @@ mod as_hard_cases;
 mod as_pipeline;
 mod bump_hard_cases;
 mod bump_pipeline;
+mod coord_f32_path;
 mod determinism;
 mod env_scene;
 mod lobe_fit_pipeline;

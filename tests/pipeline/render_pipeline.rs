@@ -301,10 +301,27 @@ fn llvmpipe_preset_samples_8_bit_texels_with_a_lod_per_quad() {
         }
     }
     assert!(px > 4000);
-    let mut per_pixel = l.clone();
+    // The per-quad LOD against the per-pixel one, on the fixed coordinate path (the float32
+    // path is llvmpipe's and always per quad).
+    let mut quad = l.clone();
+    quad.interp.coord_arith = hw_model::config::CoordArith::Fixed;
+    let q = run(&quad);
+    let differ_f32 = a
+        .hw_image
+        .px
+        .iter()
+        .zip(&q.hw_image.px)
+        .filter(|(x, y)| x != y)
+        .count();
+    assert!(differ_f32 > 0, "the float32 coordinates change pixels");
+    assert!(
+        differ_f32 < px / 4,
+        "by one rounding here and there: {differ_f32}"
+    );
+    let mut per_pixel = quad.clone();
     per_pixel.lod.lod_per_quad = false;
     let b = run(&per_pixel);
-    let differ = a
+    let differ = q
         .hw_image
         .px
         .iter()

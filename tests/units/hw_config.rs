@@ -64,7 +64,7 @@ fn presets_have_the_api_precision_floors() {
 /// The llvmpipe preset (Mesa 22.3's 8-bit AoS sampler): every field it changes from texram16.
 #[test]
 fn llvmpipe_preset_pins_its_texture_path() {
-    use hw_model::config::LodLog2;
+    use hw_model::config::{CoordArith, LodLog2};
     let l = preset("llvmpipe");
     let t = preset("texram16");
     assert_eq!(l.name, "llvmpipe");
@@ -74,7 +74,11 @@ fn llvmpipe_preset_pins_its_texture_path() {
         "8-bit texels and weights"
     );
     assert_eq!(l.trilinear.filter_rounding, Rounding::HalfUp, "pmulhrsw");
-    assert_eq!(l.trilinear.weight_rounding, Rounding::HalfUp);
+    assert_eq!(
+        l.trilinear.weight_rounding,
+        Rounding::HalfEven,
+        "lp_build_iround: round to nearest even"
+    );
     assert_eq!(l.lod.lod_frac_bits, 8);
     assert_eq!(l.lod.lod_log2, LodLog2::PiecewiseLinear);
     assert!(l.lod.lod_per_quad);
@@ -87,6 +91,18 @@ fn llvmpipe_preset_pins_its_texture_path() {
         "attribute planes from finer positions"
     );
     assert_eq!(t.interp.attr_subpixel_bits, 0);
+    assert_eq!(
+        l.interp.coord_arith,
+        CoordArith::Float32,
+        "llvmpipe's float32 coordinates"
+    );
+    assert!(PRESETS
+        .iter()
+        .all(|&p| p == "llvmpipe" || preset(p).interp.coord_arith == CoordArith::Fixed));
+    let mut bad = l.clone();
+    bad.lod.lod_per_quad = false;
+    let e = bad.validate().expect_err("float32 needs the quad LOD");
+    assert_eq!(e.field, "interp.coord_arith");
     assert_eq!(t.lod.lod_log2, LodLog2::Exact, "other presets unchanged");
     assert!(PRESETS
         .iter()

@@ -14,6 +14,7 @@ mod ndf_common;
 mod as_power;
 mod brdf_fixed;
 mod env_units;
+mod f32_units;
 mod frames_config;
 mod frames_frame;
 mod frames_pixel;

@@ -1,0 +1,154 @@
+//! IEEE 754 binary32 encoding shared by the float32 units (`f32_add`, `f32_mul`, `f32_div`,
+//! `f32_fma`, `f32_convert`): unpacking an encoding into sign, exponent and integer
+//! significand, and the one round-and-pack exit every float32 result leaves through
+//! ([`round_pack`], round to nearest, ties to even, by [`crate::fixed::round_shift_right_sticky`]).
+//!
+//! Policy (that of x86 SSE with MXCSR's DAZ and FTZ clear, the host's `f32`): gradual
+//! underflow (subnormal operands and results are exact IEEE), overflow to infinity, and NaN
+//! results as SSE produces them: an operation with a NaN operand returns its first NaN
+//! operand quieted, an invalid operation (inf - inf, 0 x inf, 0/0, inf/inf) the default NaN
+//! `0xFFC0_0000` (the tests check NaN-ness only: the host compiler may commute operands).
+//! Mesa llvmpipe runs its setup and shaders with DAZ and FTZ set
+//! (`util_fpstate_set_denorms_to_zero`); that differs from this policy only when an operand
+//! or a result is below 2^-126 in magnitude.
+
+use crate::datapath::{Component, Stage};
+use crate::fixed::{round_shift_right_sticky, Rounding};
+
+/// Sign bit of an encoding.
+pub const SIGN: u32 = 0x8000_0000;
+/// The default NaN of x86 SSE (an invalid operation's result).
+pub const DEFAULT_NAN: u32 = 0xFFC0_0000;
+/// Positive infinity.
+pub const INF: u32 = 0x7F80_0000;
+/// Fraction bits of binary32.
+pub const FRAC_BITS: u32 = 23;
+/// The exponent of the least significant bit of a subnormal (2^-149).
+pub const MIN_LSB_EXP: i32 = -149;
+
+/// An unpacked finite operand: value = (-1)^`neg` x `sig` x 2^`exp`, `sig` < 2^24.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Unpacked {
+    pub neg: bool,
+    pub exp: i32,
+    pub sig: u64,
+}
+
+/// What an encoding holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Class {
+    /// A NaN (its bits).
+    Nan(u32),
+    /// An infinity (true if negative).
+    Inf(bool),
+    /// A zero (true if negative).
+    Zero(bool),
+    /// A normal or subnormal number.
+    Finite(Unpacked),
+}
+
+/// Unpacks encoding `x`.
+#[inline]
+#[must_use]
+pub fn classify(x: u32) -> Class {
+    let neg = x & SIGN != 0;
+    let e = (x >> FRAC_BITS) & 0xFF;
+    let f = x & 0x007F_FFFF;
+    match (e, f) {
+        (0xFF, 0) => Class::Inf(neg),
+        (0xFF, _) => Class::Nan(x),
+        (0, 0) => Class::Zero(neg),
+        (0, _) => Class::Finite(Unpacked {
+            neg,
+            exp: MIN_LSB_EXP,
+            sig: u64::from(f),
+        }),
+        _ => Class::Finite(Unpacked {
+            neg,
+            exp: e as i32 - 150,
+            sig: u64::from(f | 0x0080_0000),
+        }),
+    }
+}
+
+/// `x` with its quiet bit set (SSE's propagation of a signalling NaN).
+#[inline]
+#[must_use]
+pub const fn quiet(x: u32) -> u32 {
+    x | 0x0040_0000
+}
+
+/// A signed zero.
+#[inline]
+#[must_use]
+pub const fn zero(neg: bool) -> u32 {
+    if neg {
+        SIGN
+    } else {
+        0
+    }
+}
+
+/// Signed infinity.
+#[inline]
+#[must_use]
+pub const fn inf(neg: bool) -> u32 {
+    zero(neg) | INF
+}
+
+/// Bit length of `x` (0 for 0).
+#[inline]
+fn bit_len(x: u128) -> i32 {
+    128 - x.leading_zeros() as i32
+}
+
+/// The one exit of every float32 unit: the binary32 encoding nearest (ties to even) to
+/// (-1)^`neg` x (`sig` + f) x 2^`exp`, where f in [0, 1) is what an earlier step dropped
+/// (f > 0 iff `sticky`). `sig` = 0 with `sticky` clear is an exact zero of sign `neg`.
+/// Overflow gives infinity; results below 2^-126 are subnormal (gradual underflow).
+#[must_use]
+pub fn round_pack(neg: bool, exp: i32, sig: u128, sticky: bool) -> u32 {
+    if sig == 0 && !sticky {
+        return zero(neg);
+    }
+    // Keep a sticky bit of our own below the significand, so a dropped f is never lost.
+    let (sig, exp) = (sig << 1 | u128::from(sticky), exp - 1);
+    let top = exp + bit_len(sig) - 1;
+    // The exponent of the result's least significant bit: 24 significant bits, or 2^-149.
+    let lsb = (top - FRAC_BITS as i32).max(MIN_LSB_EXP);
+    let mut q = if lsb > exp {
+        let shift = (lsb - exp).min(127) as u32;
+        round_shift_right_sticky(sig, shift, false, Rounding::HalfEven)
+    } else {
+        sig << (exp - lsb)
+    };
+    let mut lsb = lsb;
+    if q >> (FRAC_BITS + 1) != 0 {
+        // Rounding carried into a 25th bit: exact halving (the low bit is 0).
+        q >>= 1;
+        lsb += 1;
+    }
+    if q >> FRAC_BITS == 0 {
+        // Subnormal (lsb = -149) or zero after rounding.
+        return zero(neg) | q as u32;
+    }
+    let biased = lsb + 150;
+    if biased >= 0xFF {
+        return inf(neg);
+    }
+    zero(neg) | (biased as u32) << FRAC_BITS | (q as u32 & 0x007F_FFFF)
+}
+
+/// The packing stage beside each float32 unit: leading-zero count over `width` bits, the
+/// normalizing shift, the 24-bit rounding increment and the exponent adjust.
+#[must_use]
+pub fn pack_stage(name: &'static str, width: u32) -> Stage {
+    Stage::new(name)
+        .then(Component::LeadingZeros { width })
+        .then(Component::Shifter {
+            width,
+            shift_bits: crate::datapath::ceil_log2(width),
+        })
+        .then(Component::Adder { width: 24 })
+        .beside(1, Component::Adder { width: 10 })
+}
