@@ -66,14 +66,16 @@ impl Geometry {
             let mat = &scene.materials[mesh.material];
             let base = g.clip.len() as u32;
             let kd = DVec3::from(mat.kd.map(f64::from));
-            // Per vertex in parallel, collected in vertex order: identical for any thread count.
-            let verts: Vec<([f64; 4], [f64; 3])> = mesh
-                .positions
-                .par_iter()
-                .enumerate()
-                .map(|(vi, p)| {
-                    let p = DVec3::from(p.map(f64::from));
+            // Per vertex in parallel, written in vertex order: identical for any thread count.
+            g.clip.par_extend(
+                mesh.positions
+                    .par_iter()
+                    .map(|p| (vp * DVec3::from(p.map(f64::from)).extend(1.0)).to_array()),
+            );
+            g.color
+                .par_extend(mesh.positions.par_iter().enumerate().map(|(vi, p)| {
                     let c = if mat.lit {
+                        let p = DVec3::from(p.map(f64::from));
                         let nrm = mesh
                             .normals
                             .get(vi)
@@ -82,16 +84,8 @@ impl Geometry {
                     } else {
                         kd
                     };
-                    (
-                        (vp * p.extend(1.0)).to_array(),
-                        c.clamp(DVec3::ZERO, DVec3::ONE).to_array(),
-                    )
-                })
-                .collect();
-            for (clip, color) in verts {
-                g.clip.push(clip);
-                g.color.push(color);
-            }
+                    c.clamp(DVec3::ZERO, DVec3::ONE).to_array()
+                }));
             g.uv.extend(
                 (0..mesh.positions.len())
                     .map(|vi| mesh.uvs.get(vi).map_or([0.0; 2], |t| t.map(f64::from))),

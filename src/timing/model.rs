@@ -619,6 +619,7 @@ impl<'a> Simulator<'a> {
 
     /// Issues the next covered pixel (raster order): plan index `plan`, the footprints its
     /// stages fetched in `fps`.
+    #[inline]
     pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
         let nk = self.alu.len();
         let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
