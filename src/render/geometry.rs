@@ -9,6 +9,7 @@ use crate::scene::{MainDirection, Mesh};
 use crate::shading::reference as fref;
 use crate::shading::tangents::{generate_tangents, generate_uv_derivatives};
 use glam::{DMat4, DVec3};
+use rayon::prelude::*;
 
 /// Host-side geometry: clip-space vertices, Gouraud vertex colours, texture coordinates, the
 /// triangles to draw and the plan of each mesh.
@@ -72,22 +73,31 @@ impl Geometry {
             let mat = &scene.materials[mesh.material];
             let base = g.clip.len() as u32;
             let kd = DVec3::from(mat.kd.map(f64::from));
-            for (vi, p) in mesh.positions.iter().enumerate() {
-                g.object.push(*p);
-                let p = DVec3::from(p.map(f64::from));
-                g.clip.push((vp * p.extend(1.0)).to_array());
-                let c = if mat.lit {
-                    let nrm = mesh
-                        .normals
-                        .get(vi)
-                        .map_or(DVec3::Z, |n| DVec3::from(n.map(f64::from)));
-                    kd * lighting(scene, p, nrm.normalize_or_zero())
-                } else {
-                    kd
-                };
-                g.color.push(c.clamp(DVec3::ZERO, DVec3::ONE).to_array());
-                g.uv.push(mesh.uvs.get(vi).map_or([0.0; 2], |t| t.map(f64::from)));
-            }
+            g.object.extend_from_slice(&mesh.positions);
+            // Per vertex in parallel, written in vertex order: identical for any thread count.
+            g.clip.par_extend(
+                mesh.positions
+                    .par_iter()
+                    .map(|p| (vp * DVec3::from(p.map(f64::from)).extend(1.0)).to_array()),
+            );
+            g.color
+                .par_extend(mesh.positions.par_iter().enumerate().map(|(vi, p)| {
+                    let c = if mat.lit {
+                        let p = DVec3::from(p.map(f64::from));
+                        let nrm = mesh
+                            .normals
+                            .get(vi)
+                            .map_or(DVec3::Z, |n| DVec3::from(n.map(f64::from)));
+                        kd * lighting(scene, p, nrm.normalize_or_zero())
+                    } else {
+                        kd
+                    };
+                    c.clamp(DVec3::ZERO, DVec3::ONE).to_array()
+                }));
+            g.uv.extend(
+                (0..mesh.positions.len())
+                    .map(|vi| mesh.uvs.get(vi).map_or([0.0; 2], |t| t.map(f64::from))),
+            );
             let bump_map = BumpSource::of(mat).and_then(|b| {
                 sources
                     .iter()

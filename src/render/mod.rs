@@ -223,27 +223,36 @@ pub fn render(
         geo: &geo,
         m: &m,
     };
-    let (hw_image, counters, mut events) = shade(&inp, &opts.hw_impls, bg, opts.timing);
-    if let Some(fe) = events.as_mut() {
-        fe.triangles = setup.tris.len() as u64;
-        fe.spans = raster_stats.spans;
-        fe.fragments = raster_stats.fragments;
-        fe.plans = geo
-            .plans
-            .iter()
-            .map(|p| PlanTiming {
-                stages: p.stages.iter().map(|&k| (k, m.stage_cost(k, p))).collect(),
-            })
-            .collect();
-        fe.textures = maps
-            .fixed
-            .iter()
-            .map(|ch| TextureLayout {
-                levels: ch.levels.iter().map(|l| (l.width, l.height)).collect(),
-                texel_bytes: ch.format.bytes(),
-            })
-            .collect();
-    }
+    let plans: Vec<PlanTiming> = geo
+        .plans
+        .iter()
+        .map(|p| PlanTiming {
+            stages: p.stages.iter().map(|&k| (k, m.stage_cost(k, p))).collect(),
+        })
+        .collect();
+    let textures: Vec<TextureLayout> = maps
+        .fixed
+        .iter()
+        .map(|ch| TextureLayout {
+            levels: ch.levels.iter().map(|l| (l.width, l.height)).collect(),
+            texel_bytes: ch.format.bytes(),
+        })
+        .collect();
+    let sim = opts
+        .timing
+        .then(|| crate::timing::Simulator::new(&plans, &textures, hw));
+    let (hw_image, counters, timed) = shade(&inp, &opts.hw_impls, bg, sim);
+    let (events, sim) = match timed {
+        Some((mut fe, sim)) => {
+            fe.triangles = setup.tris.len() as u64;
+            fe.spans = raster_stats.spans;
+            fe.fragments = raster_stats.fragments;
+            fe.plans = plans;
+            fe.textures = textures;
+            (Some(fe), Some(sim))
+        }
+        None => (None, None),
+    };
     tm.shade_hw_ms = ms(t);
     progress("hardware shading", tm.shade_hw_ms);
     tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
@@ -271,12 +280,7 @@ pub fn render(
             }
         };
         let t = Instant::now();
-        let (img, rc, _) = shade(
-            &ShadeInput { vis: rv, ..inp },
-            &StageImpls::FLOAT,
-            bg,
-            false,
-        );
+        let (img, rc, _) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg, None);
         ref_nonfinite = rc.nonfinite;
         tm.shade_ref_ms = ms(t);
         progress("reference", ms(t_ref));
@@ -314,7 +318,7 @@ pub fn render(
             geo: &geo,
             m: &mt,
         };
-        let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, false);
+        let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, None);
         geo.plans = saved;
         truth_image = Some(img);
         progress("ground truth", ms(t_truth));
@@ -367,10 +371,12 @@ pub fn render(
     }
     // The frame's cycles: the timing model over the hardware pass's events (none for a stage
     // without a hardware cost model).
-    let timing = match (&events, issue_cycles.not_modelled) {
-        (Some(ev), None) => {
+    // The frame's cycles: the timing model, fed the hardware pass's pixels while it shaded
+    // (none for a stage without a hardware cost model).
+    let timing = match (sim, &events, issue_cycles.not_modelled) {
+        (Some(sim), Some(ev), None) => {
             let t = Instant::now();
-            let rep = crate::timing::simulate(ev, hw, &scene.name);
+            let rep = sim.finish(&ev.counts(), &scene.name);
             tm.timing_ms = ms(t);
             progress("timing model", tm.timing_ms);
             Some(rep)

@@ -10,6 +10,7 @@ use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
 use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
+use crate::timing::Simulator;
 use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
 use rayon::prelude::*;
@@ -68,7 +69,9 @@ pub(super) fn bump_attrs(
 
 /// Per-triangle attributes of every screen triangle, in the machine's formats.
 pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
-    let out: Vec<(TriAttrs, SatCounter)> = setup
+    // Written in parallel straight into their vectors (no serial copy of the attributes);
+    // the overflow counts sum in any order.
+    let (attrs, sats): (Vec<TriAttrs>, Vec<SatCounter>) = setup
         .tris
         .par_iter()
         .map(|t| {
@@ -100,15 +103,14 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             }
             (a, sat)
         })
-        .collect();
-    let mut sat = SatCounter::default();
-    let attrs = out
-        .into_iter()
-        .map(|(a, s)| {
-            sat.add(&s);
+        .unzip();
+    let sat = sats
+        .par_iter()
+        .copied()
+        .reduce(SatCounter::default, |mut a, b| {
+            a.add(&b);
             a
-        })
-        .collect();
+        });
     (attrs, sat)
 }
 
@@ -154,14 +156,21 @@ pub(super) fn shade_row(
     }
 }
 
-/// Shades every covered pixel with `impls`; returns the image, the counters and, when
-/// `timing`, the event stream (rows concatenated in row order).
-pub(super) fn shade(
+/// Rows shaded per band when the timing model runs beside the shading (see [`shade`]).
+const BAND_ROWS: usize = 16;
+
+/// Shades every covered pixel with `impls`; returns the image, the counters and, when `timing`
+/// holds the frame's timing model, the event stream (rows concatenated in row order) and the
+/// model fed with every pixel. With timing, the frame is shaded in bands of [`BAND_ROWS`] rows:
+/// while a band is shaded (in parallel by rows) the previous band's events are fed to the model
+/// and appended to the stream, so the sequential model overlaps the shading; the model and the
+/// stream see the pixels in raster order, identical for any thread count.
+pub(super) fn shade<'h>(
     inp: &ShadeInput,
     impls: &StageImpls,
     background: [u16; 4],
-    timing: bool,
-) -> (Image, Counters, Option<FrameEvents>) {
+    timing: Option<Simulator<'h>>,
+) -> (Image, Counters, Option<(FrameEvents, Simulator<'h>)>) {
     let vis = inp.vis;
     let w = vis.width as usize;
     let mut img = Image::new(vis.width, vis.height, background);
@@ -172,7 +181,7 @@ pub(super) fn shade(
         .map(|p| Program::new(p, impls, inp.m))
         .collect();
     let progs = &progs[..];
-    if !timing {
+    let Some(mut sim) = timing else {
         let counters = img
             .px
             .par_chunks_mut(w.max(1))
@@ -187,38 +196,46 @@ pub(super) fn shade(
                 a
             });
         return (img, counters, None);
-    }
+    };
     let lookups = StageKind::ALL
         .iter()
         .map(|&k| crate::timing::events::lookups(k, inp.m.hw) as usize)
         .sum::<usize>();
-    let rows: Vec<(Counters, RowEvents)> = img
-        .px
-        .par_chunks_mut(w.max(1))
-        .enumerate()
-        .map(|(y, row)| {
-            let mut c = Counters::default();
-            let mut ev = RowEvents::with_capacity(w, lookups);
-            shade_row(inp, progs, y, row, &mut c, true, |pi, t, frag| {
-                record_pixel(pi, t, frag, &mut ev);
-            });
-            (c, ev)
-        })
-        .collect();
     let mut counters = Counters::default();
     let mut fe = FrameEvents {
         width: vis.width,
         height: vis.height,
         ..FrameEvents::default()
     };
-    // Sized once: the rows are copied in without reallocating the frame's lists.
-    fe.pixels
-        .reserve_exact(rows.iter().map(|r| r.1.pixels.len()).sum());
-    fe.footprints
-        .reserve_exact(rows.iter().map(|r| r.1.footprints.len()).sum());
-    for (c, ev) in rows {
-        counters.add(&c);
-        fe.append_row(ev);
+    let mut consume = |rows: Vec<(Counters, RowEvents)>| {
+        for (c, ev) in rows {
+            counters.add(&c);
+            sim.row(&ev);
+            fe.append_row(ev);
+        }
+    };
+    let mut pending = Vec::new();
+    for (band, px) in img.px.chunks_mut((w * BAND_ROWS).max(1)).enumerate() {
+        let previous = std::mem::take(&mut pending);
+        let (rows, ()) = rayon::join(
+            || {
+                px.par_chunks_mut(w.max(1))
+                    .enumerate()
+                    .map(|(r, row)| {
+                        let mut c = Counters::default();
+                        let mut ev = RowEvents::with_capacity(w, lookups);
+                        let y = band * BAND_ROWS + r;
+                        shade_row(inp, progs, y, row, &mut c, true, |pi, t, frag| {
+                            record_pixel(pi, t, frag, &mut ev);
+                        });
+                        (c, ev)
+                    })
+                    .collect::<Vec<_>>()
+            },
+            || consume(previous),
+        );
+        pending = rows;
     }
-    (img, counters, Some(fe))
+    consume(pending);
+    (img, counters, Some((fe, sim)))
 }

@@ -88,6 +88,18 @@ impl FrameEvents {
         self.footprints.extend(row.footprints);
     }
 
+    /// The frame's size and visibility-pass counts.
+    #[must_use]
+    pub fn counts(&self) -> super::model::FrameCounts {
+        super::model::FrameCounts {
+            width: self.width,
+            height: self.height,
+            triangles: self.triangles,
+            spans: self.spans,
+            fragments: self.fragments,
+        }
+    }
+
     /// Number of events (pixels + footprints + triangles + spans).
     #[must_use]
     pub fn len(&self) -> u64 {

@@ -10,7 +10,7 @@ pub mod model;
 pub mod report;
 
 pub use events::{FrameEvents, PixelEvent, RowEvents, TexelFootprint, TextureLayout};
-pub use model::{simulate, Cache, TimingReport, LATENCY_BOTTLENECK};
+pub use model::{simulate, Cache, FrameCounts, Simulator, TimingReport, LATENCY_BOTTLENECK};
 
 use crate::render::{render, Maps, RenderOptions, Rendered};
 use crate::scene::Scene;

@@ -36,7 +36,9 @@
 //!   bank-conflict cycles (serialization beyond the slowest single access) and miss cycles (a
 //!   cache or page miss's cycles beyond a hit's), reported with the memory counters.
 
-use super::events::{FrameEvents, TexelFootprint, TextureLayout};
+use super::events::{
+    FrameEvents, PixelEvent, PlanTiming, RowEvents, TexelFootprint, TextureLayout,
+};
 use crate::pipeline::StageKind;
 use hw_model::timing_config::{BankInterleave, TimingConfig};
 use hw_model::trilinear::trilinear_cost;
@@ -245,15 +247,18 @@ impl AddressMap {
             })
     }
 
-    /// (line key, page key) of texel (x, y) of level `l`.
+    /// Cache-line key of texel (x, y) of level `l`.
     #[inline]
-    fn keys(l: &LevelAddr, x: u32, y: u32) -> (u64, u64) {
+    fn line_key(l: &LevelAddr, x: u32, y: u32) -> u64 {
         let (lx, ly) = l.line_shift;
+        l.line_base + u64::from(y >> ly) * l.line_row + u64::from(x >> lx)
+    }
+
+    /// DRAM page key of texel (x, y) of level `l`.
+    #[inline]
+    fn page_key(l: &LevelAddr, x: u32, y: u32) -> u64 {
         let (px, py) = l.page_shift;
-        (
-            l.line_base + u64::from(y >> ly) * l.line_row + u64::from(x >> lx),
-            l.page_base + u64::from(y >> py) * l.page_row + u64::from(x >> px),
-        )
+        l.page_base + u64::from(y >> py) * l.page_row + u64::from(x >> px)
     }
 }
 
@@ -261,11 +266,14 @@ impl AddressMap {
 #[must_use]
 pub fn bank_of(x: u32, y: u32, w: u32, banks: u32, mode: BankInterleave) -> usize {
     let b = banks.max(1);
+    bank_in_tile(x, y, w, b, tile(b), mode)
+}
+
+/// [`bank_of`] with the bank tile of `b` banks (`tile(b)`) resolved.
+#[inline]
+fn bank_in_tile(x: u32, y: u32, w: u32, b: u32, t: (u32, u32), mode: BankInterleave) -> usize {
     match mode {
-        BankInterleave::Tiled => {
-            let (bx, by) = tile(b);
-            ((x & (bx - 1)) + bx * (y & (by - 1))) as usize
-        }
+        BankInterleave::Tiled => ((x & (t.0 - 1)) + t.0 * (y & (t.1 - 1))) as usize,
         BankInterleave::Linear => {
             ((u64::from(y) * u64::from(w) + u64::from(x)) % u64::from(b)) as usize
         }
@@ -306,6 +314,8 @@ struct Memory<'a> {
     map: AddressMap,
     cache: Option<Cache>,
     open_page: Vec<u64>,
+    /// The bank interleave's tile (`tile(banks)`).
+    bank_tile: (u32, u32),
     rep: MemoryReport,
     conflict_cycles: u64,
     miss_cycles: u64,
@@ -323,6 +333,7 @@ impl<'a> Memory<'a> {
             map: AddressMap::new(textures, tc),
             cache,
             open_page: vec![EMPTY; tc.banks.max(1) as usize],
+            bank_tile: tile(tc.banks.max(1)),
             rep: MemoryReport::default(),
             conflict_cycles: 0,
             miss_cycles: 0,
@@ -330,62 +341,77 @@ impl<'a> Memory<'a> {
     }
 
     /// Performs one footprint's accesses; returns (occupancy, latency) in cycles and the texel
-    /// bytes read.
+    /// bytes read. The distinct texels of the footprint, in the order (x0, y0), (x1, y0),
+    /// (x0, y1), (x1, y1), are each one bank access (a footprint on a 1-texel-wide or -high
+    /// level collapses its repeated columns or rows).
     fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
         let tc = self.tc;
-        let banks = tc.banks.max(1) as usize;
-        let mut busy = [0u64; 64];
-        let mut count = [0u32; 64];
-        let mut seen: [(u32, u32); 4] = [(u32::MAX, u32::MAX); 4];
+        let banks = tc.banks.max(1);
+        let last_bank = banks as usize - 1;
+        let mut bank = [0usize; 4];
+        let mut occs = [0u64; 4];
         let mut n = 0;
         let mut slowest = 0u64;
+        let mut hits = 0u64;
         self.rep.footprints += 1;
         let lv = self.map.level(fp.tex, fp.level);
-        for (x, y) in texels(fp) {
-            if seen[..n].contains(&(x, y)) {
+        let cols = if fp.x[0] == fp.x[1] { 1 } else { 2 };
+        let rows = if fp.y[0] == fp.y[1] { 1 } else { 2 };
+        for &y in &fp.y[..rows] {
+            for &x in &fp.x[..cols] {
+                let b = bank_in_tile(x, y, lv.width, banks, self.bank_tile, tc.bank_interleave)
+                    .min(last_bank);
+                let hit = self
+                    .cache
+                    .as_mut()
+                    .is_some_and(|c| c.access(AddressMap::line_key(&lv, x, y)));
+                hits += u64::from(hit);
+                let occ = if hit {
+                    1
+                } else {
+                    let page = AddressMap::page_key(&lv, x, y);
+                    if self.open_page[b] == page {
+                        self.rep.dram_page_hits += 1;
+                        u64::from(tc.dram_page_hit_cycles)
+                    } else {
+                        self.rep.dram_page_misses += 1;
+                        self.open_page[b] = page;
+                        u64::from(tc.dram_page_miss_cycles)
+                    }
+                };
+                bank[n] = b;
+                occs[n] = occ;
+                n += 1;
+                slowest = slowest.max(occ);
+            }
+        }
+        // Per bank, the summed busy cycles of its accesses; the footprint occupies the memory
+        // for the busiest bank. Conflicts: accesses beyond the first in a bank.
+        let mut occ = 1;
+        let mut conflicts = 0u32;
+        for i in 0..n {
+            if bank[..i].contains(&bank[i]) {
+                conflicts += 1;
                 continue;
             }
-            seen[n] = (x, y);
-            n += 1;
-            let (line, page) = AddressMap::keys(&lv, x, y);
-            let b = bank_of(x, y, lv.width, tc.banks, tc.bank_interleave).min(banks - 1);
-            self.rep.texel_accesses += 1;
-            self.rep.texture_bytes += u64::from(lv.texel_bytes);
-            let hit = match &mut self.cache {
-                Some(c) => {
-                    let h = c.access(line);
-                    if h {
-                        self.rep.cache_hits += 1;
-                    } else {
-                        self.rep.cache_misses += 1;
-                        self.rep.dram_bytes += u64::from(tc.cache_line_bytes);
-                    }
-                    h
-                }
-                None => false,
-            };
-            let occ = if hit {
-                1
-            } else {
-                self.rep.dram_accesses += 1;
-                if self.cache.is_none() {
-                    self.rep.dram_bytes += u64::from(lv.texel_bytes);
-                }
-                if self.open_page[b] == page {
-                    self.rep.dram_page_hits += 1;
-                    u64::from(tc.dram_page_hit_cycles)
-                } else {
-                    self.rep.dram_page_misses += 1;
-                    self.open_page[b] = page;
-                    u64::from(tc.dram_page_miss_cycles)
-                }
-            };
-            busy[b] += occ;
-            count[b] += 1;
-            slowest = slowest.max(occ);
+            let busy: u64 = (i..n)
+                .filter(|&j| bank[j] == bank[i])
+                .map(|j| occs[j])
+                .sum();
+            occ = occ.max(busy);
         }
-        let occ = busy[..banks].iter().copied().max().unwrap_or(0).max(1);
-        let conflicts: u32 = count[..banks].iter().map(|&c| c.saturating_sub(1)).sum();
+        let accesses = n as u64;
+        let misses = accesses - hits;
+        self.rep.texel_accesses += accesses;
+        self.rep.texture_bytes += accesses * u64::from(lv.texel_bytes);
+        self.rep.dram_accesses += misses;
+        if self.cache.is_some() {
+            self.rep.cache_hits += hits;
+            self.rep.cache_misses += misses;
+            self.rep.dram_bytes += misses * u64::from(tc.cache_line_bytes);
+        } else {
+            self.rep.dram_bytes += accesses * u64::from(lv.texel_bytes);
+        }
         self.rep.bank_conflicts += u64::from(conflicts);
         if conflicts > 0 {
             self.rep.conflicting_footprints += 1;
@@ -403,7 +429,7 @@ impl<'a> Memory<'a> {
             } else {
                 0
             };
-        (occ, lat, n as u64 * u64::from(lv.texel_bytes))
+        (occ, lat, accesses * u64::from(lv.texel_bytes))
     }
 }
 
@@ -412,7 +438,6 @@ impl<'a> Memory<'a> {
 struct Unit {
     free: u64,
     busy: u64,
-    stall: u64,
 }
 
 impl Unit {
@@ -420,108 +445,228 @@ impl Unit {
     #[inline]
     fn take(&mut self, ready: u64, occ: u64) -> u64 {
         let start = ready.max(self.free);
-        self.stall += start - ready;
         self.free = start + occ;
         self.busy += occ;
         start
     }
 }
 
-/// Runs the timing model over `ev` on machine `hw`.
-#[must_use]
-pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
-    let tc = &hw.timing;
-    let rc = &hw.raster;
-    // Visibility pass.
-    let setup_busy = ev.triangles * u64::from(rc.setup_cycles);
-    let traverse_busy = ev.spans * u64::from(rc.span_cycles)
-        + ev.fragments
-            .div_ceil(u64::from(tc.raster_fragments_per_cycle.max(1)));
-    let vis = match traverse_busy.checked_div(ev.triangles) {
-        None => 0,
-        Some(avg) => (setup_busy + avg).max(u64::from(rc.setup_cycles) + traverse_busy),
-    };
+/// A pixel's footprints split into runs of one stage (in the order the stages fetched them):
+/// a stage's footprints are the first run of its kind.
+struct StageRuns {
+    /// (stage, start, end) of each run; `n > RUNS` means too many runs to list (search).
+    runs: [(u8, u32, u32); RUNS],
+    n: usize,
+}
 
-    // Shading pass.
-    let nk = StageKind::ALL.len();
-    let mut alu = vec![Unit::default(); nk];
-    let mut stage_bytes = vec![0u64; nk];
-    let mut mem_unit = Unit::default();
-    let mut filters = vec![Unit::default(); tc.trilinear_units.max(1) as usize];
-    let mut mem = Memory::new(&ev.textures, tc);
-    let glpc = hw.timing.gate_levels_per_cycle;
-    let tri_cost = trilinear_cost(&hw.trilinear, 2, glpc);
-    let (bilinear_lat, blend_lat) = hw_model::trilinear::filter_latencies(&hw.trilinear, glpc);
-    let bpc = u64::from(tc.bilinear_per_cycle.max(1));
-    let ppc = u64::from(tc.shade_pixels_per_cycle.max(1));
-    let alu_occ = |cycles: u64| {
-        if tc.alu_pipelined {
-            cycles.min(1)
-        } else {
-            cycles
+/// Runs listed per pixel (a pixel with more falls back to searching its footprints).
+const RUNS: usize = 8;
+
+impl StageRuns {
+    #[inline]
+    fn of(fps: &[TexelFootprint]) -> Self {
+        let mut r = Self {
+            runs: [(0, 0, 0); RUNS],
+            n: 0,
+        };
+        for (j, f) in fps.iter().enumerate() {
+            if r.n > 0 && r.n <= RUNS && r.runs[r.n - 1].0 == f.stage {
+                r.runs[r.n - 1].2 = j as u32 + 1;
+                continue;
+            }
+            if r.n < RUNS {
+                r.runs[r.n] = (f.stage, j as u32, j as u32 + 1);
+            }
+            r.n += 1;
         }
-    };
-    let mut end = 0u64;
-    let mut fp_start = 0usize;
-    // Causes: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2 latency.
-    let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
-    let mut stall_by = vec![0u64; nk + 3];
-    let win = tc.shade_pixels_in_flight.max(1) as usize;
-    let mut ring: Vec<(u64, usize)> = vec![(0, c_lat); win];
-    let mut last_issue = 0u64;
-    for (i, px) in ev.pixels.iter().enumerate() {
-        let fp_end = (px.fp_end as usize).min(ev.footprints.len());
-        let fps = &ev.footprints[fp_start.min(fp_end)..fp_end];
-        fp_start = fp_end;
-        let next_slot = u64::from(i > 0 && (i as u64 / ppc) * ppc == i as u64);
-        let ideal = (i as u64 / ppc).max(last_issue + next_slot);
+        r
+    }
+
+    /// The footprints of the first run of stage `k` (empty if it fetched none).
+    #[inline]
+    fn first_of<'f>(&self, fps: &'f [TexelFootprint], k: usize) -> &'f [TexelFootprint] {
+        if self.n <= RUNS {
+            return self.runs[..self.n]
+                .iter()
+                .find(|r| usize::from(r.0) == k)
+                .map_or(&[], |r| &fps[r.1 as usize..r.2 as usize]);
+        }
+        match fps.iter().position(|f| usize::from(f.stage) == k) {
+            Some(a) => {
+                let b = fps[a..]
+                    .iter()
+                    .position(|f| usize::from(f.stage) != k)
+                    .map_or(fps.len(), |e| a + e);
+                &fps[a..b]
+            }
+            None => &[],
+        }
+    }
+}
+
+/// The counts of a frame's visibility pass (what the timing model needs beside its pixels).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameCounts {
+    pub width: u32,
+    pub height: u32,
+    /// Screen triangles after setup.
+    pub triangles: u64,
+    /// Non-empty spans of the visibility pass.
+    pub spans: u64,
+    /// Fragments (covered samples before the depth test) of the visibility pass.
+    pub fragments: u64,
+}
+
+/// The shading pass of the timing model fed pixel by pixel in raster order ([`Simulator::row`]
+/// or [`Simulator::pixel`]), so a render can run it on the rows it has shaded while it shades
+/// the next ones; [`Simulator::finish`] adds the visibility pass and reports. Feeding a frame's
+/// pixels in order gives exactly [`simulate`] of its events.
+pub struct Simulator<'a> {
+    hw: &'a HwConfig,
+    /// Per plan, its stages as (kind index, cycles, arithmetic-unit occupancy).
+    steps: Vec<Vec<(usize, u64, u64)>>,
+    alu: Vec<Unit>,
+    stage_bytes: Vec<u64>,
+    mem_unit: Unit,
+    filters: Vec<Unit>,
+    mem: Memory<'a>,
+    tri_cycles: u64,
+    bilinear_lat: u64,
+    blend_lat: u64,
+    bpc: u64,
+    ppc: u64,
+    alu_pipelined: bool,
+    /// Stall cycles by cause: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2
+    /// latency.
+    stall_by: Vec<u64>,
+    /// Completion time and worst cause of the last `shade_pixels_in_flight` pixels.
+    ring: Vec<(u64, usize)>,
+    last_issue: u64,
+    end: u64,
+    /// Pixels and footprints fed so far.
+    pixels: u64,
+    footprints: u64,
+}
+
+impl<'a> Simulator<'a> {
+    /// The model of machine `hw` for a frame with these plans and textures, before any pixel.
+    #[must_use]
+    pub fn new(plans: &[PlanTiming], textures: &[TextureLayout], hw: &'a HwConfig) -> Self {
+        let tc = &hw.timing;
+        let nk = StageKind::ALL.len();
+        let glpc = tc.gate_levels_per_cycle;
+        let tri_cost = trilinear_cost(&hw.trilinear, 2, glpc);
+        let (bilinear_lat, blend_lat) = hw_model::trilinear::filter_latencies(&hw.trilinear, glpc);
+        let alu_occ = |cycles: u64| {
+            if tc.alu_pipelined {
+                cycles.min(1)
+            } else {
+                cycles
+            }
+        };
+        let steps = plans
+            .iter()
+            .map(|p| {
+                p.stages
+                    .iter()
+                    .map(|&(kind, cost)| {
+                        let c = u64::from(cost.cycles);
+                        (kind.index(), c, alu_occ(c))
+                    })
+                    .collect()
+            })
+            .collect();
+        let win = tc.shade_pixels_in_flight.max(1) as usize;
+        Self {
+            hw,
+            steps,
+            alu: vec![Unit::default(); nk],
+            stage_bytes: vec![0; nk],
+            mem_unit: Unit::default(),
+            filters: vec![Unit::default(); tc.trilinear_units.max(1) as usize],
+            mem: Memory::new(textures, tc),
+            tri_cycles: u64::from(tri_cost.cycles),
+            bilinear_lat: u64::from(bilinear_lat),
+            blend_lat: u64::from(blend_lat),
+            bpc: u64::from(tc.bilinear_per_cycle.max(1)),
+            ppc: u64::from(tc.shade_pixels_per_cycle.max(1)),
+            alu_pipelined: tc.alu_pipelined,
+            stall_by: vec![0; nk + 3],
+            ring: vec![(0, nk + 2); win],
+            last_issue: 0,
+            end: 0,
+            pixels: 0,
+            footprints: 0,
+        }
+    }
+
+    /// Feeds the pixels of one row in order (`fp_end` relative to the row's footprints).
+    pub fn row(&mut self, row: &RowEvents) {
+        self.pixels_of(&row.pixels, &row.footprints);
+    }
+
+    /// Feeds `pixels` in order; their `fp_end` index `footprints`, the previous pixel's end
+    /// (0 for the first) being each one's start.
+    fn pixels_of(&mut self, pixels: &[PixelEvent], footprints: &[TexelFootprint]) {
+        let mut fp_start = 0usize;
+        for px in pixels {
+            let fp_end = (px.fp_end as usize).min(footprints.len());
+            self.pixel(px.plan, &footprints[fp_start.min(fp_end)..fp_end]);
+            fp_start = fp_end;
+        }
+        self.footprints += footprints.len() as u64;
+    }
+
+    /// Issues the next covered pixel (raster order): plan index `plan`, the footprints its
+    /// stages fetched in `fps`.
+    #[inline]
+    pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
+        let nk = self.alu.len();
+        let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
+        let i = self.pixels;
+        self.pixels += 1;
+        let ppc = self.ppc;
+        let win = self.ring.len() as u64;
+        let next_slot = u64::from(i > 0 && (i / ppc) * ppc == i);
+        let ideal = (i / ppc).max(self.last_issue + next_slot);
         let mut t = ideal;
+        let slot = (i % win) as usize;
         if i >= win {
-            let (done, cause) = ring[i % win];
+            let (done, cause) = self.ring[slot];
             if done > t {
-                stall_by[cause] += done - t;
+                self.stall_by[cause] += done - t;
                 t = done;
             }
         }
-        last_issue = t;
+        self.last_issue = t;
         let mut worst = (0u64, c_lat);
         let mut note = |w: u64, cause: usize| {
             if w > worst.0 {
                 worst = (w, cause);
             }
         };
-        let Some(plan) = ev.plans.get(px.plan as usize) else {
-            ring[i % win] = (t, c_lat);
-            continue;
+        let Some(plan) = self.steps.get(plan as usize) else {
+            self.ring[slot] = (t, c_lat);
+            return;
         };
-        for &(kind, cost) in &plan.stages {
-            let k = kind.index();
-            let mine: &[TexelFootprint] = {
-                let a = fps.iter().position(|f| usize::from(f.stage) == k);
-                match a {
-                    Some(a) => {
-                        let b = fps[a..]
-                            .iter()
-                            .position(|f| usize::from(f.stage) != k)
-                            .map_or(fps.len(), |e| a + e);
-                        &fps[a..b]
-                    }
-                    None => &[],
-                }
-            };
+        let runs = StageRuns::of(fps);
+        for &(k, cycles, occ) in plan {
+            let mine = runs.first_of(fps, k);
             if mine.is_empty() {
-                let c = u64::from(cost.cycles);
-                let s = alu[k].take(t, alu_occ(c));
+                let s = self.alu[k].take(t, occ);
                 note(s - t, k);
-                t = s + c;
+                t = s + cycles;
                 continue;
             }
             // Texture stage: address/footprint unit, then each lookup through memory + filter.
             let lookups = u64::from(mine.last().map_or(0, |f| f.lookup) + 1);
-            let setup = u64::from(cost.cycles)
-                .saturating_sub(lookups * u64::from(tri_cost.cycles))
-                .max(1);
-            let s = alu[k].take(t, alu_occ(setup));
+            let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
+            let setup_occ = if self.alu_pipelined {
+                setup.min(1)
+            } else {
+                setup
+            };
+            let s = self.alu[k].take(t, setup_occ);
             note(s - t, k);
             let ready = s + setup;
             let mut done = ready;
@@ -534,19 +679,23 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
                     .map_or(mine.len(), |e| a + e);
                 let mut data = ready;
                 for f in &mine[a..b] {
-                    let (occ, lat, bytes) = mem.footprint(f);
-                    stage_bytes[k] += bytes;
-                    let ms = mem_unit.take(ready, occ);
+                    let (occ, lat, bytes) = self.mem.footprint(f);
+                    self.stage_bytes[k] += bytes;
+                    let ms = self.mem_unit.take(ready, occ);
                     note(ms - ready, c_mem);
                     data = data.max(ms + lat);
                 }
                 let nfp = (b - a) as u64;
-                let occ = nfp.div_ceil(bpc);
-                let lat =
-                    nfp * u64::from(bilinear_lat) + if nfp > 1 { u64::from(blend_lat) } else { 0 };
-                let fu = (0..filters.len())
-                    .min_by_key(|&j| (filters[j].free.max(data), j))
-                    .unwrap_or(0);
+                let occ = nfp.div_ceil(self.bpc);
+                let lat = nfp * self.bilinear_lat + if nfp > 1 { self.blend_lat } else { 0 };
+                let filters = &mut self.filters;
+                let fu = if filters.len() == 1 {
+                    0
+                } else {
+                    (0..filters.len())
+                        .min_by_key(|&j| (filters[j].free.max(data), j))
+                        .unwrap_or(0)
+                };
                 let fs = filters[fu].take(data, occ);
                 note(fs - data, c_filt);
                 done = done.max(fs + lat.max(occ));
@@ -554,112 +703,149 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
             }
             t = done;
         }
-        ring[i % win] = (t, worst.1);
-        end = end.max(t);
+        self.ring[slot] = (t, worst.1);
+        self.end = self.end.max(t);
     }
-    let shade = end;
-    let total = vis + shade;
-    let covered = ev.pixels.len() as u64;
-    let util = |b: u64| {
-        if total == 0 {
-            0.0
-        } else {
-            b as f64 / total as f64
+
+    /// Adds the visibility pass of the frame (`f`) and reports.
+    #[must_use]
+    pub fn finish(self, f: &FrameCounts, scene: &str) -> TimingReport {
+        let hw = self.hw;
+        let tc = &hw.timing;
+        let rc = &hw.raster;
+        let nk = self.alu.len();
+        let c_lat = nk + 2;
+        let (c_mem, c_filt) = (nk, nk + 1);
+        let (alu, stall_by, mem_unit, filters, stage_bytes) = (
+            self.alu,
+            self.stall_by,
+            self.mem_unit,
+            self.filters,
+            self.stage_bytes,
+        );
+        let mem = self.mem;
+        // Visibility pass.
+        let setup_busy = f.triangles * u64::from(rc.setup_cycles);
+        let traverse_busy = f.spans * u64::from(rc.span_cycles)
+            + f.fragments
+                .div_ceil(u64::from(tc.raster_fragments_per_cycle.max(1)));
+        let vis = match traverse_busy.checked_div(f.triangles) {
+            None => 0,
+            Some(avg) => (setup_busy + avg).max(u64::from(rc.setup_cycles) + traverse_busy),
+        };
+        let events = self.pixels + self.footprints + f.triangles + f.spans;
+        let covered = self.pixels;
+        let shade = self.end;
+        let total = vis + shade;
+        let util = |b: u64| {
+            if total == 0 {
+                0.0
+            } else {
+                b as f64 / total as f64
+            }
+        };
+        let mut units = vec![
+            UnitReport {
+                unit: "setup".into(),
+                busy_cycles: setup_busy,
+                utilization: util(setup_busy),
+                texture_bytes: 0,
+            },
+            UnitReport {
+                unit: "traverse".into(),
+                busy_cycles: traverse_busy,
+                utilization: util(traverse_busy),
+                texture_bytes: 0,
+            },
+        ];
+        for kind in StageKind::ALL {
+            let b = alu[kind.index()].busy;
+            units.push(UnitReport {
+                unit: kind.name().into(),
+                busy_cycles: b,
+                utilization: util(b),
+                texture_bytes: stage_bytes[kind.index()],
+            });
         }
-    };
-    let mut units = vec![
-        UnitReport {
-            unit: "setup".into(),
-            busy_cycles: setup_busy,
-            utilization: util(setup_busy),
-            texture_bytes: 0,
-        },
-        UnitReport {
-            unit: "traverse".into(),
-            busy_cycles: traverse_busy,
-            utilization: util(traverse_busy),
-            texture_bytes: 0,
-        },
-    ];
-    for kind in StageKind::ALL {
-        let b = alu[kind.index()].busy;
         units.push(UnitReport {
-            unit: kind.name().into(),
-            busy_cycles: b,
-            utilization: util(b),
-            texture_bytes: stage_bytes[kind.index()],
-        });
-    }
-    units.push(UnitReport {
-        unit: "memory".into(),
-        busy_cycles: mem_unit.busy,
-        utilization: util(mem_unit.busy),
-        texture_bytes: 0,
-    });
-    for (j, f) in filters.iter().enumerate() {
-        units.push(UnitReport {
-            unit: format!("filter{j}"),
-            busy_cycles: f.busy,
-            utilization: util(f.busy),
+            unit: "memory".into(),
+            busy_cycles: mem_unit.busy,
+            utilization: util(mem_unit.busy),
             texture_bytes: 0,
         });
+        for (j, f) in filters.iter().enumerate() {
+            units.push(UnitReport {
+                unit: format!("filter{j}"),
+                busy_cycles: f.busy,
+                utilization: util(f.busy),
+                texture_bytes: 0,
+            });
+        }
+        let busiest = units
+            .iter()
+            .fold(None::<&UnitReport>, |best, u| match best {
+                Some(b) if b.busy_cycles >= u.busy_cycles => Some(b),
+                _ => Some(u),
+            })
+            .map_or((String::new(), 0), |u| (u.unit.clone(), u.busy_cycles));
+        // A frame whose pixels mostly wait for results (the in-flight window is too small for the
+        // pipeline's latency) is bound by latency, not by any unit's throughput.
+        let (bottleneck, bottleneck_cycles) = if stall_by[c_lat] > busiest.1 {
+            (LATENCY_BOTTLENECK.to_string(), stall_by[c_lat])
+        } else {
+            busiest
+        };
+        let mut stalls = vec![StallReport {
+            cause: "traverse waits for setup".into(),
+            cycles: vis.saturating_sub(traverse_busy),
+        }];
+        for kind in StageKind::ALL {
+            stalls.push(StallReport {
+                cause: format!("{} busy", kind.name()),
+                cycles: stall_by[kind.index()],
+            });
+        }
+        for (cause, i) in [
+            ("memory busy", c_mem),
+            ("filter busy", c_filt),
+            ("latency", c_lat),
+        ] {
+            stalls.push(StallReport {
+                cause: cause.into(),
+                cycles: stall_by[i],
+            });
+        }
+        let mut memory = mem.rep;
+        if mem.cache.is_some() {
+            memory.cache_hit_rate =
+                Some(memory.cache_hits as f64 / memory.texel_accesses.max(1) as f64);
+        }
+        TimingReport {
+            scene: scene.to_string(),
+            hw: hw.name.clone(),
+            width: f.width,
+            height: f.height,
+            total_cycles: total,
+            visibility_pass_cycles: vis,
+            shading_pass_cycles: shade,
+            covered_pixels: covered,
+            cycles_per_pixel: total as f64 / covered.max(1) as f64,
+            units,
+            stalls,
+            memory,
+            bank_conflict_cycles: mem.conflict_cycles,
+            miss_cycles: mem.miss_cycles,
+            bottleneck,
+            bottleneck_cycles,
+            events,
+        }
     }
-    let busiest = units
-        .iter()
-        .fold(None::<&UnitReport>, |best, u| match best {
-            Some(b) if b.busy_cycles >= u.busy_cycles => Some(b),
-            _ => Some(u),
-        })
-        .map_or((String::new(), 0), |u| (u.unit.clone(), u.busy_cycles));
-    // A frame whose pixels mostly wait for results (the in-flight window is too small for the
-    // pipeline's latency) is bound by latency, not by any unit's throughput.
-    let (bottleneck, bottleneck_cycles) = if stall_by[c_lat] > busiest.1 {
-        (LATENCY_BOTTLENECK.to_string(), stall_by[c_lat])
-    } else {
-        busiest
-    };
-    let mut stalls = vec![StallReport {
-        cause: "traverse waits for setup".into(),
-        cycles: vis.saturating_sub(traverse_busy),
-    }];
-    for kind in StageKind::ALL {
-        stalls.push(StallReport {
-            cause: format!("{} busy", kind.name()),
-            cycles: stall_by[kind.index()],
-        });
-    }
-    for (cause, i) in [
-        ("memory busy", c_mem),
-        ("filter busy", c_filt),
-        ("latency", c_lat),
-    ] {
-        stalls.push(StallReport {
-            cause: cause.into(),
-            cycles: stall_by[i],
-        });
-    }
-    let mut memory = mem.rep;
-    if mem.cache.is_some() {
-        memory.cache_hit_rate =
-            Some(memory.cache_hits as f64 / memory.texel_accesses.max(1) as f64);
-    }
-    TimingReport {
-        scene: scene.to_string(),
-        hw: hw.name.clone(),
-        width: ev.width,
-        height: ev.height,
-        total_cycles: total,
-        visibility_pass_cycles: vis,
-        shading_pass_cycles: shade,
-        covered_pixels: covered,
-        cycles_per_pixel: total as f64 / covered.max(1) as f64,
-        units,
-        stalls,
-        memory,
-        bank_conflict_cycles: mem.conflict_cycles,
-        miss_cycles: mem.miss_cycles,
-        bottleneck,
-        bottleneck_cycles,
-        events: ev.len(),
-    }
+}
+
+/// Runs the timing model over `ev` on machine `hw`.
+#[must_use]
+pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
+    let mut sim = Simulator::new(&ev.plans, &ev.textures, hw);
+    sim.pixels_of(&ev.pixels, &ev.footprints);
+    sim.finish(&ev.counts(), scene)
 }
