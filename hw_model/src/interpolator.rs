@@ -104,8 +104,9 @@ fn perspective_bary_eval<M: ConstRounding>(
 /// derivatives as plain differences. Each triple sums to exactly 1.0 (`_0 = 1 - _1 - _2`).
 ///
 /// Datapath: `p` exactly as [`perspective_bary`]. For the derivatives, `D`, `q_i`, `a_i`, `S`
-/// are exact (`i128`), then all scaled by one common right shift so the largest magnitude has
-/// at most 62 bits (a scale that cancels in the ratio), `N_i = a_i D - q_i S` exactly, then
+/// are exact (`i64` when they fit, else `i128`: the same values), then all scaled by one
+/// common right shift so the largest magnitude has at most 62 bits (a scale that cancels in
+/// the ratio), `N_i = a_i D - q_i S` exactly, then
 /// `N_i` times `1/D^2` (one reciprocal shared by both axes, squared once and rounded to the
 /// reciprocal's mantissa width) rounded once to `bary_bits`. ERROR BOUND of each derivative,
 /// in LSBs of 2^-B: `|dp| 2^B (2 e_r + 2^-(M+1) + 2^-61) + 1/2` (1 for Truncate), `e_r` as in

@@ -21,8 +21,8 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         frag.bary_x
     } else {
         let mut b = [[0; 3]; 3];
-        for s in 0..n {
-            b[s] = frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat));
+        for (raw, carrier) in b.iter_mut().zip(&frag.bary).take(n) {
+            *raw = carrier.map(|x| to_raw(x, &m.bary_fmt, sat));
         }
         b
     };
