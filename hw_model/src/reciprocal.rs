@@ -166,10 +166,16 @@ fn nr_step(m: i64, y: i64, two: i64, p: u32, rnd: Rounding) -> i64 {
 #[inline]
 #[must_use]
 pub fn square(r: Recip, m_bits: u32, mode: Rounding) -> Recip {
-    let sq = i128::from(r.mant) * i128::from(r.mant);
-    let b = 128 - sq.leading_zeros();
-    let drop = b.saturating_sub(m_bits + 1);
-    let mut mant = round_shift_right_wide(sq, drop, mode) as u64;
+    let (drop, mut mant) = if r.mant >> 31 == 0 {
+        // A mantissa of at most 31 bits (every `Reciprocal` result): the square fits `i64`.
+        let sq = (r.mant * r.mant) as i64;
+        let drop = (64 - sq.leading_zeros()).saturating_sub(m_bits + 1);
+        (drop, crate::fixed::round_shift_right(sq, drop, mode) as u64)
+    } else {
+        let sq = i128::from(r.mant) * i128::from(r.mant);
+        let drop = (128 - sq.leading_zeros()).saturating_sub(m_bits + 1);
+        (drop, round_shift_right_wide(sq, drop, mode) as u64)
+    };
     let mut shift = 2 * r.shift - drop as i32;
     if mant >> (m_bits + 1) != 0 {
         mant >>= 1;

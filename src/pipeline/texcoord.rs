@@ -1,13 +1,13 @@
 //! `texcoord`: interpolation of the texture coordinates at the pixel and its helper samples
 //! (`hw_model::interpolator::interpolate`, signed `texcoord_int_bits.texcoord_frac_bits`).
 
-use super::stages::{column, column_f, Counters, Machine};
+use super::stages::{column_f, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::reference::interpolate_f64;
 use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
-use hw_model::interpolator::{interpolate, interpolate_cost};
+use hw_model::interpolator::{interpolate_cost, interpolate_pairs};
 use hw_model::UnitCost;
 
 /// Fixed twin: two interpolations per sample.
@@ -20,18 +20,27 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let fb = m.uv_fmt.frac_bits;
     let raw_bary = px.fixed(StageKind::Bary);
     let sat = &mut c.sat[StageKind::Texcoord.index()];
-    for s in 0..px.samples() {
-        let b = if raw_bary {
-            frag.bary_x[s]
-        } else {
-            frag.bary[s].map(|x| to_raw(x, &m.bary_fmt, sat))
-        };
-        for ax in 0..2 {
-            let r = interpolate(b, bb, column(&px.a.uv_x, ax), &m.uv_fmt, sat);
-            frag.uv_x[s][ax] = r;
-            if px.carriers {
-                frag.uv[s][ax] = from_raw(r, fb);
-            }
+    let n = px.samples();
+    let bary = if raw_bary {
+        frag.bary_x
+    } else {
+        let mut b = [[0; 3]; 3];
+        for (raw, carrier) in b.iter_mut().zip(&frag.bary).take(n) {
+            *raw = carrier.map(|x| to_raw(x, &m.bary_fmt, sat));
+        }
+        b
+    };
+    interpolate_pairs(
+        &bary[..n],
+        bb,
+        px.a.uv_x,
+        &m.uv_fmt,
+        sat,
+        &mut frag.uv_x[..n],
+    );
+    if px.carriers {
+        for s in 0..n {
+            frag.uv[s] = frag.uv_x[s].map(|r| from_raw(r, fb));
         }
     }
 }
