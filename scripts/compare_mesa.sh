@@ -21,7 +21,7 @@ for w in plane:w1-plane mesh:w2-mesh; do
     for threads in 1 2; do
         for path in hw ref; do
             for _ in $(seq "$REPEATS"); do
-                if [ $path = hw ]; then extra=(--no-reference); else extra=(--float bary,texcoord,lod,trilinear,color,modulate --no-reference); fi
+                if [ $path = hw ]; then extra=(--no-reference --no-cycles); else extra=(--float bary,texcoord,lod,trilinear,color,modulate --no-reference --no-cycles); fi
                 ./target/release/texsim --threads $threads render --scene "$scene" "${extra[@]}" --out target/compare-out 2>/dev/null \
                     | grep -o 'hardware path [0-9.]*' | awk '{print $3}'
             done | median | xargs printf "%-9s %-9s %8.1f ms\n" "$scene" "texsim-$path-t$threads"

@@ -59,6 +59,8 @@ pub struct Timings {
     pub geometry_ms: f64,
     pub setup_ms: f64,
     pub raster_ms: f64,
+    /// Hardware shading; with cycles on it includes the timing model fed band by band beside
+    /// it (the part that did not overlap the shading).
     pub shade_hw_ms: f64,
     pub raster_ref_ms: f64,
     pub shade_ref_ms: f64,
@@ -66,7 +68,8 @@ pub struct Timings {
     pub hw_total_ms: f64,
     /// Setup + (shared or float) raster + reference shading.
     pub ref_total_ms: f64,
-    /// The timing model over the events (0 when it did not run); not in `hw_total_ms`.
+    /// The timing model's last step after the shading (its visibility pass and report; 0 when
+    /// it did not run); not in `hw_total_ms`.
     pub timing_ms: f64,
 }
 

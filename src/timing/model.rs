@@ -181,6 +181,19 @@ struct LevelAddr {
     texel_bytes: u32,
 }
 
+/// The address record [`AddressMap::level`] answers for a footprint outside the frame's
+/// textures: one texel.
+const DUMMY_LEVEL: LevelAddr = LevelAddr {
+    width: 1,
+    line_base: 0,
+    line_row: 1,
+    page_base: 0,
+    page_row: 1,
+    line_shift: (0, 0),
+    page_shift: (0, 0),
+    texel_bytes: 1,
+};
+
 /// Address map of the textures: level base indices for cache lines and DRAM pages (tiles are
 /// powers of two, so indices are shifts).
 struct AddressMap {
@@ -224,7 +237,7 @@ impl AddressMap {
     /// The address record of a level (a dummy 1-texel level if out of range, which a
     /// render's event stream never produces: checked in debug builds).
     #[inline]
-    fn level(&self, tex: u16, level: u8) -> LevelAddr {
+    fn level(&self, tex: u16, level: u8) -> &LevelAddr {
         debug_assert!(
             self.levels
                 .get(tex as usize)
@@ -234,17 +247,7 @@ impl AddressMap {
         self.levels
             .get(tex as usize)
             .and_then(|l| l.get(level as usize))
-            .copied()
-            .unwrap_or(LevelAddr {
-                width: 1,
-                line_base: 0,
-                line_row: 1,
-                page_base: 0,
-                page_row: 1,
-                line_shift: (0, 0),
-                page_shift: (0, 0),
-                texel_bytes: 1,
-            })
+            .unwrap_or(&DUMMY_LEVEL)
     }
 
     /// Cache-line key of texel (x, y) of level `l`.
@@ -345,15 +348,28 @@ impl<'a> Memory<'a> {
     /// (x0, y1), (x1, y1), are each one bank access (a footprint on a 1-texel-wide or -high
     /// level collapses its repeated columns or rows).
     fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
+        if self.cache.is_some() {
+            self.footprint_in::<true>(fp)
+        } else {
+            self.footprint_in::<false>(fp)
+        }
+    }
+
+    /// [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache.
+    #[inline(always)]
+    fn footprint_in<const CACHED: bool>(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
         let tc = self.tc;
         let banks = tc.banks.max(1);
         let last_bank = banks as usize - 1;
+        let (page_hit, page_miss) = (
+            u64::from(tc.dram_page_hit_cycles),
+            u64::from(tc.dram_page_miss_cycles),
+        );
         let mut bank = [0usize; 4];
         let mut occs = [0u64; 4];
         let mut n = 0;
         let mut slowest = 0u64;
-        let mut hits = 0u64;
-        self.rep.footprints += 1;
+        let (mut hits, mut page_hits, mut used) = (0u64, 0u64, 0u64);
         let lv = self.map.level(fp.tex, fp.level);
         let cols = if fp.x[0] == fp.x[1] { 1 } else { 2 };
         let rows = if fp.y[0] == fp.y[1] { 1 } else { 2 };
@@ -361,75 +377,73 @@ impl<'a> Memory<'a> {
             for &x in &fp.x[..cols] {
                 let b = bank_in_tile(x, y, lv.width, banks, self.bank_tile, tc.bank_interleave)
                     .min(last_bank);
-                let hit = self
-                    .cache
-                    .as_mut()
-                    .is_some_and(|c| c.access(AddressMap::line_key(&lv, x, y)));
+                let hit = CACHED
+                    && self
+                        .cache
+                        .as_mut()
+                        .is_some_and(|c| c.access(AddressMap::line_key(lv, x, y)));
                 hits += u64::from(hit);
                 let occ = if hit {
                     1
                 } else {
-                    let page = AddressMap::page_key(&lv, x, y);
+                    let page = AddressMap::page_key(lv, x, y);
                     if self.open_page[b] == page {
-                        self.rep.dram_page_hits += 1;
-                        u64::from(tc.dram_page_hit_cycles)
+                        page_hits += 1;
+                        page_hit
                     } else {
-                        self.rep.dram_page_misses += 1;
                         self.open_page[b] = page;
-                        u64::from(tc.dram_page_miss_cycles)
+                        page_miss
                     }
                 };
+                used |= 1 << b;
                 bank[n] = b;
                 occs[n] = occ;
                 n += 1;
                 slowest = slowest.max(occ);
             }
         }
-        // Per bank, the summed busy cycles of its accesses; the footprint occupies the memory
-        // for the busiest bank. Conflicts: accesses beyond the first in a bank.
-        let mut occ = 1;
-        let mut conflicts = 0u32;
-        for i in 0..n {
-            if bank[..i].contains(&bank[i]) {
-                conflicts += 1;
-                continue;
-            }
-            let busy: u64 = (i..n)
-                .filter(|&j| bank[j] == bank[i])
-                .map(|j| occs[j])
-                .sum();
-            occ = occ.max(busy);
-        }
+        // Conflicts: accesses beyond the first in a bank. The footprint occupies the memory for
+        // its busiest bank (the summed cycles of the bank's accesses; without a conflict, the
+        // slowest access).
         let accesses = n as u64;
-        let misses = accesses - hits;
-        self.rep.texel_accesses += accesses;
-        self.rep.texture_bytes += accesses * u64::from(lv.texel_bytes);
-        self.rep.dram_accesses += misses;
-        if self.cache.is_some() {
-            self.rep.cache_hits += hits;
-            self.rep.cache_misses += misses;
-            self.rep.dram_bytes += misses * u64::from(tc.cache_line_bytes);
-        } else {
-            self.rep.dram_bytes += accesses * u64::from(lv.texel_bytes);
-        }
-        self.rep.bank_conflicts += u64::from(conflicts);
+        let conflicts = accesses - u64::from(used.count_ones());
+        let mut occ = slowest.max(1);
         if conflicts > 0 {
-            self.rep.conflicting_footprints += 1;
+            for i in 0..n {
+                let busy: u64 = (i..n)
+                    .filter(|&j| bank[j] == bank[i])
+                    .map(|j| occs[j])
+                    .sum();
+                occ = occ.max(busy);
+            }
         }
-        let fastest = if self.cache.is_some() {
-            1
+        let misses = accesses - hits;
+        let rep = &mut self.rep;
+        rep.footprints += 1;
+        rep.texel_accesses += accesses;
+        rep.texture_bytes += accesses * u64::from(lv.texel_bytes);
+        rep.dram_accesses += misses;
+        rep.dram_page_hits += page_hits;
+        rep.dram_page_misses += misses - page_hits;
+        if CACHED {
+            rep.cache_hits += hits;
+            rep.cache_misses += misses;
+            rep.dram_bytes += misses * u64::from(tc.cache_line_bytes);
         } else {
-            u64::from(tc.dram_page_hit_cycles)
+            rep.dram_bytes += accesses * u64::from(lv.texel_bytes);
+        }
+        rep.bank_conflicts += conflicts;
+        if conflicts > 0 {
+            rep.conflicting_footprints += 1;
+        }
+        let (fastest, hit_latency) = if CACHED {
+            (1, u64::from(tc.cache_hit_cycles))
+        } else {
+            (page_hit, 0)
         };
         self.conflict_cycles += occ - slowest.max(1);
         self.miss_cycles += slowest.saturating_sub(fastest);
-        let lat = occ
-            + if self.cache.is_some() {
-                u64::from(tc.cache_hit_cycles)
-            } else {
-                0
-            };
-        (occ, lat, accesses * u64::from(lv.texel_bytes))
+        (occ, occ + hit_latency, accesses * u64::from(lv.texel_bytes))
     }
 }
 
