@@ -64,7 +64,8 @@ pub fn translate(m: &Mat4f, x: f64, y: f64, z: f64) -> Mat4f {
     let (x, y, z) = (x as f32, y as f32, z as f32);
     let mut out = *m;
     for row in out.iter_mut() {
-        row[3] = row[0] * x + row[1] * y + row[2] * z + row[3];
+        // `((m0 x + m1 y) + m2 z) + m3`: the last addition commutes exactly.
+        row[3] += row[0] * x + row[1] * y + row[2] * z;
     }
     out
 }
