@@ -21,7 +21,8 @@
 //! texsim's (f64) window positions, `1/w` and texture coordinates rounded to binary32:
 //! llvmpipe's float32 clipper (`draw_pipe_clip.c`) is not modelled.
 
-use super::stages::{texcoord_offset, Counters, Machine, TriAttrs};
+use super::clip_f32::{clip_triangle, ShadedVertex};
+use super::stages::{texcoord_offset, Counters, Machine};
 use super::{Frag, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::raster::ScreenTri;
@@ -56,28 +57,17 @@ pub struct Planes {
 /// One vertex as llvmpipe's setup reads it: window x, y, `1/w`, s, t (binary32).
 pub type Vertex = [u32; 5];
 
-/// The order in which llvmpipe's setup sees the vertices of `tri`: the source triangle's
-/// order when the triangle was not clipped (texsim's setup may have swapped two), then
-/// `triangle_both`'s swap of the first two when the signed area is not positive.
+/// The order in which llvmpipe's setup sees triangle `v` (as the draw module emits it):
+/// `triangle_both` swaps the first two vertices when the signed area is not positive.
 #[must_use]
-pub fn llvmpipe_order(tri: &ScreenTri) -> [usize; 3] {
-    let src = |k: usize| {
-        let b = tri.src_bary[k];
-        (0..3).find(|&j| b[j] == 1.0 && b.iter().filter(|&&x| x == 0.0).count() == 2)
-    };
-    let mut order = [0, 1, 2];
-    if let (Some(a), Some(b), Some(c)) = (src(0), src(1), src(2)) {
-        let mut by_src = [(a, 0), (b, 1), (c, 2)];
-        by_src.sort_unstable();
-        order = by_src.map(|(_, k)| k);
-    }
-    let p = order.map(|k| tri.xy_f[k]);
+pub fn llvmpipe_order(v: [Vertex; 3]) -> [Vertex; 3] {
+    let p = v.map(|q| [0, 1].map(|i| f64::from(f32::from_bits(q[i]))));
     let area =
         (p[0][0] - p[1][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[0][1] - p[1][1]);
     if area > 0.0 {
-        order
+        v
     } else {
-        [order[1], order[0], order[2]]
+        [v[1], v[0], v[2]]
     }
 }
 
@@ -186,9 +176,21 @@ pub fn quad_lod(p: &Planes, qx: i64, qy: i64, width: u32, height: u32, frac_bits
     i64::from(floor_i32(mul(lod, scale)))
 }
 
-/// The vertices of `px`'s triangle in llvmpipe's order.
+/// The vertices of the triangle llvmpipe shades pixel `px` with, in its setup's order: the
+/// source triangle through the draw module's clipper, then the emitted triangle whose
+/// window-space interior holds the pixel centre (the first one if none does, on an edge).
 fn vertices(px: &Px) -> [Vertex; 3] {
-    llvmpipe_order(px.tri).map(|k| px.a.f32_verts[k])
+    let fan = clip_triangle(px.a.f32_src, px.a.f32_half);
+    let (cx, cy) = (px.x as f64 + 0.5, px.y as f64 + 0.5);
+    let inside = |t: &[Vertex; 3]| {
+        let p = t.map(|q| [0, 1].map(|i| f64::from(f32::from_bits(q[i]))));
+        let e =
+            |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (cy - a[1]) - (b[1] - a[1]) * (cx - a[0]);
+        let (e0, e1, e2) = (e(p[0], p[1]), e(p[1], p[2]), e(p[2], p[0]));
+        (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
+    };
+    let t = fan.iter().find(|t| inside(t)).or(fan.first());
+    llvmpipe_order(t.copied().unwrap_or_default())
 }
 
 /// The view-projection matrix as binary32 (row-major `m[row][col]`).
@@ -207,6 +209,18 @@ fn matrix_f32(vp: &DMat4) -> [[u32; 4]; 4] {
 /// down) and `1/w`.
 #[must_use]
 pub fn vertex_transform(mvp: &[[u32; 4]; 4], p: [f32; 3], width: u32, height: u32) -> [u32; 3] {
+    shade_vertex(mvp, p, [0; 2], width, height).window
+}
+
+/// [`vertex_transform`] keeping the clip position, with texture coordinates `st`.
+#[must_use]
+pub fn shade_vertex(
+    mvp: &[[u32; 4]; 4],
+    p: [f32; 3],
+    st: [u32; 2],
+    width: u32,
+    height: u32,
+) -> ShadedVertex {
     let pos = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits(), ONE];
     let clip: [u32; 4] = std::array::from_fn(|r| {
         let m = &mvp[r];
@@ -219,46 +233,40 @@ pub fn vertex_transform(mvp: &[[u32; 4]; 4], p: [f32; 3], width: u32, height: u3
     let half_w = from_i32(width as i32 / 2);
     let half_h = from_i32(height as i32 / 2);
     let vp = |v: u32, scale: u32, trans: u32| fma(mul(v, oow), scale, trans);
-    [
-        vp(clip[0], half_w, half_w),
-        vp(clip[1], half_h ^ 0x8000_0000, half_h),
-        oow,
-    ]
+    ShadedVertex {
+        clip,
+        window: [
+            vp(clip[0], half_w, half_w),
+            vp(clip[1], half_h ^ 0x8000_0000, half_h),
+            oow,
+        ],
+        st,
+    }
 }
 
-/// The vertices of screen triangle `tri` as llvmpipe's setup reads them, in `tri`'s order:
-/// for a triangle the clipper left whole, each source vertex through [`vertex_transform`] with
-/// its texture coordinates; for a clipped one (llvmpipe's float32 clipper is not modelled)
-/// texsim's window position, `1/w` and coordinates rounded to binary32.
+/// The source triangle of screen triangle `tri` as llvmpipe's vertex shader leaves it (each
+/// vertex through [`shade_vertex`] with its texture coordinates, in draw order) and the
+/// viewport's half sizes: what [`vertices`] clips and sets up.
 #[must_use]
-pub fn llvmpipe_vertices(
+pub fn llvmpipe_source(
     tri: &ScreenTri,
-    a: &TriAttrs,
     geo: &Geometry,
     width: u32,
     height: u32,
-) -> [Vertex; 3] {
+) -> ([ShadedVertex; 3], [u32; 2]) {
     let f = |x: f64| (x as f32).to_bits();
     let d = &geo.draws[tri.src as usize];
-    let mvp = matrix_f32(&geo.view_projection);
-    std::array::from_fn(|k| {
-        let b = tri.src_bary[k];
-        let src = (0..3).find(|&j| b[j] == 1.0 && b.iter().filter(|&&x| x == 0.0).count() == 2);
-        match src {
-            Some(j) => {
-                let vi = d.v[j] as usize;
-                let [x, y, w] = vertex_transform(&mvp, geo.object[vi], width, height);
-                [x, y, w, f(geo.uv[vi][0]), f(geo.uv[vi][1])]
-            }
-            None => [
-                f(tri.xy_f[k][0]),
-                f(tri.xy_f[k][1]),
-                f(a.inv_w_f[k]),
-                f(a.uv_f[k][0]),
-                f(a.uv_f[k][1]),
-            ],
-        }
-    })
+    let mvp = geo.mesa_mvp.map_or_else(
+        || matrix_f32(&geo.view_projection),
+        |m| m.map(|row| row.map(f32::to_bits)),
+    );
+    let src = d.v.map(|vi| {
+        let vi = vi as usize;
+        let st = [f(geo.uv[vi][0]), f(geo.uv[vi][1])];
+        shade_vertex(&mvp, geo.object[vi], st, width, height)
+    });
+    let half = [width / 2, height / 2].map(|h| from_i32(h as i32));
+    (src, half)
 }
 
 /// The `texcoord` stage on the float32 path: the pixel's coordinates, and for the quad's

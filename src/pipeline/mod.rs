@@ -15,6 +15,7 @@ pub mod as_shade;
 pub mod bary;
 pub mod bump;
 pub mod bump_fetch;
+pub mod clip_f32;
 pub mod color;
 pub mod coord_f32;
 pub mod env;

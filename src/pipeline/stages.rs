@@ -247,9 +247,10 @@ pub struct TriAttrs {
     pub uv_x: [[i64; 2]; 3],
     /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
     pub bump: u32,
-    /// The vertices as llvmpipe's setup reads them (binary32 window x, y, `1/w`, s, t), in
-    /// the triangle's order: set by `render` when `interp.coord_arith = "float32"`.
-    pub f32_verts: [super::coord_f32::Vertex; 3],
+    /// The source triangle as llvmpipe's vertex shader leaves it and the viewport's half
+    /// sizes (binary32): set by `render` when `interp.coord_arith = "float32"`.
+    pub f32_src: [super::clip_f32::ShadedVertex; 3],
+    pub f32_half: [u32; 2],
 }
 
 /// The integer subtracted from one axis of a triangle's texture coordinates `vals` at setup
@@ -306,7 +307,8 @@ impl TriAttrs {
             uv_f: uv,
             uv_x: uv.map(|t| [0, 1].map(|ax| to_raw(t[ax] - off[ax], &m.uv_fmt, sat))),
             bump: u32::MAX,
-            f32_verts: [[0; 5]; 3],
+            f32_src: [super::clip_f32::ShadedVertex::default(); 3],
+            f32_half: [0; 2],
         }
     }
 }

@@ -20,6 +20,9 @@ pub struct Geometry {
     pub object: Vec<[f32; 3]>,
     /// The view-projection matrix the clip positions come from.
     pub view_projection: DMat4,
+    /// The binary32 model-view-projection Mesa builds for a Mesa anchor scene
+    /// (`scene::gl_matrix::mesa_anchor_mvp`); `None` for other scenes.
+    pub mesa_mvp: Option<crate::scene::gl_matrix::Mat4f>,
     pub color: Vec<[f64; 3]>,
     pub uv: Vec<[f64; 2]>,
     /// Per-vertex bump data: empty unless some plan is bump mapped (then one per vertex;
@@ -46,6 +49,7 @@ impl Geometry {
             clip: Vec::with_capacity(n),
             object: Vec::with_capacity(n),
             view_projection: vp,
+            mesa_mvp: crate::scene::gl_matrix::mesa_anchor_mvp(&scene.name),
             color: Vec::with_capacity(n),
             uv: Vec::with_capacity(n),
             draws: Vec::with_capacity(scene.triangle_count()),

@@ -99,7 +99,8 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             let wrap = geo.plans[plan as usize].wrap;
             let mut a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
             if m.hw.interp.coord_arith == CoordArith::Float32 {
-                a.f32_verts = coord_f32::llvmpipe_vertices(t, &a, geo, setup.width, setup.height);
+                (a.f32_src, a.f32_half) =
+                    coord_f32::llvmpipe_source(t, geo, setup.width, setup.height);
             }
             (a, sat)
         })

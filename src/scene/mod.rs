@@ -18,6 +18,7 @@ mod catalogue;
 pub mod env_scenes;
 pub mod fit_scenes;
 mod geometry;
+pub mod gl_matrix;
 pub mod lobe_scenes;
 mod ndf_scenes;
 mod obj;

@@ -3,6 +3,7 @@
 //! (`mul_add` for the fused multiply-adds): bit for bit on random triangles and pixels.
 
 use crate::rng_common::Rng;
+use texsim::pipeline::clip_f32::{clip_triangle, ShadedVertex};
 use texsim::pipeline::coord_f32::{
     coords_at, fast_log2, quad_lod, setup, vertex_transform, Plane, Planes, Vertex,
 };
@@ -165,4 +166,131 @@ fn vertex_transform_matches_host_f32() {
         let got = vertex_transform(&m.map(|row| row.map(f32::to_bits)), p, 1024, 768);
         assert_eq!(got, want.map(f32::to_bits), "{m:?} {p:?}");
     }
+}
+
+/// Host `f32` twin of `clip_f32::clip_triangle` (`draw_pipe_clip.c`): outcodes, each plane in
+/// turn, the symmetric choice of `t`, `out + t (in - out)`, the C viewport transform, the fan.
+fn clip_host(v: [ShadedVertex; 3], half: [f32; 2]) -> Vec<[Vertex; 3]> {
+    #[derive(Clone, Copy)]
+    struct V {
+        clip: [f32; 4],
+        win: [f32; 3],
+        st: [f32; 2],
+    }
+    let f = |x: u32| f32::from_bits(x);
+    let planes: [[f32; 4]; 6] = [
+        [-1.0, 0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0, 1.0],
+        [0.0, -1.0, 0.0, 1.0],
+        [0.0, 1.0, 0.0, 1.0],
+        [0.0, 0.0, 1.0, 1.0],
+        [0.0, 0.0, -1.0, 1.0],
+    ];
+    let dot = |a: &[f32; 4], b: &[f32; 4]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    let interp = |t: f32, out: &V, inn: &V| {
+        let clip: [f32; 4] = std::array::from_fn(|i| out.clip[i] + t * (inn.clip[i] - out.clip[i]));
+        let oow = 1.0 / clip[3];
+        V {
+            clip,
+            win: [
+                clip[0] * oow * half[0] + half[0],
+                clip[1] * oow * -half[1] + half[1],
+                oow,
+            ],
+            st: std::array::from_fn(|i| out.st[i] + t * (inn.st[i] - out.st[i])),
+        }
+    };
+    let mut poly: Vec<V> = v
+        .iter()
+        .map(|s| V {
+            clip: s.clip.map(f),
+            win: s.window.map(f),
+            st: s.st.map(f),
+        })
+        .collect();
+    let mut mask = 0u32;
+    for q in &poly {
+        for (p, pl) in planes.iter().enumerate() {
+            if dot(&q.clip, pl) < 0.0 {
+                mask |= 1 << p;
+            }
+        }
+    }
+    let sv = |q: &V| [q.win[0], q.win[1], q.win[2], q.st[0], q.st[1]].map(f32::to_bits);
+    if mask == 0 {
+        // A triangle inside every plane bypasses the clipper.
+        return vec![[sv(&poly[0]), sv(&poly[1]), sv(&poly[2])]];
+    }
+    while mask != 0 && poly.len() >= 3 {
+        let p = mask.trailing_zeros() as usize;
+        mask &= !(1 << p);
+        let n = poly.len();
+        let mut out = Vec::new();
+        let mut prev = poly[0];
+        let mut dp_prev = dot(&prev.clip, &planes[p]);
+        for i in 1..=n {
+            let vert = poly[i % n];
+            let dp = dot(&vert.clip, &planes[p]);
+            let different = if dp_prev >= 0.0 {
+                out.push(prev);
+                dp < 0.0
+            } else {
+                dp >= 0.0
+            };
+            if different {
+                let denom = dp - dp_prev;
+                out.push(if dp < 0.0 {
+                    if -dp < dp_prev {
+                        interp(dp / denom, &vert, &prev)
+                    } else {
+                        interp(-dp_prev / denom, &prev, &vert)
+                    }
+                } else if -dp_prev < dp {
+                    interp(-dp_prev / denom, &prev, &vert)
+                } else {
+                    interp(dp / denom, &vert, &prev)
+                });
+            }
+            prev = vert;
+            dp_prev = dp;
+        }
+        poly = out;
+    }
+    (2..poly.len())
+        .map(|i| [sv(&poly[i - 1]), sv(&poly[i]), sv(&poly[0])])
+        .collect()
+}
+
+#[test]
+fn clipper_matches_host_f32() {
+    let mut r = Rng(0xC11F);
+    let mut clipped = 0;
+    for _ in 0..50_000 {
+        let v: [ShadedVertex; 3] = std::array::from_fn(|_| {
+            let w = r.range(-2.0, 6.0) as f32;
+            let clip = [
+                r.range(-8.0, 8.0) as f32,
+                r.range(-8.0, 8.0) as f32,
+                r.range(-8.0, 8.0) as f32,
+                w,
+            ];
+            ShadedVertex {
+                clip: clip.map(f32::to_bits),
+                window: [
+                    r.range(0.0, 1024.0) as f32,
+                    r.range(0.0, 1024.0) as f32,
+                    1.0 / w,
+                ]
+                .map(f32::to_bits),
+                st: [r.range(0.0, 16.0) as f32, r.range(0.0, 16.0) as f32].map(f32::to_bits),
+            }
+        });
+        let want = clip_host(v, [512.0, 384.0]);
+        let got = clip_triangle(v, [512.0f32.to_bits(), 384.0f32.to_bits()]);
+        if want.len() != 1 || got.len() != 1 {
+            clipped += 1;
+        }
+        assert_eq!(got, want, "{v:?}");
+    }
+    assert!(clipped > 10_000, "{clipped}");
 }
