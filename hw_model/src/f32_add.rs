@@ -6,7 +6,7 @@
 
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::f32_pack::{classify, quiet, round_pack, zero, Class, DEFAULT_NAN, SIGN};
+use crate::f32_pack::{classify, quiet, round_sum, zero, Class, DEFAULT_NAN, SIGN};
 
 /// Beyond this exponent difference the smaller operand lies entirely below the larger one's
 /// rounding bits and only its sign and non-zeroness matter.
@@ -30,32 +30,7 @@ pub fn add(a: u32, b: u32) -> u32 {
         (Class::Zero(na), Class::Zero(nb)) => zero(na && nb),
         (Class::Zero(_), _) => b,
         (_, Class::Zero(_)) => a,
-        (Class::Finite(x), Class::Finite(y)) => {
-            // x the operand of larger exponent.
-            let (x, y) = if x.exp >= y.exp { (x, y) } else { (y, x) };
-            let diff = x.exp - y.exp;
-            if diff > FAR {
-                // y is far below x's last bit: x moved up 3 bits, y a sticky of its sign.
-                let big = u128::from(x.sig) << 3;
-                let exp = x.exp - 3;
-                return if x.neg == y.neg {
-                    round_pack(x.neg, exp, big, true)
-                } else {
-                    round_pack(x.neg, exp, big - 1, true)
-                };
-            }
-            let big = u128::from(x.sig) << diff;
-            let small = u128::from(y.sig);
-            if x.neg == y.neg {
-                round_pack(x.neg, y.exp, big + small, false)
-            } else if big >= small {
-                // An exact zero difference is +0 under round to nearest.
-                let d = big - small;
-                round_pack(x.neg && d != 0, y.exp, d, false)
-            } else {
-                round_pack(y.neg, y.exp, small - big, false)
-            }
-        }
+        (Class::Finite(x), Class::Finite(y)) => round_sum(x, y, FAR),
     }
 }
 
@@ -71,11 +46,7 @@ pub fn sub(a: u32, b: u32) -> u32 {
 /// One addition: align, add, normalize, round.
 #[must_use]
 pub fn add_cost(gate_levels_per_cycle: u32) -> UnitCost {
-    UnitCost {
-        ops: 1,
-        cycles: datapath().latency(gate_levels_per_cycle),
-        texels: 0,
-    }
+    crate::f32_pack::one_op_cost(&datapath(), gate_levels_per_cycle)
 }
 
 /// The float32 adder: exponent compare, alignment shift of the smaller significand, the

@@ -41,11 +41,7 @@ pub fn to_i32_trunc(x: u32) -> i32 {
 /// One conversion.
 #[must_use]
 pub fn convert_cost(gate_levels_per_cycle: u32) -> UnitCost {
-    UnitCost {
-        ops: 1,
-        cycles: datapath().latency(gate_levels_per_cycle),
-        texels: 0,
-    }
+    crate::f32_pack::one_op_cost(&datapath(), gate_levels_per_cycle)
 }
 
 /// The integer-to-float converter: negate, [`crate::f32_pack::pack_stage`] over 32 bits.

@@ -41,11 +41,7 @@ pub fn div(a: u32, b: u32) -> u32 {
 /// One division (`lp_build_rcp` is `1.0 / x` as a true division).
 #[must_use]
 pub fn div_cost(gate_levels_per_cycle: u32) -> UnitCost {
-    UnitCost {
-        ops: 1,
-        cycles: datapath().latency(gate_levels_per_cycle),
-        texels: 0,
-    }
+    crate::f32_pack::one_op_cost(&datapath(), gate_levels_per_cycle)
 }
 
 /// The float32 divider: 26 restoring steps (a 25-bit subtractor each) beside the exponent

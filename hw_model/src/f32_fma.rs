@@ -9,7 +9,9 @@
 
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::f32_pack::{classify, inf, quiet, round_pack, zero, Class, Unpacked, DEFAULT_NAN};
+use crate::f32_pack::{
+    classify, inf, quiet, round_pack, round_sum, zero, Class, Unpacked, DEFAULT_NAN,
+};
 
 /// Beyond this exponent difference the smaller addend lies entirely below the larger one's
 /// rounding bits (the exact product has at most 48 bits).
@@ -46,45 +48,15 @@ pub fn fma(a: u32, b: u32, c: u32) -> u32 {
         (None, Class::Zero(nc)) => zero(pneg && nc),
         (None, _) => c,
         (Some(p), Class::Zero(_)) => round_pack(p.neg, p.exp, u128::from(p.sig), false),
-        (Some(p), Class::Finite(z)) => add_exact(p, z),
+        (Some(p), Class::Finite(z)) => round_sum(p, z, FAR),
         (Some(_), Class::Nan(_)) => unreachable!("NaN operands returned above"),
-    }
-}
-
-/// The exact sum of two unpacked values (the product of up to 48 bits and the addend),
-/// rounded once.
-fn add_exact(p: Unpacked, z: Unpacked) -> u32 {
-    let (x, y) = if p.exp >= z.exp { (p, z) } else { (z, p) };
-    let diff = x.exp - y.exp;
-    if diff > FAR && y.sig != 0 {
-        let big = u128::from(x.sig) << 3;
-        let exp = x.exp - 3;
-        return if x.neg == y.neg {
-            round_pack(x.neg, exp, big, true)
-        } else {
-            round_pack(x.neg, exp, big - 1, true)
-        };
-    }
-    let big = u128::from(x.sig) << diff;
-    let small = u128::from(y.sig);
-    if x.neg == y.neg {
-        round_pack(x.neg, y.exp, big + small, false)
-    } else if big >= small {
-        let d = big - small;
-        round_pack(x.neg && d != 0, y.exp, d, false)
-    } else {
-        round_pack(y.neg, y.exp, small - big, false)
     }
 }
 
 /// One fused multiply-add.
 #[must_use]
 pub fn fma_cost(gate_levels_per_cycle: u32) -> UnitCost {
-    UnitCost {
-        ops: 1,
-        cycles: datapath().latency(gate_levels_per_cycle),
-        texels: 0,
-    }
+    crate::f32_pack::one_op_cost(&datapath(), gate_levels_per_cycle)
 }
 
 /// The float32 FMA: the 24 x 24 product beside the addend's alignment shift over 74 bits,

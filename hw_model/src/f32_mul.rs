@@ -27,11 +27,7 @@ pub fn mul(a: u32, b: u32) -> u32 {
 /// One multiplication.
 #[must_use]
 pub fn mul_cost(gate_levels_per_cycle: u32) -> UnitCost {
-    UnitCost {
-        ops: 1,
-        cycles: datapath().latency(gate_levels_per_cycle),
-        texels: 0,
-    }
+    crate::f32_pack::one_op_cost(&datapath(), gate_levels_per_cycle)
 }
 
 /// The float32 multiplier: the 24 x 24-bit significand product beside the exponent adder,

@@ -12,7 +12,8 @@
 //! (`util_fpstate_set_denorms_to_zero`); that differs from this policy only when an operand
 //! or a result is below 2^-126 in magnitude.
 
-use crate::datapath::{Component, Stage};
+use crate::cost::UnitCost;
+use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right_sticky, Rounding};
 
 /// Sign bit of an encoding.
@@ -151,4 +152,45 @@ pub fn pack_stage(name: &'static str, width: u32) -> Stage {
         })
         .then(Component::Adder { width: 24 })
         .beside(1, Component::Adder { width: 10 })
+}
+
+/// The cost of one float32 operation on the unit whose datapath is `datapath`: one op, its
+/// latency at `gate_levels_per_cycle`.
+#[must_use]
+pub fn one_op_cost(datapath: &Datapath, gate_levels_per_cycle: u32) -> UnitCost {
+    UnitCost {
+        ops: 1,
+        cycles: datapath.latency(gate_levels_per_cycle),
+        texels: 0,
+    }
+}
+
+/// The exact sum of two unpacked finite values, rounded once (the adder's and the fused
+/// multiply-add's last step). Beyond an exponent difference of `far` the smaller operand lies
+/// entirely below the larger one's rounding bits and enters only as a sticky bit of its sign;
+/// `far` must keep `sig << far` within 128 bits.
+#[must_use]
+pub fn round_sum(p: Unpacked, z: Unpacked, far: i32) -> u32 {
+    let (x, y) = if p.exp >= z.exp { (p, z) } else { (z, p) };
+    let diff = x.exp - y.exp;
+    if diff > far && y.sig != 0 {
+        let big = u128::from(x.sig) << 3;
+        let exp = x.exp - 3;
+        return if x.neg == y.neg {
+            round_pack(x.neg, exp, big, true)
+        } else {
+            round_pack(x.neg, exp, big - 1, true)
+        };
+    }
+    let big = u128::from(x.sig) << diff;
+    let small = u128::from(y.sig);
+    if x.neg == y.neg {
+        round_pack(x.neg, y.exp, big + small, false)
+    } else if big >= small {
+        // An exact zero difference is +0 under round to nearest.
+        let d = big - small;
+        round_pack(x.neg && d != 0, y.exp, d, false)
+    } else {
+        round_pack(y.neg, y.exp, small - big, false)
+    }
 }
