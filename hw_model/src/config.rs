@@ -371,7 +371,9 @@ impl HwConfig {
     /// even (`lp_build_iround`), lerps `a + ((b - a) w + 128) >> 8` (pmulhrsw), LOD per 2x2
     /// quad from finite differences with the piecewise-linear `lp_build_fast_log2`, level
     /// fraction truncated to 8 bits; coverage on 8 sub-pixel bits; the texture coordinates
-    /// and LOD in llvmpipe's float32 arithmetic (`interp.coord_arith = "float32"`).
+    /// and LOD in llvmpipe's float32 arithmetic (`interp.coord_arith = "float32"`), handed to
+    /// the sampler on 28 fraction bits (`texcoord_frac_bits`, the widest: a binary32
+    /// coordinate below 1/2 has bits under 2^-24 that decide its rounded weight).
     #[must_use]
     pub fn llvmpipe() -> Self {
         let mut c = Self::texram16();
@@ -386,6 +388,7 @@ impl HwConfig {
         c.lod.lod_per_quad = true;
         c.interp.attr_subpixel_bits = 16;
         c.interp.coord_arith = CoordArith::Float32;
+        c.interp.texcoord_frac_bits = 28;
         c
     }
 

@@ -16,10 +16,10 @@
 //!   level-0 size, squared and summed per direction, the larger, `lp_build_fast_log2` (the
 //!   exponent minus one plus the mantissa in [1, 2)) times 1/2, floored to `lod_frac_bits`.
 //!
-//! The vertices of a triangle the clipper left whole come from [`vertex_transform`] (the
-//! vertex program and viewport transform in binary32); those of a clipped triangle are
-//! texsim's (f64) window positions, `1/w` and texture coordinates rounded to binary32:
-//! llvmpipe's float32 clipper (`draw_pipe_clip.c`) is not modelled.
+//! The vertices come from [`vertex_transform`] (the vertex program and viewport transform in
+//! binary32) through the draw module's float32 clipper (`super::clip_f32`). The sampler takes
+//! the coordinates as fixed point on `texcoord_frac_bits` (28 in the `llvmpipe` preset, exact
+//! for every binary32 coordinate of magnitude 1/32 or more).
 
 use super::clip_f32::{clip_triangle, ShadedVertex};
 use super::stages::{texcoord_offset, Counters, Machine};

@@ -99,6 +99,11 @@ fn llvmpipe_preset_pins_its_texture_path() {
     assert!(PRESETS
         .iter()
         .all(|&p| p == "llvmpipe" || preset(p).interp.coord_arith == CoordArith::Fixed));
+    assert_eq!(
+        (l.interp.texcoord_frac_bits, t.interp.texcoord_frac_bits),
+        (28, 24),
+        "binary32 coordinates below 1/2 keep their low bits"
+    );
     let mut bad = l.clone();
     bad.lod.lod_per_quad = false;
     let e = bad.validate().expect_err("float32 needs the quad LOD");
