@@ -670,6 +670,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         hw_impls: impls,
         reference: !a.no_reference || a.truth,
         timing: !a.no_cycles,
+        keep_events: false,
         coverage: match a.coverage {
             CoverageArg::Shared => CoverageMode::Shared,
             CoverageArg::Independent => CoverageMode::Independent,

@@ -282,6 +282,7 @@ pub fn compare_scene(
         );
         let ro = RenderOptions {
             timing: opts.timing,
+            keep_events: false,
             truth: opts.truth.max(1),
             ..RenderOptions::default()
         };

@@ -443,6 +443,7 @@ impl Search<'_> {
             let opts = RenderOptions {
                 truth: spec.truth,
                 timing,
+                keep_events: false,
                 ..RenderOptions::default()
             };
             let r = render(sc, maps, cfg, &opts)?;

@@ -55,9 +55,13 @@ pub struct RenderOptions {
     /// Also render the all-float reference and compare.
     pub reference: bool,
     pub coverage: CoverageMode,
-    /// Collect the timing model's event stream (`Rendered::events`). Off by default: a render
-    /// without it allocates no event buffer and does no extra work per pixel.
+    /// Run the timing model on the hardware pass (`RenderStats::timing`). Off by default: a
+    /// render without it allocates no event buffer and does no extra work per pixel.
     pub timing: bool,
+    /// With `timing`, also keep the frame's event stream in `Rendered::events` (for a caller
+    /// that replays it, e.g. `timing::simulate`). On by default; a caller that only needs the
+    /// cycle counts turns it off and the rows' events are dropped once the model has read them.
+    pub keep_events: bool,
     /// Also render the ground truth, with this many sub-samples per pixel axis (0 = off):
     /// roughness materials supersample their full-resolution bump map
     /// (`pipeline::rough`), NDF materials their finest normal map
@@ -78,6 +82,7 @@ impl Default for RenderOptions {
             reference: true,
             coverage: CoverageMode::Shared,
             timing: false,
+            keep_events: true,
             truth: 0,
             progress: None,
             ranges: false,
@@ -241,7 +246,7 @@ pub fn render(
     let sim = opts
         .timing
         .then(|| crate::timing::Simulator::new(&plans, &textures, hw));
-    let (hw_image, counters, timed) = shade(&inp, &opts.hw_impls, bg, sim);
+    let (hw_image, counters, timed) = shade(&inp, &opts.hw_impls, bg, sim, opts.keep_events);
     let (events, sim) = match timed {
         Some((mut fe, sim)) => {
             fe.triangles = setup.tris.len() as u64;
@@ -249,7 +254,8 @@ pub fn render(
             fe.fragments = raster_stats.fragments;
             fe.plans = plans;
             fe.textures = textures;
-            (Some(fe), Some(sim))
+            let counts = fe.counts();
+            (opts.keep_events.then_some(fe), Some((sim, counts)))
         }
         None => (None, None),
     };
@@ -280,7 +286,8 @@ pub fn render(
             }
         };
         let t = Instant::now();
-        let (img, rc, _) = shade(&ShadeInput { vis: rv, ..inp }, &StageImpls::FLOAT, bg, None);
+        let rinp = ShadeInput { vis: rv, ..inp };
+        let (img, rc, _) = shade(&rinp, &StageImpls::FLOAT, bg, None, false);
         ref_nonfinite = rc.nonfinite;
         tm.shade_ref_ms = ms(t);
         progress("reference", ms(t_ref));
@@ -318,7 +325,7 @@ pub fn render(
             geo: &geo,
             m: &mt,
         };
-        let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, None);
+        let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, None, false);
         geo.plans = saved;
         truth_image = Some(img);
         progress("ground truth", ms(t_truth));
@@ -369,14 +376,12 @@ pub fn render(
     {
         issue_cycles.not_modelled = Some(crate::pipeline::ndf::EXACT_NOT_MODELLED);
     }
-    // The frame's cycles: the timing model over the hardware pass's events (none for a stage
-    // without a hardware cost model).
     // The frame's cycles: the timing model, fed the hardware pass's pixels while it shaded
     // (none for a stage without a hardware cost model).
-    let timing = match (sim, &events, issue_cycles.not_modelled) {
-        (Some(sim), Some(ev), None) => {
+    let timing = match (sim, issue_cycles.not_modelled) {
+        (Some((sim, counts)), None) => {
             let t = Instant::now();
-            let rep = sim.finish(&ev.counts(), &scene.name);
+            let rep = sim.finish(&counts, &scene.name);
             tm.timing_ms = ms(t);
             progress("timing model", tm.timing_ms);
             Some(rep)

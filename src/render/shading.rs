@@ -162,15 +162,18 @@ const BAND_ROWS: usize = 16;
 
 /// Shades every covered pixel with `impls`; returns the image, the counters and, when `timing`
 /// holds the frame's timing model, the event stream (rows concatenated in row order) and the
-/// model fed with every pixel. With timing, the frame is shaded in bands of [`BAND_ROWS`] rows:
-/// while a band is shaded (in parallel by rows) the previous band's events are fed to the model
-/// and appended to the stream, so the sequential model overlaps the shading; the model and the
-/// stream see the pixels in raster order, identical for any thread count.
+/// model fed with every pixel (the stream's pixel and footprint lists stay empty unless
+/// `keep_events`: the model reads each row's events before they are dropped). With timing,
+/// the frame is shaded in bands of [`BAND_ROWS`] rows: while a band is shaded (in parallel by
+/// rows) the previous band's events are fed to the model and appended to the stream, so the
+/// sequential model overlaps the shading; the model and the stream see the pixels in raster
+/// order, identical for any thread count.
 pub(super) fn shade<'h>(
     inp: &ShadeInput,
     impls: &StageImpls,
     background: [u16; 4],
     timing: Option<Simulator<'h>>,
+    keep_events: bool,
 ) -> (Image, Counters, Option<(FrameEvents, Simulator<'h>)>) {
     let vis = inp.vis;
     let w = vis.width as usize;
@@ -212,7 +215,9 @@ pub(super) fn shade<'h>(
         for (c, ev) in rows {
             counters.add(&c);
             sim.row(&ev);
-            fe.append_row(ev);
+            if keep_events {
+                fe.append_row(ev);
+            }
         }
     };
     let mut pending = Vec::new();

@@ -146,17 +146,16 @@ impl Cache {
     pub fn access(&mut self, key: u64) -> bool {
         let s = (key % self.sets) as usize * self.ways;
         let set = &mut self.tags[s..s + self.ways];
-        match set.iter().position(|&t| t == key) {
-            Some(i) => {
-                set[..=i].rotate_right(1);
-                true
-            }
-            None => {
-                set.rotate_right(1);
-                set[0] = key;
-                false
-            }
+        // Move the line to the front: ways are few, so shift them one by one.
+        let (last, hit) = match set.iter().position(|&t| t == key) {
+            Some(i) => (i, true),
+            None => (set.len() - 1, false),
+        };
+        for j in (1..=last).rev() {
+            set[j] = set[j - 1];
         }
+        set[0] = key;
+        hit
     }
 }
 
@@ -317,8 +316,19 @@ struct Memory<'a> {
     map: AddressMap,
     cache: Option<Cache>,
     open_page: Vec<u64>,
-    /// The bank interleave's tile (`tile(banks)`).
-    bank_tile: (u32, u32),
+    /// Banks (at least 1) and the last bank's index.
+    banks: u32,
+    last_bank: usize,
+    /// Tiled interleave: the bank tile's column and row masks and the log2 of its width, so
+    /// `bank = (x & mask_x) | (y & mask_y) << shift` (the tile's width is a power of two).
+    tile_mask: (u32, u32),
+    tile_shift: u32,
+    /// Linear interleave: `banks - 1` when the bank count is a power of two (`mod` is a
+    /// mask), else 0 (the general `mod`).
+    linear_mask: u64,
+    /// DRAM page hit and miss cycles.
+    page_hit: u64,
+    page_miss: u64,
     rep: MemoryReport,
     conflict_cycles: u64,
     miss_cycles: u64,
@@ -331,12 +341,24 @@ impl<'a> Memory<'a> {
             let sets = tc.cache_bytes / (tc.cache_line_bytes * ways);
             Cache::new(u64::from(sets), ways as usize)
         });
+        let banks = tc.banks.max(1);
+        let bank_tile = tile(banks);
         Self {
             tc,
             map: AddressMap::new(textures, tc),
             cache,
-            open_page: vec![EMPTY; tc.banks.max(1) as usize],
-            bank_tile: tile(tc.banks.max(1)),
+            open_page: vec![EMPTY; banks as usize],
+            banks,
+            last_bank: banks as usize - 1,
+            tile_mask: (bank_tile.0 - 1, bank_tile.1 - 1),
+            tile_shift: bank_tile.0.trailing_zeros(),
+            linear_mask: if banks.is_power_of_two() {
+                u64::from(banks - 1)
+            } else {
+                0
+            },
+            page_hit: u64::from(tc.dram_page_hit_cycles),
+            page_miss: u64::from(tc.dram_page_miss_cycles),
             rep: MemoryReport::default(),
             conflict_cycles: 0,
             miss_cycles: 0,
@@ -348,23 +370,41 @@ impl<'a> Memory<'a> {
     /// (x0, y1), (x1, y1), are each one bank access (a footprint on a 1-texel-wide or -high
     /// level collapses its repeated columns or rows).
     fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
-        if self.cache.is_some() {
-            self.footprint_in::<true>(fp)
-        } else {
-            self.footprint_in::<false>(fp)
+        let tiled = self.tc.bank_interleave == BankInterleave::Tiled;
+        match (self.cache.is_some(), tiled) {
+            (true, true) => self.footprint_in::<true, true>(fp),
+            (true, false) => self.footprint_in::<true, false>(fp),
+            (false, true) => self.footprint_in::<false, true>(fp),
+            (false, false) => self.footprint_in::<false, false>(fp),
         }
     }
 
-    /// [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache.
+    /// The bank of texel (x, y) on a level of width `w` ([`bank_of`] with the interleave's
+    /// masks precomputed: `TILED`, else linear).
     #[inline(always)]
-    fn footprint_in<const CACHED: bool>(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
+    fn bank<const TILED: bool>(&self, x: u32, y: u32, w: u32) -> usize {
+        let b = if TILED {
+            ((x & self.tile_mask.0) | ((y & self.tile_mask.1) << self.tile_shift)) as usize
+        } else {
+            let i = u64::from(y) * u64::from(w) + u64::from(x);
+            (if self.linear_mask != 0 {
+                i & self.linear_mask
+            } else {
+                i % u64::from(self.banks)
+            }) as usize
+        };
+        b.min(self.last_bank)
+    }
+
+    /// [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache, for the tiled
+    /// (`TILED`) or linear bank interleave.
+    #[inline(always)]
+    fn footprint_in<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        fp: &TexelFootprint,
+    ) -> (u64, u64, u64) {
         let tc = self.tc;
-        let banks = tc.banks.max(1);
-        let last_bank = banks as usize - 1;
-        let (page_hit, page_miss) = (
-            u64::from(tc.dram_page_hit_cycles),
-            u64::from(tc.dram_page_miss_cycles),
-        );
+        let (page_hit, page_miss) = (self.page_hit, self.page_miss);
         let mut bank = [0usize; 4];
         let mut occs = [0u64; 4];
         let mut n = 0;
@@ -375,8 +415,7 @@ impl<'a> Memory<'a> {
         let rows = if fp.y[0] == fp.y[1] { 1 } else { 2 };
         for &y in &fp.y[..rows] {
             for &x in &fp.x[..cols] {
-                let b = bank_in_tile(x, y, lv.width, banks, self.bank_tile, tc.bank_interleave)
-                    .min(last_bank);
+                let b = self.bank::<TILED>(x, y, lv.width);
                 let hit = CACHED
                     && self
                         .cache
