@@ -1,6 +1,6 @@
 //! IEEE 754 binary32 addition and subtraction, bit-exact (0 ulp) against x86 SSE `addss` /
-//! `subss` (the host's `f32 +` and `-`) for every operand pair, NaNs included (see
-//! [`crate::f32_pack`] for the policy). Float twin: the host's `f32` addition. Tested against
+//! `subss` (the host's binary32 `+` and `-`) for every operand pair, NaNs included (see
+//! [`crate::f32_pack`] for the policy). Float twin: the host's binary32 addition. Tested against
 //! it on 10^7 seeded pairs plus boundary cases (zeros, subnormals, the largest finite value,
 //! ties, cancellation, overflow), `tests/units/f32_units.rs`.
 
@@ -55,7 +55,7 @@ pub fn add_cost(gate_levels_per_cycle: u32) -> UnitCost {
 pub fn datapath() -> Datapath {
     Datapath::new()
         .stage(
-            Stage::new("f32-add.align")
+            Stage::new("binary32-add.align")
                 .then(Component::Adder { width: 8 })
                 .then(Component::Shifter {
                     width: 27,
@@ -63,5 +63,5 @@ pub fn datapath() -> Datapath {
                 })
                 .then(Component::Adder { width: 27 }),
         )
-        .stage(crate::f32_pack::pack_stage("f32-add.pack", 27))
+        .stage(crate::f32_pack::pack_stage("binary32-add.pack", 27))
 }

@@ -1,5 +1,5 @@
 //! Conversions between binary32 and integers, bit-exact against x86 SSE: `cvtsi2ss` (an
-//! `i32` to the nearest binary32, ties to even; the host's `as f32`) and `cvttss2si`
+//! `i32` to the nearest binary32, ties to even; the host's cast to binary32) and `cvttss2si`
 //! (truncation toward zero; NaN and out-of-range give `i32::MIN`, the "integer indefinite",
 //! where the host's saturating `as i32` differs). Float twins: the host's `as` casts. Tested
 //! exhaustively over a 2^24 slice of each direction plus boundaries, `tests/units/f32_units.rs`.
@@ -8,7 +8,7 @@ use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::f32_pack::{classify, round_pack, Class};
 
-/// `x as f32`, rounded to nearest, ties to even.
+/// `x` converted to binary32, rounded to nearest, ties to even.
 #[must_use]
 pub fn from_i32(x: i32) -> u32 {
     round_pack(x < 0, 0, u128::from(x.unsigned_abs()), false)
@@ -48,6 +48,6 @@ pub fn convert_cost(gate_levels_per_cycle: u32) -> UnitCost {
 #[must_use]
 pub fn datapath() -> Datapath {
     Datapath::new()
-        .stage(Stage::new("f32-convert.abs").then(Component::Adder { width: 32 }))
-        .stage(crate::f32_pack::pack_stage("f32-convert.pack", 32))
+        .stage(Stage::new("binary32-convert.abs").then(Component::Adder { width: 32 }))
+        .stage(crate::f32_pack::pack_stage("binary32-convert.pack", 32))
 }

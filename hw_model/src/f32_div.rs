@@ -1,7 +1,7 @@
-//! IEEE 754 binary32 division, bit-exact (0 ulp) against x86 SSE `divss` (the host's `f32 /`)
+//! IEEE 754 binary32 division, bit-exact (0 ulp) against x86 SSE `divss` (the host's binary32 `/`)
 //! for every operand pair, NaNs included (policy in [`crate::f32_pack`]): a 26-bit quotient
 //! by restoring division, its remainder as the sticky bit, one rounding. Float twin: the
-//! host's `f32` division. Tested on 10^7 seeded pairs plus boundary cases, and `1/x` over a
+//! host's binary32 division. Tested on 10^7 seeded pairs plus boundary cases, and `1/x` over a
 //! 2^24 slice of `x`, `tests/units/f32_units.rs`.
 
 use crate::cost::UnitCost;
@@ -50,7 +50,7 @@ pub fn div_cost(gate_levels_per_cycle: u32) -> UnitCost {
 pub fn datapath() -> Datapath {
     Datapath::new()
         .stage(
-            Stage::new("f32-div.steps")
+            Stage::new("binary32-div.steps")
                 .then(Component::Adder { width: 25 })
                 .then(Component::Mux {
                     width: 25,
@@ -59,9 +59,9 @@ pub fn datapath() -> Datapath {
                 .times(24 + EXTRA),
         )
         .stage(
-            Stage::new("f32-div.exp")
+            Stage::new("binary32-div.exp")
                 .then(Component::Adder { width: 9 })
                 .then(Component::Comparator { width: 25 }),
         )
-        .stage(crate::f32_pack::pack_stage("f32-div.pack", 27))
+        .stage(crate::f32_pack::pack_stage("binary32-div.pack", 27))
 }

@@ -1,10 +1,10 @@
 //! IEEE 754 binary32 fused multiply-add `a x b + c` with one rounding, bit-exact (0 ulp)
-//! against the host's `f32::mul_add` (x86 `vfmadd`) for every finite and infinite operand
+//! against the host's binary32 `mul_add` (x86 `vfmadd`) for every finite and infinite operand
 //! triple; NaN results are NaN (which operand's payload an x86 FMA propagates depends on the
 //! instruction form LLVM picks; this unit returns the first NaN of `a`, `b`, `c` quieted).
 //! It models LLVM's `llvm.fmuladd`, which `lp_build_fmuladd` emits and the x86 backend fuses
 //! on a CPU with FMA (llvmpipe's attribute interpolation `a0 + dadx x + dady y`). Float twin:
-//! `f32::mul_add`. Tested on 10^7 seeded triples plus boundary cases (cancellation, zeros,
+//! the host's binary32 `mul_add`. Tested on 10^7 seeded triples plus boundary cases (cancellation, zeros,
 //! subnormals, overflow), `tests/units/f32_units.rs`.
 
 use crate::cost::UnitCost;
@@ -65,7 +65,7 @@ pub fn fma_cost(gate_levels_per_cycle: u32) -> UnitCost {
 pub fn datapath() -> Datapath {
     Datapath::new()
         .stage(
-            Stage::new("f32-fma.product")
+            Stage::new("binary32-fma.product")
                 .then(Component::Multiplier { a: 24, b: 24 })
                 .beside(1, Component::Adder { width: 9 })
                 .beside(
@@ -76,6 +76,6 @@ pub fn datapath() -> Datapath {
                     },
                 ),
         )
-        .stage(Stage::new("f32-fma.add").then(Component::Adder { width: 74 }))
-        .stage(crate::f32_pack::pack_stage("f32-fma.pack", 74))
+        .stage(Stage::new("binary32-fma.add").then(Component::Adder { width: 74 }))
+        .stage(crate::f32_pack::pack_stage("binary32-fma.pack", 74))
 }

@@ -1,6 +1,6 @@
 //! IEEE 754 binary32 multiplication, bit-exact (0 ulp) against x86 SSE `mulss` (the host's
-//! `f32 *`) for every operand pair, NaNs included (policy in [`crate::f32_pack`]). Float
-//! twin: the host's `f32` multiplication. Tested on 10^7 seeded pairs plus boundary cases,
+//! binary32 `*`) for every operand pair, NaNs included (policy in [`crate::f32_pack`]). Float
+//! twin: the host's binary32 multiplication. Tested on 10^7 seeded pairs plus boundary cases,
 //! `tests/units/f32_units.rs`.
 
 use crate::cost::UnitCost;
@@ -36,9 +36,9 @@ pub fn mul_cost(gate_levels_per_cycle: u32) -> UnitCost {
 pub fn datapath() -> Datapath {
     Datapath::new()
         .stage(
-            Stage::new("f32-mul.product")
+            Stage::new("binary32-mul.product")
                 .then(Component::Multiplier { a: 24, b: 24 })
                 .beside(1, Component::Adder { width: 9 }),
         )
-        .stage(crate::f32_pack::pack_stage("f32-mul.pack", 48))
+        .stage(crate::f32_pack::pack_stage("binary32-mul.pack", 48))
 }

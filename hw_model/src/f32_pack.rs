@@ -3,7 +3,7 @@
 //! significand, and the one round-and-pack exit every float32 result leaves through
 //! ([`round_pack`], round to nearest, ties to even, by [`crate::fixed::round_shift_right_sticky`]).
 //!
-//! Policy (that of x86 SSE with MXCSR's DAZ and FTZ clear, the host's `f32`): gradual
+//! Policy (that of x86 SSE with MXCSR's DAZ and FTZ clear, the host's binary32): gradual
 //! underflow (subnormal operands and results are exact IEEE), overflow to infinity, and NaN
 //! results as SSE produces them: an operation with a NaN operand returns its first NaN
 //! operand quieted, an invalid operation (inf - inf, 0 x inf, 0/0, inf/inf) the default NaN
