@@ -25,9 +25,6 @@ use super::clip_f32::{clip_triangle, ShadedVertex};
 use super::stages::{texcoord_offset, Counters, Machine};
 use super::{Frag, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
-use crate::raster::ScreenTri;
-use crate::render::Geometry;
-use glam::DMat4;
 use hw_model::f32_add::{add, sub};
 use hw_model::f32_convert::{from_i32, to_i32_trunc};
 use hw_model::f32_div::div;
@@ -176,11 +173,33 @@ pub fn quad_lod(p: &Planes, qx: i64, qy: i64, width: u32, height: u32, frac_bits
     i64::from(floor_i32(mul(lod, scale)))
 }
 
-/// The vertices of the triangle llvmpipe shades pixel `px` with, in its setup's order: the
-/// source triangle through the draw module's clipper, then the emitted triangle whose
+/// One screen triangle as llvmpipe sets it up, built once per triangle: the source triangle
+/// through the draw module's clipper, each emitted triangle (window-space vertices) with its
+/// planes (`setup` of the vertices in llvmpipe's order).
+#[derive(Clone, Debug, Default)]
+pub struct F32Tri {
+    pub fan: Vec<([Vertex; 3], Planes)>,
+}
+
+impl F32Tri {
+    /// Clips `src` (the vertex shader's output, [`shade_vertex`]) with the viewport's half
+    /// sizes `half` and sets up every emitted triangle.
+    #[must_use]
+    pub fn new(src: [ShadedVertex; 3], half: [u32; 2]) -> Self {
+        let fan = clip_triangle(src, half)
+            .into_iter()
+            .map(|t| (t, setup(llvmpipe_order(t))))
+            .collect();
+        Self { fan }
+    }
+}
+
+/// The planes llvmpipe shades pixel `px` with: those of the emitted triangle whose
 /// window-space interior holds the pixel centre (the first one if none does, on an edge).
-fn vertices(px: &Px) -> [Vertex; 3] {
-    let fan = clip_triangle(px.a.f32_src, px.a.f32_half);
+fn planes(px: &Px) -> Planes {
+    let Some(tri) = px.m.f32_tris.get(px.a.f32_tri as usize) else {
+        return setup(llvmpipe_order(Default::default()));
+    };
     let (cx, cy) = (px.x as f64 + 0.5, px.y as f64 + 0.5);
     let inside = |t: &[Vertex; 3]| {
         let p = t.map(|q| [0, 1].map(|i| f64::from(f32::from_bits(q[i]))));
@@ -189,14 +208,8 @@ fn vertices(px: &Px) -> [Vertex; 3] {
         let (e0, e1, e2) = (e(p[0], p[1]), e(p[1], p[2]), e(p[2], p[0]));
         (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
     };
-    let t = fan.iter().find(|t| inside(t)).or(fan.first());
-    llvmpipe_order(t.copied().unwrap_or_default())
-}
-
-/// The view-projection matrix as binary32 (row-major `m[row][col]`).
-fn matrix_f32(vp: &DMat4) -> [[u32; 4]; 4] {
-    let c = vp.to_cols_array_2d();
-    std::array::from_fn(|r| std::array::from_fn(|k| (c[k][r] as f32).to_bits()))
+    let hit = tri.fan.iter().find(|(t, _)| inside(t)).or(tri.fan.first());
+    hit.map_or_else(|| setup(llvmpipe_order(Default::default())), |(_, p)| *p)
 }
 
 /// llvmpipe's vertex transform of object position `p`: the clip position `MVP p` in
@@ -244,37 +257,12 @@ pub fn shade_vertex(
     }
 }
 
-/// The source triangle of screen triangle `tri` as llvmpipe's vertex shader leaves it (each
-/// vertex through [`shade_vertex`] with its texture coordinates, in draw order) and the
-/// viewport's half sizes: what [`vertices`] clips and sets up.
-#[must_use]
-pub fn llvmpipe_source(
-    tri: &ScreenTri,
-    geo: &Geometry,
-    width: u32,
-    height: u32,
-) -> ([ShadedVertex; 3], [u32; 2]) {
-    let f = |x: f64| (x as f32).to_bits();
-    let d = &geo.draws[tri.src as usize];
-    let mvp = geo.mesa_mvp.map_or_else(
-        || matrix_f32(&geo.view_projection),
-        |m| m.map(|row| row.map(f32::to_bits)),
-    );
-    let src = d.v.map(|vi| {
-        let vi = vi as usize;
-        let st = [f(geo.uv[vi][0]), f(geo.uv[vi][1])];
-        shade_vertex(&mvp, geo.object[vi], st, width, height)
-    });
-    let half = [width / 2, height / 2].map(|h| from_i32(h as i32));
-    (src, half)
-}
-
 /// The `texcoord` stage on the float32 path: the pixel's coordinates, and for the quad's
 /// helpers the pixel plus the quad's differences (as the fixed path's per-quad samples).
 pub fn texcoord(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let m = px.m;
     let sat = &mut c.sat[StageKind::Texcoord.index()];
-    let planes = setup(vertices(px));
+    let planes = planes(px);
     let off = reduction(px, m);
     let fixed = |st: [u32; 2], sat: &mut SatCounter| {
         [0, 1].map(|ax| to_raw(f64::from(f32::from_bits(st[ax])) - off[ax], &m.uv_fmt, sat))
@@ -314,7 +302,7 @@ pub fn lod(px: &Px, frag: &mut Frag, c: &mut Counters) {
         return;
     };
     let sat = &mut c.sat[StageKind::Lod.index()];
-    let planes = setup(vertices(px));
+    let planes = planes(px);
     let fb = m.hw.lod.lod_frac_bits;
     let raw = quad_lod(&planes, px.x & !1, px.y & !1, l0.width, l0.height, fb);
     frag.lod_x = m.lod_fmt.fit(raw, sat);

@@ -90,6 +90,9 @@ pub struct Machine<'a> {
     pub ambient_x: [u64; 3],
     /// Per-triangle bump data ([`TriAttrs::bump`] indexes it).
     pub bump_attrs: &'a [BumpAttrs],
+    /// Per-triangle llvmpipe setup of the float32 coordinate path ([`TriAttrs::f32_tri`]
+    /// indexes it).
+    pub f32_tris: &'a [super::coord_f32::F32Tri],
     /// ROMs of the anisotropic Phong unit, built on first use ([`Machine::aniso_roms`]).
     pub aniso_roms: std::sync::OnceLock<hw_model::aniso_phong::AnisoPhongRoms>,
     /// The fixed NDF unit of `hw.ndf` (`None` for the float-only `exact` normalization).
@@ -160,6 +163,7 @@ impl<'a> Machine<'a> {
             ambient: [0.0; 3],
             ambient_x: [0; 3],
             bump_attrs: &[],
+            f32_tris: &[],
             aniso_roms: std::sync::OnceLock::new(),
             ndf: super::ndf::ndf_unit(hw),
             lean_density: std::sync::OnceLock::new(),
@@ -220,6 +224,13 @@ impl<'a> Machine<'a> {
         self
     }
 
+    /// The per-triangle float32 setups ([`TriAttrs::f32_tri`] indexes them).
+    #[must_use]
+    pub fn with_f32_tris(mut self, tris: &'a [super::coord_f32::F32Tri]) -> Self {
+        self.f32_tris = tris;
+        self
+    }
+
     /// The frame a bump plan uses: its material's, else the hardware's `frame_kind`.
     #[must_use]
     pub fn frame_of(&self, bp: &BumpPlan) -> FrameKind {
@@ -247,10 +258,9 @@ pub struct TriAttrs {
     pub uv_x: [[i64; 2]; 3],
     /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
     pub bump: u32,
-    /// The source triangle as llvmpipe's vertex shader leaves it and the viewport's half
-    /// sizes (binary32): set by `render` when `interp.coord_arith = "float32"`.
-    pub f32_src: [super::clip_f32::ShadedVertex; 3],
-    pub f32_half: [u32; 2],
+    /// Index into [`Machine::f32_tris`] (`interp.coord_arith = "float32"` only; `u32::MAX`
+    /// otherwise).
+    pub f32_tri: u32,
 }
 
 /// The integer subtracted from one axis of a triangle's texture coordinates `vals` at setup
@@ -307,8 +317,7 @@ impl TriAttrs {
             uv_f: uv,
             uv_x: uv.map(|t| [0, 1].map(|ax| to_raw(t[ax] - off[ax], &m.uv_fmt, sat))),
             bump: u32::MAX,
-            f32_src: [super::clip_f32::ShadedVertex::default(); 3],
-            f32_half: [0; 2],
+            f32_tri: u32::MAX,
         }
     }
 }

@@ -18,7 +18,7 @@ mod shading;
 mod stats;
 
 pub use geometry::Geometry;
-use shading::{bump_attrs, shade, tri_attrs, ShadeInput};
+use shading::{bump_attrs, f32_tris, shade, tri_attrs, ShadeInput};
 use stats::bump_frames;
 pub use stats::{
     BumpStats, DatapathCost, IssueCycles, RenderStats, Rendered, RoughStats, StageStats, Timings,
@@ -210,7 +210,8 @@ pub fn render(
     let (mut attrs, mut input_sat) = tri_attrs(&setup, &geo, &m0);
     let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
     input_sat.add(&bsat);
-    let m = m0.with_bump_attrs(&battrs);
+    let ftris = f32_tris(&setup, &geo, &m0, &mut attrs);
+    let m = m0.with_bump_attrs(&battrs).with_f32_tris(&ftris);
     tm.setup_ms = ms(t);
     progress("setup", ms(t_start));
 
@@ -317,6 +318,7 @@ pub fn render(
         let mt = Machine::new(hw, &maps.float, &maps.fixed)
             .with_lights(&scene.lights, scene.ambient)
             .with_bump_attrs(&battrs)
+            .with_f32_tris(&ftris)
             .with_ndf_truth(&ndf_truth);
         let tin = ShadeInput {
             vis: &vis,

@@ -4,14 +4,18 @@
 
 use super::Geometry;
 use crate::pipeline::bump::{BumpAttrs, BumpVertex};
-use crate::pipeline::coord_f32;
+use crate::pipeline::clip_f32::ShadedVertex;
+use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
+use crate::raster::ScreenTri;
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
 use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
 use crate::timing::Simulator;
+use glam::DMat4;
 use hw_model::config::CoordArith;
+use hw_model::f32_convert::from_i32;
 use hw_model::fixed::SatCounter;
 use rayon::prelude::*;
 
@@ -97,11 +101,7 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             let mut sat = SatCounter::default();
             let plan = geo.draw_plan[t.src as usize];
             let wrap = geo.plans[plan as usize].wrap;
-            let mut a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
-            if m.hw.interp.coord_arith == CoordArith::Float32 {
-                (a.f32_src, a.f32_half) =
-                    coord_f32::llvmpipe_source(t, geo, setup.width, setup.height);
-            }
+            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
             (a, sat)
         })
         .unzip();
@@ -113,6 +113,61 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             a
         });
     (attrs, sat)
+}
+
+/// llvmpipe's setup of every screen triangle for the float32 coordinate path
+/// (`interp.coord_arith = "float32"`; empty otherwise), once per triangle; sets
+/// `TriAttrs::f32_tri`.
+pub(super) fn f32_tris(
+    setup: &Setup,
+    geo: &Geometry,
+    m: &Machine,
+    attrs: &mut [TriAttrs],
+) -> Vec<F32Tri> {
+    if m.hw.interp.coord_arith != CoordArith::Float32 {
+        return Vec::new();
+    }
+    for (i, a) in attrs.iter_mut().enumerate() {
+        a.f32_tri = i as u32;
+    }
+    setup
+        .tris
+        .par_iter()
+        .map(|t| {
+            let (src, half) = llvmpipe_source(t, geo, setup.width, setup.height);
+            F32Tri::new(src, half)
+        })
+        .collect()
+}
+
+/// The view-projection matrix as binary32 (row-major `m[row][col]`).
+fn matrix_f32(vp: &DMat4) -> [[u32; 4]; 4] {
+    let c = vp.to_cols_array_2d();
+    std::array::from_fn(|r| std::array::from_fn(|k| (c[k][r] as f32).to_bits()))
+}
+
+/// The source triangle of screen triangle `tri` as llvmpipe's vertex shader leaves it (each
+/// vertex through [`shade_vertex`] with its texture coordinates, in draw order) and the
+/// viewport's half sizes: what [`F32Tri::new`] clips and sets up.
+fn llvmpipe_source(
+    tri: &ScreenTri,
+    geo: &Geometry,
+    width: u32,
+    height: u32,
+) -> ([ShadedVertex; 3], [u32; 2]) {
+    let f = |x: f64| (x as f32).to_bits();
+    let d = &geo.draws[tri.src as usize];
+    let mvp = geo.mesa_mvp.map_or_else(
+        || matrix_f32(&geo.view_projection),
+        |m| m.map(|row| row.map(f32::to_bits)),
+    );
+    let src = d.v.map(|vi| {
+        let vi = vi as usize;
+        let st = [f(geo.uv[vi][0]), f(geo.uv[vi][1])];
+        coord_f32::shade_vertex(&mvp, geo.object[vi], st, width, height)
+    });
+    let half = [width / 2, height / 2].map(|h| from_i32(h as i32));
+    (src, half)
 }
 
 /// What the shading pass reads: the visible triangles and everything prepared for them.
