@@ -504,57 +504,36 @@ impl Unit {
     }
 }
 
-/// A pixel's footprints split into runs of one stage (in the order the stages fetched them):
-/// a stage's footprints are the first run of its kind.
-struct StageRuns {
-    /// (stage, start, end) of each run; `n > RUNS` means too many runs to list (search).
-    runs: [(u8, u32, u32); RUNS],
-    n: usize,
-}
+/// `Simulator::pixel` keeps a pixel's fetching stage kinds in a 64-bit mask.
+const _: () = assert!(StageKind::COUNT <= 64);
 
-/// Runs listed per pixel (a pixel with more falls back to searching its footprints).
-const RUNS: usize = 8;
-
-impl StageRuns {
-    #[inline]
-    fn of(fps: &[TexelFootprint]) -> Self {
-        let mut r = Self {
-            runs: [(0, 0, 0); RUNS],
-            n: 0,
-        };
-        for (j, f) in fps.iter().enumerate() {
-            if r.n > 0 && r.n <= RUNS && r.runs[r.n - 1].0 == f.stage {
-                r.runs[r.n - 1].2 = j as u32 + 1;
-                continue;
-            }
-            if r.n < RUNS {
-                r.runs[r.n] = (f.stage, j as u32, j as u32 + 1);
-            }
-            r.n += 1;
-        }
-        r
+/// The footprints stage `k` fetched among a pixel's `fps`: the first run of `k`'s footprints.
+/// Stages record their footprints in their plan's order, so when the plan's stage kinds are
+/// distinct (`in_order`) the run at `cursor` is `k`'s if it is `k`'s at all and everything
+/// before the cursor belongs to earlier stages; the cursor then moves past it. Otherwise the
+/// footprints are searched.
+#[inline]
+fn stage_footprints<'f>(
+    fps: &'f [TexelFootprint],
+    cursor: &mut usize,
+    k: usize,
+    in_order: bool,
+) -> &'f [TexelFootprint] {
+    let run_from = |a: usize| {
+        let b = fps[a..]
+            .iter()
+            .position(|f| usize::from(f.stage) != k)
+            .map_or(fps.len(), |e| a + e);
+        &fps[a..b]
+    };
+    if in_order && fps.get(*cursor).is_some_and(|f| usize::from(f.stage) == k) {
+        let run = run_from(*cursor);
+        *cursor += run.len();
+        return run;
     }
-
-    /// The footprints of the first run of stage `k` (empty if it fetched none).
-    #[inline]
-    fn first_of<'f>(&self, fps: &'f [TexelFootprint], k: usize) -> &'f [TexelFootprint] {
-        if self.n <= RUNS {
-            return self.runs[..self.n]
-                .iter()
-                .find(|r| usize::from(r.0) == k)
-                .map_or(&[], |r| &fps[r.1 as usize..r.2 as usize]);
-        }
-        match fps.iter().position(|f| usize::from(f.stage) == k) {
-            Some(a) => {
-                let b = fps[a..]
-                    .iter()
-                    .position(|f| usize::from(f.stage) != k)
-                    .map_or(fps.len(), |e| a + e);
-                &fps[a..b]
-            }
-            None => &[],
-        }
-    }
+    fps.iter()
+        .position(|f| usize::from(f.stage) == k)
+        .map_or(&[], run_from)
 }
 
 /// The counts of a frame's visibility pass (what the timing model needs beside its pixels).
@@ -599,6 +578,15 @@ pub struct Simulator<'a> {
     /// Pixels and footprints fed so far.
     pixels: u64,
     footprints: u64,
+    /// The next pixel's issue group (`pixels / shade_pixels_per_cycle`), its place in that
+    /// group (`pixels % shade_pixels_per_cycle`) and its ring slot (`pixels % ring.len()`),
+    /// kept incrementally so the per-pixel step divides nothing.
+    group: u64,
+    in_group: u64,
+    slot: usize,
+    /// Per plan: its stage kinds are distinct, so a pixel's footprints (recorded in the
+    /// plan's order) are matched to its stages by one cursor ([`Simulator::pixel`]).
+    distinct: Vec<bool>,
 }
 
 impl<'a> Simulator<'a> {
@@ -629,6 +617,13 @@ impl<'a> Simulator<'a> {
                     .collect()
             })
             .collect();
+        let distinct = plans
+            .iter()
+            .map(|p| {
+                let kinds = p.stages.iter().fold(0u64, |m, &(k, _)| m | 1 << k.index());
+                kinds.count_ones() as usize == p.stages.len()
+            })
+            .collect();
         let win = tc.shade_pixels_in_flight.max(1) as usize;
         Self {
             hw,
@@ -650,6 +645,10 @@ impl<'a> Simulator<'a> {
             end: 0,
             pixels: 0,
             footprints: 0,
+            group: 0,
+            in_group: 0,
+            slot: 0,
+            distinct,
         }
     }
 
@@ -676,43 +675,58 @@ impl<'a> Simulator<'a> {
     pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
         let nk = self.alu.len();
         let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
-        let i = self.pixels;
-        self.pixels += 1;
-        let ppc = self.ppc;
-        let win = self.ring.len() as u64;
-        let next_slot = u64::from(i > 0 && (i / ppc) * ppc == i);
-        let ideal = (i / ppc).max(self.last_issue + next_slot);
+        // Pixel i issues in group i / ppc, one cycle after the previous group's last pixel
+        // when it opens a group (i % ppc == 0, i > 0), and waits for the pixel `win` places
+        // before it (ring slot i % win) to complete.
+        let next_slot = u64::from(self.pixels > 0 && self.in_group == 0);
+        let ideal = self.group.max(self.last_issue + next_slot);
+        let slot = self.slot;
         let mut t = ideal;
-        let slot = (i % win) as usize;
-        if i >= win {
+        if self.pixels >= self.ring.len() as u64 {
             let (done, cause) = self.ring[slot];
             if done > t {
                 self.stall_by[cause] += done - t;
                 t = done;
             }
         }
+        self.pixels += 1;
+        self.in_group += 1;
+        if self.in_group == self.ppc {
+            self.in_group = 0;
+            self.group += 1;
+        }
+        self.slot = if slot + 1 == self.ring.len() {
+            0
+        } else {
+            slot + 1
+        };
         self.last_issue = t;
         let mut worst = (0u64, c_lat);
-        let mut note = |w: u64, cause: usize| {
-            if w > worst.0 {
-                worst = (w, cause);
-            }
-        };
-        let Some(plan) = self.steps.get(plan as usize) else {
+        let pi = plan as usize;
+        let Some(plan) = self.steps.get(pi) else {
             self.ring[slot] = (t, c_lat);
             return;
         };
-        let runs = StageRuns::of(fps);
+        // The stage kinds that fetched (stage kinds number fewer than 64).
+        let fetched = fps.iter().fold(0u64, |m, f| m | 1u64 << (f.stage & 63));
+        let cursor_ok = self.distinct[pi];
+        let mut cursor = 0usize;
         for &(k, cycles, occ) in plan {
-            let mine = runs.first_of(fps, k);
+            let mine = if fetched & (1u64 << k) == 0 {
+                &[][..]
+            } else {
+                stage_footprints(fps, &mut cursor, k, cursor_ok)
+            };
             if mine.is_empty() {
                 let s = self.alu[k].take(t, occ);
-                note(s - t, k);
+                if s - t > worst.0 {
+                    worst = (s - t, k);
+                }
                 t = s + cycles;
                 continue;
             }
             // Texture stage: address/footprint unit, then each lookup through memory + filter.
-            let lookups = u64::from(mine.last().map_or(0, |f| f.lookup) + 1);
+            let lookups = u64::from(mine[mine.len() - 1].lookup) + 1;
             let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
             let setup_occ = if self.alu_pipelined {
                 setup.min(1)
@@ -720,25 +734,31 @@ impl<'a> Simulator<'a> {
                 setup
             };
             let s = self.alu[k].take(t, setup_occ);
-            note(s - t, k);
+            if s - t > worst.0 {
+                worst = (s - t, k);
+            }
             let ready = s + setup;
             let mut done = ready;
-            let mut a = 0;
-            while a < mine.len() {
-                let l = mine[a].lookup;
-                let b = mine[a..]
+            let mut rest = mine;
+            while let Some(first) = rest.first() {
+                let l = first.lookup;
+                let n = rest
                     .iter()
                     .position(|f| f.lookup != l)
-                    .map_or(mine.len(), |e| a + e);
+                    .unwrap_or(rest.len());
+                let (one, tail) = rest.split_at(n);
+                rest = tail;
                 let mut data = ready;
-                for f in &mine[a..b] {
+                for f in one {
                     let (occ, lat, bytes) = self.mem.footprint(f);
                     self.stage_bytes[k] += bytes;
                     let ms = self.mem_unit.take(ready, occ);
-                    note(ms - ready, c_mem);
+                    if ms - ready > worst.0 {
+                        worst = (ms - ready, c_mem);
+                    }
                     data = data.max(ms + lat);
                 }
-                let nfp = (b - a) as u64;
+                let nfp = n as u64;
                 let occ = nfp.div_ceil(self.bpc);
                 let lat = nfp * self.bilinear_lat + if nfp > 1 { self.blend_lat } else { 0 };
                 let filters = &mut self.filters;
@@ -750,9 +770,10 @@ impl<'a> Simulator<'a> {
                         .unwrap_or(0)
                 };
                 let fs = filters[fu].take(data, occ);
-                note(fs - data, c_filt);
+                if fs - data > worst.0 {
+                    worst = (fs - data, c_filt);
+                }
                 done = done.max(fs + lat.max(occ));
-                a = b;
             }
             t = done;
         }
