@@ -20,8 +20,8 @@ pub struct Geometry {
     pub object: Vec<[f32; 3]>,
     /// The view-projection matrix the clip positions come from.
     pub view_projection: DMat4,
-    /// The binary32 model-view-projection Mesa builds for a Mesa anchor scene
-    /// (`scene::gl_matrix::mesa_anchor_mvp`); `None` for other scenes.
+    /// The binary32 model-view-projection of the camera's GL program (`GlView::mvp_f32`: the
+    /// Mesa anchor scenes); `None` for other cameras.
     pub mesa_mvp: Option<crate::scene::gl_matrix::Mat4f>,
     pub color: Vec<[f64; 3]>,
     pub uv: Vec<[f64; 2]>,
@@ -49,7 +49,7 @@ impl Geometry {
             clip: Vec::with_capacity(n),
             object: Vec::with_capacity(n),
             view_projection: vp,
-            mesa_mvp: crate::scene::gl_matrix::mesa_anchor_mvp(&scene.name),
+            mesa_mvp: scene.camera.view_override.and_then(|g| g.mvp_f32),
             color: Vec::with_capacity(n),
             uv: Vec::with_capacity(n),
             draws: Vec::with_capacity(scene.triangle_count()),

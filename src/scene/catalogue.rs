@@ -5,10 +5,11 @@
 use glam::{DMat4, DVec3};
 
 use super::geometry::{fit_camera, fit_light};
+use super::gl_matrix::{self, Mat4f};
 use super::texture::{
     bricks_height, checker, mesa_texture, procedural, ripples_height, MESA_TEX_SIZE,
 };
-use super::{shapes, Camera, Light, MainDirection, Material, Mesh, Scene, WrapMode};
+use super::{shapes, Camera, GlView, Light, MainDirection, Material, Mesh, Scene, WrapMode};
 use crate::{Error, Result};
 
 /// Built-in scene names with a one-line description (for `texsim scenes`).
@@ -74,8 +75,9 @@ pub fn builtin(name: &str) -> Result<Scene> {
     Ok(scene)
 }
 
-/// A camera with an exact view matrix; eye/target/up are derived from it for display only.
-fn camera_from_view(view: DMat4, fov_y_deg: f64, near: f64, far: f64) -> Camera {
+/// A camera with an exact view matrix and the binary32 model-view-projection Mesa builds for
+/// it; eye/target/up are derived from the view for display only.
+fn camera_from_view(view: DMat4, mvp_f32: Mat4f, fov_y_deg: f64, near: f64, far: f64) -> Camera {
     let inv = view.inverse();
     let eye = inv.transform_point3(DVec3::ZERO);
     let target = eye + inv.transform_vector3(DVec3::NEG_Z);
@@ -87,7 +89,10 @@ fn camera_from_view(view: DMat4, fov_y_deg: f64, near: f64, far: f64) -> Camera 
         fov_y_deg,
         near,
         far,
-        view_override: Some(view),
+        view_override: Some(GlView {
+            view,
+            mvp_f32: Some(mvp_f32),
+        }),
     }
 }
 
@@ -154,7 +159,7 @@ fn w1_plane() -> Scene {
     mesa_scene(
         "w1-plane",
         mesh,
-        camera_from_view(w1_view(), 60.0, 0.1, 1000.0),
+        camera_from_view(w1_view(), gl_matrix::w1_plane_mvp(), 60.0, 0.1, 1000.0),
     )
 }
 
@@ -165,7 +170,7 @@ fn w2_mesh() -> Scene {
     mesa_scene(
         "w2-mesh",
         mesh,
-        camera_from_view(w2_view(), 45.0, 1.0, 10.0),
+        camera_from_view(w2_view(), gl_matrix::w2_mesh_mvp(), 45.0, 1.0, 10.0),
     )
 }
 

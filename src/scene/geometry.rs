@@ -195,7 +195,11 @@ pub fn validate(scene: &Scene) -> Result<()> {
         ));
     }
     match cam.view_override {
-        Some(v) if !v.is_finite() => {
+        Some(v)
+            if !v.view.is_finite()
+                || v.mvp_f32
+                    .is_some_and(|m| !m.iter().flatten().all(|x| x.is_finite())) =>
+        {
             return Err(Error::field("camera.view_override", "must be finite"));
         }
         Some(_) => {}

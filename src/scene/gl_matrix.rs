@@ -70,25 +70,25 @@ pub fn translate(m: &Mat4f, x: f64, y: f64, z: f64) -> Mat4f {
     out
 }
 
-/// The model-view-projection matrix Mesa computes for the anchor scene `name` (`w1-plane`,
-/// `w2-mesh`: the GL calls of `shared/anchors/mesa/mesa_anchor.c`), or `None`.
+/// The model-view-projection matrix Mesa computes for the W1 anchor (the GL calls of
+/// `shared/anchors/mesa/mesa_anchor.c`): `glFrustum(-top, top, -top, top, 0.1, 1000)` with
+/// `top = 0.1 tan 30 deg`, `glRotated(10, 1,0,0)`, `glTranslated(0,-1,0)`.
 #[must_use]
-pub fn mesa_anchor_mvp(name: &str) -> Option<Mat4f> {
-    let (p, mv) = match name {
-        "w1-plane" => {
-            let top = 0.1 * (30.0 * std::f64::consts::PI / 180.0).tan();
-            let p = frustum(-top, top, -top, top, 0.1, 1000.0);
-            let mv = translate(&rotate_axis(&IDENTITY, 10.0, 0), 0.0, -1.0, 0.0);
-            (p, mv)
-        }
-        "w2-mesh" => {
-            let top = (22.5 * std::f64::consts::PI / 180.0).tan();
-            let p = frustum(-top, top, -top, top, 1.0, 10.0);
-            let mv = translate(&IDENTITY, 0.0, 0.0, -3.2);
-            let mv = rotate_axis(&rotate_axis(&mv, -50.0, 0), 20.0, 2);
-            (p, mv)
-        }
-        _ => return None,
-    };
-    Some(mul(&p, &mv))
+pub fn w1_plane_mvp() -> Mat4f {
+    let top = 0.1 * (30.0 * std::f64::consts::PI / 180.0).tan();
+    let p = frustum(-top, top, -top, top, 0.1, 1000.0);
+    let mv = translate(&rotate_axis(&IDENTITY, 10.0, 0), 0.0, -1.0, 0.0);
+    mul(&p, &mv)
+}
+
+/// The model-view-projection matrix Mesa computes for the W2 anchor: `glFrustum` with
+/// `top = tan 22.5 deg`, near 1, far 10, `glTranslated(0,0,-3.2)`, `glRotated(-50, 1,0,0)`,
+/// `glRotated(20, 0,0,1)`.
+#[must_use]
+pub fn w2_mesh_mvp() -> Mat4f {
+    let top = (22.5 * std::f64::consts::PI / 180.0).tan();
+    let p = frustum(-top, top, -top, top, 1.0, 10.0);
+    let mv = translate(&IDENTITY, 0.0, 0.0, -3.2);
+    let mv = rotate_axis(&rotate_axis(&mv, -50.0, 0), 20.0, 2);
+    mul(&p, &mv)
 }

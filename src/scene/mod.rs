@@ -414,9 +414,19 @@ pub struct Camera {
     pub fov_y_deg: f64,
     pub near: f64,
     pub far: f64,
-    /// If set, this exact view matrix is used instead of eye/target/up (the Mesa anchor scenes
-    /// reproduce a fixed-function GL modelview this way).
-    pub view_override: Option<DMat4>,
+    /// If set, this fixed-function GL camera is used instead of eye/target/up (the Mesa
+    /// anchor scenes reproduce their GL modelview this way).
+    pub view_override: Option<GlView>,
+}
+
+/// A fixed-function GL camera: its exact view matrix and, when the scene reproduces a GL
+/// program, the binary32 model-view-projection that program's matrix stack computes
+/// ([`gl_matrix`]), which llvmpipe's float32 vertex transform starts from
+/// (`interp.coord_arith = "float32"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlView {
+    pub view: DMat4,
+    pub mvp_f32: Option<gl_matrix::Mat4f>,
 }
 
 impl Camera {
@@ -424,7 +434,7 @@ impl Camera {
     #[must_use]
     pub fn view(&self) -> DMat4 {
         if let Some(v) = self.view_override {
-            return v;
+            return v.view;
         }
         DMat4::look_at_rh(
             DVec3::from(self.eye),

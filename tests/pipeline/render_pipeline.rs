@@ -277,6 +277,42 @@ fn golden_fixed_image_of_w1_plane() {
 
 const GOLDEN_W1_128: u64 = 0xc1b4_a43b_8bcf_66b8;
 
+/// Mesa's binary32 matrices come with the anchor scenes' cameras, not with their names: the
+/// built-in W1 and W2 carry them, and a scene that is only named `w1-plane` is transformed by
+/// its own camera (the float32 vertex transform then starts from its view-projection).
+#[test]
+fn mesa_matrices_belong_to_the_anchor_cameras_not_to_scene_names() {
+    use texsim::scene::gl_matrix;
+    for (name, mvp) in [
+        ("w1-plane", gl_matrix::w1_plane_mvp()),
+        ("w2-mesh", gl_matrix::w2_mesh_mvp()),
+    ] {
+        let s = scene::builtin(name).expect("scene");
+        assert_eq!(s.camera.view_override.and_then(|g| g.mvp_f32), Some(mvp));
+    }
+    let hw = hw_model::HwConfig::preset("llvmpipe").expect("preset");
+    let opts = RenderOptions {
+        reference: false,
+        ..Default::default()
+    };
+    let run = |s: &Scene| {
+        let maps = Maps::new(s, hw.trilinear.texel_bits);
+        render(s, &maps, &hw, &opts).expect("render").hw_image.px
+    };
+    let mut s = small("w1-plane", 64, 64);
+    let anchored = run(&s);
+    s.name = "user".into();
+    assert_eq!(run(&s), anchored, "the matrices do not follow the name");
+    s.camera.view_override = s.camera.view_override.map(|g| scene::GlView {
+        mvp_f32: None,
+        ..g
+    });
+    let own = run(&s);
+    s.name = "w1-plane".into();
+    assert_eq!(run(&s), own, "a user scene named w1-plane keeps its own transform");
+    assert_ne!(own, anchored, "Mesa's float32 product differs from the f64 one here");
+}
+
 /// The llvmpipe preset on a small W1: its image lies on the 8-bit grid (8-bit texels,
 /// GL_REPLACE), and the LOD per 2x2 quad changes pixels against per-pixel derivatives.
 #[test]
