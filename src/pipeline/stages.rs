@@ -339,7 +339,10 @@ pub(crate) fn unorm(raw: u32, bits: u32) -> f64 {
 }
 
 /// Runs the compiled plan `prog` of `plan` on one fragment at pixel (`x`, `y`) of `tri`; the
-/// result is in `frag.out` (and `frag.out_x` when the last stage was Fixed).
+/// result is in `frag.out` (and `frag.out_x` when the last stage was Fixed). The stages'
+/// invocations and planned costs are not counted here: the caller counts the fragments of
+/// each program and charges them once ([`Program::charge`]); a stage whose cost departs from
+/// the plan (footprint assembly's adaptive probes) adds the difference to `c` itself.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn run(
@@ -369,11 +372,6 @@ pub fn run(
         carriers: prog.carriers,
     };
     for op in &prog.ops {
-        let k = op.kind.index();
-        c.invocations[k] += 1;
-        c.cost[k][0] += u64::from(op.cost.ops);
-        c.cost[k][1] += u64::from(op.cost.cycles);
-        c.cost[k][2] += u64::from(op.cost.texels);
         (op.run)(&px, frag, c);
     }
 }

@@ -298,6 +298,22 @@ pub struct Program {
 }
 
 impl Program {
+    /// Counts `fragments` runs of this program into `c`: each stage's invocations and its
+    /// planned cost per invocation (the per-fragment [`super::stages::run`] counts neither).
+    /// Costs add modulo 2^64, because a stage that charged a fragment less than planned
+    /// (`trilinear`'s adaptive probes) may have taken the difference from `c` before the
+    /// charge; the charged totals are the true, non-negative sums.
+    pub fn charge(&self, fragments: u64, c: &mut Counters) {
+        for op in &self.ops {
+            let k = op.kind.index();
+            c.invocations[k] += fragments;
+            let cost = [op.cost.ops, op.cost.cycles, op.cost.texels];
+            for (acc, per) in c.cost[k].iter_mut().zip(cost) {
+                *acc = acc.wrapping_add(fragments.wrapping_mul(u64::from(per)));
+            }
+        }
+    }
+
     /// Compiles `plan` with the twins `impls` on the machine `m`.
     #[must_use]
     pub fn new(plan: &Plan, impls: &StageImpls, m: &Machine) -> Self {

@@ -114,10 +114,18 @@ fn per_pixel_probes(acc: [u64; 3], m: &Machine, probes: u32) -> [u64; 3] {
     let cost = |n: u32| m.footprint_costs[(n.clamp(1, 16).ilog2()) as usize];
     let planned = cost(m.hw.trilinear.aniso_probes);
     let took = cost(probes);
+    // Modulo 2^64: the planned cost is charged per program after the fragments ran
+    // (`Program::charge`), so the running sum may dip below it meanwhile.
     [
-        acc[0] - u64::from(planned.ops) + u64::from(took.ops),
-        acc[1] - u64::from(planned.cycles) + u64::from(took.cycles),
-        acc[2] - u64::from(planned.texels) + u64::from(took.texels),
+        acc[0]
+            .wrapping_sub(u64::from(planned.ops))
+            .wrapping_add(u64::from(took.ops)),
+        acc[1]
+            .wrapping_sub(u64::from(planned.cycles))
+            .wrapping_add(u64::from(took.cycles)),
+        acc[2]
+            .wrapping_sub(u64::from(planned.texels))
+            .wrapping_add(u64::from(took.texels)),
     ]
 }
 

@@ -196,12 +196,22 @@ pub(super) fn shade_row(
     let mut frag = Frag::default();
     frag.trace.on = trace;
     let tris = &inp.vis.tri[y * w..(y + 1) * w];
+    // The fragments of each run of one program, charged when the run ends.
+    let mut run_of: Option<(usize, u64)> = None;
     for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
         if t == NO_TRI {
             continue;
         }
         let a = &inp.attrs[t as usize];
         let pi = a.plan as usize;
+        match &mut run_of {
+            Some((p, n)) if *p == pi => *n += 1,
+            _ => {
+                if let Some((p, n)) = run_of.replace((pi, 1)) {
+                    progs[p].charge(n, c);
+                }
+            }
+        }
         let tri = &inp.setup.tris[t as usize];
         let plan = &inp.geo.plans[pi];
         run(
@@ -209,6 +219,9 @@ pub(super) fn shade_row(
         );
         *out = output16(&frag);
         on_pixel(a.plan, t, &frag);
+    }
+    if let Some((p, n)) = run_of {
+        progs[p].charge(n, c);
     }
 }
 

@@ -144,7 +144,12 @@ impl Cache {
     /// Looks up line `key` (set = key mod sets); on a miss the line is filled, evicting the
     /// least recently used way. Returns true on a hit.
     pub fn access(&mut self, key: u64) -> bool {
-        let s = (key % self.sets) as usize * self.ways;
+        let set_index = if self.sets.is_power_of_two() {
+            key & (self.sets - 1)
+        } else {
+            key % self.sets
+        };
+        let s = set_index as usize * self.ways;
         let set = &mut self.tags[s..s + self.ways];
         // Move the line to the front: ways are few, so shift them one by one.
         let (last, hit) = match set.iter().position(|&t| t == key) {
@@ -759,7 +764,12 @@ impl<'a> Simulator<'a> {
                     data = data.max(ms + lat);
                 }
                 let nfp = n as u64;
-                let occ = nfp.div_ceil(self.bpc);
+                // `ceil(nfp / bpc)`; a shift when `bpc` is a power of two (no division).
+                let occ = if self.bpc.is_power_of_two() {
+                    (nfp + self.bpc - 1) >> self.bpc.trailing_zeros()
+                } else {
+                    nfp.div_ceil(self.bpc)
+                };
                 let lat = nfp * self.bilinear_lat + if nfp > 1 { self.blend_lat } else { 0 };
                 let filters = &mut self.filters;
                 let fu = if filters.len() == 1 {

@@ -303,14 +303,21 @@ fn mesa_matrices_belong_to_the_anchor_cameras_not_to_scene_names() {
     let anchored = run(&s);
     s.name = "user".into();
     assert_eq!(run(&s), anchored, "the matrices do not follow the name");
-    s.camera.view_override = s.camera.view_override.map(|g| scene::GlView {
-        mvp_f32: None,
-        ..g
-    });
+    s.camera.view_override = s
+        .camera
+        .view_override
+        .map(|g| scene::GlView { mvp_f32: None, ..g });
     let own = run(&s);
     s.name = "w1-plane".into();
-    assert_eq!(run(&s), own, "a user scene named w1-plane keeps its own transform");
-    assert_ne!(own, anchored, "Mesa's float32 product differs from the f64 one here");
+    assert_eq!(
+        run(&s),
+        own,
+        "a user scene named w1-plane keeps its own transform"
+    );
+    assert_ne!(
+        own, anchored,
+        "Mesa's float32 product differs from the f64 one here"
+    );
 }
 
 /// The llvmpipe preset on a small W1: its image lies on the 8-bit grid (8-bit texels,
