@@ -43,6 +43,20 @@ pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
     fmt.fit(r as i64, sat)
 }
 
+/// `x` as a raw value with `frac` fraction bits (at most 62), rounded to nearest with ties up:
+/// [`to_raw`] into the widest signed format (saturating at +-2^62), 0 for a non-finite `x`.
+/// For values with no declared hardware format: the fixed parameters a plan quantizes once
+/// (scales, light directions), the addresses a float twin traces, the inputs of unit tests.
+#[must_use]
+pub fn to_raw_nearest(x: f64, frac: u32) -> i64 {
+    if !x.is_finite() {
+        return 0;
+    }
+    let frac = frac.min(62);
+    let widest = Format::signed(62 - frac, frac, Rounding::HalfUp);
+    to_raw(x, &widest, &mut SatCounter::default())
+}
+
 /// `raw * 2^-frac_bits` (exact for |raw| <= 2^53).
 #[inline]
 #[must_use]

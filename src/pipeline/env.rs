@@ -69,7 +69,7 @@ pub fn resolve_plans(plans: &mut [Plan], hw: &HwConfig, first_map: usize) -> Vec
             .bump
             .as_ref()
             .map_or(1, |b| hw.roughness.exponent(b.shininess).max(1));
-        ep.d_scale_q16 = (65536.0 / f64::from(exponent).sqrt()).round() as i64;
+        ep.d_scale_q16 = crate::fixedpoint::to_raw_nearest(1.0 / f64::from(exponent).sqrt(), 16);
         let key = (ep.size, ep.source);
         let k = sizes.iter().position(|&s| s == key).unwrap_or_else(|| {
             sizes.push(key);

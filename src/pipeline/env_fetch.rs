@@ -297,19 +297,11 @@ pub fn float(px: &Px, frag: &mut Frag, c: &mut Counters) {
         if frag.trace.on {
             // The footprints the hardware fetches for this footprint in its formats.
             let ec = &m.hw.env;
-            let one = f64::from(1u32 << ec.face_coord_bits);
-            let lf = f64::from(1u32 << m.hw.lod.lod_frac_bits);
-            let q = |x: f64| {
-                if x.is_finite() {
-                    (x * one).round() as i64
-                } else {
-                    0
-                }
-            };
+            let q = |x: f64| crate::fixedpoint::to_raw_nearest(x, ec.face_coord_bits);
             let fx = hw_model::footprint::Footprint {
                 probes: fp.probes,
                 axis: fp.axis.map(q),
-                lod: (fp.lod * lf).floor() as i64,
+                lod: to_raw(fp.lod, &m.lod_fmt, &mut SatCounter::default()),
             };
             let t = ep.map + usize::from(face);
             let (s0, t0) = (q(st0[0]), q(st0[1]));

@@ -81,7 +81,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let kd = bp.kd.map(|x| to_unorm(x, cb));
     let ks = bp.ks.map(|x| to_unorm(x, cb));
     let ndf_f = hw.ndf.ndf_frac_bits;
-    let scale_q = (spec_scale * f64::from(1u32 << 30)).round() as i64;
+    let scale_q = crate::fixedpoint::to_raw_nearest(spec_scale, 30);
     let mut acc = [0u64; 3];
     for ch in 0..3 {
         acc[ch] = u64::from(modulate(m.ambient_x[ch] as u32, cb, kd[ch], cb, cb, rnd));

@@ -572,8 +572,7 @@ pub fn ground_truth(
 /// `h` (unit) to the fixed unit's W = `NDF_FRAC` fraction bits.
 #[must_use]
 pub fn h_to_fixed(h: DVec3) -> [i64; 3] {
-    let s = f64::from(NDF_FRAC).exp2();
-    [h.x, h.y, h.z].map(|c| (c * s).round() as i64)
+    [h.x, h.y, h.z].map(|c| crate::fixedpoint::to_raw_nearest(c, NDF_FRAC))
 }
 
 /// The fixed unit's `h` back to float (exact).

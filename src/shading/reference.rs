@@ -39,26 +39,18 @@ pub struct NaturalVertex {
     pub len_v: f64,
 }
 
-/// Raw fixed value with `frac` fraction bits, rounded to nearest (ties away), not clamped.
-#[must_use]
-pub fn to_fixed(x: f64, frac: u32) -> i64 {
-    if !x.is_finite() {
-        return 0;
-    }
-    (x * f64::from(frac).exp2()).round() as i64
-}
-
 /// Value of a raw fixed number with `frac` fraction bits.
 #[must_use]
 pub fn from_fixed(r: i64, frac: u32) -> f64 {
     r as f64 * (-f64::from(frac)).exp2()
 }
 
-/// A float vector into vector format (s1.F), rounded to nearest and clamped to the format.
+/// A float vector into vector format (s1.F), rounded to nearest (ties up) and clamped to the
+/// format (a non-finite component gives 0).
 #[must_use]
 pub fn to_vec3x(v: DVec3, frac: u32) -> Vec3x {
     let lim = (1i64 << (frac + 1)) - 1;
-    [v.x, v.y, v.z].map(|c| to_fixed(c, frac).clamp(-lim - 1, lim))
+    [v.x, v.y, v.z].map(|c| crate::fixedpoint::to_raw_nearest(c, frac).clamp(-lim - 1, lim))
 }
 
 /// A raw vector with `frac` fraction bits as float.

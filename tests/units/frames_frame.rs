@@ -189,7 +189,10 @@ fn unit_and_natural_frames_match_twin() {
         let du = s.dir() * (0.1 + s.unit());
         let dv = s.dir() * (0.1 + s.unit());
         let (lu, lv) = (4.0 * s.unit(), 4.0 * s.unit());
-        let (lur, lvr) = (r::to_fixed(lu, lfb), r::to_fixed(lv, lfb));
+        let (lur, lvr) = (
+            texsim::fixedpoint::to_raw_nearest(lu, lfb),
+            texsim::fixedpoint::to_raw_nearest(lv, lfb),
+        );
         let fr = natural_frame(&q(n_i), &q(du), &q(dv), lur, lvr, &u, &mut sat);
         let tw = r::natural_frame(d(&q(n_i)), d(&q(du)), d(&q(dv)), lu, lv, 6);
         for (a, b) in [(fr.n, tw.n), (fr.t_u, tw.t_u), (fr.t_v, tw.t_v)] {
@@ -225,11 +228,11 @@ fn perturbed_normal_matches_twin() {
         };
         let mut fr: Frame = main_frame(&q(n_i), &q(m), role, &u, &mut sat);
         if natural {
-            fr.len_u = r::to_fixed(0.25 + 2.0 * s.unit(), lfb);
-            fr.len_v = r::to_fixed(0.25 + 2.0 * s.unit(), lfb);
+            fr.len_u = texsim::fixedpoint::to_raw_nearest(0.25 + 2.0 * s.unit(), lfb);
+            fr.len_v = texsim::fixedpoint::to_raw_nearest(0.25 + 2.0 * s.unit(), lfb);
         }
-        let fu = r::to_fixed(4.0 * s.unit() - 2.0, o);
-        let fv = r::to_fixed(4.0 * s.unit() - 2.0, o);
+        let fu = texsim::fixedpoint::to_raw_nearest(4.0 * s.unit() - 2.0, o);
+        let fv = texsim::fixedpoint::to_raw_nearest(4.0 * s.unit() - 2.0, o);
         let p = perturb_normal(&fr, fu, fv, &u, &mut sat);
         let tw = r::FrameF {
             n: d(&fr.n),
@@ -291,8 +294,8 @@ fn main_frame_roles_equal_unit_frame() {
         assert_eq!(n.dot(pu.cross(pv)) < 0.0, mirrored);
         let (du, dv) = (n.cross(pv).normalize(), pu.cross(n).normalize());
         let n_i = n * (0.3 + s.unit());
-        let fu = r::to_fixed(2.0 * s.unit() - 1.0, o);
-        let fv = r::to_fixed(2.0 * s.unit() - 1.0, o);
+        let fu = texsim::fixedpoint::to_raw_nearest(2.0 * s.unit() - 1.0, o);
+        let fv = texsim::fixedpoint::to_raw_nearest(2.0 * s.unit() - 1.0, o);
         let uf = unit_frame(&q(n_i), &q(du), &q(dv), &u, &mut sat);
         let want = perturb_normal(&uf, fu, fv, &u, &mut sat);
         let tw_unit = r::unit_frame(n_i, du, dv, t);
@@ -414,13 +417,19 @@ fn natural_length_saturation_is_counted() {
         &q(DVec3::Z),
         &q(-DVec3::X),
         &q(-DVec3::Y),
-        r::to_fixed(200.0, lfb),
-        r::to_fixed(1000.0, lfb),
+        texsim::fixedpoint::to_raw_nearest(200.0, lfb),
+        texsim::fixedpoint::to_raw_nearest(1000.0, lfb),
         &u,
         &mut sat,
     );
     assert_eq!(sat.saturated, 1, "length 1000 exceeds u8.8");
-    let p = perturb_normal(&fr, r::to_fixed(0.5, o), 0, &u, &mut sat);
+    let p = perturb_normal(
+        &fr,
+        texsim::fixedpoint::to_raw_nearest(0.5, o),
+        0,
+        &u,
+        &mut sat,
+    );
     assert_eq!(sat.saturated, 2, "0.5 * 200 exceeds the s3.12 offset range");
     // The offset saturates to 8 - 2^-12 and multiplies t_u = -x.
     let want = DVec3::new(-(8.0 - (-12f64).exp2()), 0.0, 1.0).normalize();
