@@ -253,10 +253,9 @@ fn perspective_bary_derivs_narrow<M: ConstRounding>(
         .fold(d as u64, |m, v| m | v.unsigned_abs());
     let shift = (64 - mag.leading_zeros()).saturating_sub(62);
     let ds = d >> shift;
-    let mut out = [p, p, p];
     if ds <= 0 {
         sat.saturated += 1;
-        return Some(out);
+        return Some([p, p, p]);
     }
     let r = if ds as u64 == dn {
         r0
@@ -264,20 +263,32 @@ fn perspective_bary_derivs_narrow<M: ConstRounding>(
         recip.eval(ds as u64, sat)
     };
     let r2 = square(r, recip.config().recip_mantissa_bits, M::MODE);
-    let one = 1i64 << cfg.bary_bits;
-    let wide_ds = i128::from(ds);
-    let (qs1, qs2) = (i128::from(q[1] >> shift), i128::from(q[2] >> shift));
-    for (k, (a, sum)) in [(ax, sx), (ay, sy)].into_iter().enumerate() {
-        let ss = i128::from(sum >> shift);
-        // Exact 64x64 -> 128-bit products of operands of at most 62 bits.
-        let n1 = i128::from(a[1] >> shift) * wide_ds - qs1 * ss;
-        let n2 = i128::from(a[2] >> shift) * wide_ds - qs2 * ss;
-        let dp1 = derivative::<M>(n1, r2, cfg.bary_bits, sat);
-        let dp2 = derivative::<M>(n2, r2, cfg.bary_bits, sat);
-        let (b1, b2) = (p[1] + dp1, p[2] + dp2);
-        out[k + 1] = [one - b1 - b2, b1, b2];
-    }
-    Some(out)
+    let scaled = ([q[1] >> shift, q[2] >> shift], ds, shift);
+    let bx = axis_derivs::<M>(p, ax, sx, scaled, r2, cfg.bary_bits, sat);
+    let by = axis_derivs::<M>(p, ay, sy, scaled, r2, cfg.bary_bits, sat);
+    Some([p, bx, by])
+}
+
+/// The barycentrics of the neighbour along one screen axis, `p + dp`: the numerators
+/// `N_i = a_i D - q_i S` of the per-axis `a_i` and `S = sum`, from the scaled `q_1`, `q_2`
+/// and `D` (`scaled`, with their common `shift`), as exact 64x64 -> 128-bit products of
+/// operands of at most 62 bits, each through [`derivative`].
+#[inline(always)]
+fn axis_derivs<M: ConstRounding>(
+    p: [i64; 3],
+    a: [i64; 3],
+    sum: i64,
+    (q, ds, shift): ([i64; 2], i64, u32),
+    r2: Recip,
+    bary_bits: u32,
+    sat: &mut SatCounter,
+) -> [i64; 3] {
+    let (ss, wide_ds) = (i128::from(sum >> shift), i128::from(ds));
+    let n1 = i128::from(a[1] >> shift) * wide_ds - i128::from(q[0]) * ss;
+    let n2 = i128::from(a[2] >> shift) * wide_ds - i128::from(q[1]) * ss;
+    let b1 = p[1] + derivative::<M>(n1, r2, bary_bits, sat);
+    let b2 = p[2] + derivative::<M>(n2, r2, bary_bits, sat);
+    [(1i64 << bary_bits) - b1 - b2, b1, b2]
 }
 
 /// One derivative `N / D^2` from the exact numerator `n` and `r2 = 1/D^2`: `N` keeps its top

@@ -174,7 +174,7 @@ fn nr_step(m: i64, y: i64, two: i64, p: u32, rnd: Rounding) -> i64 {
 
 /// `r * r` with its mantissa rounded once back to `m_bits + 1` significant bits (relative
 /// error of the square: `2 e_r + 2^-(m_bits+1)`).
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn square(r: Recip, m_bits: u32, mode: Rounding) -> Recip {
     let (drop, mut mant) = if r.mant >> 31 == 0 {
