@@ -405,27 +405,26 @@ fn interpolate_pairs_in<M: ConstRounding>(
     sat: &mut SatCounter,
     result: &mut [[i64; 2]],
 ) {
-    let columns = [0, 1].map(|ax| [attr[0][ax], attr[1][ax], attr[2][ax]]);
     // The sample-independent terms `a0 2^B`, `a1 - a0`, `a2 - a0` once per attribute; an
     // accumulator that leaves `i64` takes `interpolate`'s exact wide path.
-    let terms = |c: [i64; 3]| {
+    let terms = |ax: usize| {
+        let a0 = attr[0][ax];
         Some((
-            c[0].checked_mul(1i64.checked_shl(bary_bits)?)?,
-            c[1].checked_sub(c[0])?,
-            c[2].checked_sub(c[0])?,
+            a0.checked_mul(1i64.checked_shl(bary_bits)?)?,
+            attr[1][ax].checked_sub(a0)?,
+            attr[2][ax].checked_sub(a0)?,
         ))
     };
-    let (Some((t0u, d1u, d2u)), Some((t0v, d1v, d2v))) = (terms(columns[0]), terms(columns[1]))
-    else {
+    let (Some((t0u, d1u, d2u)), Some((t0v, d1v, d2v))) = (terms(0), terms(1)) else {
         for (b, r) in bary.iter().zip(result.iter_mut()) {
-            *r = [0, 1].map(|ax| interpolate_cold::<M>(b, bary_bits, &columns[ax], out, sat));
+            *r = [0, 1].map(|ax| interpolate_cold::<M>(b, bary_bits, &attr, ax, out, sat));
         }
         return;
     };
     let range = (out.min_raw(), out.max_raw());
     for (b, r) in bary.iter().zip(result.iter_mut()) {
-        r[0] = interpolate_terms::<M>(b, (t0u, d1u, d2u), bary_bits, range, &columns[0], out, sat);
-        r[1] = interpolate_terms::<M>(b, (t0v, d1v, d2v), bary_bits, range, &columns[1], out, sat);
+        r[0] = interpolate_terms::<M>(b, (t0u, d1u, d2u), bary_bits, range, (&attr, 0), out, sat);
+        r[1] = interpolate_terms::<M>(b, (t0v, d1v, d2v), bary_bits, range, (&attr, 1), out, sat);
     }
 }
 
@@ -439,7 +438,7 @@ fn interpolate_terms<M: ConstRounding>(
     (t0, d1, d2): (i64, i64, i64),
     bary_bits: u32,
     (lo, hi): (i64, i64),
-    column: &[i64; 3],
+    (attr, ax): (&[[i64; 2]; 3], usize),
     out: &Format,
     sat: &mut SatCounter,
 ) -> i64 {
@@ -448,7 +447,7 @@ fn interpolate_terms<M: ConstRounding>(
     let (s1, o3) = t0.overflowing_add(p1);
     let (acc, o4) = s1.overflowing_add(p2);
     if o1 | o2 | o3 | o4 {
-        return interpolate_cold::<M>(b, bary_bits, column, out, sat);
+        return interpolate_cold::<M>(b, bary_bits, attr, ax, out, sat);
     }
     let v = round_shift_right(acc, bary_bits, M::MODE);
     if v >= lo && v <= hi {
@@ -458,17 +457,20 @@ fn interpolate_terms<M: ConstRounding>(
     }
 }
 
-/// [`interpolate_in`] out of line: the rare accumulators beyond `i64`.
+/// [`interpolate_in`] of the attribute `ax` of `attr` out of line: the rare accumulators
+/// beyond `i64`.
 #[cold]
 #[inline(never)]
 fn interpolate_cold<M: ConstRounding>(
     bary: &[i64; 3],
     bary_bits: u32,
-    attr: &[i64; 3],
+    attr: &[[i64; 2]; 3],
+    ax: usize,
     out: &Format,
     sat: &mut SatCounter,
 ) -> i64 {
-    interpolate_in::<M>(*bary, bary_bits, *attr, out, sat)
+    let column = [attr[0][ax], attr[1][ax], attr[2][ax]];
+    interpolate_in::<M>(*bary, bary_bits, column, out, sat)
 }
 
 /// [`interpolate`] compiled for the rounding mode `M` (`out.rounding`).
