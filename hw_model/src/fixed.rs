@@ -221,9 +221,14 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     if shift >= 64 {
         return round_shift_right_wide(i128::from(x), shift, mode);
     }
+    round_shift_right_narrow(x, shift, mode)
+}
+
+/// [`round_shift_right`] for a `shift` in 1..=63: the floor plus the carry out of the dropped
+/// bits, left-aligned in 64 bits (one half = 2^63), when [`round_bias`] is added to them.
+#[inline(always)]
+fn round_shift_right_narrow(x: i64, shift: u32, mode: Rounding) -> i64 {
     let floor = x >> shift;
-    // The dropped bits, left-aligned: one half is 2^63, and their carry out of 64 bits when
-    // the bias is added is the decision.
     let rem = (x as u64) << (64 - shift);
     floor + i64::from(rem.overflowing_add(round_bias(floor & 1 == 1, mode)).1)
 }
@@ -301,9 +306,35 @@ const fn round_up(above_half: bool, half: bool, odd: bool, mode: Rounding) -> bo
 
 /// `round_shift_right` for `i128` accumulators, result saturated to `i64`. Exact for every
 /// `i128` input and every `shift` (shifts of 128 or more behave as the exact quotient).
+///
+/// When the quotient fits `i64` with two bits to spare, the 64-bit routine decides: `x` is
+/// shifted right by all but two of the dropped bits (by `shift - 2` below 64, by 62 from 64
+/// to 125) and the bits shifted out are ORed, as one sticky bit, into the lowest bit left.
+/// The floor, the half bit and whether anything below the half is set are unchanged, so is
+/// the decision of every mode.
 #[inline(always)]
 #[must_use]
 pub fn round_shift_right_wide(x: i128, shift: u32, mode: Rounding) -> i64 {
+    if (2..64).contains(&shift) {
+        let pre = shift - 2;
+        let sticky = (x as u64) & ((1u64 << pre) - 1) != 0;
+        // `pre` < 62: the shift is a 64-bit funnel shift.
+        if let Ok(y) = i64::try_from(x >> (pre & 63)) {
+            return round_shift_right_narrow(y | i64::from(sticky), 2, mode);
+        }
+    } else if (64..126).contains(&shift) {
+        let sticky = (x as u64) << 2 != 0;
+        if let Ok(y) = i64::try_from(x >> 62) {
+            return round_shift_right_narrow(y | i64::from(sticky), shift - 62, mode);
+        }
+    }
+    round_shift_right_wide_any(x, shift, mode)
+}
+
+/// [`round_shift_right_wide`] for every input: the floor and the carry of the dropped bits
+/// in 128-bit arithmetic, then the saturation to `i64`.
+#[inline(never)]
+fn round_shift_right_wide_any(x: i128, shift: u32, mode: Rounding) -> i64 {
     let v = if shift == 0 {
         x
     } else if shift >= 128 {
@@ -507,5 +538,55 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// 4M seeded cases of every shift 0..=129 and mode: `round_shift_right_wide` (its two
+    /// 64-bit paths with the sticky bit, and the 128-bit one) gives the exact 128-bit
+    /// routine's result, around the paths' bounds (quotients near 2^61 and 2^63, shifts 1, 2,
+    /// 63, 64, 125, 126), with ties, near ties and sticky bits far below the half; each
+    /// 64-bit path is taken many times.
+    #[test]
+    fn round_shift_right_wide_fast_paths_match_the_exact_routine() {
+        let mut s = 0x5eed_0007;
+        let (mut below64, mut from64, mut exact) = (0u32, 0u32, 0u32);
+        for i in 0..4_000_000u32 {
+            let shift = match i % 10 {
+                0 => [0, 1, 2, 63, 64, 65, 125, 126, 127, 128][(i / 10 % 10) as usize],
+                _ => (next(&mut s) % 130) as u32,
+            };
+            // A quotient of about `qb` bits, then the dropped bits.
+            let qb = [40, 60, 61, 62, 63, 64, 70][(i / 100 % 7) as usize];
+            let q = (next(&mut s) >> (64 - qb.min(63))) as i128 * if qb > 63 { 2 } else { 1 };
+            let low = i128::from(next(&mut s)) << 64 | i128::from(next(&mut s));
+            let sh = shift.min(127);
+            let mask = (1i128 << sh).wrapping_sub(1);
+            let mut x = q.checked_shl(sh).unwrap_or(0) | (low & mask);
+            if sh > 0 {
+                match i / 700 % 4 {
+                    0 => x = (x & !mask) | (1i128 << (sh - 1)),
+                    1 => x = (x & !mask) | (1i128 << (sh - 1)) | 1,
+                    2 => x = (x & !mask) | ((1i128 << (sh - 1)) - 1),
+                    _ => {}
+                }
+            }
+            if next(&mut s) & 1 == 1 {
+                x = x.wrapping_neg();
+            }
+            for mode in MODES {
+                assert_eq!(
+                    round_shift_right_wide(x, shift, mode),
+                    round_shift_right_wide_any(x, shift, mode),
+                    "{x} >> {shift} {mode:?}"
+                );
+            }
+            if (2..64).contains(&shift) && i64::try_from(x >> (shift - 2)).is_ok() {
+                below64 += 1;
+            } else if (64..126).contains(&shift) && i64::try_from(x >> 62).is_ok() {
+                from64 += 1;
+            } else {
+                exact += 1;
+            }
+        }
+        assert!(below64 > 500_000 && from64 > 500_000 && exact > 500_000);
     }
 }

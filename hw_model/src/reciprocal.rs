@@ -29,6 +29,9 @@ use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, ConstRounding, Rounding, SatCounter};
 
+#[cfg(test)]
+pub(crate) mod previous;
+
 /// Guard bits carried by the working precision beyond `recip_mantissa_bits`.
 pub const GUARD_BITS: u32 = 3;
 
@@ -121,8 +124,16 @@ impl Reciprocal {
         let idx = (top & ((1i64 << l) - 1)) as usize;
         let mut y = self.lut[idx] as i64;
         let two = 2i64 << p;
-        for _ in 0..self.cfg.recip_iterations {
-            y = nr_step(m, y, two, p, rnd);
+        if (1..=29).contains(&p) {
+            // `nr_step`'s 64-bit products, the test on `p` out of the loop.
+            for _ in 0..self.cfg.recip_iterations {
+                let t = crate::fixed::round_shift_right(m * y, p, rnd);
+                y = crate::fixed::round_shift_right(y * (two - t), p, rnd);
+            }
+        } else {
+            for _ in 0..self.cfg.recip_iterations {
+                y = nr_step(m, y, two, p, rnd);
+            }
         }
         // Normalize y (positive, about 2^P / m) to M + 1 significant bits.
         let b = 64 - (y as u64).leading_zeros();
@@ -163,7 +174,7 @@ fn nr_step(m: i64, y: i64, two: i64, p: u32, rnd: Rounding) -> i64 {
 
 /// `r * r` with its mantissa rounded once back to `m_bits + 1` significant bits (relative
 /// error of the square: `2 e_r + 2^-(m_bits+1)`).
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn square(r: Recip, m_bits: u32, mode: Rounding) -> Recip {
     let (drop, mut mant) = if r.mant >> 31 == 0 {
@@ -196,23 +207,34 @@ pub fn apply(r: Recip, x: i128, frac_bits: u32, mode: Rounding) -> i64 {
 #[inline(always)]
 #[must_use]
 pub fn apply_in<M: ConstRounding>(r: Recip, x: i128, frac_bits: u32) -> i64 {
-    let mode = M::MODE;
     let sh = r.shift - frac_bits as i32;
-    // Exact i64 fast path: same product, same single rounding.
-    if sh >= 0 {
-        if let (Ok(x64), Ok(m64)) = (i64::try_from(x), i64::try_from(r.mant)) {
-            if let Some(prod) = x64.checked_mul(m64) {
-                return crate::fixed::round_shift_right(prod, sh as u32, mode);
-            }
-        }
+    // |x| < 2^96 and a mantissa below 2^31 (at most 30 bits + 1, every `Reciprocal` result
+    // and its `square`): the product is exact below 2^127, then the one rounding.
+    if sh >= 0 && x.unsigned_abs() >> 96 == 0 && r.mant >> 31 == 0 {
+        return round_shift_right_wide(x * i128::from(r.mant), sh as u32, M::MODE);
     }
-    // |x| < 2^96 and a mantissa below 2^31 (at most 30 bits + 1): the product is below 2^127
-    // and the saturating multiply's overflow check can be skipped (same value).
-    let prod = if x.unsigned_abs() >> 96 == 0 && r.mant >> 31 == 0 {
-        x * i128::from(r.mant)
-    } else {
-        x.saturating_mul(i128::from(r.mant))
-    };
+    apply_general::<M>(r, x, sh)
+}
+
+/// [`apply_in`] of an `x` that fits `i64` (the barycentrics' `q_i`): the same bits, the
+/// product a single 64x64 -> 128-bit multiply.
+#[inline(always)]
+#[must_use]
+pub fn apply_i64_in<M: ConstRounding>(r: Recip, x: i64, frac_bits: u32) -> i64 {
+    let sh = r.shift - frac_bits as i32;
+    if sh >= 0 && r.mant >> 31 == 0 {
+        let prod = i128::from(x) * i128::from(r.mant as i64);
+        return round_shift_right_wide(prod, sh as u32, M::MODE);
+    }
+    apply_general::<M>(r, i128::from(x), sh)
+}
+
+/// [`apply_in`] for any operands, `sh` = `r.shift - frac_bits`: the product saturated to
+/// `i128`, then rounded (`sh >= 0`) or scaled up and saturated (`sh < 0`).
+#[inline(never)]
+fn apply_general<M: ConstRounding>(r: Recip, x: i128, sh: i32) -> i64 {
+    let mode = M::MODE;
+    let prod = x.saturating_mul(i128::from(r.mant));
     if sh >= 0 {
         round_shift_right_wide(prod, sh as u32, mode)
     } else {
@@ -391,5 +413,65 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// 3M seeded cases over 15 configurations (every mode; LUT, iteration and mantissa widths
+    /// varied, the 30-bit mantissa's 128-bit Newton-Raphson products included; arguments of 0
+    /// to 64 bits): `eval`, `apply` and `apply_i64_in` give the previous routines' bits and
+    /// counts, `apply` on both its one-multiply path and the general one (a mantissa of 31 or
+    /// more bits, `|x| >= 2^96`, a negative scale).
+    #[test]
+    fn eval_and_apply_match_the_previous_routines() {
+        let mut s = 0x5eed_0006;
+        let base = HwConfig::texram16().reciprocal;
+        let (mut fast, mut general) = (0u64, 0u64);
+        for mode in MODES {
+            for (l, n, mb) in [(8, 2, 24), (8, 1, 24), (4, 3, 30), (12, 1, 16), (16, 0, 8)] {
+                let cfg = ReciprocalConfig {
+                    recip_lut_bits: l,
+                    recip_iterations: n,
+                    recip_mantissa_bits: mb,
+                    recip_rounding: mode,
+                    ..base.clone()
+                };
+                let u = Reciprocal::new(&cfg);
+                for i in 0..200_000u32 {
+                    let x = if i == 0 { 0 } else { next(&mut s) >> (i % 64) };
+                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
+                    let r = u.eval(x, &mut sa);
+                    assert_eq!(
+                        (r, sa),
+                        (previous::eval(&u, x, &mut sb), sb),
+                        "1/{x} {cfg:?}"
+                    );
+                    let r = if i % 16 == 1 {
+                        Recip {
+                            mant: next(&mut s) >> (next(&mut s) % 40),
+                            shift: r.shift,
+                        }
+                    } else {
+                        r
+                    };
+                    let xb = [20, 62, 63, 90, 95, 96, 100, 126][(i % 8) as usize];
+                    let v =
+                        (i128::from(next(&mut s)) << 64 | i128::from(next(&mut s))) >> (127 - xb);
+                    let fb = (next(&mut s) % 140) as u32;
+                    let v64 = v as i64;
+                    for m2 in MODES {
+                        let want = previous::apply(r, v, fb, m2);
+                        assert_eq!(apply(r, v, fb, m2), want, "{v} {r:?} {fb}");
+                        let got = crate::with_rounding!(m2, M => apply_i64_in::<M>(r, v64, fb));
+                        let want = previous::apply(r, i128::from(v64), fb, m2);
+                        assert_eq!(got, want, "{v64} {r:?} {fb}");
+                    }
+                    if r.shift >= fb as i32 && v.unsigned_abs() >> 96 == 0 && r.mant >> 31 == 0 {
+                        fast += 1;
+                    } else {
+                        general += 1;
+                    }
+                }
+            }
+        }
+        assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
     }
 }

@@ -21,23 +21,16 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let raw_bary = px.fixed(StageKind::Bary);
     let sat = &mut c.sat[StageKind::Texcoord.index()];
     let n = px.samples();
-    let bary = if raw_bary {
-        frag.bary_x
+    let uv = &mut frag.uv_x[..n];
+    if raw_bary {
+        interpolate_pairs(&frag.bary_x[..n], bb, px.a.uv_x, &m.uv_fmt, sat, uv);
     } else {
-        let mut b = [[0; 3]; 3];
-        for (raw, carrier) in b.iter_mut().zip(&frag.bary).take(n) {
+        let mut raw = [[0; 3]; 3];
+        for (raw, carrier) in raw.iter_mut().zip(&frag.bary).take(n) {
             *raw = carrier.map(|x| to_raw(x, &m.bary_fmt, sat));
         }
-        b
-    };
-    interpolate_pairs(
-        &bary[..n],
-        bb,
-        px.a.uv_x,
-        &m.uv_fmt,
-        sat,
-        &mut frag.uv_x[..n],
-    );
+        interpolate_pairs(&raw[..n], bb, px.a.uv_x, &m.uv_fmt, sat, uv);
+    }
     if px.carriers {
         for s in 0..n {
             frag.uv[s] = frag.uv_x[s].map(|r| from_raw(r, fb));

@@ -12,6 +12,7 @@ mod raster_common;
 
 mod as_hard_cases;
 mod as_pipeline;
+mod bary_edges;
 mod bump_hard_cases;
 mod bump_pipeline;
 mod coord_f32_path;
