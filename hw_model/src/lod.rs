@@ -8,7 +8,9 @@
 //! repeated squaring of the normalized mantissa
 //! `m` in [1, 2) (`m <- m^2`; a bit is 1 iff `m >= 2`, then `m <- m/2`), with `m` kept to
 //! [`MANT_BITS`] fraction bits by truncation so each square fits a `u64`. The output is
-//! floor-rounded.
+//! floor-rounded. The simulator takes the loop's bits from a table ([`table_log2_bits`]: the
+//! same bits for every one of the 2^31 mantissas, checked exhaustively), the loop itself only
+//! within a few mantissas of a result's threshold.
 //!
 //! ERROR BOUND: truncation only ever lowers `m`, and each squaring step's truncation error
 //! (< 2^-31 relative) contributes < 2^-30 to `log2(L)`; so the result is `floor(lambda * 2^F)`
@@ -45,16 +47,16 @@ pub const fn lod_zero(lod_frac_bits: u32) -> i64 {
 
 /// LOD with `cfg.lod_frac_bits` fraction bits (floor-rounded, signed) from the derivatives
 /// `d = (du/dx, dv/dx, du/dy, dv/dy)` in level-0 texel units with `frac` fraction bits.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64 {
     let f = cfg.lod_frac_bits.min(16);
     let floor_val = lod_zero(f);
     // The squared lengths in u64 when every |d| < 2^31 (each sum < 2^63), else in u128.
-    let small = d.iter().all(|x| x.unsigned_abs() < 1 << 31);
+    let a = d.map(i64::unsigned_abs);
+    let small = (a[0] | a[1] | a[2] | a[3]) < 1 << 31;
     let (e, mant, l) = if small {
-        let sq = |a: i64| a.unsigned_abs() * a.unsigned_abs();
-        let l = (sq(d[0]) + sq(d[1])).max(sq(d[2]) + sq(d[3]));
+        let l = (a[0] * a[0] + a[1] * a[1]).max(a[2] * a[2] + a[3] * a[3]);
         if l == 0 {
             return floor_val;
         }
@@ -66,18 +68,7 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
         };
         (e, m, u128::from(l))
     } else {
-        let sq = |a: i64| -> u128 {
-            let u = u128::from(a.unsigned_abs());
-            u * u
-        };
-        let l = (sq(d[0]) + sq(d[1])).max(sq(d[2]) + sq(d[3]));
-        let e = 127 - l.leading_zeros(); // bit index of the MSB
-        let m = if e >= MANT_BITS {
-            (l >> (e - MANT_BITS)) as u64
-        } else {
-            (l << (MANT_BITS - e)) as u64
-        };
-        (e, m, l)
+        wide_squares(d)
     };
     if cfg.lod_log2 == LodLog2::PiecewiseLinear {
         // floor((e - 2 frac + (L - 2^e) / 2^e) 2^16), then floor(/ 2^(17 - F)) = floor(* 2^(F-1)).
@@ -107,6 +98,24 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
         return floor_val;
     }
     v
+}
+
+/// The larger squared length `L` of [`lod`] in `u128` (some `|d| >= 2^31`, so `L > 0`): its
+/// MSB index and its mantissa with [`MANT_BITS`] fraction bits (truncated).
+#[inline(never)]
+fn wide_squares(d: [i64; 4]) -> (u32, u64, u128) {
+    let sq = |a: i64| -> u128 {
+        let u = u128::from(a.unsigned_abs());
+        u * u
+    };
+    let l = (sq(d[0]) + sq(d[1])).max(sq(d[2]) + sq(d[3]));
+    let e = 127 - l.leading_zeros(); // bit index of the MSB
+    let m = if e >= MANT_BITS {
+        (l >> (e - MANT_BITS)) as u64
+    } else {
+        (l << (MANT_BITS - e)) as u64
+    };
+    (e, m, l)
 }
 
 /// Squaring steps of the widest LOD (`lod_frac_bits` = 16).

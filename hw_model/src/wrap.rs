@@ -63,23 +63,57 @@ pub fn wrap_in<W: crate::fixed::ConstRounding>(
     mode: WrapMode,
     cfg: &crate::config::TrilinearConfig,
 ) -> WrapOut {
+    if fits_i64(coord, frac) {
+        wrap_i64_in::<W>(coord, frac, size, mode, cfg.weight_bits.min(16))
+    } else {
+        wrap_wide_in::<W>(coord, frac, size, mode, cfg)
+    }
+}
+
+/// Whether [`wrap`] of `coord` takes its 64-bit path (`|s| < 2^63`).
+#[inline(always)]
+#[must_use]
+pub fn fits_i64(coord: i64, frac: u32) -> bool {
+    frac <= 30 && coord.unsigned_abs() < (1u64 << 29)
+}
+
+/// [`wrap_in`] of a coordinate that [`fits_i64`], `wb` = `weight_bits.min(16)`.
+#[inline(always)]
+#[must_use]
+pub fn wrap_i64_in<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    frac: u32,
+    size: u32,
+    mode: WrapMode,
+    wb: u32,
+) -> WrapOut {
+    let size = size.max(1);
+    let sf = frac + 1;
+    let s = 2 * coord * i64::from(size) - (1i64 << frac);
+    let i0 = s >> sf;
+    let fr = s - (i0 << sf);
+    // Reduced to `wb` fraction bits when `sf >= wb`, else widened (exact).
+    let w = crate::fixed::round_shift_right(fr, sf.saturating_sub(wb), W::MODE)
+        << wb.saturating_sub(sf);
+    // Truncation cannot carry (`fr < 2^sf`, so `w < 2^wb`).
+    let carry = W::MODE != crate::fixed::Rounding::Truncate && w >> wb != 0;
+    let (i0, w) = if carry { (i0 + 1, 0) } else { (i0, w) };
+    finish(i0, w as u32, size, mode)
+}
+
+/// [`wrap_in`] in `i128` (any coordinate).
+#[inline(never)]
+#[must_use]
+pub fn wrap_wide_in<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    frac: u32,
+    size: u32,
+    mode: WrapMode,
+    cfg: &crate::config::TrilinearConfig,
+) -> WrapOut {
     let size = size.max(1);
     let wb = cfg.weight_bits.min(16);
     let rnd = W::MODE;
-    if frac <= 30 && coord.unsigned_abs() < (1u64 << 29) {
-        // Fast path: |s| < 2^63, all in i64.
-        let sf = frac + 1;
-        let s = 2 * coord * i64::from(size) - (1i64 << frac);
-        let i0 = s >> sf;
-        let fr = s - (i0 << sf);
-        let w = if sf >= wb {
-            crate::fixed::round_shift_right(fr, sf - wb, rnd)
-        } else {
-            fr << (wb - sf)
-        };
-        let (i0, w) = if w >> wb != 0 { (i0 + 1, 0) } else { (i0, w) };
-        return finish(i0, w as u32, size, mode);
-    }
     let frac = frac.min(62);
     let sf = frac + 1;
     let s = 2 * i128::from(coord) * i128::from(size) - (1i128 << frac);
@@ -117,7 +151,7 @@ pub fn wrap_in<W: crate::fixed::ConstRounding>(
 #[inline(always)]
 fn finish(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
     let n = i64::from(size);
-    let (a, b) = if i0 >= 0 && i0 < n - 1 {
+    let (a, b) = if (i0 as u64) < (n - 1) as u64 {
         (i0 as u32, i0 as u32 + 1)
     } else {
         match mode {
