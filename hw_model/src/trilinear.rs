@@ -10,7 +10,8 @@
 //! - Levels are row-major, top row first: texel (x, y) is `texels[y * width + x]`; `u` runs
 //!   along x, `v` along y. Channel values are `texel_bits`-wide unsigned normalized raw values.
 //! - Bilinear order: lerp along x on row `y0` and on row `y1`, then along y between the two.
-//!   Each lerp rounds ONCE (by `filter_rounding`) back to texel precision.
+//!   Each lerp rounds ONCE (by `filter_rounding`) back to texel precision. (The simulator
+//!   computes two channels per `u64`, one per 32-bit lane: the same integers.)
 //! - Trilinear: `lod <= 0` -> level 0 only; `lod >= (levels - 1)` -> last level only; else
 //!   levels `floor(lod)` and `floor(lod) + 1` blended with the `lod_frac_bits` LOD fraction as
 //!   the weight of the finer-to-coarser lerp (a zero fraction uses one level: same result).
@@ -27,7 +28,7 @@ use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, ConstRounding, Rounding};
-use crate::wrap::{wrap_in, WrapMode};
+use crate::wrap::{fits_i64, wrap_i64_in, wrap_in, WrapMode, WrapOut};
 
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
@@ -81,6 +82,195 @@ fn fetch(level: &Level, x: u32, y: u32) -> [u16; 4] {
     level.texels.get(idx).copied().unwrap_or([0; 4])
 }
 
+/// Receives what a trilinear sample did, footprint by footprint: the filter reports each
+/// bilinear footprint it read (finer level first) and then the sample. `()` ignores
+/// everything (the filter then builds nothing for it); [`TrilinearTrace`] keeps it all.
+pub trait SampleSink {
+    /// Footprint `index` (0 = finer level) of the sample.
+    fn footprint(&mut self, index: usize, fp: &BilinearTrace);
+    /// The sample: levels used, weight of the coarser level, filtered value.
+    fn sample(&mut self, levels_used: u32, level_weight: u32, result: [u16; 4]);
+}
+
+impl SampleSink for () {
+    #[inline(always)]
+    fn footprint(&mut self, _: usize, _: &BilinearTrace) {}
+    #[inline(always)]
+    fn sample(&mut self, _: u32, _: u32, _: [u16; 4]) {}
+}
+
+impl SampleSink for TrilinearTrace {
+    #[inline(always)]
+    fn footprint(&mut self, index: usize, fp: &BilinearTrace) {
+        self.level[index] = *fp;
+    }
+    #[inline(always)]
+    fn sample(&mut self, levels_used: u32, level_weight: u32, result: [u16; 4]) {
+        if levels_used < 2 {
+            self.level[1] = BilinearTrace::default();
+        }
+        self.levels_used = levels_used;
+        self.level_weight = level_weight;
+        self.result = result;
+    }
+}
+
+/// Lanes of one 32-bit half of a `u64` that hold a channel value (< 2^16).
+const LANE16: u64 = 0x0000_ffff_0000_ffff;
+/// The lowest bit of each 32-bit lane.
+const LANE_LSB: u64 = 0x0000_0001_0000_0001;
+
+/// The four channels of a texel as two `u64` words of two 32-bit lanes: `(c0, c2)` and
+/// `(c1, c3)`, so one multiply by a weight serves two channels (a lane's product of a
+/// 16-bit value and a weight of at most 2^16 stays below 2^32).
+#[derive(Clone, Copy)]
+struct Lanes {
+    even: u64,
+    odd: u64,
+}
+
+impl Lanes {
+    /// The channels of a texel.
+    #[inline(always)]
+    fn of(t: [u16; 4]) -> Self {
+        let word =
+            u64::from(t[0]) | u64::from(t[1]) << 16 | u64::from(t[2]) << 32 | u64::from(t[3]) << 48;
+        Self {
+            even: word & LANE16,
+            odd: (word >> 16) & LANE16,
+        }
+    }
+
+    #[inline(always)]
+    fn channels(self) -> [u32; 4] {
+        [
+            self.even as u32,
+            self.odd as u32,
+            (self.even >> 32) as u32,
+            (self.odd >> 32) as u32,
+        ]
+    }
+
+    /// [`lerp`] of every channel (`a` = self, `b` = `b`) by `l` with weight `w`.
+    #[inline(always)]
+    fn lerp(self, b: Self, w: u32, l: &LaneLerp) -> Self {
+        Self {
+            even: l.lerp(self.even, b.even, w),
+            odd: l.lerp(self.odd, b.odd, w),
+        }
+    }
+}
+
+/// [`lerp`] with `weight_bits` = `wb` (at most 16) and a rounding mode, in both 32-bit lanes of
+/// a `u64` (values < 2^16, weights `w < 2^wb`): `a (2^wb - w) + b w` is `(a << wb) + (b - a)
+/// w`, non-negative and below 2^32 per lane, and the rounding of [`round_shift_right`] adds
+/// its carry per lane: `floor + 1` iff the dropped part reaches one half (HalfUp, a bias of
+/// one half) or exceeds it, or equals it with an odd floor (HalfEven, a bias of one half less
+/// one plus the floor's lowest bit). Built once per sample.
+#[derive(Clone, Copy)]
+struct LaneLerp {
+    wb: u32,
+    one: u32,
+    /// The bias in both lanes.
+    bias: u64,
+    /// The lanes' floor bit added to the bias (HalfEven with `wb > 0`), else 0.
+    odd: u64,
+}
+
+impl LaneLerp {
+    #[inline(always)]
+    fn new<M: ConstRounding>(wb: u32) -> Self {
+        let half = (1u64 << wb) >> 1;
+        let (bias, odd) = match M::MODE {
+            Rounding::Truncate => (0, 0),
+            Rounding::HalfUp => (half * LANE_LSB, 0),
+            Rounding::HalfEven if wb > 0 => ((half - 1) * LANE_LSB, LANE_LSB),
+            Rounding::HalfEven => (0, 0),
+        };
+        Self {
+            wb,
+            one: 1 << wb,
+            bias,
+            odd,
+        }
+    }
+
+    #[inline(always)]
+    fn lerp(&self, a: u64, b: u64, w: u32) -> u64 {
+        let num = a * u64::from(self.one - w) + b * u64::from(w);
+        ((num + self.bias + ((num >> self.wb) & self.odd)) >> self.wb) & LANE16
+    }
+}
+
+/// The four texels of a footprint: `(x0,y0), (x1,y0), (x0,y1), (x1,y1)`; a quad inside the
+/// level (the common case) is read from one bounds-checked slice.
+#[inline(always)]
+fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
+    let w = level.width as usize;
+    let i00 = wy.i0 as usize * w + wx.i0 as usize;
+    if wx.i1 == wx.i0 + 1 && wy.i1 == wy.i0 + 1 {
+        if let Some(q) = level.texels.get(i00..i00 + w + 2) {
+            return [q[0], q[1], q[w], q[w + 1]];
+        }
+    }
+    [
+        fetch(level, wx.i0, wy.i0),
+        fetch(level, wx.i1, wy.i0),
+        fetch(level, wx.i0, wy.i1),
+        fetch(level, wx.i1, wy.i1),
+    ]
+}
+
+/// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
+/// (as footprint `index` of level `level_index`) when the sink keeps them.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
+    level: &Level,
+    level_index: u32,
+    u: i64,
+    v: i64,
+    frac: u32,
+    wrap_mode: [WrapMode; 2],
+    cfg: &TrilinearConfig,
+    filter: &LaneLerp,
+    index: usize,
+    sink: &mut S,
+) -> Lanes {
+    let (wx, wy) = if fits_i64(u, frac) && fits_i64(v, frac) {
+        let wb = cfg.weight_bits.min(16);
+        (
+            wrap_i64_in::<W>(u, frac, level.width, wrap_mode[0], wb),
+            wrap_i64_in::<W>(v, frac, level.height, wrap_mode[1], wb),
+        )
+    } else {
+        (
+            wrap_in::<W>(u, frac, level.width, wrap_mode[0], cfg),
+            wrap_in::<W>(v, frac, level.height, wrap_mode[1], cfg),
+        )
+    };
+    let [t00, t10, t01, t11] = fetch_quad(level, &wx, &wy);
+    let top = Lanes::of(t00).lerp(Lanes::of(t10), wx.weight, filter);
+    let bot = Lanes::of(t01).lerp(Lanes::of(t11), wx.weight, filter);
+    let out = top.lerp(bot, wy.weight, filter);
+    sink.footprint(
+        index,
+        &BilinearTrace {
+            level: level_index,
+            coords: [
+                (wx.i0, wy.i0),
+                (wx.i1, wy.i0),
+                (wx.i0, wy.i1),
+                (wx.i1, wy.i1),
+            ],
+            texels: [t00, t10, t01, t11],
+            weights: [wx.weight, wy.weight],
+            result: out.channels(),
+        },
+    );
+    out
+}
+
 /// Bilinear filter of one level at normalized (u, v) with `frac` fraction bits. A level with
 /// too few texels reads zeros for the missing ones.
 #[inline]
@@ -94,51 +284,28 @@ pub fn bilinear(
     cfg: &TrilinearConfig,
     trace: Option<&mut BilinearTrace>,
 ) -> [u32; 4] {
+    /// Keeps the one footprint of a bilinear filter.
+    struct One<'a>(&'a mut BilinearTrace);
+    impl SampleSink for One<'_> {
+        fn footprint(&mut self, _: usize, fp: &BilinearTrace) {
+            *self.0 = *fp;
+        }
+        fn sample(&mut self, _: u32, _: u32, _: [u16; 4]) {}
+    }
     crate::with_rounding!(cfg.filter_rounding, F => {
-        crate::with_rounding!(cfg.weight_rounding, W => {
-            bilinear_in::<F, W>(level, u, v, frac, wrap_mode, cfg, trace)
-        })
+        crate::with_rounding!(cfg.weight_rounding, W => match trace {
+            None => {
+                let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
+                bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, &mut ())
+            }
+            Some(t) => {
+                let mut one = One(t);
+                let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
+                bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, &mut one)
+            }
+        }
+        .channels())
     })
-}
-
-/// [`bilinear`] compiled for the filter rounding `F` (`filter_rounding`) and the weight
-/// rounding `W` (`weight_rounding`).
-#[inline(always)]
-fn bilinear_in<F: ConstRounding, W: ConstRounding>(
-    level: &Level,
-    u: i64,
-    v: i64,
-    frac: u32,
-    wrap_mode: [WrapMode; 2],
-    cfg: &TrilinearConfig,
-    trace: Option<&mut BilinearTrace>,
-) -> [u32; 4] {
-    let wx = wrap_in::<W>(u, frac, level.width, wrap_mode[0], cfg);
-    let wy = wrap_in::<W>(v, frac, level.height, wrap_mode[1], cfg);
-    let t00 = fetch(level, wx.i0, wy.i0);
-    let t10 = fetch(level, wx.i1, wy.i0);
-    let t01 = fetch(level, wx.i0, wy.i1);
-    let t11 = fetch(level, wx.i1, wy.i1);
-    let wb = cfg.weight_bits.min(16);
-    let r = F::MODE;
-    let mut out = [0u32; 4];
-    for c in 0..4 {
-        let top = lerp(u32::from(t00[c]), u32::from(t10[c]), wx.weight, wb, r);
-        let bot = lerp(u32::from(t01[c]), u32::from(t11[c]), wx.weight, wb, r);
-        out[c] = lerp(top, bot, wy.weight, wb, r);
-    }
-    if let Some(t) = trace {
-        t.coords = [
-            (wx.i0, wy.i0),
-            (wx.i1, wy.i0),
-            (wx.i0, wy.i1),
-            (wx.i1, wy.i1),
-        ];
-        t.texels = [t00, t10, t01, t11];
-        t.weights = [wx.weight, wy.weight];
-        t.result = out;
-    }
-    out
 }
 
 /// Trilinear filter: the LOD rule and conventions of the module doc. `lod` has
@@ -157,17 +324,28 @@ pub fn trilinear(
     cfg: &TrilinearConfig,
     trace: Option<&mut TrilinearTrace>,
 ) -> [u16; 4] {
-    crate::with_rounding!(cfg.filter_rounding, F => {
-        crate::with_rounding!(cfg.weight_rounding, W => {
-            trilinear_in::<F, W>(levels, u, v, frac, lod, lod_frac_bits, wrap_mode, cfg, trace)
-        })
-    })
+    match trace {
+        None => trilinear_to(
+            levels,
+            u,
+            v,
+            frac,
+            lod,
+            lod_frac_bits,
+            wrap_mode,
+            cfg,
+            &mut (),
+        ),
+        Some(t) => trilinear_to(levels, u, v, frac, lod, lod_frac_bits, wrap_mode, cfg, t),
+    }
 }
 
-/// [`trilinear`] compiled for the filter rounding `F` and the weight rounding `W`.
+/// [`trilinear`] reporting its footprints to `sink` (e.g. the timing model's trace), with
+/// nothing built for a sink that keeps nothing.
 #[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn trilinear_in<F: ConstRounding, W: ConstRounding>(
+#[inline]
+#[must_use]
+pub fn trilinear_to<S: SampleSink>(
     levels: &[Level],
     u: i64,
     v: i64,
@@ -176,7 +354,28 @@ fn trilinear_in<F: ConstRounding, W: ConstRounding>(
     lod_frac_bits: u32,
     wrap_mode: [WrapMode; 2],
     cfg: &TrilinearConfig,
-    mut trace: Option<&mut TrilinearTrace>,
+    sink: &mut S,
+) -> [u16; 4] {
+    crate::with_rounding!(cfg.filter_rounding, F => {
+        crate::with_rounding!(cfg.weight_rounding, W => {
+            trilinear_in::<F, W, S>(levels, u, v, frac, lod, lod_frac_bits, wrap_mode, cfg, sink)
+        })
+    })
+}
+
+/// [`trilinear`] compiled for the filter rounding `F` and the weight rounding `W`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn trilinear_in<F: ConstRounding, W: ConstRounding, S: SampleSink>(
+    levels: &[Level],
+    u: i64,
+    v: i64,
+    frac: u32,
+    lod: i64,
+    lod_frac_bits: u32,
+    wrap_mode: [WrapMode; 2],
+    cfg: &TrilinearConfig,
+    sink: &mut S,
 ) -> [u16; 4] {
     let n = levels.len();
     if n == 0 {
@@ -191,58 +390,45 @@ fn trilinear_in<F: ConstRounding, W: ConstRounding>(
     } else {
         ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
     };
-    let mut bt0 = BilinearTrace {
-        level: l0 as u32,
-        ..BilinearTrace::default()
-    };
-    let c0 = bilinear_in::<F, W>(
+    let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
+    let c0 = bilinear_lanes::<W, S>(
         &levels[l0],
+        l0 as u32,
         u,
         v,
         frac,
         wrap_mode,
         cfg,
-        trace.as_ref().map(|_| &mut bt0),
+        &f,
+        0,
+        sink,
     );
-    let mut out = [0u16; 4];
     if lw == 0 {
-        for c in 0..4 {
-            out[c] = c0[c] as u16;
-        }
-        if let Some(t) = trace.as_deref_mut() {
-            *t = TrilinearTrace {
-                levels_used: 1,
-                level: [bt0, BilinearTrace::default()],
-                level_weight: 0,
-                result: out,
-            };
-        }
+        let out = c0.channels().map(|c| c as u16);
+        sink.sample(1, 0, out);
         return out;
     }
-    let mut bt1 = BilinearTrace {
-        level: l0 as u32 + 1,
-        ..BilinearTrace::default()
-    };
-    let c1 = bilinear_in::<F, W>(
-        &levels[l0 + 1],
+    let l1 = l0 + 1;
+    let c1 = bilinear_lanes::<W, S>(
+        &levels[l1],
+        l1 as u32,
         u,
         v,
         frac,
         wrap_mode,
         cfg,
-        trace.as_ref().map(|_| &mut bt1),
+        &f,
+        1,
+        sink,
     );
-    for c in 0..4 {
-        out[c] = lerp(c0[c], c1[c], lw, lf, F::MODE) as u16;
-    }
-    if let Some(t) = trace {
-        *t = TrilinearTrace {
-            levels_used: 2,
-            level: [bt0, bt1],
-            level_weight: lw,
-            result: out,
-        };
-    }
+    let out = if lf <= 16 {
+        let blend = LaneLerp::new::<F>(lf);
+        c0.lerp(c1, lw, &blend).channels().map(|c| c as u16)
+    } else {
+        let (a, b) = (c0.channels(), c1.channels());
+        std::array::from_fn(|c| lerp(a[c], b[c], lw, lf, F::MODE) as u16)
+    };
+    sink.sample(2, lw, out);
     out
 }
 
@@ -347,6 +533,7 @@ pub fn filter_latencies(cfg: &TrilinearConfig, gate_levels_per_cycle: u32) -> (u
 mod tests {
     use super::*;
     use crate::config::HwConfig;
+    use crate::wrap::tests::wrap_before;
     use crate::wrap::wrap;
 
     const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
@@ -430,5 +617,278 @@ mod tests {
                 }
             }
         }
+    }
+    /// The bilinear footprint before it was computed in lanes (scalar lerps, its trace built
+    /// field by field), its wraps by the previous wrap routine: the oracle.
+    fn bilinear_in_before<F: ConstRounding, W: ConstRounding>(
+        level: &Level,
+        u: i64,
+        v: i64,
+        frac: u32,
+        wrap_mode: [WrapMode; 2],
+        cfg: &TrilinearConfig,
+        trace: Option<&mut BilinearTrace>,
+    ) -> [u32; 4] {
+        let wx = wrap_before(u, frac, level.width, wrap_mode[0], W::MODE, cfg.weight_bits);
+        let wy = wrap_before(
+            v,
+            frac,
+            level.height,
+            wrap_mode[1],
+            W::MODE,
+            cfg.weight_bits,
+        );
+        let t00 = fetch(level, wx.i0, wy.i0);
+        let t10 = fetch(level, wx.i1, wy.i0);
+        let t01 = fetch(level, wx.i0, wy.i1);
+        let t11 = fetch(level, wx.i1, wy.i1);
+        let wb = cfg.weight_bits.min(16);
+        let r = F::MODE;
+        let mut out = [0u32; 4];
+        for c in 0..4 {
+            let top = lerp(u32::from(t00[c]), u32::from(t10[c]), wx.weight, wb, r);
+            let bot = lerp(u32::from(t01[c]), u32::from(t11[c]), wx.weight, wb, r);
+            out[c] = lerp(top, bot, wy.weight, wb, r);
+        }
+        if let Some(t) = trace {
+            t.coords = [
+                (wx.i0, wy.i0),
+                (wx.i1, wy.i0),
+                (wx.i0, wy.i1),
+                (wx.i1, wy.i1),
+            ];
+            t.texels = [t00, t10, t01, t11];
+            t.weights = [wx.weight, wy.weight];
+            t.result = out;
+        }
+        out
+    }
+
+    /// The trilinear filter before it was computed in lanes and reported to a sink: the oracle.
+    #[allow(clippy::too_many_arguments)]
+    fn trilinear_in_before<F: ConstRounding, W: ConstRounding>(
+        levels: &[Level],
+        u: i64,
+        v: i64,
+        frac: u32,
+        lod: i64,
+        lod_frac_bits: u32,
+        wrap_mode: [WrapMode; 2],
+        cfg: &TrilinearConfig,
+        mut trace: Option<&mut TrilinearTrace>,
+    ) -> [u16; 4] {
+        let n = levels.len();
+        if n == 0 {
+            return [0; 4];
+        }
+        let lf = lod_frac_bits.min(30);
+        let last = (n - 1) as i64;
+        let (l0, lw) = if lod <= 0 {
+            (0usize, 0u32)
+        } else if (lod >> lf) >= last {
+            (n - 1, 0)
+        } else {
+            ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
+        };
+        let mut bt0 = BilinearTrace {
+            level: l0 as u32,
+            ..BilinearTrace::default()
+        };
+        let c0 = bilinear_in_before::<F, W>(
+            &levels[l0],
+            u,
+            v,
+            frac,
+            wrap_mode,
+            cfg,
+            trace.as_ref().map(|_| &mut bt0),
+        );
+        let mut out = [0u16; 4];
+        if lw == 0 {
+            for c in 0..4 {
+                out[c] = c0[c] as u16;
+            }
+            if let Some(t) = trace.as_deref_mut() {
+                *t = TrilinearTrace {
+                    levels_used: 1,
+                    level: [bt0, BilinearTrace::default()],
+                    level_weight: 0,
+                    result: out,
+                };
+            }
+            return out;
+        }
+        let mut bt1 = BilinearTrace {
+            level: l0 as u32 + 1,
+            ..BilinearTrace::default()
+        };
+        let c1 = bilinear_in_before::<F, W>(
+            &levels[l0 + 1],
+            u,
+            v,
+            frac,
+            wrap_mode,
+            cfg,
+            trace.as_ref().map(|_| &mut bt1),
+        );
+        for c in 0..4 {
+            out[c] = lerp(c0[c], c1[c], lw, lf, F::MODE) as u16;
+        }
+        if let Some(t) = trace {
+            *t = TrilinearTrace {
+                levels_used: 2,
+                level: [bt0, bt1],
+                level_weight: lw,
+                result: out,
+            };
+        }
+        out
+    }
+
+    /// [`trilinear_in_before`] for run-time modes.
+    #[allow(clippy::too_many_arguments)]
+    fn trilinear_before(
+        levels: &[Level],
+        u: i64,
+        v: i64,
+        frac: u32,
+        lod: i64,
+        lfb: u32,
+        wm: [WrapMode; 2],
+        cfg: &TrilinearConfig,
+        trace: Option<&mut TrilinearTrace>,
+    ) -> [u16; 4] {
+        crate::with_rounding!(cfg.filter_rounding, F => {
+            crate::with_rounding!(cfg.weight_rounding, W => {
+                trilinear_in_before::<F, W>(levels, u, v, frac, lod, lfb, wm, cfg, trace)
+            })
+        })
+    }
+
+    /// 3M seeded samples against the scalar filter it replaced: the nine (filter, weight)
+    /// rounding pairs, the nine wrap-mode pairs, weight widths 0 to 16, LOD fractions 0 to 16
+    /// (lanes) and 17 to 30 (the scalar level blend), chains of square, non-square, 1x1 and
+    /// short (missing texels read zero) levels, coordinates inside and far outside [0, 1],
+    /// LODs below 0, inside and past the chain; the untraced result, the traced result and
+    /// the whole trace (coordinates, texels, weights, per-level results) are identical.
+    #[test]
+    fn lanes_match_the_previous_filter() {
+        let mut s = 0x5eed_0012;
+        let texels: Vec<[u16; 4]> = (0..4096)
+            .map(|_| [0; 4].map(|_| next(&mut s) as u16))
+            .collect();
+        let sizes: [&[(u32, u32)]; 5] = [
+            &[(16, 16), (8, 8), (4, 4), (2, 2), (1, 1)],
+            &[(13, 5), (6, 2), (3, 1), (1, 1)],
+            &[(1, 1)],
+            &[(1, 40), (1, 20), (1, 10)],
+            &[(64, 64), (32, 32)],
+        ];
+        let chains: Vec<Vec<Level>> = sizes
+            .iter()
+            .map(|c| {
+                let mut at = 1024usize;
+                c.iter()
+                    .map(|&(width, height)| {
+                        let n = (width * height) as usize;
+                        // The 64x64 level is short: its last 16 rows read zeros.
+                        let end = (at + n).min(texels.len());
+                        let l = Level {
+                            width,
+                            height,
+                            texels: &texels[at..end],
+                        };
+                        at = end % 1024;
+                        l
+                    })
+                    .collect()
+            })
+            .collect();
+        let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
+        let (mut lanes_blend, mut scalar_blend, mut one_level) = (0u32, 0u32, 0u32);
+        let (mut inside, mut wrapped, mut missing) = (0u32, 0u32, 0u32);
+        for i in 0..3_000_000u32 {
+            let mut cfg = HwConfig::texram16().trilinear;
+            cfg.filter_rounding = MODES[(i % 3) as usize];
+            cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
+            cfg.weight_bits = i / 9 % 17;
+            let levels = &chains[(i / 153 % 5) as usize];
+            let wm = [modes[(i % 3) as usize], modes[(i / 7 % 3) as usize]];
+            let frac = [24, 16, 8, 30, 12][(i / 11 % 5) as usize];
+            let lfb = if i % 13 == 0 {
+                17 + i / 13 % 14
+            } else {
+                i / 17 % 17
+            };
+            let (u, v) = if i % 4 == 0 {
+                let sh = (next(&mut s) % 64) as u32;
+                ((next(&mut s) as i64) >> sh, (next(&mut s) as i64) >> sh)
+            } else {
+                // Mostly inside [-1/4, 5/4): the common interior footprints.
+                let one = 1i64 << frac;
+                let r = |x: u64| (x % (3 * one as u64 / 2)) as i64 - one / 4;
+                (r(next(&mut s)), r(next(&mut s)))
+            };
+            let lod = (next(&mut s) % ((levels.len() as u64 + 1) << lfb)) as i64 - (1 << lfb >> 1);
+            let want = trilinear_before(levels, u, v, frac, lod, lfb, wm, &cfg, None);
+            assert_eq!(
+                trilinear(levels, u, v, frac, lod, lfb, wm, &cfg, None),
+                want,
+                "{u} {v} {frac} {lod} {lfb} {wm:?} {cfg:?}"
+            );
+            let mut want_trace = TrilinearTrace::default();
+            let _ = trilinear_before(
+                levels,
+                u,
+                v,
+                frac,
+                lod,
+                lfb,
+                wm,
+                &cfg,
+                Some(&mut want_trace),
+            );
+            // A reused trace (a stale second level from a two-level sample) is overwritten.
+            let mut got_trace = TrilinearTrace {
+                levels_used: 2,
+                level: [BilinearTrace {
+                    level: 9,
+                    ..BilinearTrace::default()
+                }; 2],
+                ..TrilinearTrace::default()
+            };
+            let got = trilinear(levels, u, v, frac, lod, lfb, wm, &cfg, Some(&mut got_trace));
+            assert_eq!(got, want);
+            assert_eq!(got_trace, want_trace, "{u} {v} {lod} {lfb} {cfg:?}");
+            match (want_trace.levels_used, lfb <= 16) {
+                (1, _) => one_level += 1,
+                (_, true) => lanes_blend += 1,
+                (_, false) => scalar_blend += 1,
+            }
+            for b in &want_trace.level[..want_trace.levels_used as usize] {
+                let l = &levels[b.level as usize];
+                if b.coords[3].1 * l.width + b.coords[3].0 >= l.texels.len() as u32 {
+                    missing += 1;
+                }
+                if b.coords[1].0 == b.coords[0].0 + 1 && b.coords[2].1 == b.coords[0].1 + 1 {
+                    inside += 1;
+                } else {
+                    wrapped += 1;
+                }
+            }
+            let l = &levels[(i % levels.len() as u32) as usize];
+            let mut bt = BilinearTrace::default();
+            let want = bilinear_before(l, u, v, frac, wm, &cfg);
+            assert_eq!(bilinear(l, u, v, frac, wm, &cfg, Some(&mut bt)), want);
+            assert_eq!(bt.result, want);
+        }
+        assert!(
+            lanes_blend > 1_000_000 && scalar_blend > 50_000 && one_level > 500_000,
+            "{lanes_blend} {scalar_blend} {one_level}"
+        );
+        assert!(
+            inside > 500_000 && wrapped > 500_000 && missing > 10_000,
+            "{inside} {wrapped} {missing}"
+        );
     }
 }

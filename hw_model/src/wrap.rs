@@ -63,26 +63,57 @@ pub fn wrap_in<W: crate::fixed::ConstRounding>(
     mode: WrapMode,
     cfg: &crate::config::TrilinearConfig,
 ) -> WrapOut {
+    if fits_i64(coord, frac) {
+        wrap_i64_in::<W>(coord, frac, size, mode, cfg.weight_bits.min(16))
+    } else {
+        wrap_wide_in::<W>(coord, frac, size, mode, cfg)
+    }
+}
+
+/// Whether [`wrap`] of `coord` takes its 64-bit path (`|s| < 2^63`).
+#[inline(always)]
+#[must_use]
+pub fn fits_i64(coord: i64, frac: u32) -> bool {
+    frac <= 30 && coord.unsigned_abs() < (1u64 << 29)
+}
+
+/// [`wrap_in`] of a coordinate that [`fits_i64`], `wb` = `weight_bits.min(16)`.
+#[inline(always)]
+#[must_use]
+pub fn wrap_i64_in<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    frac: u32,
+    size: u32,
+    mode: WrapMode,
+    wb: u32,
+) -> WrapOut {
+    let size = size.max(1);
+    let sf = frac + 1;
+    let s = 2 * coord * i64::from(size) - (1i64 << frac);
+    let i0 = s >> sf;
+    let fr = s - (i0 << sf);
+    // Reduced to `wb` fraction bits when `sf >= wb`, else widened (exact).
+    let w = crate::fixed::round_shift_right(fr, sf.saturating_sub(wb), W::MODE)
+        << wb.saturating_sub(sf);
+    // Truncation cannot carry (`fr < 2^sf`, so `w < 2^wb`).
+    let carry = W::MODE != crate::fixed::Rounding::Truncate && w >> wb != 0;
+    let (i0, w) = if carry { (i0 + 1, 0) } else { (i0, w) };
+    finish(i0, w as u32, size, mode)
+}
+
+/// [`wrap_in`] in `i128` (any coordinate).
+#[inline(never)]
+#[must_use]
+pub fn wrap_wide_in<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    frac: u32,
+    size: u32,
+    mode: WrapMode,
+    cfg: &crate::config::TrilinearConfig,
+) -> WrapOut {
     let size = size.max(1);
     let wb = cfg.weight_bits.min(16);
     let rnd = W::MODE;
-    if frac <= 30 && coord.unsigned_abs() < (1u64 << 29) {
-        // Fast path: |s| < 2^63, all in i64.
-        let sf = frac + 1;
-        let s = 2 * coord * i64::from(size) - (1i64 << frac);
-        let i0 = s >> sf;
-        let fr = s - (i0 << sf);
-        let w = if sf >= wb {
-            crate::fixed::round_shift_right(fr, sf - wb, rnd)
-        } else {
-            fr << (wb - sf)
-        };
-        return if w >> wb != 0 {
-            finish(i0 + 1, 0, size, mode)
-        } else {
-            finish(i0, w as u32, size, mode)
-        };
-    }
     let frac = frac.min(62);
     let sf = frac + 1;
     let s = 2 * i128::from(coord) * i128::from(size) - (1i128 << frac);
@@ -114,16 +145,39 @@ pub fn wrap_in<W: crate::fixed::ConstRounding>(
     finish(i0, w as u32, size, mode)
 }
 
+/// The wrapped indices `i0` and `i0 + 1` (saturating) of a level of `size >= 1` texels: both
+/// inside the level (the common case) need no wrap; with Repeat the second is the first's
+/// successor modulo the size; with ClampToEdge each is clamped.
 #[inline(always)]
 fn finish(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
+    let n = i64::from(size);
+    let (a, b) = if (i0 as u64) < (n - 1) as u64 {
+        (i0 as u32, i0 as u32 + 1)
+    } else {
+        match mode {
+            WrapMode::Repeat if i0 < i64::MAX => {
+                let a = wrap_index(i0, size, mode);
+                (a, if a + 1 == size { 0 } else { a + 1 })
+            }
+            WrapMode::ClampToEdge => (
+                i0.clamp(0, n - 1) as u32,
+                i0.saturating_add(1).clamp(0, n - 1) as u32,
+            ),
+            _ => (
+                wrap_index(i0, size, mode),
+                wrap_index(i0.saturating_add(1), size, mode),
+            ),
+        }
+    };
     WrapOut {
-        i0: wrap_index(i0, size, mode),
-        i1: wrap_index(i0.saturating_add(1), size, mode),
+        i0: a,
+        i1: b,
         weight,
     }
 }
+
 /// Wraps a texel index into `[0, size-1]` by `mode` (`size >= 1`).
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn wrap_index(i: i64, size: u32, mode: WrapMode) -> u32 {
     let n = i64::from(size.max(1));
@@ -200,15 +254,25 @@ pub fn datapath(cfg: &TrilinearConfig) -> Datapath {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::config::HwConfig;
     use crate::fixed::{round_shift_right, round_shift_right_wide, Rounding};
 
     use crate::test_rng::splitmix64 as next;
 
-    /// `wrap` as it was before it was compiled per rounding mode: the oracle.
-    fn wrap_before(
+    /// The wrap of both indices as it was before the in-level and Repeat shortcuts.
+    fn finish_before(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
+        WrapOut {
+            i0: wrap_index(i0, size, mode),
+            i1: wrap_index(i0.saturating_add(1), size, mode),
+            weight,
+        }
+    }
+
+    /// `wrap` as it was before it was compiled per rounding mode: the oracle (also of the
+    /// trilinear unit's tests).
+    pub(crate) fn wrap_before(
         coord: i64,
         frac: u32,
         size: u32,
@@ -229,9 +293,9 @@ mod tests {
                 fr << (wb - sf)
             };
             return if w >> wb != 0 {
-                finish(i0 + 1, 0, size, mode)
+                finish_before(i0 + 1, 0, size, mode)
             } else {
-                finish(i0, w as u32, size, mode)
+                finish_before(i0, w as u32, size, mode)
             };
         }
         let frac = frac.min(62);
@@ -261,7 +325,7 @@ mod tests {
                 _ => i0.rem_euclid(2 * i128::from(size)) as i64,
             },
         };
-        finish(i0, w as u32, size, mode)
+        finish_before(i0, w as u32, size, mode)
     }
 
     /// 3M seeded cases (every rounding and wrap mode, weight widths 0 to 16, the 64-bit and
@@ -283,6 +347,73 @@ mod tests {
                 wrap(coord, frac, size, mode, &cfg),
                 wrap_before(coord, frac, size, mode, rnd, cfg.weight_bits),
                 "{coord} {frac} {size} {mode:?} {cfg:?}"
+            );
+        }
+    }
+
+    /// 3M seeded texture-space cases (every rounding and wrap mode, weight widths 0 to 16,
+    /// level sizes 1, 2, 3, powers of two and others up to 70,000, coordinates mostly in
+    /// [-2, 3) and some far outside or at the ends of `i64`): `wrap` gives the previous
+    /// result through each of its paths (counted); and `finish` gives the previous pair of
+    /// wrapped indices for 3M seeded indices including the ends of `i64`.
+    #[test]
+    fn shortcuts_match_the_previous_wrap() {
+        let mut s = 0x5eed_0015;
+        let mut cfg = HwConfig::texram16().trilinear;
+        let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
+        let mut paths = [0u32; 4]; // inside, outside (64-bit), wide, i64 ends
+        for i in 0..3_000_000u32 {
+            let rnd = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven][(i % 3) as usize];
+            let mode = modes[(i / 3 % 3) as usize];
+            cfg.weight_rounding = rnd;
+            cfg.weight_bits = i / 9 % 17;
+            let frac = if i % 10 == 0 {
+                31 + (next(&mut s) % 32) as u32
+            } else {
+                4 + (next(&mut s) % 27) as u32
+            };
+            let size = match i / 153 % 4 {
+                0 => [1, 2, 3][(i / 612 % 3) as usize],
+                1 => 1 << (i / 612 % 17),
+                _ => (next(&mut s) % 70_000) as u32,
+            };
+            let coord = match i % 7 {
+                0 => (next(&mut s) as i64) >> (next(&mut s) % 64),
+                1 => [i64::MIN, i64::MAX, i64::MIN + 1, i64::MAX - 1][(i / 7 % 4) as usize],
+                _ => {
+                    let one = 1i128 << frac.min(62);
+                    let r = i128::from(next(&mut s)) % (5 * one) - 2 * one;
+                    r.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+                }
+            };
+            let want = wrap_before(coord, frac, size, mode, rnd, cfg.weight_bits);
+            assert_eq!(
+                wrap(coord, frac, size, mode, &cfg),
+                want,
+                "{coord} {frac} {size} {mode:?} {cfg:?}"
+            );
+            let fast = frac <= 30 && coord.unsigned_abs() < (1u64 << 29);
+            let inside = want.i1 == want.i0 + 1;
+            paths[match (fast, inside) {
+                _ if i % 7 == 1 => 3,
+                (true, true) => 0,
+                (true, false) => 1,
+                (false, _) => 2,
+            }] += 1;
+        }
+        assert!(paths.iter().all(|&n| n > 100_000), "{paths:?}");
+        for i in 0..3_000_000u32 {
+            let mode = modes[(i % 3) as usize];
+            let size = [1, 2, 3, 4, 5, 64, 1000, 65_536][(i / 3 % 8) as usize];
+            let i0 = match i / 24 % 4 {
+                0 => [i64::MIN, i64::MIN + 1, -1, 0, i64::MAX - 1, i64::MAX][(i / 96 % 6) as usize],
+                1 => (next(&mut s) as i64) >> (next(&mut s) % 64),
+                _ => (next(&mut s) % 200_000) as i64 - 100_000,
+            };
+            assert_eq!(
+                finish(i0, 7, size, mode),
+                finish_before(i0, 7, size, mode),
+                "{i0} {size} {mode:?}"
             );
         }
     }

@@ -11,7 +11,7 @@
 
 use super::StageKind;
 use hw_model::config::TrilinearConfig;
-use hw_model::trilinear::{trilinear, Level, TrilinearTrace};
+use hw_model::trilinear::{trilinear_to, BilinearTrace, Level, SampleSink, TrilinearTrace};
 use hw_model::wrap::WrapMode;
 use serde::Serialize;
 
@@ -77,25 +77,48 @@ impl Trace {
 
     /// Appends the footprints of one trilinear lookup (one per level it used).
     pub fn record(&mut self, stage: StageKind, lookup: u32, tex: usize, t: &TrilinearTrace) {
+        let at = Lookup { stage, lookup, tex };
         for b in t.level.iter().take(t.levels_used as usize) {
-            let Some(slot) = self.fps.get_mut(self.len as usize) else {
-                debug_assert!(
-                    false,
-                    "more than {MAX_FOOTPRINTS} footprints in one fragment"
-                );
-                return;
-            };
-            *slot = TexelFootprint {
-                stage: stage.index() as u8,
-                lookup: lookup as u8,
-                level: b.level as u8,
-                tex: tex as u16,
-                x: [b.coords[0].0, b.coords[1].0],
-                y: [b.coords[0].1, b.coords[2].1],
-            };
-            self.len += 1;
+            self.push(at, b);
         }
     }
+
+    /// Appends one bilinear footprint of lookup `at`.
+    #[inline]
+    fn push(&mut self, at: Lookup, b: &BilinearTrace) {
+        let Some(slot) = self.fps.get_mut(self.len as usize) else {
+            debug_assert!(
+                false,
+                "more than {MAX_FOOTPRINTS} footprints in one fragment"
+            );
+            return;
+        };
+        *slot = TexelFootprint {
+            stage: at.stage.index() as u8,
+            lookup: at.lookup as u8,
+            level: b.level as u8,
+            tex: at.tex as u16,
+            x: [b.coords[0].0, b.coords[1].0],
+            y: [b.coords[0].1, b.coords[2].1],
+        };
+        self.len += 1;
+    }
+}
+
+/// The sink of a traced lookup: each footprint the filter reads goes straight into the
+/// fragment's trace.
+struct Recorder<'a> {
+    trace: &'a mut Trace,
+    at: Lookup,
+}
+
+impl SampleSink for Recorder<'_> {
+    #[inline(always)]
+    fn footprint(&mut self, _: usize, fp: &BilinearTrace) {
+        self.trace.push(self.at, fp);
+    }
+    #[inline(always)]
+    fn sample(&mut self, _: u32, _: u32, _: [u16; 4]) {}
 }
 
 /// Where a traced lookup comes from: the stage, its lookup number and the map it reads.
@@ -123,22 +146,10 @@ pub fn trilinear_traced(
     at: Lookup,
 ) -> [u16; 4] {
     if !trace.on {
-        return trilinear(levels, u, v, frac, lod, lod_frac_bits, wrap, cfg, None);
+        return trilinear_to(levels, u, v, frac, lod, lod_frac_bits, wrap, cfg, &mut ());
     }
-    let mut t = TrilinearTrace::default();
-    let r = trilinear(
-        levels,
-        u,
-        v,
-        frac,
-        lod,
-        lod_frac_bits,
-        wrap,
-        cfg,
-        Some(&mut t),
-    );
-    trace.record(at.stage, at.lookup, at.tex, &t);
-    r
+    let mut sink = Recorder { trace, at };
+    trilinear_to(levels, u, v, frac, lod, lod_frac_bits, wrap, cfg, &mut sink)
 }
 
 /// The fragment's texture coordinates as the hardware sees them: the raw values when the

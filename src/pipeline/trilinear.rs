@@ -133,7 +133,7 @@ fn per_pixel_probes(acc: [u64; 3], m: &Machine, probes: u32) -> [u64; 3] {
 /// LOD `l`: footprint assembly when `aniso`, else one trilinear lookup; its footprints go into
 /// `trace`. Returns the filtered texel and the probes it took.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 fn lookup(
     m: &Machine,
     plan: &Plan,
@@ -144,31 +144,46 @@ fn lookup(
     trace: &mut Trace,
     sat: &mut SatCounter,
 ) -> ([u16; 4], u32) {
+    if aniso {
+        return footprint_lookup(m, plan, t, uv, trace, sat);
+    }
+    let hw = m.hw;
+    let at = Lookup {
+        stage: KIND,
+        lookup: 0,
+        tex: t,
+    };
+    let [u, v] = uv[0];
+    let r = trilinear_traced(
+        &m.tex_fixed[t],
+        u,
+        v,
+        m.uv_fmt.frac_bits,
+        l,
+        hw.lod.lod_frac_bits,
+        plan.wrap,
+        &hw.trilinear,
+        trace,
+        at,
+    );
+    (r, hw.trilinear.aniso_probes)
+}
+
+/// [`lookup`] by footprint assembly.
+#[inline(never)]
+fn footprint_lookup(
+    m: &Machine,
+    plan: &Plan,
+    t: usize,
+    uv: &[[i64; 2]; 3],
+    trace: &mut Trace,
+    sat: &mut SatCounter,
+) -> ([u16; 4], u32) {
     let hw = m.hw;
     let fb = m.uv_fmt.frac_bits;
     let lfb = hw.lod.lod_frac_bits;
     let levels = &m.tex_fixed[t];
     let [u, v] = uv[0];
-    if !aniso {
-        let at = Lookup {
-            stage: KIND,
-            lookup: 0,
-            tex: t,
-        };
-        let r = trilinear_traced(
-            levels,
-            u,
-            v,
-            fb,
-            l,
-            lfb,
-            plan.wrap,
-            &hw.trilinear,
-            trace,
-            at,
-        );
-        return (r, hw.trilinear.aniso_probes);
-    }
     let size = levels.first().map_or((1, 1), |l0| (l0.width, l0.height));
     let (probes, adaptive) = (hw.trilinear.aniso_probes, hw.trilinear.aniso_adaptive);
     let fp = footprint(uv, size, fb, probes, adaptive, &hw.lod, sat);
