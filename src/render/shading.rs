@@ -32,14 +32,15 @@ pub(super) fn bump_attrs(
     if geo.bump.is_empty() {
         return (out, sat);
     }
-    for (t, a) in setup.tris.iter().zip(attrs.iter_mut()) {
+    for (i, (t, a)) in setup.tris.iter().zip(attrs.iter_mut()).enumerate() {
         let plan = &geo.plans[a.plan as usize];
         if plan.bump.is_none() {
             continue;
         }
         let d = &geo.draws[t.src as usize];
+        let src_bary = setup.src_bary(i);
         let blend = |k: usize| -> BumpVertex {
-            let w = t.src_bary[k];
+            let w = src_bary[k];
             let mut r = BumpVertex::default();
             for (&wj, &vi) in w.iter().zip(&d.v) {
                 let Some(b) = geo.bump.get(vi as usize) else {
@@ -73,15 +74,16 @@ pub(super) fn bump_attrs(
 
 /// Per-triangle attributes of every screen triangle, in the machine's formats.
 pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
-    // Written in parallel straight into their vectors (no serial copy of the attributes);
-    // the overflow counts sum in any order.
-    let (attrs, sats): (Vec<TriAttrs>, Vec<SatCounter>) = setup
+    // Written in parallel straight into their vector; the overflow counts sum in any order.
+    let (attrs, SatSum(sat)): (Vec<TriAttrs>, SatSum) = setup
         .tris
         .par_iter()
-        .map(|t| {
+        .enumerate()
+        .map(|(i, t)| {
             let d = &geo.draws[t.src as usize];
+            let src_bary = setup.src_bary(i);
             let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
-                let w = t.src_bary[k];
+                let w = src_bary[k];
                 let mut c = [0.0; 3];
                 let mut uv = [0.0; 2];
                 for (&wj, &vi) in w.iter().zip(&d.v) {
@@ -105,14 +107,23 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             (a, sat)
         })
         .unzip();
-    let sat = sats
-        .par_iter()
-        .copied()
-        .reduce(SatCounter::default, |mut a, b| {
-            a.add(&b);
-            a
-        });
     (attrs, sat)
+}
+
+/// The sum of overflow counters collected from a parallel iterator (nothing stored per item).
+#[derive(Default)]
+struct SatSum(SatCounter);
+
+impl ParallelExtend<SatCounter> for SatSum {
+    fn par_extend<I: IntoParallelIterator<Item = SatCounter>>(&mut self, items: I) {
+        let s = items
+            .into_par_iter()
+            .reduce(SatCounter::default, |mut a, b| {
+                a.add(&b);
+                a
+            });
+        self.0.add(&s);
+    }
 }
 
 /// llvmpipe's setup of every screen triangle for the float32 coordinate path
