@@ -89,6 +89,7 @@ struct FixedTri {
 }
 
 impl FixedTri {
+    #[inline]
     fn new(t: &ScreenTri, s: u32, width: u32) -> Self {
         let h = 1i64 << (s - 1);
         let e = [0usize, 1, 2].map(|i| {
@@ -124,6 +125,7 @@ impl FixedTri {
     }
 
     /// Exact span [xl, xr) of row `py` and the edge values at `xl`.
+    #[inline]
     fn span(&self, py: i64) -> (i64, i64, [i64; 3]) {
         let y = (py << self.s) + self.h;
         let mut xl = self.x0;
@@ -147,6 +149,7 @@ impl FixedTri {
 
     /// Depth walker at the span start: (quotient, remainder, dq, dr) with `dq`, `dr` zero for
     /// one-pixel spans (the step is only bounded between two covered pixels).
+    #[inline]
     fn depth_start(&self, ev: &[i64; 3], len: i64) -> (i64, i64, i64, i64) {
         let n: i128 = (0..3).map(|i| i128::from(ev[i]) * self.z[i]).sum();
         let den = i128::from(self.den);
@@ -325,15 +328,15 @@ struct Bins {
     lists: Vec<Vec<Vec<u32>>>,
 }
 
+/// The triangles of one band: `lists[chunk][band]` over the chunks, in submission order.
+#[derive(Clone, Copy)]
+struct BandIds<'a> {
+    bins: &'a Bins,
+    band: usize,
+}
+
 /// Triangles per parallel binning task.
 const BIN_CHUNK: usize = 16384;
-
-impl Bins {
-    /// The triangles of band `b`, in submission order.
-    fn band(&self, b: usize) -> impl Iterator<Item = u32> + '_ {
-        self.lists.iter().flat_map(move |c| c[b].iter().copied())
-    }
-}
 
 fn bin(setup: &Setup, bands: usize) -> Bins {
     let band_range = |t: &ScreenTri| -> Option<(usize, usize)> {
@@ -376,7 +379,7 @@ enum Sink<'a> {
 /// Traverses the triangles of one band (rows [y0, y1)) into `sink` (rows of this band only).
 fn band(
     setup: &Setup,
-    ids: impl Iterator<Item = u32>,
+    ids: BandIds,
     y0: u32,
     y1: u32,
     coverage: Coverage,
@@ -471,14 +474,14 @@ enum Prep<'a> {
 /// submission order.
 fn for_spans(
     setup: &Setup,
-    ids: impl Iterator<Item = u32>,
+    ids: BandIds,
     y0: u32,
     y1: u32,
     coverage: Coverage,
     s: u32,
     mut f: impl FnMut(u32, i64, i64, i64, Prep<'_>),
 ) {
-    for id in ids {
+    for &id in ids.bins.lists.iter().flat_map(|c| &c[ids.band]) {
         let t = &setup.tris[id as usize];
         let ya = t.bbox[1].max(y0);
         let yb = t.bbox[3].min(y1);
@@ -525,7 +528,10 @@ fn run(setup: &Setup, coverage: Coverage, out: &mut [u32], vis: Option<bool>) ->
         .map(|(b, rows)| {
             let y0 = b as u32 * BAND_ROWS;
             let y1 = (y0 + BAND_ROWS).min(h);
-            let ids = bins.band(b);
+            let ids = BandIds {
+                bins: &bins,
+                band: b,
+            };
             let sink = match vis {
                 Some(depth_test) => Sink::Vis {
                     tri: rows,
