@@ -52,6 +52,7 @@
 mod setup;
 mod traverse;
 
+pub(crate) use setup::vec_populated;
 pub use setup::{
     setup, DrawTri, ScreenTri, Setup, SetupStats, VertexSource, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
 };

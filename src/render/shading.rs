@@ -75,39 +75,38 @@ pub(super) fn bump_attrs(
 /// Per-triangle attributes of every screen triangle, in the machine's formats.
 pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
     // Written in parallel straight into their vector; the overflow counts sum in any order.
-    let (attrs, SatSum(sat)): (Vec<TriAttrs>, SatSum) = setup
-        .tris
-        .par_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let d = &geo.draws[t.src as usize];
-            let src_bary = setup.src_bary(i);
-            let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
-                let w = src_bary[k];
-                let mut c = [0.0; 3];
-                let mut uv = [0.0; 2];
-                for (&wj, &vi) in w.iter().zip(&d.v) {
-                    let vi = vi as usize;
-                    for (acc, &x) in c.iter_mut().zip(&geo.color[vi]) {
-                        *acc += wj * x;
-                    }
-                    for (acc, &x) in uv.iter_mut().zip(&geo.uv[vi]) {
-                        *acc += wj * x;
-                    }
+    let mut out = (
+        crate::raster::vec_populated(setup.tris.len()),
+        SatSum::default(),
+    );
+    out.par_extend(setup.tris.par_iter().enumerate().map(|(i, t)| {
+        let d = &geo.draws[t.src as usize];
+        let src_bary = setup.src_bary(i);
+        let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
+            let w = src_bary[k];
+            let mut c = [0.0; 3];
+            let mut uv = [0.0; 2];
+            for (&wj, &vi) in w.iter().zip(&d.v) {
+                let vi = vi as usize;
+                for (acc, &x) in c.iter_mut().zip(&geo.color[vi]) {
+                    *acc += wj * x;
                 }
-                (c, uv)
-            };
-            let (c0, t0) = blend(0);
-            let (c1, t1) = blend(1);
-            let (c2, t2) = blend(2);
-            let mut sat = SatCounter::default();
-            let plan = geo.draw_plan[t.src as usize];
-            let wrap = geo.plans[plan as usize].wrap;
-            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
-            (a, sat)
-        })
-        .unzip();
-    (attrs, sat)
+                for (acc, &x) in uv.iter_mut().zip(&geo.uv[vi]) {
+                    *acc += wj * x;
+                }
+            }
+            (c, uv)
+        };
+        let (c0, t0) = blend(0);
+        let (c1, t1) = blend(1);
+        let (c2, t2) = blend(2);
+        let mut sat = SatCounter::default();
+        let plan = geo.draw_plan[t.src as usize];
+        let wrap = geo.plans[plan as usize].wrap;
+        let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
+        (a, sat)
+    }));
+    (out.0, out.1 .0)
 }
 
 /// The sum of overflow counters collected from a parallel iterator (nothing stored per item).
