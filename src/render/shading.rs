@@ -8,7 +8,7 @@ use crate::pipeline::clip_f32::ShadedVertex;
 use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
-use crate::raster::ScreenTri;
+use crate::raster::{ScreenTri, VertexSource};
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
 use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
@@ -81,9 +81,8 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
     );
     out.par_extend(setup.tris.par_iter().enumerate().map(|(i, t)| {
         let d = &geo.draws[t.src as usize];
-        let src_bary = setup.src_bary(i);
         let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
-            let w = src_bary[k];
+            let w = setup.src_bary(i)[k];
             let mut c = [0.0; 3];
             let mut uv = [0.0; 2];
             for (&wj, &vi) in w.iter().zip(&d.v) {
@@ -97,9 +96,32 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
             }
             (c, uv)
         };
-        let (c0, t0) = blend(0);
-        let (c1, t1) = blend(1);
-        let (c2, t2) = blend(2);
+        // An unclipped triangle's vertices are its source's: the blend with unit weights is
+        // `x + 0.0` (a zero's sign dropped) when every blended value is finite.
+        let direct = match t.source {
+            VertexSource::Unclipped { swapped } => {
+                let vs = if swapped {
+                    [d.v[0], d.v[2], d.v[1]]
+                } else {
+                    d.v
+                };
+                let finite = vs.iter().all(|&vi| {
+                    let vi = vi as usize;
+                    geo.color[vi]
+                        .iter()
+                        .chain(&geo.uv[vi])
+                        .all(|x| x.is_finite())
+                });
+                finite.then(|| {
+                    vs.map(|vi| {
+                        let vi = vi as usize;
+                        (geo.color[vi].map(|x| x + 0.0), geo.uv[vi].map(|x| x + 0.0))
+                    })
+                })
+            }
+            VertexSource::Clipped => None,
+        };
+        let [(c0, t0), (c1, t1), (c2, t2)] = direct.unwrap_or_else(|| [0, 1, 2].map(blend));
         let mut sat = SatCounter::default();
         let plan = geo.draw_plan[t.src as usize];
         let wrap = geo.plans[plan as usize].wrap;
