@@ -16,13 +16,13 @@ pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
         return 0;
     }
     let y = x * pow2(fmt.frac_bits as i32);
-    let fl = y.floor();
+    let fl = floor_exact(y);
     let rem = y - fl;
     let r = match fmt.rounding {
         Rounding::Truncate => fl,
         Rounding::HalfUp => fl + if rem >= 0.5 { 1.0 } else { 0.0 },
         Rounding::HalfEven => {
-            let odd = (fl * 0.5).floor() != fl * 0.5;
+            let odd = floor_exact(fl * 0.5) != fl * 0.5;
             fl + if rem > 0.5 || (rem == 0.5 && odd) {
                 1.0
             } else {
@@ -57,6 +57,25 @@ pub fn to_raw_nearest(x: f64, frac: u32) -> i64 {
     to_raw(x, &widest, &mut SatCounter::default())
 }
 
+/// `y.floor()`, bit for bit (signed zeros, infinities and NaN included), without the libm
+/// call `floor` is on x86-64 without SSE4.1: below 2^52 in magnitude through `i64`
+/// truncation, above it every double is already an integer.
+#[inline]
+#[must_use]
+pub fn floor_exact(y: f64) -> f64 {
+    const TWO_52: f64 = 4_503_599_627_370_496.0;
+    if y.abs() < TWO_52 {
+        let t = y as i64 as f64;
+        if t > y {
+            t - 1.0
+        } else {
+            t.copysign(y)
+        }
+    } else {
+        y
+    }
+}
+
 /// `raw * 2^-frac_bits` (exact for |raw| <= 2^53).
 #[inline]
 #[must_use]
@@ -64,14 +83,20 @@ pub fn from_raw(raw: i64, frac_bits: u32) -> f64 {
     raw as f64 * pow2(-(frac_bits as i32))
 }
 
-/// `2^e` exactly, built from its bit pattern (no libm call in per-pixel code).
+/// `2^e` exactly (`2f64.powi(e)`), built from its bit pattern (no libm or `powi` call in
+/// per-pixel code).
 #[inline]
 #[must_use]
 pub fn pow2(e: i32) -> f64 {
     if (-1022..=1023).contains(&e) {
         f64::from_bits(((1023 + e) as u64) << 52)
+    } else if e > 1023 {
+        f64::INFINITY
+    } else if e == -1023 {
+        // Subnormal; `powi` divides by `2^-e`, which overflows below.
+        f64::from_bits(1u64 << 51)
     } else {
-        2f64.powi(e)
+        0.0
     }
 }
 

@@ -253,7 +253,8 @@ pub struct TriAttrs {
     /// 1/w normalized so the largest is exactly 1 << inv_w_bits.
     pub inv_w_x: [i64; 3],
     pub color_f: [[f64; 3]; 3],
-    pub color_x: [[i64; 3]; 3],
+    /// Unorm `color_bits` per vertex and channel.
+    pub color_x: [[u32; 3]; 3],
     pub uv_f: [[f64; 2]; 3],
     pub uv_x: [[i64; 2]; 3],
     /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
@@ -306,25 +307,38 @@ impl TriAttrs {
         let bits = m.hw.interp.inv_w_bits;
         let max = inv_w.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
         let norm = Format::unsigned(1, bits, Rounding::HalfEven);
-        let inv_w_x = inv_w.map(|q| to_raw(q / max, &norm, sat).max(1));
         let cb = m.hw.color.color_bits;
+        // Plain loops: nested array `map`s cost several hundred instructions per triangle.
+        let mut inv_w_x = [0i64; 3];
+        let mut color_x = [[0u32; 3]; 3];
+        let mut uv_x = [[0i64; 2]; 3];
+        for v in 0..3 {
+            inv_w_x[v] = to_raw(inv_w[v] / max, &norm, sat).max(1);
+            for ch in 0..3 {
+                color_x[v][ch] = to_unorm(color[v][ch], cb);
+            }
+            for ax in 0..2 {
+                uv_x[v][ax] = to_raw(uv[v][ax] - off[ax], &m.uv_fmt, sat);
+            }
+        }
         Self {
             plan,
             inv_w_f: inv_w,
             inv_w_x,
             color_f: color,
-            color_x: color.map(|c| c.map(|x| i64::from(to_unorm(x, cb)))),
+            color_x,
             uv_f: uv,
-            uv_x: uv.map(|t| [0, 1].map(|ax| to_raw(t[ax] - off[ax], &m.uv_fmt, sat))),
+            uv_x,
             bump: u32::MAX,
             f32_tri: u32::MAX,
         }
     }
 }
 
+/// Component `c` of three vertices' attributes, as the interpolator's `i64` inputs.
 #[inline]
-pub(crate) fn column<const N: usize>(v: &[[i64; N]; 3], c: usize) -> [i64; 3] {
-    [v[0][c], v[1][c], v[2][c]]
+pub(crate) fn column<T: Copy + Into<i64>, const N: usize>(v: &[[T; N]; 3], c: usize) -> [i64; 3] {
+    [v[0][c].into(), v[1][c].into(), v[2][c].into()]
 }
 
 #[inline]

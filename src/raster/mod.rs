@@ -39,7 +39,9 @@
 //! - Float coverage evaluates each edge with its endpoints in a canonical (lexicographic) order
 //!   and negates, so the two triangles sharing an edge see exactly opposite values; spans are
 //!   found by a division guess refined with those evaluations (exact for the float model).
-//! - Setup runs on chunks of draws in parallel, concatenated in submission order.
+//! - Setup runs in parallel: each vertex is projected once (shared by the unclipped triangles
+//!   that use it), a first pass counts each draw's output triangles, a second writes them in
+//!   place, in submission order.
 //! - Float coverage draws only the triangles fixed setup kept (same list, same culling
 //!   decision); a sliver whose snapped orientation is flipped (`area2_f < 0`) is drawn in float
 //!   with its own orientation. Float depth is f64, cleared to 1.0, strictly-less as well.
@@ -50,8 +52,9 @@
 mod setup;
 mod traverse;
 
+pub(crate) use setup::vec_populated;
 pub use setup::{
-    setup, DrawTri, ScreenTri, Setup, SetupStats, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
+    setup, DrawTri, ScreenTri, Setup, SetupStats, VertexSource, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
 };
 pub use traverse::{
     coverage_count, rasterize, Coverage, RasterStats, VisBuffer, BAND_ROWS, NO_TRI,

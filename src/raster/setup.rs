@@ -41,8 +41,9 @@ pub struct ScreenTri {
     pub inv_w: [f64; 3],
     /// Index into `draws` of the source triangle.
     pub src: u32,
-    /// Each vertex as clip-space-linear barycentrics of the source triangle's vertices.
-    pub src_bary: [[f64; 3]; 3],
+    /// Where the vertices come from ([`Setup::src_bary`] gives them as barycentrics of the
+    /// source triangle's vertices).
+    pub source: VertexSource,
     /// `E0 + E1 + E2` of the snapped triangle, > 0.
     pub area2: i64,
     /// The same from `xy_f`; negative for slivers whose snapping flipped them (float traversal
@@ -50,6 +51,16 @@ pub struct ScreenTri {
     pub area2_f: f64,
     /// x0, y0, x1, y1 (exclusive) of pixels possibly covered (fixed or float), in the viewport.
     pub bbox: [u32; 4],
+}
+
+/// Where a screen triangle's vertices come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexSource {
+    /// The source triangle's own vertices, in its order or, `swapped`, with vertices 1 and 2
+    /// exchanged (setup orients every triangle to `area2 > 0`).
+    Unclipped { swapped: bool },
+    /// Clipping produced them: their barycentrics are in [`Setup::clipped_bary`].
+    Clipped,
 }
 
 /// Setup counters. Every input triangle lands in exactly one of `non_finite`, `clipped_away`,
@@ -76,11 +87,34 @@ pub struct SetupStats {
 #[derive(Clone, Debug)]
 pub struct Setup {
     pub tris: Vec<ScreenTri>,
+    /// The vertices of every [`VertexSource::Clipped`] triangle as clip-space-linear
+    /// barycentrics of its source triangle's vertices, by triangle index (ascending).
+    pub clipped_bary: Vec<(u32, [[f64; 3]; 3])>,
     pub width: u32,
     pub height: u32,
     pub subpixel_bits: u32,
     pub depth_bits: u32,
     pub stats: SetupStats,
+}
+
+impl Setup {
+    /// Each vertex of triangle `i` as clip-space-linear barycentrics of its source triangle's
+    /// vertices (unit vectors, in setup's vertex order, for an unclipped triangle).
+    #[must_use]
+    pub fn src_bary(&self, i: usize) -> [[f64; 3]; 3] {
+        const ID: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        match self.tris[i].source {
+            VertexSource::Unclipped { swapped: false } => ID,
+            VertexSource::Unclipped { swapped: true } => [ID[0], ID[2], ID[1]],
+            VertexSource::Clipped => {
+                let k = self
+                    .clipped_bary
+                    .binary_search_by_key(&(i as u32), |e| e.0)
+                    .expect("every clipped triangle has its barycentrics");
+                self.clipped_bary[k].1
+            }
+        }
+    }
 }
 
 impl ScreenTri {
@@ -318,7 +352,6 @@ struct ScreenVert {
     z: u32,
     zf: f64,
     inv_w: f64,
-    b: [f64; 3],
 }
 
 /// Parameters of the viewport transform and snapping.
@@ -331,8 +364,8 @@ struct Viewport {
 
 impl Viewport {
     /// Divide, viewport-transform and snap; `None` if anything is non-finite.
-    fn project(&self, v: &ClipVert) -> Option<ScreenVert> {
-        let [x, y, z, w] = v.p;
+    fn project(&self, p: &[f64; 4]) -> Option<ScreenVert> {
+        let [x, y, z, w] = *p;
         let inv_w = 1.0 / w;
         let xn = x * inv_w;
         let yn = y * inv_w;
@@ -340,7 +373,7 @@ impl Viewport {
         let px = (xn + 1.0) * 0.5 * self.w;
         let py = (1.0 - yn) * 0.5 * self.h;
         let zf = ((zn + 1.0) * 0.5).clamp(0.0, 1.0);
-        let all = [inv_w, px, py, zf, v.b[0], v.b[1], v.b[2]];
+        let all = [inv_w, px, py, zf];
         if !all.iter().all(|c| c.is_finite()) {
             return None;
         }
@@ -354,12 +387,18 @@ impl Viewport {
             z: zu,
             zf,
             inv_w,
-            b: v.b,
         })
+    }
+
+    /// [`Self::project`] of a clipped vertex, `None` also if its barycentrics are not finite.
+    fn project_clipped(&self, v: &ClipVert) -> Option<ScreenVert> {
+        self.project(&v.p)
+            .filter(|_| v.b.iter().all(|c| c.is_finite()))
     }
 }
 
 /// What happened to one input triangle.
+#[derive(Clone, Copy)]
 enum Outcome {
     NonFinite,
     ClippedAway,
@@ -367,7 +406,7 @@ enum Outcome {
         culled: bool,
         degenerate: bool,
         clipped: bool,
-        n: usize,
+        n: u8,
     },
 }
 
@@ -397,26 +436,36 @@ fn pixel_range_float(min: f64, max: f64, limit: u32) -> (i64, i64) {
     (lo.max(0), hi.min(i64::from(limit)))
 }
 
-fn make_tri(
+/// A fan triangle setup keeps: its vertices oriented to `area2 > 0` (`swapped`: vertices 1 and
+/// 2 exchanged), with their barycentrics in the source triangle when it was clipped.
+struct Kept {
     vs: [ScreenVert; 3],
-    src: u32,
-    cull_back: bool,
-    s: u32,
-    width: u32,
-    height: u32,
-) -> Result<ScreenTri, bool> {
+    area2: i64,
+    swapped: bool,
+    bary: Option<[[f64; 3]; 3]>,
+}
+
+/// Orients `vs`; `Err(true)` if culled, `Err(false)` if degenerate.
+fn orient(vs: [ScreenVert; 3], cull_back: bool) -> Result<([ScreenVert; 3], i64, bool), bool> {
     let mut vs = vs;
-    let mut area2 = cross_fixed(vs[0].xs, vs[1].xs, vs[2].xs);
+    let area2 = cross_fixed(vs[0].xs, vs[1].xs, vs[2].xs);
     if area2 == 0 {
         return Err(false);
     }
     if area2 < 0 {
         // Counter-clockwise in NDC = clockwise in y-down screen space: front-facing.
         vs.swap(1, 2);
-        area2 = -area2;
+        Ok((vs, -area2, true))
     } else if cull_back {
-        return Err(true);
+        Err(true)
+    } else {
+        Ok((vs, area2, false))
     }
+}
+
+/// The screen triangle of a kept fan triangle of draw `src`.
+fn make_tri(k: &Kept, src: u32, s: u32, width: u32, height: u32) -> ScreenTri {
+    let vs = &k.vs;
     let area2_f = cross_float(vs[0].xf, vs[1].xf, vs[2].xf);
     let mut bbox = [0u32; 4];
     for axis in 0..2 {
@@ -435,22 +484,50 @@ fn make_tri(
         bbox[axis] = lo as u32;
         bbox[axis + 2] = hi as u32;
     }
-    Ok(ScreenTri {
+    ScreenTri {
         xy: vs.map(|v| v.xs),
         xy_f: vs.map(|v| v.xf),
         z: vs.map(|v| v.z),
         z_f: vs.map(|v| v.zf),
         inv_w: vs.map(|v| v.inv_w),
         src,
-        src_bary: vs.map(|v| v.b),
-        area2,
+        source: match k.bary {
+            None => VertexSource::Unclipped { swapped: k.swapped },
+            Some(_) => VertexSource::Clipped,
+        },
+        area2: k.area2,
         area2_f,
         bbox,
-    })
+    }
+}
+
+/// A clip-space vertex as every unclipped triangle that uses it sees it: its outcode
+/// ([`NON_FINITE`] for a non-finite position) and, inside every clip plane, its projection.
+#[derive(Clone, Copy)]
+struct VertexProj {
+    code: u32,
+    screen: Option<ScreenVert>,
+}
+
+/// Outcode of a vertex with a non-finite coordinate.
+const NON_FINITE: u32 = u32::MAX;
+/// Outcode bits of the clip planes.
+const CLIP_MASK: u32 = (1 << PLANES) - 1;
+
+/// Everything the per-draw setup reads.
+struct Ctx<'a> {
+    clip: &'a [[f64; 4]],
+    proj: &'a [VertexProj],
+    draws: &'a [DrawTri],
+    vp: Viewport,
 }
 
 /// Sets up every triangle of `draws` (see the module header for the conventions).
 /// `width`/`height` are clamped to `0..=MAX_VIEWPORT`, the config widths to their valid ranges.
+///
+/// In parallel and identical for any thread count: every vertex is projected once; a first
+/// pass counts each draw's output triangles (and the outcome counters), a second writes each
+/// output triangle straight into its slot of the result, in submission order.
 #[must_use]
 pub fn setup(
     clip: &[[f64; 4]],
@@ -469,37 +546,79 @@ pub fn setup(
         scale: f64::from(1u32 << s),
         zmax: f64::from((1u32 << depth_bits) - 1),
     };
-    // Chunks in parallel, concatenated in submission order: identical for any thread count.
-    let parts: Vec<(Vec<ScreenTri>, SetupStats)> = draws
-        .par_chunks(SETUP_CHUNK)
-        .enumerate()
-        .map(|(c, chunk)| {
-            let mut st = SetupStats::default();
-            let mut tris = Vec::with_capacity(chunk.len());
-            for (k, d) in chunk.iter().enumerate() {
-                let src = (c * SETUP_CHUNK + k) as u32;
-                let outcome = setup_one(clip, d, src, &vp, s, width, height, &mut tris);
-                st.count(&outcome);
+    let proj: Vec<VertexProj> = clip
+        .par_iter()
+        .map(|p| {
+            if !p.iter().all(|c| c.is_finite()) {
+                return VertexProj {
+                    code: NON_FINITE,
+                    screen: None,
+                };
             }
-            (tris, st)
+            let code = outcode(p);
+            VertexProj {
+                code,
+                screen: if code & CLIP_MASK == 0 {
+                    vp.project(p)
+                } else {
+                    None
+                },
+            }
         })
         .collect();
-    let mut stats = SetupStats {
-        input: draws.len() as u64,
-        ..SetupStats::default()
+    let ctx = Ctx {
+        clip,
+        proj: &proj,
+        draws,
+        vp,
     };
-    let mut tris = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
-    for (t, st) in parts {
-        tris.extend(t);
-        stats.non_finite += st.non_finite;
-        stats.clipped_away += st.clipped_away;
-        stats.culled += st.culled;
-        stats.degenerate += st.degenerate;
-        stats.clipped += st.clipped;
+    let outcomes: Vec<Outcome> = (0..draws.len() as u32)
+        .into_par_iter()
+        .map(|src| ctx.for_kept(src, |_| {}))
+        .collect();
+    let mut stats = outcomes
+        .par_iter()
+        .fold(SetupStats::default, |mut st, o| {
+            st.count(o);
+            st
+        })
+        .reduce(SetupStats::default, |mut a, b| {
+            a.add(&b);
+            a
+        });
+    stats.input = draws.len() as u64;
+    // (draw, its kept fan triangle) of every output triangle, in submission order.
+    let mut out: Vec<(u32, u8)> = Vec::with_capacity(draws.len());
+    for (src, o) in outcomes.iter().enumerate() {
+        if let Outcome::Produced { n, .. } = *o {
+            out.extend((0..n).map(|k| (src as u32, k)));
+        }
     }
+    let mut tris = vec_populated(out.len());
+    out.par_iter()
+        .map(|&(src, k)| {
+            let t = ctx.nth_kept(src, k);
+            make_tri(&t, src, s, width, height)
+        })
+        .collect_into_vec(&mut tris);
+    let clipped_bary = out
+        .par_iter()
+        .enumerate()
+        .filter(|&(_, &(src, _))| {
+            matches!(
+                outcomes[src as usize],
+                Outcome::Produced { clipped: true, .. }
+            )
+        })
+        .map(|(i, &(src, k))| {
+            let b = ctx.nth_kept(src, k).bary;
+            (i as u32, b.expect("a clipped triangle has barycentrics"))
+        })
+        .collect();
     stats.output = tris.len() as u64;
     Setup {
         tris,
+        clipped_bary,
         width,
         height,
         subpixel_bits: s,
@@ -508,10 +627,161 @@ pub fn setup(
     }
 }
 
-/// Draws per parallel setup task.
-const SETUP_CHUNK: usize = 4096;
+/// An empty vector with room for `n` items, its memory already allocated by the kernel in
+/// parallel (Linux `madvise(MADV_POPULATE_WRITE)` on 2 MiB pieces from the worker threads;
+/// below 4 MiB, or elsewhere, a plain `Vec::with_capacity`). The per-triangle arrays of a
+/// large mesh are written once: touched 4 KiB page by page by the writers, their page faults
+/// cost more than computing them and did not scale with threads (1M triangles: about 125,000
+/// faults, 2/3 of the setup phase's CPU time).
+pub(crate) fn vec_populated<T>(n: usize) -> Vec<T> {
+    let v: Vec<T> = Vec::with_capacity(n);
+    #[cfg(target_os = "linux")]
+    {
+        const PAGE: usize = 4096;
+        const PIECE: usize = 2 << 20;
+        let bytes = n.saturating_mul(std::mem::size_of::<T>());
+        let start = v.as_ptr() as usize;
+        let first = start.next_multiple_of(PAGE);
+        let end = (start + bytes) / PAGE * PAGE;
+        if bytes >= 4 << 20 && end > first {
+            (0..(end - first).div_ceil(PIECE))
+                .into_par_iter()
+                .for_each(|k| {
+                    let a = first + k * PIECE;
+                    let len = PIECE.min(end - a);
+                    // SAFETY: [a, a + len) lies inside the vector's own allocation (rounded
+                    // inward to pages); MADV_POPULATE_WRITE only allocates its pages (an
+                    // error leaves them to be faulted in on first write) and changes no
+                    // content the vector could observe.
+                    unsafe {
+                        libc::madvise(a as *mut libc::c_void, len, libc::MADV_POPULATE_WRITE);
+                    }
+                });
+        }
+    }
+    v
+}
+
+impl Ctx<'_> {
+    /// The `k`-th fan triangle draw `src` keeps (as [`Self::for_kept`] counted it).
+    fn nth_kept(&self, src: u32, k: u8) -> Kept {
+        let mut i = 0;
+        let mut found = None;
+        self.for_kept(src, |t| {
+            if i == k {
+                found = Some(t);
+            }
+            i += 1;
+        });
+        found.expect("the draw keeps the triangles its outcome counted")
+    }
+
+    /// Runs setup on draw `src` and calls `kept` for each fan triangle it keeps, in order.
+    fn for_kept(&self, src: u32, mut kept: impl FnMut(Kept)) -> Outcome {
+        let d = &self.draws[src as usize];
+        let mut codes = [0u32; 3];
+        for (c, &idx) in codes.iter_mut().zip(&d.v) {
+            match self.proj.get(idx as usize) {
+                Some(v) if v.code != NON_FINITE => *c = v.code,
+                _ => return Outcome::NonFinite,
+            }
+        }
+        if codes[0] & codes[1] & codes[2] != 0 {
+            return Outcome::ClippedAway;
+        }
+        if (codes[0] | codes[1] | codes[2]) & CLIP_MASK == 0 {
+            let mut vs = [ScreenVert::default(); 3];
+            for (out, &idx) in vs.iter_mut().zip(&d.v) {
+                match self.proj[idx as usize].screen {
+                    Some(v) => *out = v,
+                    None => return Outcome::NonFinite,
+                }
+            }
+            let (mut culled, mut degenerate, mut n) = (false, false, 0);
+            match orient(vs, d.cull_back) {
+                Ok((vs, area2, swapped)) => {
+                    kept(Kept {
+                        vs,
+                        area2,
+                        swapped,
+                        bary: None,
+                    });
+                    n = 1;
+                }
+                Err(true) => culled = true,
+                Err(false) => degenerate = true,
+            }
+            return Outcome::Produced {
+                culled,
+                degenerate,
+                clipped: false,
+                n,
+            };
+        }
+        let mut poly = Poly {
+            v: [ClipVert::default(); MAX_POLY],
+            n: 3,
+        };
+        for (i, &idx) in d.v.iter().enumerate() {
+            let mut b = [0.0; 3];
+            b[i] = 1.0;
+            poly.v[i] = ClipVert {
+                p: self.clip[idx as usize],
+                b,
+            };
+        }
+        // Every plane, even those no input vertex is outside of: an edge's cut then depends
+        // only on its endpoints, identically in both triangles that share it.
+        for plane in 0..PLANES {
+            poly = clip_plane(&poly, plane);
+            if poly.n < 3 {
+                return Outcome::ClippedAway;
+            }
+        }
+        let mut sv = [ScreenVert::default(); MAX_POLY];
+        for (out, v) in sv.iter_mut().zip(&poly.v[..poly.n]) {
+            match self.vp.project_clipped(v) {
+                Some(p) => *out = p,
+                None => return Outcome::NonFinite,
+            }
+        }
+        let (mut culled, mut degenerate, mut n) = (false, false, 0);
+        for i in 1..poly.n - 1 {
+            match orient([sv[0], sv[i], sv[i + 1]], d.cull_back) {
+                Ok((vs, area2, swapped)) => {
+                    let b = [poly.v[0].b, poly.v[i].b, poly.v[i + 1].b];
+                    let b = if swapped { [b[0], b[2], b[1]] } else { b };
+                    kept(Kept {
+                        vs,
+                        area2,
+                        swapped,
+                        bary: Some(b),
+                    });
+                    n += 1;
+                }
+                Err(true) => culled = true,
+                Err(false) => degenerate = true,
+            }
+        }
+        Outcome::Produced {
+            culled,
+            degenerate,
+            clipped: true,
+            n,
+        }
+    }
+}
 
 impl SetupStats {
+    /// Adds another set of counters (all but `input` and `output`).
+    fn add(&mut self, o: &SetupStats) {
+        self.non_finite += o.non_finite;
+        self.clipped_away += o.clipped_away;
+        self.culled += o.culled;
+        self.degenerate += o.degenerate;
+        self.clipped += o.clipped;
+    }
+
     /// Counts one input triangle's outcome.
     fn count(&mut self, outcome: &Outcome) {
         match *outcome {
@@ -537,82 +807,5 @@ impl SetupStats {
                 }
             }
         }
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn setup_one(
-    clip: &[[f64; 4]],
-    d: &DrawTri,
-    src: u32,
-    vp: &Viewport,
-    s: u32,
-    width: u32,
-    height: u32,
-    tris: &mut Vec<ScreenTri>,
-) -> Outcome {
-    let mut poly = Poly {
-        v: [ClipVert::default(); MAX_POLY],
-        n: 3,
-    };
-    for (i, &idx) in d.v.iter().enumerate() {
-        let Some(p) = clip.get(idx as usize) else {
-            return Outcome::NonFinite;
-        };
-        if !p.iter().all(|c| c.is_finite()) {
-            return Outcome::NonFinite;
-        }
-        let mut b = [0.0; 3];
-        b[i] = 1.0;
-        poly.v[i] = ClipVert { p: *p, b };
-    }
-    let codes = [0, 1, 2].map(|i| outcode(&poly.v[i].p));
-    if codes[0] & codes[1] & codes[2] != 0 {
-        return Outcome::ClippedAway;
-    }
-    let clip_mask = (1u32 << PLANES) - 1;
-    let clipped = (codes[0] | codes[1] | codes[2]) & clip_mask != 0;
-    if clipped {
-        // Every plane, even those no input vertex is outside of: an edge's cut then depends
-        // only on its endpoints, identically in both triangles that share it.
-        for plane in 0..PLANES {
-            poly = clip_plane(&poly, plane);
-            if poly.n < 3 {
-                return Outcome::ClippedAway;
-            }
-        }
-    }
-    let mut sv = [ScreenVert::default(); MAX_POLY];
-    for (out, v) in sv.iter_mut().zip(&poly.v[..poly.n]) {
-        match vp.project(v) {
-            Some(p) => *out = p,
-            None => return Outcome::NonFinite,
-        }
-    }
-    let mut culled = false;
-    let mut degenerate = false;
-    let mut n = 0;
-    for i in 1..poly.n - 1 {
-        match make_tri(
-            [sv[0], sv[i], sv[i + 1]],
-            src,
-            d.cull_back,
-            s,
-            width,
-            height,
-        ) {
-            Ok(t) => {
-                tris.push(t);
-                n += 1;
-            }
-            Err(true) => culled = true,
-            Err(false) => degenerate = true,
-        }
-    }
-    Outcome::Produced {
-        culled,
-        degenerate,
-        clipped,
-        n,
     }
 }

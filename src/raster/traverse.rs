@@ -89,6 +89,7 @@ struct FixedTri {
 }
 
 impl FixedTri {
+    #[inline]
     fn new(t: &ScreenTri, s: u32, width: u32) -> Self {
         let h = 1i64 << (s - 1);
         let e = [0usize, 1, 2].map(|i| {
@@ -124,6 +125,7 @@ impl FixedTri {
     }
 
     /// Exact span [xl, xr) of row `py` and the edge values at `xl`.
+    #[inline]
     fn span(&self, py: i64) -> (i64, i64, [i64; 3]) {
         let y = (py << self.s) + self.h;
         let mut xl = self.x0;
@@ -147,6 +149,7 @@ impl FixedTri {
 
     /// Depth walker at the span start: (quotient, remainder, dq, dr) with `dq`, `dr` zero for
     /// one-pixel spans (the step is only bounded between two covered pixels).
+    #[inline]
     fn depth_start(&self, ev: &[i64; 3], len: i64) -> (i64, i64, i64, i64) {
         let n: i128 = (0..3).map(|i| i128::from(ev[i]) * self.z[i]).sum();
         let den = i128::from(self.den);
@@ -318,11 +321,22 @@ fn last_pass(lo: i64, hi: i64, g: i64, f: impl Fn(i64) -> bool) -> i64 {
     }
 }
 
-/// Triangle indices per band, in submission order (counting sort, flat).
+/// Triangle indices per band, in submission order: binned in parallel by chunks of
+/// triangles, each chunk's lists kept apart (`lists[chunk][band]`); a band walks the chunks
+/// in order, so no list is concatenated.
 struct Bins {
-    start: Vec<usize>,
-    ids: Vec<u32>,
+    lists: Vec<Vec<Vec<u32>>>,
 }
+
+/// The triangles of one band: `lists[chunk][band]` over the chunks, in submission order.
+#[derive(Clone, Copy)]
+struct BandIds<'a> {
+    bins: &'a Bins,
+    band: usize,
+}
+
+/// Triangles per parallel binning task.
+const BIN_CHUNK: usize = 16384;
 
 fn bin(setup: &Setup, bands: usize) -> Bins {
     let band_range = |t: &ScreenTri| -> Option<(usize, usize)> {
@@ -333,28 +347,24 @@ fn bin(setup: &Setup, bands: usize) -> Bins {
         }
         Some(((y0 / BAND_ROWS) as usize, ((y1 - 1) / BAND_ROWS) as usize))
     };
-    let mut start = vec![0usize; bands + 1];
-    for t in &setup.tris {
-        if let Some((b0, b1)) = band_range(t) {
-            for c in &mut start[b0 + 1..=b1 + 1] {
-                *c += 1;
+    let lists = setup
+        .tris
+        .par_chunks(BIN_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut lists = vec![Vec::new(); bands];
+            for (k, t) in chunk.iter().enumerate() {
+                if let Some((b0, b1)) = band_range(t) {
+                    let id = (c * BIN_CHUNK + k) as u32;
+                    for list in &mut lists[b0..=b1] {
+                        list.push(id);
+                    }
+                }
             }
-        }
-    }
-    for b in 0..bands {
-        start[b + 1] += start[b];
-    }
-    let mut fill = start.clone();
-    let mut ids = vec![0u32; start[bands]];
-    for (i, t) in setup.tris.iter().enumerate() {
-        if let Some((b0, b1)) = band_range(t) {
-            for f in &mut fill[b0..=b1] {
-                ids[*f] = i as u32;
-                *f += 1;
-            }
-        }
-    }
-    Bins { start, ids }
+            lists
+        })
+        .collect();
+    Bins { lists }
 }
 
 /// What a band does with its spans.
@@ -369,7 +379,7 @@ enum Sink<'a> {
 /// Traverses the triangles of one band (rows [y0, y1)) into `sink` (rows of this band only).
 fn band(
     setup: &Setup,
-    ids: &[u32],
+    ids: BandIds,
     y0: u32,
     y1: u32,
     coverage: Coverage,
@@ -464,14 +474,14 @@ enum Prep<'a> {
 /// submission order.
 fn for_spans(
     setup: &Setup,
-    ids: &[u32],
+    ids: BandIds,
     y0: u32,
     y1: u32,
     coverage: Coverage,
     s: u32,
     mut f: impl FnMut(u32, i64, i64, i64, Prep<'_>),
 ) {
-    for &id in ids {
+    for &id in ids.bins.lists.iter().flat_map(|c| &c[ids.band]) {
         let t = &setup.tris[id as usize];
         let ya = t.bbox[1].max(y0);
         let yb = t.bbox[3].min(y1);
@@ -518,7 +528,10 @@ fn run(setup: &Setup, coverage: Coverage, out: &mut [u32], vis: Option<bool>) ->
         .map(|(b, rows)| {
             let y0 = b as u32 * BAND_ROWS;
             let y1 = (y0 + BAND_ROWS).min(h);
-            let ids = &bins.ids[bins.start[b]..bins.start[b + 1]];
+            let ids = BandIds {
+                bins: &bins,
+                band: b,
+            };
             let sink = match vis {
                 Some(depth_test) => Sink::Vis {
                     tri: rows,

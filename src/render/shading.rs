@@ -8,7 +8,7 @@ use crate::pipeline::clip_f32::ShadedVertex;
 use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
-use crate::raster::ScreenTri;
+use crate::raster::{ScreenTri, VertexSource};
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
 use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
@@ -32,14 +32,15 @@ pub(super) fn bump_attrs(
     if geo.bump.is_empty() {
         return (out, sat);
     }
-    for (t, a) in setup.tris.iter().zip(attrs.iter_mut()) {
+    for (i, (t, a)) in setup.tris.iter().zip(attrs.iter_mut()).enumerate() {
         let plan = &geo.plans[a.plan as usize];
         if plan.bump.is_none() {
             continue;
         }
         let d = &geo.draws[t.src as usize];
+        let src_bary = setup.src_bary(i);
         let blend = |k: usize| -> BumpVertex {
-            let w = t.src_bary[k];
+            let w = src_bary[k];
             let mut r = BumpVertex::default();
             for (&wj, &vi) in w.iter().zip(&d.v) {
                 let Some(b) = geo.bump.get(vi as usize) else {
@@ -73,46 +74,77 @@ pub(super) fn bump_attrs(
 
 /// Per-triangle attributes of every screen triangle, in the machine's formats.
 pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
-    // Written in parallel straight into their vectors (no serial copy of the attributes);
-    // the overflow counts sum in any order.
-    let (attrs, sats): (Vec<TriAttrs>, Vec<SatCounter>) = setup
-        .tris
-        .par_iter()
-        .map(|t| {
-            let d = &geo.draws[t.src as usize];
-            let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
-                let w = t.src_bary[k];
-                let mut c = [0.0; 3];
-                let mut uv = [0.0; 2];
-                for (&wj, &vi) in w.iter().zip(&d.v) {
-                    let vi = vi as usize;
-                    for (acc, &x) in c.iter_mut().zip(&geo.color[vi]) {
-                        *acc += wj * x;
-                    }
-                    for (acc, &x) in uv.iter_mut().zip(&geo.uv[vi]) {
-                        *acc += wj * x;
-                    }
+    // Written in parallel straight into their vector; the overflow counts sum in any order.
+    let mut out = (
+        crate::raster::vec_populated(setup.tris.len()),
+        SatSum::default(),
+    );
+    out.par_extend(setup.tris.par_iter().enumerate().map(|(i, t)| {
+        let d = &geo.draws[t.src as usize];
+        let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
+            let w = setup.src_bary(i)[k];
+            let mut c = [0.0; 3];
+            let mut uv = [0.0; 2];
+            for (&wj, &vi) in w.iter().zip(&d.v) {
+                let vi = vi as usize;
+                for (acc, &x) in c.iter_mut().zip(&geo.color[vi]) {
+                    *acc += wj * x;
                 }
-                (c, uv)
-            };
-            let (c0, t0) = blend(0);
-            let (c1, t1) = blend(1);
-            let (c2, t2) = blend(2);
-            let mut sat = SatCounter::default();
-            let plan = geo.draw_plan[t.src as usize];
-            let wrap = geo.plans[plan as usize].wrap;
-            let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
-            (a, sat)
-        })
-        .unzip();
-    let sat = sats
-        .par_iter()
-        .copied()
-        .reduce(SatCounter::default, |mut a, b| {
-            a.add(&b);
-            a
-        });
-    (attrs, sat)
+                for (acc, &x) in uv.iter_mut().zip(&geo.uv[vi]) {
+                    *acc += wj * x;
+                }
+            }
+            (c, uv)
+        };
+        // An unclipped triangle's vertices are its source's: the blend with unit weights is
+        // `x + 0.0` (a zero's sign dropped) when every blended value is finite.
+        let direct = match t.source {
+            VertexSource::Unclipped { swapped } => {
+                let vs = if swapped {
+                    [d.v[0], d.v[2], d.v[1]]
+                } else {
+                    d.v
+                };
+                let finite = vs.iter().all(|&vi| {
+                    let vi = vi as usize;
+                    geo.color[vi]
+                        .iter()
+                        .chain(&geo.uv[vi])
+                        .all(|x| x.is_finite())
+                });
+                finite.then(|| {
+                    vs.map(|vi| {
+                        let vi = vi as usize;
+                        (geo.color[vi].map(|x| x + 0.0), geo.uv[vi].map(|x| x + 0.0))
+                    })
+                })
+            }
+            VertexSource::Clipped => None,
+        };
+        let [(c0, t0), (c1, t1), (c2, t2)] = direct.unwrap_or_else(|| [0, 1, 2].map(blend));
+        let mut sat = SatCounter::default();
+        let plan = geo.draw_plan[t.src as usize];
+        let wrap = geo.plans[plan as usize].wrap;
+        let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
+        (a, sat)
+    }));
+    (out.0, out.1 .0)
+}
+
+/// The sum of overflow counters collected from a parallel iterator (nothing stored per item).
+#[derive(Default)]
+struct SatSum(SatCounter);
+
+impl ParallelExtend<SatCounter> for SatSum {
+    fn par_extend<I: IntoParallelIterator<Item = SatCounter>>(&mut self, items: I) {
+        let s = items
+            .into_par_iter()
+            .reduce(SatCounter::default, |mut a, b| {
+                a.add(&b);
+                a
+            });
+        self.0.add(&s);
+    }
 }
 
 /// llvmpipe's setup of every screen triangle for the float32 coordinate path

@@ -3,7 +3,7 @@
 use crate::raster_common::*;
 use glam::{DMat4, DVec3};
 use std::time::Instant;
-use texsim::raster::{coverage_count, rasterize, setup, Coverage, DrawTri, Setup};
+use texsim::raster::{coverage_count, rasterize, setup, Coverage, DrawTri, Setup, NO_TRI};
 
 fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new()
@@ -76,6 +76,42 @@ fn identical_for_any_thread_count() {
             }
         }
     }
+}
+
+/// More triangles than one binning task takes (the bins are built by chunks of triangles in
+/// parallel and walked chunk by chunk): the same buffers and counters for any thread count.
+#[test]
+fn binned_by_chunks_identical_for_any_thread_count() {
+    let s = random_scene(4, 40_000, 257, 190);
+    for cov in [Coverage::Fixed, Coverage::Float] {
+        let r1 = in_pool(1, || rasterize(&s, cov, true));
+        for threads in [2, 3] {
+            let r = in_pool(threads, || rasterize(&s, cov, true));
+            assert_eq!(r.0, r1.0, "{cov:?} threads={threads}");
+            assert_eq!(r.1, r1.1);
+        }
+        let c1 = in_pool(1, || coverage_count(&s, cov));
+        assert_eq!(in_pool(2, || coverage_count(&s, cov)), c1);
+        // Every fragment of the counts is a fragment of the traversal.
+        assert_eq!(
+            c1.iter().map(|&c| u64::from(c)).sum::<u64>(),
+            r1.1.fragments
+        );
+    }
+    // Without the depth test the last covering triangle in submission order wins: the bins
+    // keep that order across their chunks.
+    let (vis, _) = in_pool(2, || rasterize(&s, Coverage::Fixed, false));
+    let mut last = vec![NO_TRI; vis.tri.len()];
+    for (id, t) in s.tris.iter().enumerate() {
+        for py in t.bbox[1]..t.bbox[3] {
+            for px in t.bbox[0]..t.bbox[2] {
+                if covers_fixed(t, i64::from(px), i64::from(py), s.subpixel_bits) {
+                    last[(py * s.width + px) as usize] = id as u32;
+                }
+            }
+        }
+    }
+    assert_eq!(vis.tri, last);
 }
 
 /// A ~100k-triangle sphere at 1024x1024; prints the timings (run with --nocapture; use

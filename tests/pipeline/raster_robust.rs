@@ -2,6 +2,7 @@
 //! or clipped, counted, never a panic, never a NaN in a set-up triangle.
 
 use crate::raster_common::*;
+use glam::{DMat4, DVec3};
 use texsim::raster::{
     coverage_count, rasterize, setup, Coverage, DrawTri, Setup, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
 };
@@ -29,15 +30,16 @@ fn check_setup(clip: &[[f64; 4]], d: &[DrawTri], s: &Setup) {
     let mut produced = vec![false; d.len()];
     let zmax = (1u64 << s.depth_bits) - 1;
     let bound = (2.5 * f64::from(MAX_VIEWPORT) * 4096.0) as i64;
-    for t in &s.tris {
+    for (i, t) in s.tris.iter().enumerate() {
         produced[t.src as usize] = true;
+        let src_bary = s.src_bary(i);
         let floats = t
             .xy_f
             .iter()
             .flatten()
             .chain(&t.z_f)
             .chain(&t.inv_w)
-            .chain(t.src_bary.iter().flatten())
+            .chain(src_bary.iter().flatten())
             .chain(std::iter::once(&t.area2_f));
         assert!(
             floats.into_iter().all(|v| v.is_finite()),
@@ -59,7 +61,7 @@ fn check_setup(clip: &[[f64; 4]], d: &[DrawTri], s: &Setup) {
         let big = src.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
         let w_min = src.iter().map(|c| c[3].abs()).fold(f64::MAX, f64::min);
         let conditioned = big < 1e6 && w_min > 1e-3;
-        for (k, b) in t.src_bary.iter().enumerate() {
+        for (k, b) in src_bary.iter().enumerate() {
             assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-9, "bary {b:?}");
             assert!(b.iter().all(|&c| (-1e-9..=1.0 + 1e-9).contains(&c)));
             if !conditioned {
@@ -407,10 +409,12 @@ fn shared_clipped_edges_are_cut_identically() {
         let on_edge = |src: u32, third: usize| -> Vec<[u64; 2]> {
             s.tris
                 .iter()
-                .filter(|t| t.src == src)
-                .flat_map(|t| {
+                .enumerate()
+                .filter(|(_, t)| t.src == src)
+                .flat_map(|(i, t)| {
+                    let b = s.src_bary(i);
                     (0..3)
-                        .filter(move |&k| t.src_bary[k][third] == 0.0)
+                        .filter(move |&k| b[k][third] == 0.0)
                         .map(move |k| t.xy_f[k].map(f64::to_bits))
                 })
                 .collect()
@@ -426,4 +430,32 @@ fn shared_clipped_edges_are_cut_identically() {
         }
     }
     assert!(checked > 1000, "{checked}");
+}
+
+/// Setup projects each vertex once for the unclipped triangles that share it: a mesh with
+/// shared vertices sets up exactly as the same triangles with a copy of every vertex each,
+/// clipped ones (near plane, guard band) and culled ones included.
+#[test]
+fn shared_vertices_set_up_as_copies() {
+    let (p, t) = uv_sphere(200, 100);
+    let view = DMat4::look_at_rh(
+        DVec3::new(0.3, 0.2, 0.6),
+        DVec3::new(1.0, 0.0, -0.5),
+        DVec3::Y,
+    );
+    let proj = DMat4::perspective_rh_gl(100f64.to_radians(), 1.3, 0.35, 10.0);
+    let clip = transform(&(proj * view), &p);
+    let copies: Vec<[f64; 4]> = t.iter().flatten().map(|&i| clip[i as usize]).collect();
+    for cull in [false, true] {
+        let shared = setup(&clip, &draws(&t, cull), 200, 150, &cfg(8, 24));
+        let unrolled: Vec<[u32; 3]> = (0..t.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        let copied = setup(&copies, &draws(&unrolled, cull), 200, 150, &cfg(8, 24));
+        assert!(shared.stats.clipped > 50, "{:?}", shared.stats);
+        assert_eq!(shared.stats, copied.stats);
+        assert_eq!(shared.tris, copied.tris);
+        assert_eq!(shared.clipped_bary, copied.clipped_bary);
+        check_setup(&clip, &draws(&t, cull), &shared);
+    }
 }

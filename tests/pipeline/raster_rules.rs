@@ -2,7 +2,7 @@
 
 use crate::raster_common::*;
 use texsim::raster::{
-    coverage_count, rasterize, setup, Coverage, DrawTri, ScreenTri, Setup, NO_TRI,
+    coverage_count, rasterize, setup, Coverage, DrawTri, ScreenTri, Setup, VertexSource, NO_TRI,
 };
 
 const BOTH: [Coverage; 2] = [Coverage::Fixed, Coverage::Float];
@@ -427,7 +427,7 @@ fn edge_steps_match_three_evaluations() {
         z_f: [0.0; 3],
         inv_w: [1.0; 3],
         src: 0,
-        src_bary: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        source: VertexSource::Unclipped { swapped: false },
         area2: 1,
         area2_f: 1.0,
         bbox: [0; 4],
@@ -473,7 +473,7 @@ fn edges_on_a_finer_grid_match_the_snapped_edges() {
         z_f: [0.0; 3],
         inv_w: [1.0; 3],
         src: 0,
-        src_bary: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        source: VertexSource::Unclipped { swapped: false },
         area2: 1,
         area2_f: 1.0,
         bbox: [0; 4],

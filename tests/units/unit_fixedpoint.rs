@@ -94,3 +94,57 @@ fn round_ties_even_small_is_round_ties_even() {
         assert_eq!(round_ties_even_small(y), y.round_ties_even(), "{y}");
     }
 }
+
+/// `floor_exact` is `f64::floor` bit for bit: signed zeros, infinities, NaN, the integers and
+/// half-integers around 0 and 2^52, and 10M seeded doubles (random bit patterns and values
+/// spread over [-2^60, 2^60]).
+#[test]
+fn floor_exact_is_floor() {
+    use texsim::fixedpoint::floor_exact;
+    let same = |y: f64| {
+        let (a, b) = (floor_exact(y), y.floor());
+        assert!(
+            a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+            "{y:e}: {a:e} vs {b:e}"
+        );
+    };
+    for y in [
+        0.0,
+        -0.0,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        f64::MIN_POSITIVE,
+    ] {
+        same(y);
+        same(-y);
+    }
+    let two52 = 4_503_599_627_370_496.0f64;
+    for k in -4096..=4096 {
+        let y = f64::from(k) * 0.25;
+        for base in [0.0, two52, -two52, two52 * 2.0, -two52 * 2.0] {
+            same(base + y);
+            same(base + y * 1e-9);
+        }
+        for e in [-1074, -60, -1, 0, 1, 51, 52, 53, 62, 63, 64, 1000] {
+            same(y * 2f64.powi(e));
+        }
+    }
+    let mut rng = Rng(0x5eed_f100);
+    for _ in 0..5_000_000 {
+        same(f64::from_bits(rng.next()));
+        same((rng.unit() * 2.0 - 1.0) * 2f64.powi((rng.next() % 61) as i32));
+    }
+}
+
+/// `pow2` is `2f64.powi` for every exponent from below the subnormals to beyond overflow.
+#[test]
+fn pow2_is_powi() {
+    use texsim::fixedpoint::pow2;
+    for e in -1200..=1200 {
+        assert_eq!(pow2(e).to_bits(), 2f64.powi(e).to_bits(), "2^{e}");
+    }
+    for e in [i32::MIN, i32::MIN + 1, -100_000, 100_000, i32::MAX] {
+        assert_eq!(pow2(e).to_bits(), 2f64.powi(e).to_bits(), "2^{e}");
+    }
+}
