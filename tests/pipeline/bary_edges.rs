@@ -14,7 +14,7 @@ fn tri() -> ScreenTri {
         z_f: [0.0; 3],
         inv_w: [1.0; 3],
         src: 0,
-        src_bary: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        source: texsim::raster::VertexSource::Unclipped { swapped: false },
         area2: 1,
         area2_f: 1.0,
         bbox: [0; 4],
