@@ -120,22 +120,14 @@ impl Setup {
 impl ScreenTri {
     /// Exact edge values at the centre of pixel (px, py), in units of 2^-2*subpixel_bits
     /// pixel^2 (saturated to `i64` for absurd pixel positions far outside the viewport).
+    #[inline]
     #[must_use]
     pub fn edges_fixed(&self, px: i64, py: i64, subpixel_bits: u32) -> [i64; 3] {
         let s = subpixel_bits.clamp(1, 12);
-        let h = 1i128 << (s - 1);
-        let x = (i128::from(px) << s) + h;
-        let y = (i128::from(py) << s) + h;
-        let mut e = [0i64; 3];
-        for (i, out) in e.iter_mut().enumerate() {
-            let j = (i + 1) % 3;
-            let k = (i + 2) % 3;
-            let [xj, yj] = self.xy[j].map(i128::from);
-            let [xk, yk] = self.xy[k].map(i128::from);
-            let v = (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
-            *out = v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64;
+        match small_point(magnitudes(&self.xy), px, py, s) {
+            Some((x, y)) => small_edges(&self.xy, x, y),
+            None => wide_edges(&self.xy.map(|p| p.map(i128::from)), px, py, s),
         }
-        e
     }
 
     /// [`Self::edges_fixed`] from the float positions `xy_f` snapped (rounded) to `bits`
@@ -148,23 +140,22 @@ impl ScreenTri {
         let v = self
             .xy_f
             .map(|p| p.map(|c| (c * g).round_ties_even() as i128));
-        let h = 1i128 << (s - 1);
-        let x = (i128::from(px) << s) + h;
-        let y = (i128::from(py) << s) + h;
-        let mut e = [0i64; 3];
-        for (i, out) in e.iter_mut().enumerate() {
-            let [xj, yj] = v[(i + 1) % 3];
-            let [xk, yk] = v[(i + 2) % 3];
-            let w = (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
-            *out = w.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64;
+        let small = v
+            .iter()
+            .flatten()
+            .all(|c| c.unsigned_abs() < u128::from(SMALL_EDGES));
+        match small.then(|| small_point(0, px, py, s)).flatten() {
+            Some((x, y)) => small_edges(&v.map(|p| p.map(|c| c as i64)), x, y),
+            None => wide_edges(&v, px, py, s),
         }
-        e
     }
 
     /// The edge values at the centres of pixels (px, py), (px + 1, py) and (px, py + 1), as
     /// `(e, e(px + 1) - e, e(py + 1) - e)`: bit-identical to three calls of
-    /// [`Self::edges_fixed`], computed once in `i64` plus the edges' constant steps
-    /// (`-(y_k - y_j) 2^s`, `(x_k - x_j) 2^s`); any overflow falls back to the exact calls.
+    /// [`Self::edges_fixed`], computed once plus the edges' constant steps
+    /// (`-(y_k - y_j) 2^s`, `(x_k - x_j) 2^s`): in plain `i64` under [`SMALL_EDGES`]' bounds,
+    /// else with checked `i64` operations, and on any overflow by the exact calls.
+    #[inline]
     #[must_use]
     pub fn edges_fixed_with_steps(
         &self,
@@ -172,6 +163,16 @@ impl ScreenTri {
         py: i64,
         subpixel_bits: u32,
     ) -> ([i64; 3], [i64; 3], [i64; 3]) {
+        let s = subpixel_bits.clamp(1, 12);
+        let v = self.xy;
+        if let Some((x, y)) = small_point(magnitudes(&v), px, py, s) {
+            let [[x0, y0], [x1, y1], [x2, y2]] = v;
+            return (
+                small_edges(&v, x, y),
+                [-((y2 - y1) << s), -((y0 - y2) << s), -((y1 - y0) << s)],
+                [(x2 - x1) << s, (x0 - x2) << s, (x1 - x0) << s],
+            );
+        }
         self.edges_steps_i64(px, py, subpixel_bits)
             .unwrap_or_else(|| {
                 let e = self.edges_fixed(px, py, subpixel_bits);
@@ -225,6 +226,49 @@ impl ScreenTri {
         }
         e
     }
+}
+
+/// Vertex coordinates below this bound (in magnitude, on the evaluation grid) and sample
+/// positions below 2^28 keep every product and sum of an edge value below 2^61: the edge
+/// values are computed in plain `i64`.
+const SMALL_EDGES: u64 = 1 << 29;
+
+/// The OR of the vertex coordinates' magnitudes (below [`SMALL_EDGES`] iff each is).
+#[inline(always)]
+fn magnitudes(v: &[[i64; 2]; 3]) -> u64 {
+    v.iter().flatten().fold(0, |m, c| m | c.unsigned_abs())
+}
+
+/// The centre of pixel (px, py) on a grid of `s` sub-pixel bits, when the vertices'
+/// `magnitudes` and the pixel are within [`SMALL_EDGES`]' bounds.
+#[inline(always)]
+fn small_point(magnitudes: u64, px: i64, py: i64, s: u32) -> Option<(i64, i64)> {
+    let small = magnitudes < SMALL_EDGES && (px.unsigned_abs() | py.unsigned_abs()) < 1 << (28 - s);
+    let h = 1i64 << (s - 1);
+    small.then(|| ((px << s) + h, (py << s) + h))
+}
+
+/// The three edge values at the grid point (x, y) in `i64` (within [`SMALL_EDGES`]' bounds).
+#[inline(always)]
+fn small_edges(v: &[[i64; 2]; 3], x: i64, y: i64) -> [i64; 3] {
+    let edge = |[xj, yj]: [i64; 2], [xk, yk]: [i64; 2]| (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
+    [edge(v[1], v[2]), edge(v[2], v[0]), edge(v[0], v[1])]
+}
+
+/// Exact edge values of the vertices `v` (on a grid of `s` sub-pixel bits) at the centre of
+/// pixel (px, py) in `i128`, saturated to `i64`.
+fn wide_edges(v: &[[i128; 2]; 3], px: i64, py: i64, s: u32) -> [i64; 3] {
+    let h = 1i128 << (s - 1);
+    let x = (i128::from(px) << s) + h;
+    let y = (i128::from(py) << s) + h;
+    let mut e = [0i64; 3];
+    for (i, out) in e.iter_mut().enumerate() {
+        let [xj, yj] = v[(i + 1) % 3];
+        let [xk, yk] = v[(i + 2) % 3];
+        let w = (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
+        *out = w.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64;
+    }
+    e
 }
 
 /// `cross(b - a, p - a)` with (a, b) put in lexicographic order first and the sign restored, so

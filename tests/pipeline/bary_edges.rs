@@ -1,10 +1,21 @@
-//! The `bary` stage's edge evaluation (`pipeline::bary::edges_with_steps`, `edges_at`: `i64`
-//! without overflow checks under their bounds) gives the `ScreenTri` routines' values, inside
-//! the bounds and beyond them (where it falls back to those routines).
+//! `ScreenTri`'s edge functions (plain `i64` under their bounds, checked or `i128` beyond them)
+//! give the exact `i128` edge values, inside the bounds and beyond them.
 
 use crate::rng_common::Rng;
-use texsim::pipeline::bary::{edges_at, edges_with_steps};
 use texsim::raster::ScreenTri;
+
+/// The exact edge values of vertices `v` (on a grid of `s` bits) at pixel (px, py)'s centre,
+/// saturated to `i64`.
+fn exact(v: [[i128; 2]; 3], px: i64, py: i64, s: u32) -> [i64; 3] {
+    let h = 1i128 << (s - 1);
+    let (x, y) = ((i128::from(px) << s) + h, (i128::from(py) << s) + h);
+    [0, 1, 2].map(|i| {
+        let [xj, yj] = v[(i + 1) % 3];
+        let [xk, yk] = v[(i + 2) % 3];
+        let w = (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
+        w.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
+    })
+}
 
 fn tri() -> ScreenTri {
     ScreenTri {
@@ -26,7 +37,7 @@ fn tri() -> ScreenTri {
 /// setup (1..=16 bits, from the float positions): the same edges and steps, and both the
 /// `i64` evaluation and the fallback are exercised.
 #[test]
-fn bary_edges_match_the_screen_tri_routines() {
+fn screen_tri_edges_match_the_exact_values() {
     let mut rng = Rng(0x5eed_0ba1);
     let mut t = tri();
     let (mut small, mut large) = (0u32, 0u32);
@@ -55,16 +66,27 @@ fn bary_edges_match_the_screen_tri_routines() {
         } else {
             large += 1;
         }
+        let e = exact(t.xy.map(|p| p.map(i128::from)), px, py, sub);
+        assert_eq!(t.edges_fixed(px, py, sub), e, "case {case}");
+        let (ws, dx, dy) = t.edges_fixed_with_steps(px, py, sub);
+        let ex = exact(t.xy.map(|p| p.map(i128::from)), px + 1, py, sub);
+        let ey = exact(t.xy.map(|p| p.map(i128::from)), px, py + 1, sub);
+        assert_eq!(ws, e, "case {case}: {:?} at ({px}, {py}) sub {sub}", t.xy);
         assert_eq!(
-            edges_with_steps(&t, px, py, sub),
-            t.edges_fixed_with_steps(px, py, sub),
-            "case {case}: {:?} at ({px}, {py}) sub {sub}",
-            t.xy
+            dx,
+            [0, 1, 2].map(|i| ex[i].wrapping_sub(e[i])),
+            "case {case}"
         );
-        assert_eq!(edges_at(&t, px, py, sub, None), t.edges_fixed(px, py, sub));
         assert_eq!(
-            edges_at(&t, px, py, sub, Some(grid)),
+            dy,
+            [0, 1, 2].map(|i| ey[i].wrapping_sub(e[i])),
+            "case {case}"
+        );
+        let g = f64::from(1u32 << grid);
+        let snapped = t.xy_f.map(|p| p.map(|c| (c * g).round_ties_even() as i128));
+        assert_eq!(
             t.edges_fixed_on_grid(px, py, grid),
+            exact(snapped, px, py, grid),
             "case {case}: {:?} at ({px}, {py}) grid {grid}",
             t.xy_f
         );
