@@ -682,6 +682,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         },
         progress: Some(progress_line),
         ranges: a.ranges,
+        ..RenderOptions::default()
     };
     let mut r = render(&sc, &maps, &hw, &opts)?;
     let t = std::time::Instant::now();

@@ -269,6 +269,182 @@ fn perspective_bary_derivs_narrow<M: ConstRounding>(
     Some([p, bx, by])
 }
 
+/// [`perspective_bary_derivs`] at the samples of a row span: lane `j` of `out` is the result
+/// for the edges `edge + j edge_dx` (which must fit `i64`, as at the pixels `(x + j, y)`),
+/// with the same `edge_dx`, `edge_dy`. Bit-identical to one call per lane, with the same
+/// saturation counts.
+///
+/// Along the row the exact `q_i = E_i invw_i` step by `a_i = dE_i/dx invw_i` and `D` by
+/// `S = sum a_j`. When the common scale shift is 0 (every operand below 2^62, the common
+/// case) the x numerators `N_i = a_i D - q_i S` are the same at every lane (and the y
+/// numerators `b_i D - q_i T` step by `b_i S - a_i T`, as cheap to form directly), so per
+/// lane only `1/D`, its square, two 64x64-bit products per y numerator and the roundings
+/// remain. A lane outside those preconditions (operands beyond `i64` or 2^62,
+/// `D <= 0`, a clamped `p_i`) takes the per-sample datapath.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn perspective_bary_derivs_span(
+    edge: [i64; 3],
+    edge_dx: [i64; 3],
+    edge_dy: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    out: &mut [[[i64; 3]; 3]],
+) {
+    crate::with_rounding!(cfg.interp_rounding, M => {
+        perspective_bary_derivs_span_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat, out)
+    })
+}
+
+/// The edges of lane `j` of a span: `edge + j edge_dx`.
+#[inline(always)]
+fn lane_edges(edge: [i64; 3], edge_dx: [i64; 3], j: usize) -> [i64; 3] {
+    let j = j as i64;
+    [0, 1, 2].map(|i| edge[i].wrapping_add(j.wrapping_mul(edge_dx[i])))
+}
+
+/// [`perspective_bary_derivs_in`] out of line: a span lane outside the fast form.
+#[inline(never)]
+fn derivs_lane<M: ConstRounding>(
+    edge: [i64; 3],
+    edge_dx: [i64; 3],
+    edge_dy: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+) -> [[i64; 3]; 3] {
+    perspective_bary_derivs_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat)
+}
+
+/// Lanes the span datapath works on at once (structure of arrays): a longer span is done in
+/// chunks of this many.
+pub const SPAN_LANES: usize = 16;
+
+/// [`perspective_bary_derivs_span`] compiled for the rounding mode `M` (`interp_rounding`).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn perspective_bary_derivs_span_in<M: ConstRounding>(
+    edge: [i64; 3],
+    edge_dx: [i64; 3],
+    edge_dy: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    out: &mut [[[i64; 3]; 3]],
+) {
+    let times_w = |e: [i64; 3]| -> Option<[i64; 3]> {
+        Some([
+            e[0].checked_mul(inv_w[0])?,
+            e[1].checked_mul(inv_w[1])?,
+            e[2].checked_mul(inv_w[2])?,
+        ])
+    };
+    let sum = |v: [i64; 3]| v[0].checked_add(v[1])?.checked_add(v[2]);
+    // The lane-independent operands: `a_i`, `b_i` (the y steps), `S`, `T` and the OR of the
+    // magnitudes that enter the scale, all below 2^62 for the fast form.
+    let steps = (|| {
+        let (a, b) = (times_w(edge_dx)?, times_w(edge_dy)?);
+        let (s, t) = (sum(a)?, sum(b)?);
+        let mag = [a[1], a[2], s, b[1], b[2], t]
+            .into_iter()
+            .fold(0u64, |m, v| m | v.unsigned_abs());
+        (mag >> 62 == 0).then_some((a, b, s, t, mag))
+    })();
+    let Some((a, b, s, t, steps_mag)) = steps else {
+        for (j, o) in out.iter_mut().enumerate() {
+            let e = lane_edges(edge, edge_dx, j);
+            *o = derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat);
+        }
+        return;
+    };
+    let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
+    let m_bits = recip.config().recip_mantissa_bits;
+    let wide = i128::from;
+    // The x numerators' top bits, from the first fast lane (the same at every fast lane).
+    let mut x_numerators: Option<[(i128, u32); 2]> = None;
+    for (c, chunk) in out.chunks_mut(SPAN_LANES).enumerate() {
+        let base = c * SPAN_LANES;
+        // Per lane, stage by stage: `q` and `D` (fast when the scale shift is 0: `D`, positive,
+        // and `q_1`, `q_2` below 2^62 as the steps are), the reciprocal of `D`, the
+        // barycentrics (fast while no `p_i` needs the clamp) and the square.
+        let mut q = [[0i64; 3]; SPAN_LANES];
+        let mut d = [0i64; SPAN_LANES];
+        let mut fast = [false; SPAN_LANES];
+        for j in 0..chunk.len() {
+            let lane =
+                times_w(lane_edges(edge, edge_dx, base + j)).and_then(|q| Some((q, sum(q)?)));
+            if let Some((qj, dj)) = lane {
+                (q[j], d[j]) = (qj, dj);
+                fast[j] = (dj as u64 | qj[1].unsigned_abs() | qj[2].unsigned_abs() | steps_mag)
+                    >> 62
+                    == 0
+                    && dj > 0;
+            }
+        }
+        let mut r = [Recip { mant: 0, shift: 0 }; SPAN_LANES];
+        for j in 0..chunk.len() {
+            if fast[j] {
+                // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+                r[j] = recip.eval(d[j] as u64, &mut SatCounter::default());
+            }
+        }
+        let mut p = [[0i64; 3]; SPAN_LANES];
+        for j in 0..chunk.len() {
+            if fast[j] {
+                let p1 = apply_i64_in::<M>(r[j], q[j][1], bb);
+                let p2 = apply_i64_in::<M>(r[j], q[j][2], bb);
+                p[j] = [one - p1 - p2, p1, p2];
+                fast[j] = p1.unsigned_abs() <= BARY_LIMIT as u64
+                    && p2.unsigned_abs() <= BARY_LIMIT as u64;
+                // The reciprocal of the barycentrics is that of the derivatives: its square.
+                r[j] = square(r[j], m_bits, M::MODE);
+            }
+        }
+        for (j, o) in chunk.iter_mut().enumerate() {
+            if !fast[j] {
+                let e = lane_edges(edge, edge_dx, base + j);
+                *o = derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat);
+                continue;
+            }
+            let (pj, qj, r2, dw) = (p[j], q[j], r[j], wide(d[j]));
+            let nx = x_numerators.get_or_insert_with(|| {
+                [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s)))
+            });
+            let ny = [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t));
+            let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
+            let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
+            let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
+            let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
+            *o = [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]];
+        }
+    }
+}
+
+/// [`perspective_bary`] at the samples of a row span: lane `j` of `out` is the result for the
+/// edges `edge + j edge_dx` (which must fit `i64`). Bit-identical to one call per lane, with
+/// the same saturation counts, the rounding mode resolved once.
+#[inline]
+pub fn perspective_bary_span(
+    edge: [i64; 3],
+    edge_dx: [i64; 3],
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    out: &mut [[i64; 3]],
+) {
+    crate::with_rounding!(cfg.interp_rounding, M => {
+        for (j, o) in out.iter_mut().enumerate() {
+            let e = lane_edges(edge, edge_dx, j);
+            *o = perspective_bary_eval::<M>(e, inv_w, cfg, recip, sat).0;
+        }
+    })
+}
+
 /// The barycentrics of the neighbour along one screen axis, `p + dp`: the numerators
 /// `N_i = a_i D - q_i S` of the per-axis `a_i` and `S = sum`, from the scaled `q_1`, `q_2`
 /// and `D` (`scaled`, with their common `shift`), as exact 64x64 -> 128-bit products of
@@ -297,9 +473,25 @@ fn axis_derivs<M: ConstRounding>(
 /// +-[`BARY_LIMIT`] (counted).
 #[inline(always)]
 fn derivative<M: ConstRounding>(n: i128, r2: Recip, bary_bits: u32, sat: &mut SatCounter) -> i64 {
+    derivative_of_top::<M>(numerator_top(n), r2, bary_bits, sat)
+}
+
+/// The numerator of [`derivative`] kept to its top 94 bits: `(N >> ns, ns)`.
+#[inline(always)]
+fn numerator_top(n: i128) -> (i128, u32) {
     // |N| < 2^126, so `ns` <= 32 and `n >> ns` is a 64-bit funnel shift.
     let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94) & 63;
-    let x = n >> ns;
+    (n >> ns, ns)
+}
+
+/// [`derivative`] from the numerator's top bits `(x, ns)` ([`numerator_top`]).
+#[inline(always)]
+fn derivative_of_top<M: ConstRounding>(
+    (x, ns): (i128, u32),
+    r2: Recip,
+    bary_bits: u32,
+    sat: &mut SatCounter,
+) -> i64 {
     let sh = r2.shift - (bary_bits + ns) as i32;
     // `apply_in`'s exact product and rounding (|x| <= 2^94, a mantissa below 2^31).
     let v = if sh >= 0 && r2.mant >> 31 == 0 {
@@ -391,19 +583,35 @@ pub fn interpolate_pairs(
     result: &mut [[i64; 2]],
 ) {
     crate::with_rounding!(out.rounding, M => {
-        interpolate_pairs_in::<M>(bary, bary_bits, attr, out, sat, result)
+        interpolate_pairs_in::<M>(std::iter::once((bary, result)), bary_bits, attr, out, sat)
     })
 }
 
-/// [`interpolate_pairs`] compiled for the rounding mode `M` (`out.rounding`).
-#[inline(always)]
-fn interpolate_pairs_in<M: ConstRounding>(
-    bary: &[[i64; 3]],
+/// [`interpolate_pairs`] over the fragments of a span: each item of `lanes` is one fragment's
+/// samples' barycentrics and the slots of their results. The per-triangle terms `a0 2^B`,
+/// `a1 - a0`, `a2 - a0`, the format's range and the rounding mode are resolved once for the
+/// span; the same bits and counts as one [`interpolate_pairs`] call per fragment.
+#[inline]
+pub fn interpolate_pairs_span<'a>(
+    lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; 2]])>,
     bary_bits: u32,
     attr: [[i64; 2]; 3],
     out: &Format,
     sat: &mut SatCounter,
-    result: &mut [[i64; 2]],
+) {
+    crate::with_rounding!(out.rounding, M => {
+        interpolate_pairs_in::<M>(lanes, bary_bits, attr, out, sat)
+    })
+}
+
+/// [`interpolate_pairs_span`] compiled for the rounding mode `M` (`out.rounding`).
+#[inline(always)]
+fn interpolate_pairs_in<'a, M: ConstRounding>(
+    lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; 2]])>,
+    bary_bits: u32,
+    attr: [[i64; 2]; 3],
+    out: &Format,
+    sat: &mut SatCounter,
 ) {
     // The sample-independent terms `a0 2^B`, `a1 - a0`, `a2 - a0` once per attribute; an
     // accumulator that leaves `i64` takes `interpolate`'s exact wide path.
@@ -416,15 +624,21 @@ fn interpolate_pairs_in<M: ConstRounding>(
         ))
     };
     let (Some((t0u, d1u, d2u)), Some((t0v, d1v, d2v))) = (terms(0), terms(1)) else {
-        for (b, r) in bary.iter().zip(result.iter_mut()) {
-            *r = [0, 1].map(|ax| interpolate_cold::<M>(b, bary_bits, &attr, ax, out, sat));
+        for (bary, result) in lanes {
+            for (b, r) in bary.iter().zip(result.iter_mut()) {
+                *r = [0, 1].map(|ax| interpolate_cold::<M>(b, bary_bits, &attr, ax, out, sat));
+            }
         }
         return;
     };
     let range = (out.min_raw(), out.max_raw());
-    for (b, r) in bary.iter().zip(result.iter_mut()) {
-        r[0] = interpolate_terms::<M>(b, (t0u, d1u, d2u), bary_bits, range, (&attr, 0), out, sat);
-        r[1] = interpolate_terms::<M>(b, (t0v, d1v, d2v), bary_bits, range, (&attr, 1), out, sat);
+    for (bary, result) in lanes {
+        for (b, r) in bary.iter().zip(result.iter_mut()) {
+            r[0] =
+                interpolate_terms::<M>(b, (t0u, d1u, d2u), bary_bits, range, (&attr, 0), out, sat);
+            r[1] =
+                interpolate_terms::<M>(b, (t0v, d1v, d2v), bary_bits, range, (&attr, 1), out, sat);
+        }
     }
 }
 

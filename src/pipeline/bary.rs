@@ -3,12 +3,13 @@
 //! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad;
 //! with `attr_subpixel_bits` the edges come from the float positions on that finer grid.
 
-use super::stages::{Counters, Machine};
+use super::stages::{each_fragment, Counters, Machine, SPAN_MAX};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
 use crate::reference::{perspective_bary_derivs_f64, perspective_bary_f64};
 use hw_model::interpolator::{
     perspective_bary, perspective_bary_cost, perspective_bary_derivs, perspective_bary_derivs_cost,
+    perspective_bary_derivs_span, perspective_bary_span,
 };
 use hw_model::UnitCost;
 
@@ -62,6 +63,49 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     if px.carriers {
         for s in 0..px.samples() {
             frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+        }
+    }
+}
+
+/// Fixed twin over a span: the edges at the span's first pixel and their constant steps
+/// (`ScreenTri::edges_fixed_span`), then the interpolator's span datapath
+/// (`perspective_bary_derivs_span`, `perspective_bary_span`), bit-identical to [`fixed`] on
+/// each fragment. `lod_per_quad`, `attr_subpixel_bits` and spans beyond the edges' `i64`
+/// bounds run [`fixed`] per fragment.
+pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    let hw = px.m.hw;
+    let sub = hw.raster.subpixel_bits;
+    let grid = hw.interp.attr_subpixel_bits;
+    let regrid = grid != 0 && grid != sub;
+    let quad = px.plan.derivatives && hw.lod.lod_per_quad;
+    let n = frags.len().min(SPAN_MAX);
+    let steps = (!regrid && !quad)
+        .then(|| px.tri.edges_fixed_span(px.x, px.y, n, sub))
+        .flatten();
+    let (Some((e, dx, dy)), true) = (steps, frags.len() == n) else {
+        return each_fragment(fixed, px, frags, c);
+    };
+    let sat = &mut c.sat[StageKind::Bary.index()];
+    let (inv_w, cfg, recip) = (px.a.inv_w_x, &hw.interp, &px.m.recip);
+    if px.plan.derivatives {
+        let mut out = [[[0i64; 3]; 3]; SPAN_MAX];
+        perspective_bary_derivs_span(e, dx, dy, inv_w, cfg, recip, sat, &mut out[..n]);
+        for (frag, b) in frags.iter_mut().zip(&out) {
+            frag.bary_x = *b;
+        }
+    } else {
+        let mut out = [[0i64; 3]; SPAN_MAX];
+        perspective_bary_span(e, dx, inv_w, cfg, recip, sat, &mut out[..n]);
+        for (frag, b) in frags.iter_mut().zip(&out) {
+            frag.bary_x[0] = *b;
+        }
+    }
+    if px.carriers {
+        let bb = hw.interp.bary_bits;
+        for frag in frags.iter_mut() {
+            for s in 0..px.samples() {
+                frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
+            }
         }
     }
 }

@@ -1,10 +1,12 @@
 //! What every stage shares: the [`Machine`] (the units and formats of one hardware
 //! configuration, built once per render), the per-triangle vertex data ([`TriAttrs`], in float
 //! and in the hardware's input formats, so the per-pixel loop allocates nothing), the run's
-//! [`Counters`], and [`run`], which runs a compiled [`Program`] on one fragment. The stages
-//! themselves are one file each, registered in [`super::table`].
+//! [`Counters`], [`run`], which runs a compiled [`Program`] on one fragment, and [`run_span`],
+//! which runs it on a span of fragments, stage by stage. The stages themselves are one file
+//! each, registered in [`super::table`].
 
 use super::bump::BumpAttrs;
+use super::table::RunFn;
 use super::{BumpPlan, Frag, Plan, Program, Px, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
@@ -387,6 +389,64 @@ pub fn run(
     };
     for op in &prog.ops {
         (op.run)(&px, frag, c);
+    }
+}
+
+/// Most fragments in one span of [`run_span`].
+pub const SPAN_MAX: usize = 16;
+
+/// [`run`] on a span: `frags[j]` is the fragment at pixel (`x + j`, `y`) of `tri` (consecutive
+/// covered pixels of one triangle in one row, at most [`SPAN_MAX`]). The program runs stage by
+/// stage, each over the whole span: its span twin ([`super::table::SpanFn`]) when it has one,
+/// else its per-fragment twin on each fragment in turn. Every fragment ends as [`run`] leaves
+/// it, and the counters get the same sums.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn run_span(
+    prog: &Program,
+    plan: &Plan,
+    m: &Machine,
+    tri: &ScreenTri,
+    a: &TriAttrs,
+    x: i64,
+    y: i64,
+    frags: &mut [Frag],
+    c: &mut Counters,
+) {
+    for frag in frags.iter_mut() {
+        frag.color = plan.const_color;
+        frag.out = plan.const_color;
+        frag.out_bits = 0;
+        frag.trace.clear();
+    }
+    let px = Px {
+        plan,
+        impls: &prog.impls,
+        m,
+        tri,
+        a,
+        x,
+        y,
+        color_raw: prog.color_raw,
+        carriers: prog.carriers,
+    };
+    for op in &prog.ops {
+        match op.span {
+            Some(span) => span(&px, frags, c),
+            None => each_fragment(op.run, &px, frags, c),
+        }
+    }
+}
+
+/// The per-fragment twin `run` on each fragment of the span of `px`, in order.
+#[inline]
+pub fn each_fragment(run: RunFn, px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    for (j, frag) in frags.iter_mut().enumerate() {
+        let at = Px {
+            x: px.x + j as i64,
+            ..*px
+        };
+        run(&at, frag, c);
     }
 }
 

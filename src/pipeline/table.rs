@@ -4,8 +4,10 @@
 //! costs resolved, so the pixel loop only calls what is in the program.
 //!
 //! A row names the stage's fixed twin, its float twin, its cost per invocation and its texture
-//! lookups per invocation (what the timing model budgets events for). Adding a stage is a file
-//! with those four functions and a row here (see `docs/ARCHITECTURE.md`).
+//! lookups per invocation (what the timing model budgets events for), and optionally a fixed
+//! twin over a span of fragments (`fixed_span`, see [`SpanFn`]; without one, a span runs the
+//! fixed twin on each fragment). Adding a stage is a file with those four functions and a row
+//! here (see `docs/ARCHITECTURE.md`).
 
 use super::stages::{Counters, Machine, TriAttrs};
 use super::{
@@ -19,7 +21,8 @@ use hw_model::{HwConfig, UnitCost};
 use serde::Serialize;
 use std::fmt;
 
-/// What a stage twin sees of the pixel it shades.
+/// What a stage twin sees of the pixel it shades (of the first fragment of a span).
+#[derive(Clone, Copy)]
 pub struct Px<'a> {
     /// The material's plan (maps, frame, lights and options of its stages).
     pub plan: &'a Plan,
@@ -29,7 +32,7 @@ pub struct Px<'a> {
     pub m: &'a Machine<'a>,
     pub tri: &'a ScreenTri,
     pub a: &'a TriAttrs,
-    /// The pixel.
+    /// The pixel (for a span: its first fragment's; fragment `j` is at (`x + j`, `y`)).
     pub x: i64,
     pub y: i64,
     /// The plan's colour comes from a Fixed `color` stage (its raw value is in `Frag::color_x`).
@@ -61,6 +64,10 @@ impl Px<'_> {
 
 /// A stage twin: shades one fragment, counting into the run's counters.
 pub type RunFn = fn(&Px, &mut Frag, &mut Counters);
+/// A stage twin over a span: the fragments of consecutive pixels (`px.x + j`, `px.y`) of one
+/// triangle, `j` = index in the slice; the same results and counts as the [`RunFn`] twin on
+/// each fragment in turn.
+pub type SpanFn = fn(&Px, &mut [Frag], &mut Counters);
 /// A stage's cost per invocation in a plan on a machine (fixed units' ops, cycles, texels).
 pub type CostFn = fn(&Machine, &Plan) -> UnitCost;
 /// Texture lookups per invocation on a hardware configuration.
@@ -72,6 +79,8 @@ pub struct StageRow {
     pub kind: StageKind,
     pub name: &'static str,
     pub fixed: RunFn,
+    /// The fixed twin over a span, when the stage has one.
+    pub fixed_span: Option<SpanFn>,
     pub float: RunFn,
     pub cost: CostFn,
     pub lookups: LookupsFn,
@@ -87,9 +96,20 @@ fn one_lookup(_: &HwConfig) -> u32 {
     1
 }
 
+/// `Some(span)` for a row's `fixed_span`, `None` without one.
+macro_rules! optional_span {
+    () => {
+        None
+    };
+    ($span:expr) => {
+        Some($span)
+    };
+}
+
 macro_rules! stage_table {
     ($( $(#[doc = $doc:literal])* $kind:ident $name:literal {
-        fixed: $fixed:expr, float: $float:expr, cost: $cost:expr, lookups: $lookups:expr $(,)?
+        fixed: $fixed:expr, $(fixed_span: $span:expr,)? float: $float:expr, cost: $cost:expr,
+        lookups: $lookups:expr $(,)?
     } )*) => {
         /// The kinds of stage, in pipeline order (generated from the stage table).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -112,6 +132,7 @@ macro_rules! stage_table {
                 kind: StageKind::$kind,
                 name: $name,
                 fixed: $fixed,
+                fixed_span: optional_span!($($span)?),
                 float: $float,
                 cost: $cost,
                 lookups: $lookups,
@@ -123,7 +144,8 @@ macro_rules! stage_table {
 stage_table! {
     /// Perspective-correct barycentrics (reciprocal unit + interpolator setup).
     Bary "bary" {
-        fixed: bary::fixed, float: bary::float, cost: bary::cost, lookups: no_lookups
+        fixed: bary::fixed, fixed_span: bary::fixed_span, float: bary::float, cost: bary::cost,
+        lookups: no_lookups,
     }
     /// Vertex colour interpolation (Gouraud lighting result).
     Color "color" {
@@ -131,8 +153,8 @@ stage_table! {
     }
     /// Texture-coordinate interpolation, with the helper samples for derivatives.
     Texcoord "texcoord" {
-        fixed: texcoord::fixed, float: texcoord::float, cost: texcoord::cost,
-        lookups: no_lookups,
+        fixed: texcoord::fixed, fixed_span: texcoord::fixed_span, float: texcoord::float,
+        cost: texcoord::cost, lookups: no_lookups,
     }
     /// LOD from the texture-coordinate derivatives.
     Lod "lod" {
@@ -276,11 +298,14 @@ impl fmt::Display for StageKind {
     }
 }
 
-/// One compiled stage: its kind, the twin that runs and its cost per invocation.
+/// One compiled stage: its kind, the twin that runs (per fragment and, when it has one, over
+/// a span) and its cost per invocation.
 #[derive(Clone, Copy)]
 pub struct Op {
     pub kind: StageKind,
     pub run: RunFn,
+    /// The twin over a span (`None`: `run` on each fragment of the span).
+    pub span: Option<SpanFn>,
     pub cost: UnitCost,
 }
 
@@ -322,12 +347,14 @@ impl Program {
             .iter()
             .map(|&kind| {
                 let row = kind.row();
+                let (run, span) = match impls.of(kind) {
+                    Impl::Fixed => (row.fixed, row.fixed_span),
+                    Impl::Float => (row.float, None),
+                };
                 Op {
                     kind,
-                    run: match impls.of(kind) {
-                        Impl::Fixed => row.fixed,
-                        Impl::Float => row.float,
-                    },
+                    run,
+                    span,
                     cost: (row.cost)(m, plan),
                 }
             })

@@ -1,13 +1,13 @@
 //! `texcoord`: interpolation of the texture coordinates at the pixel and its helper samples
 //! (`hw_model::interpolator::interpolate`, signed `texcoord_int_bits.texcoord_frac_bits`).
 
-use super::stages::{column_f, Counters, Machine};
+use super::stages::{column_f, each_fragment, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::reference::interpolate_f64;
 use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
-use hw_model::interpolator::{interpolate_cost, interpolate_pairs};
+use hw_model::interpolator::{interpolate_cost, interpolate_pairs, interpolate_pairs_span};
 use hw_model::UnitCost;
 
 /// Fixed twin: two interpolations per sample.
@@ -34,6 +34,32 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     if px.carriers {
         for s in 0..n {
             frag.uv[s] = frag.uv_x[s].map(|r| from_raw(r, fb));
+        }
+    }
+}
+
+/// Fixed twin over a span: after a Fixed `bary`, the triangle's terms resolved once for the
+/// span (`interpolate_pairs_span`), bit-identical to [`fixed`] on each fragment; otherwise
+/// [`fixed`] per fragment.
+pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    let m = px.m;
+    if m.hw.interp.coord_arith == CoordArith::Float32 || !px.fixed(StageKind::Bary) {
+        return each_fragment(fixed, px, frags, c);
+    }
+    let n = px.samples();
+    let lanes = frags.iter_mut().map(|f| {
+        let Frag { bary_x, uv_x, .. } = f;
+        (&bary_x[..n], &mut uv_x[..n])
+    });
+    let sat = &mut c.sat[StageKind::Texcoord.index()];
+    let bb = m.hw.interp.bary_bits;
+    interpolate_pairs_span(lanes, bb, px.a.uv_x, &m.uv_fmt, sat);
+    if px.carriers {
+        let fb = m.uv_fmt.frac_bits;
+        for frag in frags.iter_mut() {
+            for s in 0..n {
+                frag.uv[s] = frag.uv_x[s].map(|r| from_raw(r, fb));
+            }
         }
     }
 }

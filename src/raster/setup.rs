@@ -166,12 +166,8 @@ impl ScreenTri {
         let s = subpixel_bits.clamp(1, 12);
         let v = self.xy;
         if let Some((x, y)) = small_point(magnitudes(&v), px, py, s) {
-            let [[x0, y0], [x1, y1], [x2, y2]] = v;
-            return (
-                small_edges(&v, x, y),
-                [-((y2 - y1) << s), -((y0 - y2) << s), -((y1 - y0) << s)],
-                [(x2 - x1) << s, (x0 - x2) << s, (x1 - x0) << s],
-            );
+            let (dx, dy) = small_steps(&v, s);
+            return (small_edges(&v, x, y), dx, dy);
         }
         self.edges_steps_i64(px, py, subpixel_bits)
             .unwrap_or_else(|| {
@@ -182,6 +178,30 @@ impl ScreenTri {
                 let dy = [0, 1, 2].map(|i| ey[i].wrapping_sub(e[i]));
                 (e, dx, dy)
             })
+    }
+
+    /// The edge values at the centre of pixel (px, py) and their constant steps along x and
+    /// y, as [`Self::edges_fixed_with_steps`], when the `n` pixels (px + j, py) of a row span
+    /// are all within [`SMALL_EDGES`]' bounds: then pixel (px + j, py)'s edges are exactly
+    /// `e + j dx` in `i64`, bit-identical to [`Self::edges_fixed`] there. `None` otherwise
+    /// (the caller evaluates each pixel).
+    #[inline]
+    #[must_use]
+    pub fn edges_fixed_span(
+        &self,
+        px: i64,
+        py: i64,
+        n: usize,
+        subpixel_bits: u32,
+    ) -> Option<([i64; 3], [i64; 3], [i64; 3])> {
+        let s = subpixel_bits.clamp(1, 12);
+        let v = self.xy;
+        let mags = magnitudes(&v);
+        let last = px.checked_add(i64::try_from(n).ok()?.checked_sub(1)?)?;
+        small_point(mags, last, py, s)?;
+        let (x, y) = small_point(mags, px, py, s)?;
+        let (dx, dy) = small_steps(&v, s);
+        Some((small_edges(&v, x, y), dx, dy))
     }
 
     /// [`Self::edges_fixed_with_steps`] in `i64`, `None` when any intermediate (including
@@ -253,6 +273,17 @@ fn small_point(magnitudes: u64, px: i64, py: i64, s: u32) -> Option<(i64, i64)> 
 fn small_edges(v: &[[i64; 2]; 3], x: i64, y: i64) -> [i64; 3] {
     let edge = |[xj, yj]: [i64; 2], [xk, yk]: [i64; 2]| (xk - xj) * (y - yj) - (yk - yj) * (x - xj);
     [edge(v[1], v[2]), edge(v[2], v[0]), edge(v[0], v[1])]
+}
+
+/// The edges' constant steps from one pixel centre to the next along x and along y
+/// (`-(y_k - y_j) 2^s`, `(x_k - x_j) 2^s`), within [`SMALL_EDGES`]' bounds.
+#[inline(always)]
+fn small_steps(v: &[[i64; 2]; 3], s: u32) -> ([i64; 3], [i64; 3]) {
+    let [[x0, y0], [x1, y1], [x2, y2]] = *v;
+    (
+        [-((y2 - y1) << s), -((y0 - y2) << s), -((y1 - y0) << s)],
+        [(x2 - x1) << s, (x0 - x2) << s, (x1 - x0) << s],
+    )
 }
 
 /// Exact edge values of the vertices `v` (on a grid of `s` sub-pixel bits) at the centre of

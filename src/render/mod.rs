@@ -73,6 +73,9 @@ pub struct RenderOptions {
     pub progress: Option<fn(&str, f64)>,
     /// Also run the range-instrumented float pass ([`ranges`]): `RenderStats::ranges`.
     pub ranges: bool,
+    /// Shade one fragment at a time through every stage (the reference of the default, which
+    /// runs each stage over spans of consecutive pixels of one triangle): the same frame.
+    pub per_fragment: bool,
 }
 
 impl Default for RenderOptions {
@@ -86,6 +89,7 @@ impl Default for RenderOptions {
             truth: 0,
             progress: None,
             ranges: false,
+            per_fragment: false,
         }
     }
 }
@@ -228,6 +232,7 @@ pub fn render(
         attrs: &attrs,
         geo: &geo,
         m: &m,
+        per_fragment: opts.per_fragment,
     };
     let plans: Vec<PlanTiming> = geo
         .plans
@@ -326,6 +331,7 @@ pub fn render(
             attrs: &attrs,
             geo: &geo,
             m: &mt,
+            per_fragment: opts.per_fragment,
         };
         let (img, _, _) = shade(&tin, &StageImpls::FLOAT, bg, None, false);
         geo.plans = saved;

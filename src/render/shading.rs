@@ -6,7 +6,7 @@ use super::Geometry;
 use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::clip_f32::ShadedVertex;
 use crate::pipeline::coord_f32::{self, F32Tri};
-use crate::pipeline::stages::{output16, run, Counters, Machine, TriAttrs};
+use crate::pipeline::stages::{output16, run, run_span, Counters, Machine, TriAttrs, SPAN_MAX};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 use crate::raster::{ScreenTri, VertexSource};
 use crate::raster::{Setup, VisBuffer, NO_TRI};
@@ -209,11 +209,16 @@ pub(super) struct ShadeInput<'a> {
     pub(super) attrs: &'a [TriAttrs],
     pub(super) geo: &'a Geometry,
     pub(super) m: &'a Machine<'a>,
+    /// Shade one fragment at a time through [`run`] (the reference of the span path).
+    pub(super) per_fragment: bool,
 }
 
-/// Shades row `y` into `row` with the plans compiled as `progs`, adding to `c`; `on_pixel(plan index, triangle, frag)` sees every
-/// shaded fragment (a no-op closure compiles to the plain loop; the timing model records its
-/// events through it, from the footprints the stages traced when `trace`).
+/// Shades row `y` into `row` with the plans compiled as `progs`, adding to `c`; `on_pixel(plan
+/// index, triangle, frag)` sees every shaded fragment in raster order (a no-op closure
+/// compiles to the plain loop; the timing model records its events through it, from the
+/// footprints the stages traced when `trace`). The covered pixels run in spans of up to
+/// [`SPAN_MAX`] consecutive pixels of one triangle ([`run_span`]), or one at a time
+/// ([`run`]) with `inp.per_fragment`: the same image, counters and fragments.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn shade_row(
     inp: &ShadeInput,
@@ -225,35 +230,52 @@ pub(super) fn shade_row(
     mut on_pixel: impl FnMut(u32, u32, &Frag),
 ) {
     let w = inp.vis.width as usize;
-    let mut frag = Frag::default();
-    frag.trace.on = trace;
+    let cap = if inp.per_fragment { 1 } else { SPAN_MAX };
+    let mut frags = vec![Frag::default(); cap];
+    for frag in &mut frags {
+        frag.trace.on = trace;
+    }
     let tris = &inp.vis.tri[y * w..(y + 1) * w];
     // The fragments of each run of one program, charged when the run ends.
     let mut run_of: Option<(usize, u64)> = None;
-    for (x, (&t, out)) in tris.iter().zip(row.iter_mut()).enumerate() {
+    let mut x = 0;
+    while x < w {
+        let t = tris[x];
         if t == NO_TRI {
+            x += 1;
             continue;
         }
+        let n = tris[x..(x + cap).min(w)]
+            .iter()
+            .take_while(|&&u| u == t)
+            .count();
         let a = &inp.attrs[t as usize];
         let pi = a.plan as usize;
         match &mut run_of {
-            Some((p, n)) if *p == pi => *n += 1,
+            Some((p, k)) if *p == pi => *k += n as u64,
             _ => {
-                if let Some((p, n)) = run_of.replace((pi, 1)) {
-                    progs[p].charge(n, c);
+                if let Some((p, k)) = run_of.replace((pi, n as u64)) {
+                    progs[p].charge(k, c);
                 }
             }
         }
         let tri = &inp.setup.tris[t as usize];
         let plan = &inp.geo.plans[pi];
-        run(
-            &progs[pi], plan, inp.m, tri, a, x as i64, y as i64, &mut frag, c,
-        );
-        *out = output16(&frag);
-        on_pixel(a.plan, t, &frag);
+        let (px, py) = (x as i64, y as i64);
+        let span = &mut frags[..n];
+        if inp.per_fragment {
+            run(&progs[pi], plan, inp.m, tri, a, px, py, &mut span[0], c);
+        } else {
+            run_span(&progs[pi], plan, inp.m, tri, a, px, py, span, c);
+        }
+        for (frag, out) in span.iter().zip(&mut row[x..x + n]) {
+            *out = output16(frag);
+            on_pixel(a.plan, t, frag);
+        }
+        x += n;
     }
-    if let Some((p, n)) = run_of {
-        progs[p].charge(n, c);
+    if let Some((p, k)) = run_of {
+        progs[p].charge(k, c);
     }
 }
 

@@ -28,6 +28,7 @@ mod raster_rules;
 mod raster_watertight;
 mod render_pipeline;
 mod roughness_scene;
+mod span_stages;
 mod timing_golden;
 mod toksvig_pipeline;
 mod tune_search;

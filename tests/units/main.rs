@@ -32,6 +32,7 @@ mod timing_footprint;
 mod timing_units;
 mod toksvig_unit;
 mod unit_bary_derivs;
+mod unit_bary_span;
 mod unit_cost;
 mod unit_fixed;
 mod unit_fixedpoint;

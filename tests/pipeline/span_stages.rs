@@ -1,0 +1,248 @@
+//! Stages over spans of fragments: the span twins of `bary` and `texcoord` against their
+//! per-fragment twins on seeded spans (values, carriers and saturation counts), and whole
+//! frames shaded in spans against the same frames shaded one fragment at a time (images,
+//! statistics, counters and cycle counts).
+
+use crate::rng_common::Rng;
+use hw_model::config::{CoordArith, HwConfig};
+use hw_model::fixed::Rounding;
+use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
+use texsim::pipeline::{bary, plan, texcoord, Frag, Impl, Px, StageImpls, StageKind};
+use texsim::raster::{ScreenTri, VertexSource};
+use texsim::render::{render, Maps, RenderOptions, Rendered};
+use texsim::scene::{self, Material};
+use texsim::timing::simulate;
+
+const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+/// A fixed-point configuration with random raster, interpolator and reciprocal widths, rounding
+/// modes, `lod_per_quad` and attribute grid (off, the raster's, or finer).
+fn config(rng: &mut Rng) -> HwConfig {
+    let mut hw = HwConfig::texram16();
+    hw.raster.subpixel_bits = rng.int_in(1, 12) as u32;
+    let i = &mut hw.interp;
+    i.bary_bits = rng.int_in(4, 30) as u32;
+    i.inv_w_bits = rng.int_in(4, 30) as u32;
+    i.interp_rounding = MODES[rng.below(3) as usize];
+    i.texcoord_frac_bits = rng.int_in(4, 28) as u32;
+    i.texcoord_int_bits = rng.int_in(1, 16) as u32;
+    i.coord_arith = CoordArith::Fixed;
+    i.attr_subpixel_bits = match rng.below(4) {
+        0 => rng.int_in(1, 16) as u32,
+        1 => hw.raster.subpixel_bits,
+        _ => 0,
+    };
+    hw.lod.lod_per_quad = rng.below(3) == 0;
+    hw.reciprocal.recip_mantissa_bits = rng.int_in(8, 30) as u32;
+    hw.reciprocal.recip_iterations = rng.int_in(0, 3) as u32;
+    hw.reciprocal.recip_rounding = MODES[rng.below(3) as usize];
+    hw
+}
+
+/// A triangle on the raster's grid of `sub` bits: screen-sized, huge (beyond the edges' `i64`
+/// bounds), or near-degenerate; its float positions a little off the grid.
+fn triangle(rng: &mut Rng, sub: u32) -> ScreenTri {
+    let size = 1i64 << [rng.int_in(1, 10), rng.int_in(10, 24)][rng.below(2) as usize];
+    let mut xy = [[0i64; 2]; 3].map(|_| [0, 1].map(|_| rng.int_in(-size, size) << sub));
+    if rng.below(4) == 0 {
+        let t = rng.int_in(-3, 3);
+        xy[2] = [0, 1].map(|k| xy[0][k] + t * (xy[1][k] - xy[0][k]) + rng.int_in(-2, 2));
+    }
+    let g = f64::from(1u32 << sub);
+    let xy_f = xy.map(|p| p.map(|c| (c as f64 + rng.range(-0.5, 0.5)) / g));
+    ScreenTri {
+        xy,
+        xy_f,
+        z: [0; 3],
+        z_f: [0.0; 3],
+        inv_w: [1.0; 3],
+        src: 0,
+        source: VertexSource::Unclipped { swapped: false },
+        area2: 1,
+        area2_f: 1.0,
+        bbox: [0; 4],
+    }
+}
+
+/// Vertex data: 1/w normalized to `2^inv_w_bits` for the largest (some tiny: a vertex far
+/// behind), texture coordinates within the format or beyond it.
+fn attrs(rng: &mut Rng, hw: &HwConfig) -> TriAttrs {
+    let bits = hw.interp.inv_w_bits;
+    let one = 1i64 << bits;
+    let mut inv_w_x = [0i64; 3].map(|_| match rng.below(4) {
+        0 => one,
+        1 => rng.int_in(1, 8),
+        _ => rng.int_in(1, one),
+    });
+    inv_w_x[rng.below(3) as usize] = one;
+    let inv_w_f = inv_w_x.map(|w| w as f64 / one as f64);
+    let uv_bits = hw.interp.texcoord_frac_bits + hw.interp.texcoord_int_bits + 2;
+    let uv_max = 1i64 << uv_bits.min(60);
+    let uv_x = [[0i64; 2]; 3].map(|_| [0, 1].map(|_| rng.int_in(-uv_max, uv_max)));
+    let uv_f = uv_x.map(|t| t.map(|v| v as f64 / f64::from(1u32 << hw.interp.texcoord_frac_bits)));
+    TriAttrs {
+        inv_w_f,
+        inv_w_x,
+        uv_f,
+        uv_x,
+        ..TriAttrs::default()
+    }
+}
+
+/// The fields `bary` and `texcoord` write, of the first `samples` samples.
+fn written(f: &Frag, samples: usize) -> String {
+    format!(
+        "{:?} {:?} {:?} {:?}",
+        &f.bary_x[..samples],
+        &f.uv_x[..samples],
+        f.bary[..samples]
+            .iter()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>(),
+        f.uv[..samples]
+            .iter()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>(),
+    )
+}
+
+/// 300k seeded spans of 1..=16 fragments (pixels in and out of the triangle): `bary` then
+/// `texcoord` over the span give, at every fragment, the values and carriers of their
+/// per-fragment twins, and the same counters; over raster and interpolator widths, rounding
+/// modes, `lod_per_quad`, `attr_subpixel_bits`, derivatives on and off, a Float `bary`
+/// before a Fixed `texcoord`, near-degenerate and huge triangles and tiny 1/w.
+#[test]
+fn span_twins_match_the_per_fragment_twins() {
+    let mut rng = Rng(0x5a4e_1001);
+    let textured = Material {
+        texture: Some(0),
+        ..Material::default()
+    };
+    for group in 0..150u32 {
+        let hw = config(&mut rng);
+        let m = Machine::new(&hw, &[], &[]);
+        let sub = hw.raster.subpixel_bits;
+        for case in 0..2000u32 {
+            let tri = triangle(&mut rng, sub);
+            let a = attrs(&mut rng, &hw);
+            let mut pl = plan(&textured, true);
+            pl.derivatives = rng.below(4) != 0;
+            let impls = if rng.below(8) == 0 {
+                StageImpls::FIXED.with(StageKind::Bary, Impl::Float)
+            } else {
+                StageImpls::FIXED
+            };
+            // A span around the triangle's first vertex (partly outside it, or all outside).
+            let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
+            let n = rng.int_in(1, 16) as usize;
+            let px = Px {
+                plan: &pl,
+                impls: &impls,
+                m: &m,
+                tri: &tri,
+                a: &a,
+                x: vx + rng.int_in(-12, 4),
+                y: vy + rng.int_in(-3, 3),
+                color_raw: false,
+                carriers: rng.below(2) == 0,
+            };
+            let bary_twin = if impls.of(StageKind::Bary) == Impl::Fixed {
+                bary::fixed
+            } else {
+                bary::float
+            };
+            let mut span = vec![Frag::default(); n];
+            let mut c_span = Counters::default();
+            if impls.of(StageKind::Bary) == Impl::Fixed {
+                bary::fixed_span(&px, &mut span, &mut c_span);
+            } else {
+                texsim::pipeline::stages::each_fragment(bary::float, &px, &mut span, &mut c_span);
+            }
+            texcoord::fixed_span(&px, &mut span, &mut c_span);
+            let mut c_one = Counters::default();
+            let samples = px.samples();
+            for (j, got) in span.iter().enumerate() {
+                let at = Px {
+                    x: px.x + j as i64,
+                    ..px
+                };
+                let mut f = Frag::default();
+                bary_twin(&at, &mut f, &mut c_one);
+                texcoord::fixed(&at, &mut f, &mut c_one);
+                assert_eq!(
+                    written(got, samples),
+                    written(&f, samples),
+                    "group {group} case {case} fragment {j}"
+                );
+            }
+            for k in [StageKind::Bary, StageKind::Texcoord] {
+                assert_eq!(
+                    c_span.sat[k.index()],
+                    c_one.sat[k.index()],
+                    "group {group} case {case}: {k} counts"
+                );
+            }
+        }
+    }
+}
+
+fn render_with(s: &scene::Scene, hw: &HwConfig, per_fragment: bool) -> Rendered {
+    let maps = Maps::new(s, hw.trilinear.texel_bits);
+    let opts = RenderOptions {
+        timing: true,
+        per_fragment,
+        ..RenderOptions::default()
+    };
+    render(s, &maps, hw, &opts).expect("render")
+}
+
+/// The stats without the wall-clock timings.
+fn stats_json(r: &Rendered) -> serde_json::Value {
+    let mut v = serde_json::to_value(&r.stats).expect("json");
+    v.as_object_mut().expect("object").remove("timings");
+    v
+}
+
+/// Scenes of every kind of plan, on the fixed-point presets, llvmpipe's float32 path, footprint
+/// assembly with adaptive probes, `lod_per_quad` and a finer attribute grid: shading in spans
+/// gives the per-fragment frame (hardware and reference images, statistics with every stage's
+/// counters, and the timing model's cycles).
+#[test]
+fn frames_in_spans_equal_frames_per_fragment() {
+    let mut aniso = HwConfig::texram16();
+    aniso.trilinear.aniso_probes = 4;
+    aniso.trilinear.aniso_adaptive = true;
+    let mut quad = HwConfig::d3d11();
+    quad.lod.lod_per_quad = true;
+    quad.interp.attr_subpixel_bits = 12;
+    quad.interp.interp_rounding = Rounding::Truncate;
+    let configs = [
+        HwConfig::texram16(),
+        HwConfig::vulkan_min(),
+        HwConfig::llvmpipe(),
+        aniso,
+        quad,
+    ];
+    for hw in &configs {
+        for name in [
+            "demo", "w1-plane", "w2-mesh", "bumps", "lod-pair", "sky-lake",
+        ] {
+            let mut s = scene::builtin(name).expect("builtin");
+            s.width = 96;
+            s.height = 64;
+            let (a, b) = (render_with(&s, hw, false), render_with(&s, hw, true));
+            let what = format!("{name} on {}", hw.name);
+            assert!(a.hw_image == b.hw_image, "{what}: hardware image");
+            assert!(a.ref_image == b.ref_image, "{what}: reference image");
+            assert_eq!(stats_json(&a), stats_json(&b), "{what}: stats");
+            let (ea, eb) = (a.events.expect("events"), b.events.expect("events"));
+            assert_eq!(
+                serde_json::to_value(simulate(&ea, hw, name)).expect("json"),
+                serde_json::to_value(simulate(&eb, hw, name)).expect("json"),
+                "{what}: timing report"
+            );
+        }
+    }
+}
