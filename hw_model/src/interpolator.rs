@@ -276,10 +276,9 @@ fn perspective_bary_derivs_narrow<M: ConstRounding>(
 ///
 /// Along the row the exact `q_i = E_i invw_i` step by `a_i = dE_i/dx invw_i` and `D` by
 /// `S = sum a_j`. When the common scale shift is 0 (every operand below 2^62, the common
-/// case) the x numerators `N_i = a_i D - q_i S` are the same at every lane (and the y
-/// numerators `b_i D - q_i T` step by `b_i S - a_i T`, as cheap to form directly), so per
-/// lane only `1/D`, its square, two 64x64-bit products per y numerator and the roundings
-/// remain. A lane outside those preconditions (operands beyond `i64` or 2^62,
+/// case) the x numerators `N_i = a_i D - q_i S` are the same at every lane and the y
+/// numerators `b_i D - q_i T` step by `b_i S - a_i T`, so per lane only `1/D`, its square
+/// and the roundings remain. A lane outside those preconditions (operands beyond `i64` or 2^62,
 /// `D <= 0`, a clamped `p_i`) takes the per-sample datapath.
 #[allow(clippy::too_many_arguments)]
 #[inline]
@@ -364,8 +363,11 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
     let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
     let m_bits = recip.config().recip_mantissa_bits;
     let wide = i128::from;
-    // The x numerators' top bits, from the first fast lane (the same at every fast lane).
-    let mut x_numerators: Option<[(i128, u32); 2]> = None;
+    let y_step = [1, 2].map(|i| wide(b[i]) * wide(s) - wide(a[i]) * wide(t));
+    // From the first fast lane on: the x numerators' top bits (the same at every fast lane)
+    // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
+    // wrapping steps across the lanes between are exact modulo 2^128).
+    let mut numerators: Option<([NumeratorTop; 2], [i128; 2])> = None;
     for (c, chunk) in out.chunks_mut(SPAN_LANES).enumerate() {
         let base = c * SPAN_LANES;
         // Per lane, stage by stage: `q` and `D` (fast when the scale shift is 0: `D`, positive,
@@ -405,16 +407,22 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
             }
         }
         for (j, o) in chunk.iter_mut().enumerate() {
+            if let Some((_, ny)) = &mut numerators {
+                *ny = [ny[0].wrapping_add(y_step[0]), ny[1].wrapping_add(y_step[1])];
+            }
             if !fast[j] {
                 let e = lane_edges(edge, edge_dx, base + j);
                 *o = derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat);
                 continue;
             }
-            let (pj, qj, r2, dw) = (p[j], q[j], r[j], wide(d[j]));
-            let nx = x_numerators.get_or_insert_with(|| {
-                [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s)))
+            let (pj, qj, r2) = (p[j], q[j], r[j]);
+            let (nx, ny) = *numerators.get_or_insert_with(|| {
+                let dw = wide(d[j]);
+                (
+                    [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
+                    [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+                )
             });
-            let ny = [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t));
             let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
             let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
             let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
@@ -476,9 +484,12 @@ fn derivative<M: ConstRounding>(n: i128, r2: Recip, bary_bits: u32, sat: &mut Sa
     derivative_of_top::<M>(numerator_top(n), r2, bary_bits, sat)
 }
 
-/// The numerator of [`derivative`] kept to its top 94 bits: `(N >> ns, ns)`.
+/// A numerator of [`derivative`] kept to its top 94 bits, and the shift dropped: `(N >> ns, ns)`.
+type NumeratorTop = (i128, u32);
+
+/// The numerator of [`derivative`] kept to its top 94 bits ([`NumeratorTop`]).
 #[inline(always)]
-fn numerator_top(n: i128) -> (i128, u32) {
+fn numerator_top(n: i128) -> NumeratorTop {
     // |N| < 2^126, so `ns` <= 32 and `n >> ns` is a 64-bit funnel shift.
     let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94) & 63;
     (n >> ns, ns)
@@ -487,7 +498,7 @@ fn numerator_top(n: i128) -> (i128, u32) {
 /// [`derivative`] from the numerator's top bits `(x, ns)` ([`numerator_top`]).
 #[inline(always)]
 fn derivative_of_top<M: ConstRounding>(
-    (x, ns): (i128, u32),
+    (x, ns): NumeratorTop,
     r2: Recip,
     bary_bits: u32,
     sat: &mut SatCounter,
@@ -643,9 +654,9 @@ fn interpolate_pairs_in<'a, M: ConstRounding>(
 }
 
 /// One interpolation from the sample-independent terms `(a0 2^B, a1 - a0, a2 - a0)` of the
-/// attribute `column`: the accumulator in `i64` when it fits (else [`interpolate_in`]), then
-/// `Format::requantize` from `frac_bits + bary_bits` with the range `(min_raw, max_raw)` of
-/// `out` tested inline.
+/// attribute `column`: the exact accumulator (64x64 -> 128-bit products) when it fits `i64`
+/// (else [`interpolate_in`]), then `Format::requantize` from `frac_bits + bary_bits` with the
+/// range `(min_raw, max_raw)` of `out` tested inline.
 #[inline(always)]
 fn interpolate_terms<M: ConstRounding>(
     b: &[i64; 3],
@@ -656,13 +667,11 @@ fn interpolate_terms<M: ConstRounding>(
     out: &Format,
     sat: &mut SatCounter,
 ) -> i64 {
-    let (p1, o1) = b[1].overflowing_mul(d1);
-    let (p2, o2) = b[2].overflowing_mul(d2);
-    let (s1, o3) = t0.overflowing_add(p1);
-    let (acc, o4) = s1.overflowing_add(p2);
-    if o1 | o2 | o3 | o4 {
+    let wide =
+        i128::from(t0) + i128::from(b[1]) * i128::from(d1) + i128::from(b[2]) * i128::from(d2);
+    let Ok(acc) = i64::try_from(wide) else {
         return interpolate_cold::<M>(b, bary_bits, attr, ax, out, sat);
-    }
+    };
     let v = round_shift_right(acc, bary_bits, M::MODE);
     if v >= lo && v <= hi {
         v
