@@ -269,31 +269,37 @@ fn perspective_bary_derivs_narrow<M: ConstRounding>(
     Some([p, bx, by])
 }
 
-/// [`perspective_bary_derivs`] at the samples of a row span: lane `j` of `out` is the result
-/// for the edges `edge + j edge_dx` (which must fit `i64`, as at the pixels `(x + j, y)`),
-/// with the same `edge_dx`, `edge_dy`. Bit-identical to one call per lane, with the same
-/// saturation counts.
+/// The edge values over a row span of `lanes` samples `(x + j, y)`: at its first sample and
+/// their constant steps along x and y (every lane's `edge + j dx` must fit `i64`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeSpan {
+    pub edge: [i64; 3],
+    pub dx: [i64; 3],
+    pub dy: [i64; 3],
+    pub lanes: usize,
+}
+
+/// [`perspective_bary_derivs`] at the samples of a row span: `out(j, result)` gets lane `j`'s
+/// result (the edges `edge + j dx`, the steps `dx`, `dy`), each lane once, in no promised
+/// order. Bit-identical to one call per lane, with the same saturation counts.
 ///
 /// Along the row the exact `q_i = E_i invw_i` step by `a_i = dE_i/dx invw_i` and `D` by
 /// `S = sum a_j`. When the common scale shift is 0 (every operand below 2^62, the common
 /// case) the x numerators `N_i = a_i D - q_i S` are the same at every lane and the y
 /// numerators `b_i D - q_i T` step by `b_i S - a_i T`, so per lane only `1/D`, its square
-/// and the roundings remain. A lane outside those preconditions (operands beyond `i64` or 2^62,
-/// `D <= 0`, a clamped `p_i`) takes the per-sample datapath.
-#[allow(clippy::too_many_arguments)]
+/// and the roundings remain. A lane outside those preconditions (operands beyond `i64` or
+/// 2^62, `D <= 0`, a clamped `p_i`) takes the per-sample datapath.
 #[inline]
 pub fn perspective_bary_derivs_span(
-    edge: [i64; 3],
-    edge_dx: [i64; 3],
-    edge_dy: [i64; 3],
+    span: &EdgeSpan,
     inv_w: [i64; 3],
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    out: &mut [[[i64; 3]; 3]],
+    out: impl FnMut(usize, [[i64; 3]; 3]),
 ) {
     crate::with_rounding!(cfg.interp_rounding, M => {
-        perspective_bary_derivs_span_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat, out)
+        perspective_bary_derivs_span_in::<M>(span, inv_w, cfg, recip, sat, out)
     })
 }
 
@@ -323,17 +329,19 @@ fn derivs_lane<M: ConstRounding>(
 pub const SPAN_LANES: usize = 16;
 
 /// [`perspective_bary_derivs_span`] compiled for the rounding mode `M` (`interp_rounding`).
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn perspective_bary_derivs_span_in<M: ConstRounding>(
-    edge: [i64; 3],
-    edge_dx: [i64; 3],
-    edge_dy: [i64; 3],
+    &EdgeSpan {
+        edge,
+        dx: edge_dx,
+        dy: edge_dy,
+        lanes,
+    }: &EdgeSpan,
     inv_w: [i64; 3],
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    out: &mut [[[i64; 3]; 3]],
+    mut out: impl FnMut(usize, [[i64; 3]; 3]),
 ) {
     let times_w = |e: [i64; 3]| -> Option<[i64; 3]> {
         Some([
@@ -354,9 +362,12 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
         (mag >> 62 == 0).then_some((a, b, s, t, mag))
     })();
     let Some((a, b, s, t, steps_mag)) = steps else {
-        for (j, o) in out.iter_mut().enumerate() {
+        for j in 0..lanes {
             let e = lane_edges(edge, edge_dx, j);
-            *o = derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat);
+            out(
+                j,
+                derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
+            );
         }
         return;
     };
@@ -368,15 +379,15 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
     // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
     // wrapping steps across the lanes between are exact modulo 2^128).
     let mut numerators: Option<([NumeratorTop; 2], [i128; 2])> = None;
-    for (c, chunk) in out.chunks_mut(SPAN_LANES).enumerate() {
-        let base = c * SPAN_LANES;
+    for base in (0..lanes).step_by(SPAN_LANES) {
+        let chunk = (lanes - base).min(SPAN_LANES);
         // Per lane, stage by stage: `q` and `D` (fast when the scale shift is 0: `D`, positive,
         // and `q_1`, `q_2` below 2^62 as the steps are), the reciprocal of `D`, the
         // barycentrics (fast while no `p_i` needs the clamp) and the square.
         let mut q = [[0i64; 3]; SPAN_LANES];
         let mut d = [0i64; SPAN_LANES];
         let mut fast = [false; SPAN_LANES];
-        for j in 0..chunk.len() {
+        for j in 0..chunk {
             let lane =
                 times_w(lane_edges(edge, edge_dx, base + j)).and_then(|q| Some((q, sum(q)?)));
             if let Some((qj, dj)) = lane {
@@ -388,14 +399,14 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
             }
         }
         let mut r = [Recip { mant: 0, shift: 0 }; SPAN_LANES];
-        for j in 0..chunk.len() {
+        for j in 0..chunk {
             if fast[j] {
                 // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
                 r[j] = recip.eval(d[j] as u64, &mut SatCounter::default());
             }
         }
         let mut p = [[0i64; 3]; SPAN_LANES];
-        for j in 0..chunk.len() {
+        for j in 0..chunk {
             if fast[j] {
                 let p1 = apply_i64_in::<M>(r[j], q[j][1], bb);
                 let p2 = apply_i64_in::<M>(r[j], q[j][2], bb);
@@ -406,13 +417,16 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
                 r[j] = square(r[j], m_bits, M::MODE);
             }
         }
-        for (j, o) in chunk.iter_mut().enumerate() {
+        for j in 0..chunk {
             if let Some((_, ny)) = &mut numerators {
                 *ny = [ny[0].wrapping_add(y_step[0]), ny[1].wrapping_add(y_step[1])];
             }
             if !fast[j] {
                 let e = lane_edges(edge, edge_dx, base + j);
-                *o = derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat);
+                out(
+                    base + j,
+                    derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
+                );
                 continue;
             }
             let (pj, qj, r2) = (p[j], q[j], r[j]);
@@ -427,28 +441,30 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
             let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
             let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
             let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
-            *o = [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]];
+            out(
+                base + j,
+                [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]],
+            );
         }
     }
 }
 
-/// [`perspective_bary`] at the samples of a row span: lane `j` of `out` is the result for the
-/// edges `edge + j edge_dx` (which must fit `i64`). Bit-identical to one call per lane, with
-/// the same saturation counts, the rounding mode resolved once.
+/// [`perspective_bary`] at the samples of a row span: `out(j, result)` gets lane `j`'s result
+/// (the edges `edge + j dx`; `dy` is not used), each lane once. Bit-identical to one call per
+/// lane, with the same saturation counts, the rounding mode resolved once.
 #[inline]
 pub fn perspective_bary_span(
-    edge: [i64; 3],
-    edge_dx: [i64; 3],
+    span: &EdgeSpan,
     inv_w: [i64; 3],
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    out: &mut [[i64; 3]],
+    mut out: impl FnMut(usize, [i64; 3]),
 ) {
     crate::with_rounding!(cfg.interp_rounding, M => {
-        for (j, o) in out.iter_mut().enumerate() {
-            let e = lane_edges(edge, edge_dx, j);
-            *o = perspective_bary_eval::<M>(e, inv_w, cfg, recip, sat).0;
+        for j in 0..span.lanes {
+            let e = lane_edges(span.edge, span.dx, j);
+            out(j, perspective_bary_eval::<M>(e, inv_w, cfg, recip, sat).0);
         }
     })
 }

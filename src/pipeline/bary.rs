@@ -3,13 +3,13 @@
 //! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad;
 //! with `attr_subpixel_bits` the edges come from the float positions on that finer grid.
 
-use super::stages::{each_fragment, Counters, Machine, SPAN_MAX};
+use super::stages::{each_fragment, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
 use crate::reference::{perspective_bary_derivs_f64, perspective_bary_f64};
 use hw_model::interpolator::{
     perspective_bary, perspective_bary_cost, perspective_bary_derivs, perspective_bary_derivs_cost,
-    perspective_bary_derivs_span, perspective_bary_span,
+    perspective_bary_derivs_span, perspective_bary_span, EdgeSpan,
 };
 use hw_model::UnitCost;
 
@@ -78,27 +78,27 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let grid = hw.interp.attr_subpixel_bits;
     let regrid = grid != 0 && grid != sub;
     let quad = px.plan.derivatives && hw.lod.lod_per_quad;
-    let n = frags.len().min(SPAN_MAX);
+    let n = frags.len();
     let steps = (!regrid && !quad)
         .then(|| px.tri.edges_fixed_span(px.x, px.y, n, sub))
         .flatten();
-    let (Some((e, dx, dy)), true) = (steps, frags.len() == n) else {
+    let Some((e, dx, dy)) = steps else {
         return each_fragment(fixed, px, frags, c);
     };
     let sat = &mut c.sat[StageKind::Bary.index()];
     let (inv_w, cfg, recip) = (px.a.inv_w_x, &hw.interp, &px.m.recip);
+    let span = EdgeSpan {
+        edge: e,
+        dx,
+        dy,
+        lanes: n,
+    };
     if px.plan.derivatives {
-        let mut out = [[[0i64; 3]; 3]; SPAN_MAX];
-        perspective_bary_derivs_span(e, dx, dy, inv_w, cfg, recip, sat, &mut out[..n]);
-        for (frag, b) in frags.iter_mut().zip(&out) {
-            frag.bary_x = *b;
-        }
+        let out = |j: usize, b| frags[j].bary_x = b;
+        perspective_bary_derivs_span(&span, inv_w, cfg, recip, sat, out);
     } else {
-        let mut out = [[0i64; 3]; SPAN_MAX];
-        perspective_bary_span(e, dx, inv_w, cfg, recip, sat, &mut out[..n]);
-        for (frag, b) in frags.iter_mut().zip(&out) {
-            frag.bary_x[0] = *b;
-        }
+        let out = |j: usize, b| frags[j].bary_x[0] = b;
+        perspective_bary_span(&span, inv_w, cfg, recip, sat, out);
     }
     if px.carriers {
         let bb = hw.interp.bary_bits;

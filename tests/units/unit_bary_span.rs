@@ -9,7 +9,7 @@ use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Overflow, Rounding, SatCounter};
 use hw_model::interpolator::{
     interpolate_pairs, interpolate_pairs_span, perspective_bary, perspective_bary_derivs,
-    perspective_bary_derivs_span, perspective_bary_span, SPAN_LANES,
+    perspective_bary_derivs_span, perspective_bary_span, EdgeSpan, SPAN_LANES,
 };
 use hw_model::reciprocal::Reciprocal;
 
@@ -125,7 +125,20 @@ fn derivs_span_matches_the_per_sample_routine() {
         let (e, dx, dy) = span_edges(&mut rng, n);
         let w = inv_w(&mut rng, hw.interp.inv_w_bits);
         let mut sat = SatCounter::default();
-        perspective_bary_derivs_span(e, dx, dy, w, &hw.interp, &recip, &mut sat, &mut out[..n]);
+        let mut seen = 0u64;
+        let put = |j: usize, b| {
+            assert!(seen & 1 << j == 0, "case {case}: lane {j} twice");
+            seen |= 1 << j;
+            out[j] = b;
+        };
+        let span = EdgeSpan {
+            edge: e,
+            dx,
+            dy,
+            lanes: n,
+        };
+        perspective_bary_derivs_span(&span, w, &hw.interp, &recip, &mut sat, put);
+        assert_eq!(seen, (1u64 << n) - 1, "case {case}: every lane once");
         let mut sat_ref = SatCounter::default();
         for (j, got) in out[..n].iter().enumerate() {
             let ej = lane(e, dx, j);
@@ -166,10 +179,17 @@ fn bary_span_matches_the_per_sample_routine() {
             recip = Reciprocal::new(&hw.reciprocal);
         }
         let n = rng.int_in(1, 40) as usize;
-        let (e, dx, _) = span_edges(&mut rng, n);
+        let (e, dx, dy) = span_edges(&mut rng, n);
         let w = inv_w(&mut rng, hw.interp.inv_w_bits);
         let mut sat = SatCounter::default();
-        perspective_bary_span(e, dx, w, &hw.interp, &recip, &mut sat, &mut out[..n]);
+        let put = |j: usize, b| out[j] = b;
+        let span = EdgeSpan {
+            edge: e,
+            dx,
+            dy,
+            lanes: n,
+        };
+        perspective_bary_span(&span, w, &hw.interp, &recip, &mut sat, put);
         let mut sat_ref = SatCounter::default();
         for (j, got) in out[..n].iter().enumerate() {
             let want = perspective_bary(lane(e, dx, j), w, &hw.interp, &recip, &mut sat_ref);
