@@ -372,24 +372,21 @@ pub fn run(
     frag: &mut Frag,
     c: &mut Counters,
 ) {
+    start(frag, plan);
+    let px = prog.px(plan, m, tri, a, x, y);
+    for op in &prog.ops {
+        (op.run)(&px, frag, c);
+    }
+}
+
+/// What every run of a program starts a fragment from: the plan's constant colour as its
+/// colour and output, no raw output, no footprints.
+#[inline]
+fn start(frag: &mut Frag, plan: &Plan) {
     frag.color = plan.const_color;
     frag.out = plan.const_color;
     frag.out_bits = 0;
     frag.trace.clear();
-    let px = Px {
-        plan,
-        impls: &prog.impls,
-        m,
-        tri,
-        a,
-        x,
-        y,
-        color_raw: prog.color_raw,
-        carriers: prog.carriers,
-    };
-    for op in &prog.ops {
-        (op.run)(&px, frag, c);
-    }
 }
 
 /// Most fragments in one span of [`run_span`].
@@ -414,22 +411,9 @@ pub fn run_span(
     c: &mut Counters,
 ) {
     for frag in frags.iter_mut() {
-        frag.color = plan.const_color;
-        frag.out = plan.const_color;
-        frag.out_bits = 0;
-        frag.trace.clear();
+        start(frag, plan);
     }
-    let px = Px {
-        plan,
-        impls: &prog.impls,
-        m,
-        tri,
-        a,
-        x,
-        y,
-        color_raw: prog.color_raw,
-        carriers: prog.carriers,
-    };
+    let px = prog.px(plan, m, tri, a, x, y);
     for op in &prog.ops {
         match op.span {
             Some(span) => span(&px, frags, c),

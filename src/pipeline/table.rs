@@ -339,6 +339,31 @@ impl Program {
         }
     }
 
+    /// What the stages of this program see at pixel (`x`, `y`) of `tri` (for a span, its first
+    /// fragment's pixel).
+    #[must_use]
+    pub fn px<'a>(
+        &'a self,
+        plan: &'a Plan,
+        m: &'a Machine<'a>,
+        tri: &'a ScreenTri,
+        a: &'a TriAttrs,
+        x: i64,
+        y: i64,
+    ) -> Px<'a> {
+        Px {
+            plan,
+            impls: &self.impls,
+            m,
+            tri,
+            a,
+            x,
+            y,
+            color_raw: self.color_raw,
+            carriers: self.carriers,
+        }
+    }
+
     /// Compiles `plan` with the twins `impls` on the machine `m`.
     #[must_use]
     pub fn new(plan: &Plan, impls: &StageImpls, m: &Machine) -> Self {
