@@ -379,7 +379,8 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
     // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
     // wrapping steps across the lanes between are exact modulo 2^128).
     let mut numerators: Option<([NumeratorTop; 2], [i128; 2])> = None;
-    for base in (0..lanes).step_by(SPAN_LANES) {
+    for c in 0..lanes.div_ceil(SPAN_LANES) {
+        let base = c * SPAN_LANES;
         let chunk = (lanes - base).min(SPAN_LANES);
         // Per lane, stage by stage: `q` and `D` (fast when the scale shift is 0: `D`, positive,
         // and `q_1`, `q_2` below 2^62 as the steps are), the reciprocal of `D`, the
