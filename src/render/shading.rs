@@ -7,7 +7,7 @@ use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::clip_f32::ShadedVertex;
 use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{output16, run, run_span, Counters, Machine, TriAttrs, SPAN_MAX};
-use crate::pipeline::{Frag, Program, StageImpls, StageKind};
+use crate::pipeline::{Frag, Program, StageImpls};
 use crate::raster::{ScreenTri, VertexSource};
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
@@ -285,11 +285,14 @@ const BAND_ROWS: usize = 16;
 /// Shades every covered pixel with `impls`; returns the image, the counters and, when `timing`
 /// holds the frame's timing model, the event stream (rows concatenated in row order) and the
 /// model fed with every pixel (the stream's pixel and footprint lists stay empty unless
-/// `keep_events`: the model reads each row's events before they are dropped). With timing,
-/// the frame is shaded in bands of [`BAND_ROWS`] rows: while a band is shaded (in parallel by
-/// rows) the previous band's events are fed to the model and appended to the stream, so the
-/// sequential model overlaps the shading; the model and the stream see the pixels in raster
-/// order, identical for any thread count.
+/// `keep_events`). The model and the stream see the pixels in raster order, identical for
+/// any thread count:
+/// - on one thread the rows are shaded in order and each fragment's trace goes straight to
+///   the model (and, with `keep_events`, to the stream): no row's events are stored;
+/// - on more, the frame is shaded in bands of [`BAND_ROWS`] rows: while a band is shaded (in
+///   parallel by rows, each row recording its events) the previous band's events are fed to
+///   the model and appended to the stream, so the sequential model overlaps the shading; the
+///   two sets of row buffers alternate between the bands.
 pub(super) fn shade<'h>(
     inp: &ShadeInput,
     impls: &StageImpls,
@@ -323,35 +326,72 @@ pub(super) fn shade<'h>(
             });
         return (img, counters, None);
     };
-    let lookups = StageKind::ALL
-        .iter()
-        .map(|&k| crate::timing::events::lookups(k, inp.m.hw) as usize)
-        .sum::<usize>();
     let mut counters = Counters::default();
     let mut fe = FrameEvents {
         width: vis.width,
         height: vis.height,
         ..FrameEvents::default()
     };
-    let mut consume = |rows: Vec<(Counters, RowEvents)>| {
-        for (c, ev) in rows {
-            counters.add(&c);
-            sim.row(&ev);
+    if rayon::current_num_threads() == 1 {
+        let mut ev = RowEvents::default();
+        for (y, row) in img.px.chunks_mut(w.max(1)).enumerate() {
+            shade_row(inp, progs, y, row, &mut counters, true, |pi, t, frag| {
+                sim.pixel(pi, frag.trace.footprints());
+                if keep_events {
+                    record_pixel(pi, t, frag, &mut ev);
+                }
+            });
             if keep_events {
-                fe.append_row(ev);
+                fe.append_row(&ev);
+                ev.clear();
             }
         }
+        return (img, counters, Some((fe, sim)));
+    }
+    // A row's events: at most the most lookups of a plan, of two levels each, per pixel.
+    let lookups = inp
+        .geo
+        .plans
+        .iter()
+        .map(|p| {
+            p.stages
+                .iter()
+                .map(|&k| crate::timing::events::lookups(k, inp.m.hw) as usize)
+                .sum::<usize>()
+        })
+        .max()
+        .unwrap_or(0);
+    let new_row = || RowEvents {
+        pixels: Vec::with_capacity(w),
+        footprints: Vec::with_capacity(w * 2 * lookups),
+    };
+    let mut consume = |rows: Vec<(Counters, RowEvents)>| {
+        rows.into_iter()
+            .map(|(c, mut ev)| {
+                counters.add(&c);
+                sim.row(&ev);
+                if keep_events {
+                    fe.append_row(&ev);
+                }
+                ev.clear();
+                ev
+            })
+            .collect::<Vec<_>>()
     };
     let mut pending = Vec::new();
+    let mut spare: Vec<RowEvents> = Vec::new();
     for (band, px) in img.px.chunks_mut((w * BAND_ROWS).max(1)).enumerate() {
         let previous = std::mem::take(&mut pending);
-        let (rows, ()) = rayon::join(
+        let rows = px.len().div_ceil(w.max(1));
+        spare.resize_with(rows, new_row);
+        let buffers = std::mem::take(&mut spare);
+        let (shaded, returned) = rayon::join(
             || {
                 px.par_chunks_mut(w.max(1))
+                    .zip(buffers)
                     .enumerate()
-                    .map(|(r, row)| {
+                    .map(|(r, (row, mut ev))| {
                         let mut c = Counters::default();
-                        let mut ev = RowEvents::with_capacity(w, lookups);
                         let y = band * BAND_ROWS + r;
                         shade_row(inp, progs, y, row, &mut c, true, |pi, t, frag| {
                             record_pixel(pi, t, frag, &mut ev);
@@ -362,7 +402,8 @@ pub(super) fn shade<'h>(
             },
             || consume(previous),
         );
-        pending = rows;
+        pending = shaded;
+        spare = returned;
     }
     consume(pending);
     (img, counters, Some((fe, sim)))

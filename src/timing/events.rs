@@ -33,13 +33,11 @@ pub struct RowEvents {
 }
 
 impl RowEvents {
-    /// Buffers sized for a row of `width` pixels with up to `lookups` lookups of 2 levels each.
-    #[must_use]
-    pub fn with_capacity(width: usize, lookups: usize) -> Self {
-        Self {
-            pixels: Vec::with_capacity(width),
-            footprints: Vec::with_capacity(width * 2 * lookups.max(1)),
-        }
+    /// Empties the lists, keeping their buffers (a row's buffers serve the rows of later
+    /// bands).
+    pub fn clear(&mut self) {
+        self.pixels.clear();
+        self.footprints.clear();
     }
 }
 
@@ -79,13 +77,13 @@ pub struct FrameEvents {
 
 impl FrameEvents {
     /// Concatenates rows (in row order) into the frame's lists; `fp_end` is rebased.
-    pub fn append_row(&mut self, row: RowEvents) {
+    pub fn append_row(&mut self, row: &RowEvents) {
         let base = self.footprints.len() as u32;
-        self.pixels.extend(row.pixels.into_iter().map(|mut p| {
-            p.fp_end += base;
-            p
+        self.pixels.extend(row.pixels.iter().map(|&p| PixelEvent {
+            fp_end: p.fp_end + base,
+            ..p
         }));
-        self.footprints.extend(row.footprints);
+        self.footprints.extend_from_slice(&row.footprints);
     }
 
     /// The frame's size and visibility-pass counts.

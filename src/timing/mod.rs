@@ -9,6 +9,11 @@ pub mod events;
 pub mod model;
 pub mod report;
 
+#[cfg(test)]
+mod equivalence;
+#[cfg(test)]
+mod previous;
+
 pub use events::{FrameEvents, PixelEvent, RowEvents, TexelFootprint, TextureLayout};
 pub use model::{simulate, Cache, FrameCounts, Simulator, TimingReport, LATENCY_BOTTLENECK};
 

@@ -199,73 +199,62 @@ const DUMMY_LEVEL: LevelAddr = LevelAddr {
 };
 
 /// Address map of the textures: level base indices for cache lines and DRAM pages (tiles are
-/// powers of two, so indices are shifts).
+/// powers of two, so indices are shifts). The levels of every texture are in one list,
+/// texture `t`'s from `first[t]` to `first[t + 1]`.
 struct AddressMap {
-    levels: Vec<Vec<LevelAddr>>,
+    levels: Vec<LevelAddr>,
+    first: Vec<usize>,
 }
 
 impl AddressMap {
     fn new(textures: &[TextureLayout], tc: &TimingConfig) -> Self {
         let (mut lb, mut pb) = (0u64, 0u64);
-        let levels = textures
-            .iter()
-            .map(|t| {
-                let bytes = t.texel_bytes.max(1);
-                let lt = tile(tc.cache_line_bytes / bytes);
-                let pt = tile(tc.dram_page_bytes / bytes);
-                t.levels
-                    .iter()
-                    .map(|&(w, h)| {
-                        let line_row = u64::from(w.div_ceil(lt.0));
-                        let page_row = u64::from(w.div_ceil(pt.0));
-                        let e = LevelAddr {
-                            width: w,
-                            line_base: lb,
-                            line_row,
-                            page_base: pb,
-                            page_row,
-                            line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
-                            page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
-                            texel_bytes: bytes,
-                        };
-                        lb += line_row * u64::from(h.div_ceil(lt.1));
-                        pb += page_row * u64::from(h.div_ceil(pt.1));
-                        e
-                    })
-                    .collect()
-            })
-            .collect();
-        Self { levels }
+        let mut levels = Vec::new();
+        let mut first = vec![0];
+        for t in textures {
+            let bytes = t.texel_bytes.max(1);
+            let lt = tile(tc.cache_line_bytes / bytes);
+            let pt = tile(tc.dram_page_bytes / bytes);
+            for &(w, h) in &t.levels {
+                let line_row = u64::from(w.div_ceil(lt.0));
+                let page_row = u64::from(w.div_ceil(pt.0));
+                levels.push(LevelAddr {
+                    width: w,
+                    line_base: lb,
+                    line_row,
+                    page_base: pb,
+                    page_row,
+                    line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
+                    page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
+                    texel_bytes: bytes,
+                });
+                lb += line_row * u64::from(h.div_ceil(lt.1));
+                pb += page_row * u64::from(h.div_ceil(pt.1));
+            }
+            first.push(levels.len());
+        }
+        Self { levels, first }
     }
 
     /// The address record of a level (a dummy 1-texel level if out of range, which a
     /// render's event stream never produces: checked in debug builds).
     #[inline]
     fn level(&self, tex: u16, level: u8) -> &LevelAddr {
+        let t = usize::from(tex);
+        let i = self
+            .first
+            .get(t)
+            .map_or(usize::MAX, |&f| f + usize::from(level));
+        let end = self.first.get(t + 1).copied().unwrap_or(0);
         debug_assert!(
-            self.levels
-                .get(tex as usize)
-                .is_some_and(|l| (level as usize) < l.len()),
+            i < end,
             "footprint of texture {tex} level {level} outside the frame's textures"
         );
-        self.levels
-            .get(tex as usize)
-            .and_then(|l| l.get(level as usize))
-            .unwrap_or(&DUMMY_LEVEL)
-    }
-
-    /// Cache-line key of texel (x, y) of level `l`.
-    #[inline]
-    fn line_key(l: &LevelAddr, x: u32, y: u32) -> u64 {
-        let (lx, ly) = l.line_shift;
-        l.line_base + u64::from(y >> ly) * l.line_row + u64::from(x >> lx)
-    }
-
-    /// DRAM page key of texel (x, y) of level `l`.
-    #[inline]
-    fn page_key(l: &LevelAddr, x: u32, y: u32) -> u64 {
-        let (px, py) = l.page_shift;
-        l.page_base + u64::from(y >> py) * l.page_row + u64::from(x >> px)
+        if i < end {
+            &self.levels[i]
+        } else {
+            &DUMMY_LEVEL
+        }
     }
 }
 
@@ -334,9 +323,48 @@ struct Memory<'a> {
     /// DRAM page hit and miss cycles.
     page_hit: u64,
     page_miss: u64,
-    rep: MemoryReport,
+    counts: MemoryCounts,
+}
+
+/// The memory's running sums; [`MemoryCounts::report`] derives the rest of the report.
+#[derive(Clone, Copy, Debug, Default)]
+struct MemoryCounts {
+    footprints: u64,
+    accesses: u64,
+    /// Bytes of the texel accesses.
+    bytes: u64,
+    cache_hits: u64,
+    page_hits: u64,
+    bank_conflicts: u64,
+    conflicting_footprints: u64,
     conflict_cycles: u64,
     miss_cycles: u64,
+}
+
+impl MemoryCounts {
+    /// The memory report: every access that misses the cache (all of them without one) goes
+    /// to DRAM, and a DRAM access that does not hit its bank's open page misses it.
+    fn report(&self, tc: &TimingConfig, cached: bool) -> MemoryReport {
+        let dram = self.accesses - self.cache_hits;
+        MemoryReport {
+            footprints: self.footprints,
+            texel_accesses: self.accesses,
+            cache_hits: if cached { self.cache_hits } else { 0 },
+            cache_misses: if cached { dram } else { 0 },
+            cache_hit_rate: cached.then(|| self.cache_hits as f64 / self.accesses.max(1) as f64),
+            bank_conflicts: self.bank_conflicts,
+            conflicting_footprints: self.conflicting_footprints,
+            dram_accesses: dram,
+            dram_page_hits: self.page_hits,
+            dram_page_misses: dram - self.page_hits,
+            texture_bytes: self.bytes,
+            dram_bytes: if cached {
+                dram * u64::from(tc.cache_line_bytes)
+            } else {
+                self.bytes
+            },
+        }
+    }
 }
 
 impl<'a> Memory<'a> {
@@ -364,84 +392,82 @@ impl<'a> Memory<'a> {
             },
             page_hit: u64::from(tc.dram_page_hit_cycles),
             page_miss: u64::from(tc.dram_page_miss_cycles),
-            rep: MemoryReport::default(),
-            conflict_cycles: 0,
-            miss_cycles: 0,
+            counts: MemoryCounts::default(),
         }
     }
 
     /// Performs one footprint's accesses; returns (occupancy, latency) in cycles and the texel
     /// bytes read. The distinct texels of the footprint, in the order (x0, y0), (x1, y0),
     /// (x0, y1), (x1, y1), are each one bank access (a footprint on a 1-texel-wide or -high
-    /// level collapses its repeated columns or rows).
-    fn footprint(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
-        let tiled = self.tc.bank_interleave == BankInterleave::Tiled;
-        match (self.cache.is_some(), tiled) {
-            (true, true) => self.footprint_in::<true, true>(fp),
-            (true, false) => self.footprint_in::<true, false>(fp),
-            (false, true) => self.footprint_in::<false, true>(fp),
-            (false, false) => self.footprint_in::<false, false>(fp),
-        }
-    }
-
-    /// The bank of texel (x, y) on a level of width `w` ([`bank_of`] with the interleave's
-    /// masks precomputed: `TILED`, else linear).
+    /// level collapses its repeated columns or rows). Compiled with (`CACHED`) or without a
+    /// texel cache, for the tiled (`TILED`) or linear bank interleave; a row's page (and line)
+    /// index is computed once for its columns, and conflicts are counted as the accesses find
+    /// their bank already used.
     #[inline(always)]
-    fn bank<const TILED: bool>(&self, x: u32, y: u32, w: u32) -> usize {
-        let b = if TILED {
-            ((x & self.tile_mask.0) | ((y & self.tile_mask.1) << self.tile_shift)) as usize
-        } else {
-            let i = u64::from(y) * u64::from(w) + u64::from(x);
-            (if self.linear_mask != 0 {
-                i & self.linear_mask
-            } else {
-                i % u64::from(self.banks)
-            }) as usize
-        };
-        b.min(self.last_bank)
-    }
-
-    /// [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache, for the tiled
-    /// (`TILED`) or linear bank interleave.
-    #[inline(always)]
-    fn footprint_in<const CACHED: bool, const TILED: bool>(
+    fn footprint<const CACHED: bool, const TILED: bool>(
         &mut self,
         fp: &TexelFootprint,
     ) -> (u64, u64, u64) {
-        let tc = self.tc;
         let (page_hit, page_miss) = (self.page_hit, self.page_miss);
+        let lv = *self.map.level(fp.tex, fp.level);
+        let (tile_mask, tile_shift) = (self.tile_mask, self.tile_shift);
+        let (linear_mask, banks, last_bank) = (self.linear_mask, self.banks, self.last_bank);
+        // The bank of texel (x, y) ([`bank_of`] with the interleave's masks precomputed).
+        let bank_of_texel = |x: u32, y: u32| -> usize {
+            let b = if TILED {
+                ((x & tile_mask.0) | ((y & tile_mask.1) << tile_shift)) as usize
+            } else {
+                let i = u64::from(y) * u64::from(lv.width) + u64::from(x);
+                (if linear_mask != 0 {
+                    i & linear_mask
+                } else {
+                    i % u64::from(banks)
+                }) as usize
+            };
+            b.min(last_bank)
+        };
+        let cols = if fp.x[0] == fp.x[1] { 1 } else { 2 };
+        let rows = if fp.y[0] == fp.y[1] { 1 } else { 2 };
+        let (px, py) = lv.page_shift;
+        let (lx, ly) = lv.line_shift;
+        let page_col = fp.x.map(|x| u64::from(x >> px));
+        let line_col = fp.x.map(|x| u64::from(x >> lx));
+        let mut cache = self.cache.as_mut();
+        let open_page = &mut self.open_page[..];
         let mut bank = [0usize; 4];
         let mut occs = [0u64; 4];
         let mut n = 0;
         let mut slowest = 0u64;
-        let (mut hits, mut page_hits, mut used) = (0u64, 0u64, 0u64);
-        let lv = self.map.level(fp.tex, fp.level);
-        let cols = if fp.x[0] == fp.x[1] { 1 } else { 2 };
-        let rows = if fp.y[0] == fp.y[1] { 1 } else { 2 };
-        for &y in &fp.y[..rows] {
-            for &x in &fp.x[..cols] {
-                let b = self.bank::<TILED>(x, y, lv.width);
+        let (mut hits, mut page_hits, mut used, mut conflicts) = (0u64, 0u64, 0u64, 0u64);
+        for &y in fp.y.iter().take(rows) {
+            let page_row = lv.page_base + u64::from(y >> py) * lv.page_row;
+            let line_row = lv.line_base + u64::from(y >> ly) * lv.line_row;
+            for c in 0..cols {
+                let b = bank_of_texel(fp.x[c], y);
                 let hit = CACHED
-                    && self
-                        .cache
+                    && cache
                         .as_mut()
-                        .is_some_and(|c| c.access(AddressMap::line_key(lv, x, y)));
+                        .is_some_and(|cache| cache.access(line_row + line_col[c]));
                 hits += u64::from(hit);
                 let occ = if hit {
                     1
                 } else {
-                    let page = AddressMap::page_key(lv, x, y);
-                    if self.open_page[b] == page {
+                    let page = page_row + page_col[c];
+                    let open = &mut open_page[b];
+                    if *open == page {
                         page_hits += 1;
                         page_hit
                     } else {
-                        self.open_page[b] = page;
+                        *open = page;
                         page_miss
                     }
                 };
-                used |= 1 << b;
-                bank[n] = b;
-                occs[n] = occ;
+                // Banks number at most 64 (`TimingConfig::validate`).
+                let bit = 1u64 << (b & 63);
+                conflicts += u64::from(used & bit != 0);
+                used |= bit;
+                bank[n & 3] = b;
+                occs[n & 3] = occ;
                 n += 1;
                 slowest = slowest.max(occ);
             }
@@ -450,7 +476,6 @@ impl<'a> Memory<'a> {
         // its busiest bank (the summed cycles of the bank's accesses; without a conflict, the
         // slowest access).
         let accesses = n as u64;
-        let conflicts = accesses - u64::from(used.count_ones());
         let mut occ = slowest.max(1);
         if conflicts > 0 {
             for i in 0..n {
@@ -461,33 +486,23 @@ impl<'a> Memory<'a> {
                 occ = occ.max(busy);
             }
         }
-        let misses = accesses - hits;
-        let rep = &mut self.rep;
-        rep.footprints += 1;
-        rep.texel_accesses += accesses;
-        rep.texture_bytes += accesses * u64::from(lv.texel_bytes);
-        rep.dram_accesses += misses;
-        rep.dram_page_hits += page_hits;
-        rep.dram_page_misses += misses - page_hits;
-        if CACHED {
-            rep.cache_hits += hits;
-            rep.cache_misses += misses;
-            rep.dram_bytes += misses * u64::from(tc.cache_line_bytes);
-        } else {
-            rep.dram_bytes += accesses * u64::from(lv.texel_bytes);
-        }
-        rep.bank_conflicts += conflicts;
-        if conflicts > 0 {
-            rep.conflicting_footprints += 1;
-        }
+        let bytes = accesses * u64::from(lv.texel_bytes);
         let (fastest, hit_latency) = if CACHED {
-            (1, u64::from(tc.cache_hit_cycles))
+            (1, u64::from(self.tc.cache_hit_cycles))
         } else {
             (page_hit, 0)
         };
-        self.conflict_cycles += occ - slowest.max(1);
-        self.miss_cycles += slowest.saturating_sub(fastest);
-        (occ, occ + hit_latency, accesses * u64::from(lv.texel_bytes))
+        let k = &mut self.counts;
+        k.footprints += 1;
+        k.accesses += accesses;
+        k.bytes += bytes;
+        k.cache_hits += hits;
+        k.page_hits += page_hits;
+        k.bank_conflicts += conflicts;
+        k.conflicting_footprints += u64::from(conflicts > 0);
+        k.conflict_cycles += occ - slowest.max(1);
+        k.miss_cycles += slowest.saturating_sub(fastest);
+        (occ, occ + hit_latency, bytes)
     }
 }
 
@@ -668,16 +683,39 @@ impl<'a> Simulator<'a> {
         let mut fp_start = 0usize;
         for px in pixels {
             let fp_end = (px.fp_end as usize).min(footprints.len());
-            self.pixel(px.plan, &footprints[fp_start.min(fp_end)..fp_end]);
+            self.issue(px.plan, &footprints[fp_start.min(fp_end)..fp_end]);
             fp_start = fp_end;
         }
         self.footprints += footprints.len() as u64;
     }
 
     /// Issues the next covered pixel (raster order): plan index `plan`, the footprints its
-    /// stages fetched in `fps`.
+    /// stages fetched in `fps` (counted as events), e.g. straight from the fragment's trace.
     #[inline]
     pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
+        self.issue(plan, fps);
+        self.footprints += fps.len() as u64;
+    }
+
+    /// [`Simulator::pixel`] without counting the footprints (the caller counts its list's).
+    #[inline]
+    fn issue(&mut self, plan: u32, fps: &[TexelFootprint]) {
+        let tiled = self.mem.tc.bank_interleave == BankInterleave::Tiled;
+        match (self.mem.cache.is_some(), tiled) {
+            (true, true) => self.issue_in::<true, true>(plan, fps),
+            (true, false) => self.issue_in::<true, false>(plan, fps),
+            (false, true) => self.issue_in::<false, true>(plan, fps),
+            (false, false) => self.issue_in::<false, false>(plan, fps),
+        }
+    }
+
+    /// [`Simulator::issue`] with the memory's [`Memory::footprint`] compiled for the machine.
+    #[inline(always)]
+    fn issue_in<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        plan: u32,
+        fps: &[TexelFootprint],
+    ) {
         let nk = self.alu.len();
         let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
         // Pixel i issues in group i / ppc, one cycle after the previous group's last pixel
@@ -744,26 +782,24 @@ impl<'a> Simulator<'a> {
             }
             let ready = s + setup;
             let mut done = ready;
-            let mut rest = mine;
-            while let Some(first) = rest.first() {
+            let mut bytes = 0u64;
+            // The footprints of one lookup are consecutive: `i` walks them lookup by lookup.
+            let mut i = 0;
+            while let Some(first) = mine.get(i) {
                 let l = first.lookup;
-                let n = rest
-                    .iter()
-                    .position(|f| f.lookup != l)
-                    .unwrap_or(rest.len());
-                let (one, tail) = rest.split_at(n);
-                rest = tail;
                 let mut data = ready;
-                for f in one {
-                    let (occ, lat, bytes) = self.mem.footprint(f);
-                    self.stage_bytes[k] += bytes;
+                let mut nfp = 0u64;
+                while let Some(f) = mine.get(i).filter(|f| f.lookup == l) {
+                    let (occ, lat, b) = self.mem.footprint::<CACHED, TILED>(f);
+                    bytes += b;
                     let ms = self.mem_unit.take(ready, occ);
                     if ms - ready > worst.0 {
                         worst = (ms - ready, c_mem);
                     }
                     data = data.max(ms + lat);
+                    nfp += 1;
+                    i += 1;
                 }
-                let nfp = n as u64;
                 // `ceil(nfp / bpc)`; a shift when `bpc` is a power of two (no division).
                 let occ = if self.bpc.is_power_of_two() {
                     (nfp + self.bpc - 1) >> self.bpc.trailing_zeros()
@@ -785,6 +821,7 @@ impl<'a> Simulator<'a> {
                 }
                 done = done.max(fs + lat.max(occ));
             }
+            self.stage_bytes[k] += bytes;
             t = done;
         }
         self.ring[slot] = (t, worst.1);
@@ -899,11 +936,7 @@ impl<'a> Simulator<'a> {
                 cycles: stall_by[i],
             });
         }
-        let mut memory = mem.rep;
-        if mem.cache.is_some() {
-            memory.cache_hit_rate =
-                Some(memory.cache_hits as f64 / memory.texel_accesses.max(1) as f64);
-        }
+        let memory = mem.counts.report(tc, mem.cache.is_some());
         TimingReport {
             scene: scene.to_string(),
             hw: hw.name.clone(),
@@ -917,8 +950,8 @@ impl<'a> Simulator<'a> {
             units,
             stalls,
             memory,
-            bank_conflict_cycles: mem.conflict_cycles,
-            miss_cycles: mem.miss_cycles,
+            bank_conflict_cycles: mem.counts.conflict_cycles,
+            miss_cycles: mem.counts.miss_cycles,
             bottleneck,
             bottleneck_cycles,
             events,

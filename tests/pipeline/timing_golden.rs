@@ -599,3 +599,55 @@ fn texel_bits_size_the_memory_traffic() {
         assert_eq!(per_stage, w.texture_bytes, "{preset}");
     }
 }
+
+/// The timing report of `name` (96x64) rendered on `threads` threads, keeping the event
+/// stream or not, and that stream.
+fn timed_on(
+    threads: usize,
+    name: &str,
+    hw: &hw_model::HwConfig,
+    keep_events: bool,
+) -> (TimingReport, Option<texsim::timing::FrameEvents>) {
+    let mut s = scene::builtin(name).expect("builtin scene");
+    s.width = 96;
+    s.height = 64;
+    let maps = Maps::new(&s, hw.trilinear.texel_bits);
+    let opts = RenderOptions {
+        reference: false,
+        timing: true,
+        keep_events,
+        ..Default::default()
+    };
+    let r = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+        .install(|| render(&s, &maps, hw, &opts).expect("render"));
+    (r.stats.timing.expect("timing report"), r.events)
+}
+
+#[test]
+fn streamed_model_is_the_same_on_one_thread_and_in_bands() {
+    // One thread feeds each fragment's trace to the model; more shade in bands and feed rows.
+    // With or without the kept stream, the report is that of `simulate` over the stream.
+    let mut aniso = hw_model::HwConfig::d3d11();
+    aniso.trilinear.aniso_probes = 4;
+    aniso.trilinear.aniso_adaptive = true;
+    for hw in [hw_model::HwConfig::texram16(), aniso] {
+        for &(name, _) in BUILTIN {
+            let (kept, ev) = timed_on(1, name, &hw, true);
+            let ev = ev.expect("kept events");
+            assert_eq!(simulate(&ev, &hw, name), kept, "{name}: one thread, kept");
+            let (banded, ev3) = timed_on(3, name, &hw, true);
+            assert_eq!(banded, kept, "{name}: three threads, kept");
+            let ev3 = ev3.expect("kept events");
+            assert_eq!(ev3.pixels, ev.pixels, "{name}: pixel events");
+            assert_eq!(ev3.footprints, ev.footprints, "{name}: footprints");
+            for threads in [1, 3] {
+                let (r, none) = timed_on(threads, name, &hw, false);
+                assert!(none.is_none(), "{name}: no stream unless kept");
+                assert_eq!(r, kept, "{name}: {threads} threads, not kept");
+            }
+        }
+    }
+}

@@ -1,0 +1,178 @@
+//! The timing model against its previous implementation ([`super::previous`], the oracle) on
+//! seeded random event streams: random machines (cache or not, tiled or linear interleave, bank
+//! counts that are not powers of two, several filter units, pipelined or not), textures of
+//! every texel size and plans with repeated stage kinds, pixels with thin, wrapped and
+//! out-of-plan footprints. Every report must be identical, fed as a frame ([`simulate`]),
+//! row by row ([`Simulator::row`]) or pixel by pixel ([`Simulator::pixel`]).
+
+#[path = "../../tests/rng_common/mod.rs"]
+mod rng_common;
+
+use super::events::{
+    FrameEvents, PixelEvent, PlanTiming, RowEvents, TexelFootprint, TextureLayout,
+};
+use super::model::{simulate, Simulator};
+use super::previous;
+use crate::pipeline::StageKind;
+use hw_model::timing_config::BankInterleave;
+use hw_model::{HwConfig, UnitCost};
+use rng_common::Rng;
+
+fn pick<T: Copy>(r: &mut Rng, xs: &[T]) -> T {
+    xs[r.below(xs.len() as u64) as usize]
+}
+
+fn machine(r: &mut Rng) -> HwConfig {
+    let mut hw = HwConfig::texram16();
+    let t = &mut hw.timing;
+    t.trilinear_units = pick(r, &[1, 1, 2, 3]);
+    t.bilinear_per_cycle = pick(r, &[1, 2, 3]);
+    t.banks = pick(r, &[1, 2, 3, 4, 6, 8, 16, 64]);
+    t.bank_interleave = pick(r, &[BankInterleave::Tiled, BankInterleave::Linear]);
+    t.cache_line_bytes = pick(r, &[8, 16, 32, 64]);
+    t.cache_ways = pick(r, &[1, 2, 3, 4]);
+    t.cache_bytes = pick(r, &[0, 0, 256, 1024, 16384]);
+    t.cache_hit_cycles = pick(r, &[0, 1, 4]);
+    t.dram_page_bytes = pick(r, &[64, 512, 2048]);
+    t.dram_page_hit_cycles = pick(r, &[1, 2, 8]);
+    t.dram_page_miss_cycles = pick(r, &[1, 6, 40]);
+    t.shade_pixels_per_cycle = pick(r, &[1, 1, 2, 3]);
+    t.shade_pixels_in_flight = pick(r, &[1, 4, 16, 64]);
+    t.alu_pipelined = r.below(4) != 0;
+    hw
+}
+
+fn frame(r: &mut Rng, pixels: usize) -> FrameEvents {
+    let textures: Vec<TextureLayout> = (0..1 + r.below(3))
+        .map(|_| {
+            let (mut w, mut h) = (1 + r.below(80) as u32, 1 + r.below(80) as u32);
+            let mut levels = vec![(w, h)];
+            while (w, h) != (1, 1) && levels.len() < 8 {
+                (w, h) = ((w / 2).max(1), (h / 2).max(1));
+                levels.push((w, h));
+            }
+            TextureLayout {
+                levels,
+                texel_bytes: pick(r, &[1, 2, 4, 8]),
+            }
+        })
+        .collect();
+    let kinds = StageKind::ALL;
+    let plans: Vec<PlanTiming> = (0..1 + r.below(3))
+        .map(|_| PlanTiming {
+            stages: (0..1 + r.below(6))
+                .map(|_| {
+                    let cost = UnitCost {
+                        cycles: r.below(24) as u32,
+                        ..UnitCost::default()
+                    };
+                    (pick(r, &kinds[..8]), cost)
+                })
+                .collect(),
+        })
+        .collect();
+    let mut ev = FrameEvents {
+        width: 64,
+        height: 64,
+        triangles: r.below(50),
+        spans: r.below(500),
+        fragments: r.below(5000),
+        plans,
+        textures,
+        ..FrameEvents::default()
+    };
+    for _ in 0..pixels {
+        // Now and then a plan the frame does not have.
+        let extra = u64::from(r.below(50) == 0);
+        let plan = r.below(ev.plans.len() as u64 + extra) as u32;
+        let stages: Vec<StageKind> = ev
+            .plans
+            .get(plan as usize)
+            .map_or(vec![StageKind::Trilinear], |p| {
+                p.stages.iter().map(|s| s.0).collect()
+            });
+        // Footprints in plan order (now and then a stage outside the plan, or out of order).
+        let mut order: Vec<StageKind> =
+            stages.iter().filter(|_| r.below(3) == 0).copied().collect();
+        if r.below(30) == 0 {
+            order.push(pick(r, &kinds));
+            order.reverse();
+        }
+        for kind in order {
+            for lookup in 0..1 + r.below(3) as u8 {
+                let tex = r.below(ev.textures.len() as u64) as usize;
+                let lv = &ev.textures[tex].levels;
+                for _ in 0..1 + r.below(2) {
+                    let level = r.below(lv.len() as u64) as usize;
+                    let (w, h) = lv[level];
+                    let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
+                    let x1 = if r.below(8) == 0 { x0 } else { (x0 + 1) % w };
+                    let y1 = if r.below(8) == 0 { y0 } else { (y0 + 1) % h };
+                    ev.footprints.push(TexelFootprint {
+                        stage: kind.index() as u8,
+                        lookup,
+                        level: level as u8,
+                        tex: tex as u16,
+                        x: [x0, x1],
+                        y: [y0, y1],
+                    });
+                }
+            }
+        }
+        ev.pixels.push(PixelEvent {
+            plan,
+            tri: 0,
+            fp_end: ev.footprints.len() as u32,
+        });
+    }
+    ev
+}
+
+#[test]
+fn model_matches_previous_on_random_streams() {
+    let mut r = Rng(0x7131_2026);
+    for case in 0..400 {
+        let hw = machine(&mut r);
+        let n = 1 + r.below(3000) as usize;
+        let ev = frame(&mut r, n);
+        let want = previous::simulate(&ev, &hw, "t");
+        assert_eq!(simulate(&ev, &hw, "t"), want, "case {case}: frame");
+        // Row by row (rows of 1..40 pixels, `fp_end` rebased) and pixel by pixel.
+        let mut rows = Simulator::new(&ev.plans, &ev.textures, &hw);
+        let mut pixels = Simulator::new(&ev.plans, &ev.textures, &hw);
+        let start = |i: usize| {
+            if i == 0 {
+                0
+            } else {
+                ev.pixels[i - 1].fp_end as usize
+            }
+        };
+        let mut p = 0;
+        while p < ev.pixels.len() {
+            let end = (p + 1 + r.below(40) as usize).min(ev.pixels.len());
+            let f = start(p);
+            let row = RowEvents {
+                pixels: ev.pixels[p..end]
+                    .iter()
+                    .map(|&e| PixelEvent {
+                        fp_end: e.fp_end - f as u32,
+                        ..e
+                    })
+                    .collect(),
+                footprints: ev.footprints[f..start(end)].to_vec(),
+            };
+            rows.row(&row);
+            for i in p..end {
+                let fps = &ev.footprints[start(i)..start(i + 1)];
+                pixels.pixel(ev.pixels[i].plan, fps);
+            }
+            p = end;
+        }
+        assert_eq!(rows.finish(&ev.counts(), "t"), want, "case {case}: rows");
+        assert_eq!(
+            pixels.finish(&ev.counts(), "t"),
+            want,
+            "case {case}: pixels"
+        );
+    }
+}
