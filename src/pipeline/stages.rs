@@ -6,7 +6,7 @@
 
 use super::bump::BumpAttrs;
 use super::{BumpPlan, Frag, Plan, Program, Px, StageKind, MAX_POINT_LIGHTS};
-use crate::fixedpoint::{to_raw, to_unorm};
+use crate::fixedpoint::{floor_exact, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
 use crate::reference::LevelF;
@@ -278,8 +278,8 @@ pub fn texcoord_offset(vals: [f64; 3], wrap: WrapMode) -> f64 {
     }
     let mid = lo * 0.5 + hi * 0.5;
     match wrap {
-        WrapMode::Repeat => mid.floor(),
-        WrapMode::Mirror => 2.0 * (mid * 0.5).floor(),
+        WrapMode::Repeat => floor_exact(mid),
+        WrapMode::Mirror => 2.0 * floor_exact(mid * 0.5),
         WrapMode::ClampToEdge => 0.0,
     }
 }
