@@ -11,6 +11,27 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 #[inline]
 #[must_use]
 pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
+    let y = x * pow2(fmt.frac_bits as i32);
+    // Below 2^52 in magnitude (never NaN): the floor and the rounding in `i64`, the same
+    // integers as the general path below (an exact truncation, an exact remainder, the
+    // floor's parity from its lowest bit).
+    if y.abs() < 4_503_599_627_370_496.0 {
+        let t = y as i64;
+        let fl = t - i64::from(t as f64 > y);
+        let rem = y - fl as f64;
+        let up = match fmt.rounding {
+            Rounding::Truncate => false,
+            Rounding::HalfUp => rem >= 0.5,
+            Rounding::HalfEven => rem > 0.5 || (rem == 0.5 && fl & 1 == 1),
+        };
+        return fmt.fit(fl + i64::from(up), sat);
+    }
+    to_raw_wide(x, fmt, sat)
+}
+
+/// [`to_raw`] for `|x 2^frac_bits| >= 2^52`, infinite or NaN.
+#[inline(never)]
+fn to_raw_wide(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
     if x.is_nan() {
         sat.saturated += 1;
         return 0;

@@ -148,15 +148,15 @@ const THRESHOLD_SLACK: u32 = 4;
 
 /// `ceil(2^31 2^(k / 2^15)) - 2^31` for k = 0..=2^15 (within one: the powers are formed by
 /// repeated multiplication by `2^(2^-15)` on 32 fraction bits, `(2^(2^-15) - 1) 2^64` =
-/// 390211300099399.33), then `u32::MAX`: where the exact log2 of the mantissa reaches
-/// `k / 2^15`.
-pub static LOG2_IDEAL: [u32; RESULTS + 2] = ideal_thresholds();
+/// 390211300099399.33), then `u32::MAX` (three times, so that a bucket's four candidates can
+/// be read at once): where the exact log2 of the mantissa reaches `k / 2^15`.
+pub static LOG2_IDEAL: [u32; RESULTS + 4] = ideal_thresholds();
 /// For each bucket of 2^16 mantissa offsets, how many of `LOG2_IDEAL[1..]` are at or below
 /// its first offset.
 static LOG2_BUCKET: [u16; 1 << (MANT_BITS - BUCKET_BITS)] = buckets();
 
-const fn ideal_thresholds() -> [u32; RESULTS + 2] {
-    let mut t = [0u32; RESULTS + 2];
+const fn ideal_thresholds() -> [u32; RESULTS + 4] {
+    let mut t = [0u32; RESULTS + 4];
     let mut x: u128 = 1 << 63; // 2^31 with 32 fraction bits
     let mut k = 1;
     while k < RESULTS {
@@ -166,6 +166,8 @@ const fn ideal_thresholds() -> [u32; RESULTS + 2] {
     }
     t[RESULTS] = 1 << MANT_BITS;
     t[RESULTS + 1] = u32::MAX;
+    t[RESULTS + 2] = u32::MAX;
+    t[RESULTS + 3] = u32::MAX;
     t
 }
 
@@ -198,11 +200,20 @@ const fn buckets() -> [u16; 1 << (MANT_BITS - BUCKET_BITS)] {
 #[must_use]
 pub fn table_log2_bits(m: u64) -> u32 {
     let off = (m as u32) ^ (1 << MANT_BITS);
-    let mut k = usize::from(LOG2_BUCKET[(off >> BUCKET_BITS) as usize]);
-    k += usize::from(off >= LOG2_IDEAL[k + 1]);
-    k += usize::from(off >= LOG2_IDEAL[k + 1]);
-    if off - LOG2_IDEAL[k] >= THRESHOLD_SLACK && LOG2_IDEAL[k + 1] - off > THRESHOLD_SLACK {
-        k as u32
+    let k0 = usize::from(LOG2_BUCKET[(off >> BUCKET_BITS) as usize]);
+    // The bucket's candidates read at once (not one after the other): the thresholds
+    // increase, so `off >= t[2]` implies `off >= t[1]` and `k = k0 + both`.
+    let Some(&[t0, t1, t2, t3]) = LOG2_IDEAL.get(k0..k0 + 4) else {
+        return serial_log2_bits(m, SERIAL_STEPS);
+    };
+    let (a, b) = (off >= t1, off >= t2);
+    let (lo, hi) = match (a, b) {
+        (false, _) => (t0, t1),
+        (true, false) => (t1, t2),
+        (true, true) => (t2, t3),
+    };
+    if off - lo >= THRESHOLD_SLACK && hi - off > THRESHOLD_SLACK {
+        (k0 + usize::from(a) + usize::from(b)) as u32
     } else {
         serial_log2_bits(m, SERIAL_STEPS)
     }

@@ -8,7 +8,7 @@
 use super::bump::BumpAttrs;
 use super::table::RunFn;
 use super::{BumpPlan, Frag, Plan, Program, Px, StageKind, MAX_POINT_LIGHTS};
-use crate::fixedpoint::{to_raw, to_unorm};
+use crate::fixedpoint::{floor_exact, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
 use crate::reference::LevelF;
@@ -255,8 +255,8 @@ pub struct TriAttrs {
     /// 1/w normalized so the largest is exactly 1 << inv_w_bits.
     pub inv_w_x: [i64; 3],
     pub color_f: [[f64; 3]; 3],
-    /// Unorm `color_bits` per vertex and channel.
-    pub color_x: [[u32; 3]; 3],
+    /// Unorm `color_bits` (at most 16) per vertex and channel.
+    pub color_x: [[u16; 3]; 3],
     pub uv_f: [[f64; 2]; 3],
     pub uv_x: [[i64; 2]; 3],
     /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
@@ -280,8 +280,8 @@ pub fn texcoord_offset(vals: [f64; 3], wrap: WrapMode) -> f64 {
     }
     let mid = lo * 0.5 + hi * 0.5;
     match wrap {
-        WrapMode::Repeat => mid.floor(),
-        WrapMode::Mirror => 2.0 * (mid * 0.5).floor(),
+        WrapMode::Repeat => floor_exact(mid),
+        WrapMode::Mirror => 2.0 * floor_exact(mid * 0.5),
         WrapMode::ClampToEdge => 0.0,
     }
 }
@@ -312,12 +312,13 @@ impl TriAttrs {
         let cb = m.hw.color.color_bits;
         // Plain loops: nested array `map`s cost several hundred instructions per triangle.
         let mut inv_w_x = [0i64; 3];
-        let mut color_x = [[0u32; 3]; 3];
+        let mut color_x = [[0u16; 3]; 3];
         let mut uv_x = [[0i64; 2]; 3];
         for v in 0..3 {
             inv_w_x[v] = to_raw(inv_w[v] / max, &norm, sat).max(1);
             for ch in 0..3 {
-                color_x[v][ch] = to_unorm(color[v][ch], cb);
+                // `color.color_bits <= 16` (validated), so the unorm fits.
+                color_x[v][ch] = to_unorm(color[v][ch], cb) as u16;
             }
             for ax in 0..2 {
                 uv_x[v][ax] = to_raw(uv[v][ax] - off[ax], &m.uv_fmt, sat);

@@ -37,8 +37,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     } else {
         to_raw(frag.lod, &m.lod_fmt, sat)
     };
-    let uv = frag.uv_x;
-    let (r, took) = lookup(m, px.plan, t, &uv, l, aniso, &mut frag.trace, sat);
+    let (r, took) = lookup(m, px.plan, t, &frag.uv_x, l, aniso, &mut frag.trace, sat);
     if took != m.hw.trilinear.aniso_probes {
         c.cost[k] = per_pixel_probes(c.cost[k], m, took);
     }

@@ -35,7 +35,11 @@
 //!   snapped coordinates satisfy `|x| <= 2.5 * 8192 * 2^12 < 2^27`; edge values are below 2^57
 //!   and fit `i64`; the depth numerator `sum(E_i * z_i)` (< 2^89) uses `i128`.
 //! - Depth is interpolated as `round_half_up(sum(E_i * z_i) / area2)` per pixel, exactly, by an
-//!   incremental quotient/remainder walk along each span (no per-pixel division).
+//!   incremental quotient/remainder walk along each span (no per-pixel division; the span's
+//!   first numerator in `i64` when it fits, else `i128`).
+//! - Spans: a row's span is bounded by each edge's `floor((E(0) - t) / |step|)` (`t` the
+//!   fill rule's threshold); these are walked down a triangle's rows by the same exact
+//!   quotient/remainder steps, so only its first row in a band divides.
 //! - Float coverage evaluates each edge with its endpoints in a canonical (lexicographic) order
 //!   and negates, so the two triangles sharing an edge see exactly opposite values; spans are
 //!   found by a division guess refined with those evaluations (exact for the float model).

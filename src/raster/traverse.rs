@@ -52,11 +52,13 @@ impl RasterStats {
 }
 
 /// `floor(a / b)` for `b > 0`.
+#[cfg(test)]
 fn floor_div(a: i64, b: i64) -> i64 {
     a.div_euclid(b)
 }
 
 /// `ceil(a / b)` for `b > 0`.
+#[cfg(test)]
 fn ceil_div(a: i64, b: i64) -> i64 {
     -((-a).div_euclid(b))
 }
@@ -80,10 +82,12 @@ struct FixedTri {
     h: i64,
     x0: i64,
     x1: i64,
-    z: [i128; 3],
+    /// The vertices' depths (below 2^30).
+    z: [i64; 3],
     /// Denominator of the rounded depth `(2N + area2) / (2 area2)`.
     den: i64,
-    /// Per-pixel quotient/remainder step of the depth numerator.
+    /// Per-pixel quotient/remainder step of the depth numerator (the quotient is only used,
+    /// as `i64`, between two covered pixels, where it is bounded).
     dq: i128,
     dr: i64,
 }
@@ -107,10 +111,21 @@ impl FixedTri {
                 step: -(b << s),
             }
         });
-        let z = t.z.map(i128::from);
+        let z = t.z.map(i64::from);
         let den = 2 * t.area2;
-        let dm: i128 = 2 * (0..3).map(|i| i128::from(e[i].step) * z[i]).sum::<i128>();
-        let den128 = i128::from(den);
+        let (dq, dr) = match depth_numerator([e[0].step, e[1].step, e[2].step], z)
+            .and_then(|n| n.checked_mul(2))
+        {
+            Some(dm) => (i128::from(dm.div_euclid(den)), dm.rem_euclid(den)),
+            None => {
+                let dm = 2
+                    * (0..3)
+                        .map(|i| i128::from(e[i].step) * i128::from(z[i]))
+                        .sum::<i128>();
+                let den128 = i128::from(den);
+                (dm.div_euclid(den128), dm.rem_euclid(den128) as i64)
+            }
+        };
         Self {
             e,
             s,
@@ -119,13 +134,75 @@ impl FixedTri {
             x1: i64::from(t.bbox[2].min(width)),
             z,
             den,
-            dq: dm.div_euclid(den128),
-            dr: dm.rem_euclid(den128) as i64,
+            dq,
+            dr,
+        }
+    }
+
+    /// The walk of rows `py0..py1` (`py0 < py1`) starting at `py0`: each edge's value at the
+    /// centre of pixel 0 and the floor of `(value - t) / |step|` as quotient and remainder
+    /// (the edge's span bound), with their per-row increments when there is a second row.
+    #[inline]
+    fn walk(&self, py0: i64, py1: i64) -> RowWalk {
+        let y = (py0 << self.s) + self.h;
+        let mut w = RowWalk {
+            c: [0; 3],
+            q: [0; 3],
+            r: [0; 3],
+            dc: [0; 3],
+            dq: [0; 3],
+            dr: [0; 3],
+        };
+        for (i, e) in self.e.iter().enumerate() {
+            let c = e.a * (y - e.yj) - e.b * (self.h - e.xj);
+            let d = e.step.abs().max(1);
+            w.c[i] = c;
+            (w.q[i], w.r[i]) = floor_qr(c - e.t, d);
+            if py1 - py0 >= 2 {
+                w.dc[i] = e.a << self.s;
+                (w.dq[i], w.dr[i]) = floor_qr(w.dc[i], d);
+            }
+        }
+        w
+    }
+
+    /// Exact span [xl, xr) of the walk's current row and the edge values at `xl`: equal to
+    /// [`Self::span`] of that row.
+    #[inline(always)]
+    fn walk_span(&self, w: &RowWalk) -> (i64, i64, [i64; 3]) {
+        let mut xl = self.x0;
+        let mut xr = self.x1;
+        for (e, &q) in self.e.iter().zip(&w.q) {
+            if e.step == 0 {
+                if q < 0 {
+                    return (xl, xl, w.c);
+                }
+            } else if e.step > 0 {
+                xl = xl.max(-q);
+            } else {
+                xr = xr.min(q + 1);
+            }
+        }
+        let ev = [0, 1, 2].map(|i| w.c[i] + self.e[i].step * xl);
+        (xl, xr, ev)
+    }
+
+    /// Advances the walk one row down (only within the rows [`Self::walk`] was given).
+    #[inline(always)]
+    fn walk_next(&self, w: &mut RowWalk) {
+        for (i, e) in self.e.iter().enumerate() {
+            let d = e.step.abs().max(1);
+            w.c[i] += w.dc[i];
+            w.q[i] += w.dq[i];
+            w.r[i] += w.dr[i];
+            let carry = w.r[i] >= d;
+            w.r[i] -= if carry { d } else { 0 };
+            w.q[i] += i64::from(carry);
         }
     }
 
     /// Exact span [xl, xr) of row `py` and the edge values at `xl`.
-    #[inline]
+    #[cfg(test)]
     fn span(&self, py: i64) -> (i64, i64, [i64; 3]) {
         let y = (py << self.s) + self.h;
         let mut xl = self.x0;
@@ -151,17 +228,56 @@ impl FixedTri {
     /// one-pixel spans (the step is only bounded between two covered pixels).
     #[inline]
     fn depth_start(&self, ev: &[i64; 3], len: i64) -> (i64, i64, i64, i64) {
-        let n: i128 = (0..3).map(|i| i128::from(ev[i]) * self.z[i]).sum();
-        let den = i128::from(self.den);
-        let m = 2 * n + den / 2;
-        let q = m.div_euclid(den) as i64;
-        let r = m.rem_euclid(den) as i64;
+        let (q, r) = match depth_numerator(*ev, self.z)
+            .and_then(|n| n.checked_mul(2)?.checked_add(self.den / 2))
+        {
+            Some(m) => (m.div_euclid(self.den), m.rem_euclid(self.den)),
+            None => {
+                let n: i128 = (0..3)
+                    .map(|i| i128::from(ev[i]) * i128::from(self.z[i]))
+                    .sum();
+                let den = i128::from(self.den);
+                let m = 2 * n + den / 2;
+                (m.div_euclid(den) as i64, m.rem_euclid(den) as i64)
+            }
+        };
         if len >= 2 {
             (q, r, self.dq as i64, self.dr)
         } else {
             (q, r, 0, 0)
         }
     }
+}
+
+/// The state of [`FixedTri::walk`]: per edge the value at the centre of pixel 0 of the
+/// current row `c`, `floor((c - t) / d)` (`d = |step|`, 1 for a horizontal edge) as `q` and
+/// `r`, and their per-row steps (`c` grows by `a 2^s` per row).
+struct RowWalk {
+    c: [i64; 3],
+    q: [i64; 3],
+    r: [i64; 3],
+    dc: [i64; 3],
+    dq: [i64; 3],
+    dr: [i64; 3],
+}
+
+/// `(floor(m / d), m mod d)` for `d > 0` (no division for `d == 1`).
+#[inline(always)]
+fn floor_qr(m: i64, d: i64) -> (i64, i64) {
+    if d == 1 {
+        (m, 0)
+    } else {
+        (m.div_euclid(d), m.rem_euclid(d))
+    }
+}
+
+/// `sum(e_i z_i)` in `i64`, `None` if a product or sum would overflow (the caller then
+/// takes the exact `i128` sum).
+#[inline(always)]
+fn depth_numerator(e: [i64; 3], z: [i64; 3]) -> Option<i64> {
+    e[0].checked_mul(z[0])?
+        .checked_add(e[1].checked_mul(z[1])?)?
+        .checked_add(e[2].checked_mul(z[2])?)
 }
 
 /// One float edge in canonical order: `E = sign * (dx * (y - p1) - dy * (x - p0))`.
@@ -415,22 +531,23 @@ fn band(
                             return;
                         }
                         let (mut q, mut r, dq, dr) = ft.depth_start(ev, xr - xl);
-                        for px in xl..xr {
-                            let i = row + px as usize;
+                        let (d, t) = (
+                            &mut depth[row + xl as usize..row + xr as usize],
+                            &mut tri[row + xl as usize..row + xr as usize],
+                        );
+                        let mut fails = 0;
+                        for (dz, tz) in d.iter_mut().zip(t.iter_mut()) {
                             let zq = q.clamp(0, i64::from(zmax)) as u32;
-                            if zq < depth[i] {
-                                depth[i] = zq;
-                                tri[i] = id;
-                            } else {
-                                st.depth_fails += 1;
-                            }
+                            let pass = zq < *dz;
+                            *dz = if pass { zq } else { *dz };
+                            *tz = if pass { id } else { *tz };
+                            fails += u64::from(!pass);
                             r += dr;
-                            q += dq;
-                            if r >= ft.den {
-                                r -= ft.den;
-                                q += 1;
-                            }
+                            let carry = r >= ft.den;
+                            r -= if carry { ft.den } else { 0 };
+                            q += dq + i64::from(carry);
                         }
+                        st.depth_fails += fails;
                     });
                 }
                 Coverage::Float => {
@@ -487,10 +604,17 @@ fn for_spans(
         let yb = t.bbox[3].min(y1);
         match coverage {
             Coverage::Fixed => {
+                if ya >= yb {
+                    continue;
+                }
                 let ft = FixedTri::new(t, s, setup.width);
+                let (ya, yb) = (i64::from(ya), i64::from(yb));
+                let mut walk = ft.walk(ya, yb);
                 for py in ya..yb {
-                    let py = i64::from(py);
-                    let (xl, xr, ev) = ft.span(py);
+                    if py > ya {
+                        ft.walk_next(&mut walk);
+                    }
+                    let (xl, xr, ev) = ft.walk_span(&walk);
                     if xl < xr {
                         f(id, py, xl, xr, Prep::Fixed(&ft, &ev));
                     }
@@ -569,4 +693,93 @@ pub fn coverage_count(setup: &Setup, coverage: Coverage) -> Vec<u32> {
     let mut cnt = vec![0u32; n];
     let _ = run(setup, coverage, &mut cnt, None);
     cnt
+}
+
+/// The tests' shared generator.
+#[cfg(test)]
+#[path = "../../tests/rng_common/mod.rs"]
+mod rng_common;
+
+#[cfg(test)]
+mod tests {
+    use super::rng_common::Rng;
+    use super::*;
+    use crate::raster::VertexSource;
+
+    /// The row walk gives the per-row span and edge values of [`FixedTri::span`] (the exact
+    /// per-row division) on 250k seeded triangles, small to guard-band sized, every sub-pixel
+    /// width, horizontal and vertical edges included, over each triangle's rows and beyond.
+    #[test]
+    fn row_walk_matches_the_per_row_spans() {
+        let mut rng = Rng(0x5eed_3a1c);
+        let (mut rows, mut covered, mut horizontal) = (0u64, 0u64, 0u64);
+        for i in 0..250_000u32 {
+            let s = 1 + i % 12;
+            let scale = 1i64 << s;
+            let reach = [4i64, 64, 1024, 20_000][(i / 12 % 4) as usize] * scale;
+            let cx = rng.int_in(-reach, reach) + 512 * scale;
+            let cy = rng.int_in(-reach, reach) + 512 * scale;
+            let mut xy = [[0i64; 2]; 3];
+            for p in &mut xy {
+                *p = [
+                    cx + rng.int_in(-reach, reach),
+                    cy + rng.int_in(-reach, reach),
+                ];
+            }
+            if i % 7 == 0 {
+                xy[2][1] = xy[1][1];
+            }
+            if i % 11 == 0 {
+                xy[0][0] = xy[2][0];
+            }
+            let cross = (xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1])
+                - (xy[1][1] - xy[0][1]) * (xy[2][0] - xy[0][0]);
+            if cross == 0 {
+                continue;
+            }
+            if cross < 0 {
+                xy.swap(1, 2);
+            }
+            horizontal += u64::from(
+                xy.iter()
+                    .enumerate()
+                    .any(|(k, p)| p[1] == xy[(k + 1) % 3][1]),
+            );
+            let width = 1024 + (i % 3) * 500;
+            let lo = |c: usize| xy.iter().map(|p| p[c]).min().unwrap_or(0) >> s;
+            let hi = |c: usize| xy.iter().map(|p| p[c]).max().unwrap_or(0) >> s;
+            let clampw = |v: i64| v.clamp(0, i64::from(width)) as u32;
+            let t = ScreenTri {
+                xy,
+                xy_f: [[0.0; 2]; 3],
+                z: [0; 3],
+                z_f: [0.0; 3],
+                inv_w: [1.0; 3],
+                src: 0,
+                source: VertexSource::Unclipped { swapped: false },
+                area2: cross.abs(),
+                area2_f: 1.0,
+                bbox: [clampw(lo(0) - 1), 0, clampw(hi(0) + 2), 0],
+            };
+            let ft = FixedTri::new(&t, s, width);
+            let py0 = lo(1) - 2 + rng.int_in(0, 3);
+            let py1 = (hi(1) + 2).min(py0 + 40).max(py0 + 1);
+            let mut walk = ft.walk(py0, py1);
+            for py in py0..py1 {
+                if py > py0 {
+                    ft.walk_next(&mut walk);
+                }
+                let (xl, xr, ev) = ft.walk_span(&walk);
+                let (xl0, xr0, ev0) = ft.span(py);
+                assert_eq!(xl < xr, xl0 < xr0, "{xy:?} {s} {py}");
+                if xl < xr {
+                    assert_eq!((xl, xr, ev), (xl0, xr0, ev0), "{xy:?} {s} {py}");
+                    covered += 1;
+                }
+                rows += 1;
+            }
+        }
+        assert!(rows > 2_000_000 && covered > 500_000, "{rows} {covered}");
+        assert!(horizontal > 30_000, "{horizontal}");
+    }
 }

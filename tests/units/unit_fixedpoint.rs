@@ -148,3 +148,96 @@ fn pow2_is_powi() {
         assert_eq!(pow2(e).to_bits(), 2f64.powi(e).to_bits(), "2^{e}");
     }
 }
+
+/// `to_raw` before its `i64` fast path (the floor and rounding in `f64` throughout): the oracle.
+fn to_raw_before(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
+    if x.is_nan() {
+        sat.saturated += 1;
+        return 0;
+    }
+    let y = x * texsim::fixedpoint::pow2(fmt.frac_bits as i32);
+    let fl = texsim::fixedpoint::floor_exact(y);
+    let rem = y - fl;
+    let r = match fmt.rounding {
+        Rounding::Truncate => fl,
+        Rounding::HalfUp => fl + if rem >= 0.5 { 1.0 } else { 0.0 },
+        Rounding::HalfEven => {
+            let odd = texsim::fixedpoint::floor_exact(fl * 0.5) != fl * 0.5;
+            fl + if rem > 0.5 || (rem == 0.5 && odd) {
+                1.0
+            } else {
+                0.0
+            }
+        }
+    };
+    const LIM: f64 = 9_223_372_036_854_775_808.0;
+    if r >= LIM {
+        sat.saturated += 1;
+        return fmt.max_raw();
+    }
+    if r < -LIM {
+        sat.saturated += 1;
+        return fmt.min_raw();
+    }
+    fmt.fit(r as i64, sat)
+}
+
+/// 4M seeded values (exact ties, integers, values near 2^52 on either side, huge, tiny,
+/// infinite and NaN; every rounding, both overflow rules, signed and unsigned formats) give
+/// the previous `to_raw`'s raw value and overflow counts.
+#[test]
+fn to_raw_matches_the_previous_routine() {
+    let mut rng = Rng(0x5eed_0ac1);
+    let (mut sat, mut sat_before) = (SatCounter::default(), SatCounter::default());
+    let (mut fast, mut wide) = (0u32, 0u32);
+    for i in 0..4_000_000u32 {
+        let rounding = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven][(i % 3) as usize];
+        let frac = (rng.next() % 40) as u32;
+        let int = (rng.next() % (62 - frac as u64).min(40)) as u32;
+        let mut fmt = if i / 3 % 2 == 0 {
+            Format::signed(int, frac, rounding)
+        } else {
+            Format::unsigned(int.max(1), frac, rounding)
+        };
+        if i / 6 % 4 == 0 {
+            fmt.overflow = Overflow::Wrap;
+        }
+        let scale = texsim::fixedpoint::pow2(-(frac as i32));
+        let sign = if rng.next() & 1 == 0 { 1.0 } else { -1.0 };
+        let x = match i / 24 % 8 {
+            // Exact ties and near-ties on the raw grid.
+            0 => sign * ((rng.next() >> 24) as f64 + 0.5) * scale,
+            1 => sign * ((rng.next() >> 20) as f64 + [0.5, 0.25, 0.75][(i % 3) as usize]) * scale,
+            // Integers and neighbours of 2^52 on the raw grid.
+            2 => sign * (rng.next() >> 12) as f64 * scale,
+            3 => sign * (4_503_599_627_370_496.0 + (rng.next() % 64) as f64 - 32.0) * scale,
+            // Arbitrary doubles, small to huge.
+            4 => sign * rng.unit() * texsim::fixedpoint::pow2((rng.next() % 140) as i32 - 70),
+            5 => f64::from_bits(rng.next()),
+            6 => [
+                f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                0.0,
+                -0.0,
+                1e300,
+                -1e300,
+            ][(i % 7) as usize],
+            _ => sign * rng.range(0.0, 4.0),
+        };
+        let y = x * texsim::fixedpoint::pow2(frac as i32);
+        if y.abs() < 4_503_599_627_370_496.0 {
+            fast += 1;
+        } else {
+            wide += 1;
+        }
+        assert_eq!(
+            to_raw(x, &fmt, &mut sat),
+            to_raw_before(x, &fmt, &mut sat_before),
+            "{x:e} {fmt:?}"
+        );
+        assert_eq!(sat, sat_before, "{x:e} {fmt:?}");
+    }
+    assert!(fast > 2_500_000 && wide > 300_000, "{fast} {wide}");
+    assert!(sat.saturated > 100_000 && sat.wrapped > 10_000, "{sat:?}");
+}
