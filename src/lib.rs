@@ -67,4 +67,9 @@ pub mod tune_cli;
 pub mod vectors;
 pub mod warnings;
 
+/// The tests' shared seeded generator (splitmix64), the one the test binaries use.
+#[cfg(test)]
+#[path = "../tests/rng_common/mod.rs"]
+mod rng_common;
+
 pub use error::{Error, Result};

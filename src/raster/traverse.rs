@@ -695,16 +695,11 @@ pub fn coverage_count(setup: &Setup, coverage: Coverage) -> Vec<u32> {
     cnt
 }
 
-/// The tests' shared generator.
-#[cfg(test)]
-#[path = "../../tests/rng_common/mod.rs"]
-mod rng_common;
-
 #[cfg(test)]
 mod tests {
-    use super::rng_common::Rng;
     use super::*;
     use crate::raster::VertexSource;
+    use crate::rng_common::Rng;
 
     /// The row walk gives the per-row span and edge values of [`FixedTri::span`] (the exact
     /// per-row division) on 250k seeded triangles, small to guard-band sized, every sub-pixel

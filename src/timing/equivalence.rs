@@ -5,18 +5,15 @@
 //! out-of-plan footprints. Every report must be identical, fed as a frame ([`simulate`]),
 //! row by row ([`Simulator::row`]) or pixel by pixel ([`Simulator::pixel`]).
 
-#[path = "../../tests/rng_common/mod.rs"]
-mod rng_common;
-
 use super::events::{
     FrameEvents, PixelEvent, PlanTiming, RowEvents, TexelFootprint, TextureLayout,
 };
 use super::model::{simulate, Simulator};
 use super::previous;
 use crate::pipeline::StageKind;
+use crate::rng_common::Rng;
 use hw_model::timing_config::BankInterleave;
 use hw_model::{HwConfig, UnitCost};
-use rng_common::Rng;
 
 fn pick<T: Copy>(r: &mut Rng, xs: &[T]) -> T {
     xs[r.below(xs.len() as u64) as usize]
