@@ -10,7 +10,7 @@
 //! A separate pass over the covered pixels with the all-float twins: the hardware and
 //! reference passes carry no counters for it, so a render without `--ranges` costs nothing.
 
-use super::shading::{shade_row, ShadeInput};
+use super::shading::{frag_scratch, shade_row, ShadeInput};
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 use hw_model::fixed::Format;
 use rayon::prelude::*;
@@ -253,28 +253,37 @@ pub(super) fn measure(inp: &ShadeInput) -> Vec<SignalRange> {
     let rows = inp.vis.height as usize;
     let acc = (0..rows)
         .into_par_iter()
-        .map(|y| {
+        .map_init(frag_scratch, |frags, y| {
             let mut acc = Acc::new();
             let mut row = vec![[0u16; 4]; w];
             let mut c = crate::pipeline::stages::Counters::default();
-            shade_row(inp, &progs, y, &mut row, &mut c, false, |pi, _, frag| {
-                let plan = &plans[pi as usize];
-                for (i, s) in SIGNALS.iter().enumerate() {
-                    if !plan.stages.contains(&s.stage) {
-                        continue;
-                    }
-                    let (lo, hi) = bounds[i];
-                    (s.values)(frag, &mut |x| {
-                        if !x.is_finite() {
-                            return;
+            shade_row(
+                inp,
+                &progs,
+                y,
+                &mut row,
+                frags,
+                &mut c,
+                false,
+                |pi, _, frag| {
+                    let plan = &plans[pi as usize];
+                    for (i, s) in SIGNALS.iter().enumerate() {
+                        if !plan.stages.contains(&s.stage) {
+                            continue;
                         }
-                        acc.count[i] += 1;
-                        acc.outside[i] += u64::from(x < lo || x > hi);
-                        acc.min[i] = acc.min[i].min(x);
-                        acc.max[i] = acc.max[i].max(x);
-                    });
-                }
-            });
+                        let (lo, hi) = bounds[i];
+                        (s.values)(frag, &mut |x| {
+                            if !x.is_finite() {
+                                return;
+                            }
+                            acc.count[i] += 1;
+                            acc.outside[i] += u64::from(x < lo || x > hi);
+                            acc.min[i] = acc.min[i].min(x);
+                            acc.max[i] = acc.max[i].max(x);
+                        });
+                    }
+                },
+            );
             acc
         })
         .reduce(Acc::new, Acc::merge);

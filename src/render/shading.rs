@@ -219,20 +219,23 @@ pub(super) struct ShadeInput<'a> {
 /// footprints the stages traced when `trace`). The covered pixels run in spans of up to
 /// [`SPAN_MAX`] consecutive pixels of one triangle ([`run_span`]), or one at a time
 /// ([`run`]) with `inp.per_fragment`: the same image, counters and fragments.
+/// `frags` is the caller's scratch ([`frag_scratch`], one per worker: a fragment is ~3 KB, so
+/// a span's worth is not built per row).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn shade_row(
     inp: &ShadeInput,
     progs: &[Program],
     y: usize,
     row: &mut [[u16; 4]],
+    frags: &mut [Frag],
     c: &mut Counters,
     trace: bool,
     mut on_pixel: impl FnMut(u32, u32, &Frag),
 ) {
     let w = inp.vis.width as usize;
     let cap = if inp.per_fragment { 1 } else { SPAN_MAX };
-    let mut frags = vec![Frag::default(); cap];
-    for frag in &mut frags {
+    let frags = &mut frags[..cap];
+    for frag in frags.iter_mut() {
         frag.trace.on = trace;
     }
     let tris = &inp.vis.tri[y * w..(y + 1) * w];
@@ -279,6 +282,11 @@ pub(super) fn shade_row(
     }
 }
 
+/// The fragments [`shade_row`] works in: one span's worth.
+pub(super) fn frag_scratch() -> Vec<Frag> {
+    vec![Frag::default(); SPAN_MAX]
+}
+
 /// Rows shaded per band when the timing model runs beside the shading (see [`shade`]).
 const BAND_ROWS: usize = 16;
 
@@ -315,9 +323,9 @@ pub(super) fn shade<'h>(
             .px
             .par_chunks_mut(w.max(1))
             .enumerate()
-            .map(|(y, row)| {
+            .map_init(frag_scratch, |frags, (y, row)| {
                 let mut c = Counters::default();
-                shade_row(inp, progs, y, row, &mut c, false, |_, _, _| {});
+                shade_row(inp, progs, y, row, frags, &mut c, false, |_, _, _| {});
                 c
             })
             .reduce(Counters::default, |mut a, b| {
@@ -334,8 +342,10 @@ pub(super) fn shade<'h>(
     };
     if rayon::current_num_threads() == 1 {
         let mut ev = RowEvents::default();
+        let mut frags = frag_scratch();
         for (y, row) in img.px.chunks_mut(w.max(1)).enumerate() {
-            shade_row(inp, progs, y, row, &mut counters, true, |pi, t, frag| {
+            let c = &mut counters;
+            shade_row(inp, progs, y, row, &mut frags, c, true, |pi, t, frag| {
                 sim.pixel(pi, frag.trace.footprints());
                 if keep_events {
                     record_pixel(pi, t, frag, &mut ev);
@@ -390,10 +400,10 @@ pub(super) fn shade<'h>(
                 px.par_chunks_mut(w.max(1))
                     .zip(buffers)
                     .enumerate()
-                    .map(|(r, (row, mut ev))| {
+                    .map_init(frag_scratch, |frags, (r, (row, mut ev))| {
                         let mut c = Counters::default();
                         let y = band * BAND_ROWS + r;
-                        shade_row(inp, progs, y, row, &mut c, true, |pi, t, frag| {
+                        shade_row(inp, progs, y, row, frags, &mut c, true, |pi, t, frag| {
                             record_pixel(pi, t, frag, &mut ev);
                         });
                         (c, ev)
