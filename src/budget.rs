@@ -29,10 +29,29 @@ pub const ENV_MAX_MEMORY: &str = "TEXSIM_MAX_MEMORY";
 /// Largest scene TOML, MTL or hardware TOML file read, bytes.
 pub const MAX_TEXT_FILE_BYTES: u64 = 64 << 20;
 
-/// Bytes per triangle of a whole run: the scene's mesh, geometry, triangle setup and
-/// attribute setup of the hardware and the reference pass (measured: 190 B, on a 33M-triangle
-/// sphere).
-pub const BYTES_PER_TRIANGLE: u64 = 256;
+/// Bytes per triangle of a whole run, every triangle assumed visible: its set-up screen
+/// triangle and its attributes in the units' formats (the two per-triangle arrays the shading
+/// pass reads), and [`BYTES_PER_DRAW`] for its indices, draw, plan index and setup outcome.
+/// The sizes are the types' own, so the estimate follows them (544 B in all today). With
+/// [`BYTES_PER_VERTEX`] a grid mesh is estimated at 640 B per triangle; measured, the peak
+/// resident memory grows by 584 B per triangle of a fully visible grid at 256x256 (3,200 to
+/// 180,000 triangles) and by 528 B at 1024x1024 (250k to 1M triangles).
+pub const BYTES_PER_TRIANGLE: u64 = (std::mem::size_of::<crate::raster::ScreenTri>()
+    + std::mem::size_of::<crate::pipeline::stages::TriAttrs>())
+    as u64
+    + BYTES_PER_DRAW;
+/// ...of which the input triangle's indices (12 B), draw (16 B), plan index (4 B), the
+/// setup's outcome and output order (16 B) and the loader's working copies, with headroom.
+pub const BYTES_PER_DRAW: u64 = 96;
+/// Bytes per vertex of a whole run: the mesh (32 B), the transformed and lit vertex of the
+/// geometry (84 B) and its projection in the setup (48 B), with headroom.
+pub const BYTES_PER_VERTEX: u64 = 192;
+/// Extra bytes per triangle of a bump-mapped material (its per-triangle bump attributes)...
+pub const BYTES_PER_BUMP_TRIANGLE: u64 =
+    std::mem::size_of::<crate::pipeline::bump::BumpAttrs>() as u64;
+/// ...and per vertex of a scene with a bump-mapped material (its bump vertex).
+pub const BYTES_PER_BUMP_VERTEX: u64 =
+    std::mem::size_of::<crate::pipeline::bump::BumpVertex>() as u64;
 /// Bytes per texel of level 0 of a texture: the decoded image (8 B), its float (16 B) and
 /// quantized (8 B) MIP chains (4/3 of level 0 each) and the working copies while they are
 /// built.
@@ -210,7 +229,7 @@ impl RunNeed {
             })
             .fold(0u64, u64::saturating_add);
         Self {
-            triangles: mul(scene.triangle_count() as u64, BYTES_PER_TRIANGLE),
+            triangles: mesh_bytes(scene),
             texels: mul(texels, BYTES_PER_TEXEL)
                 .saturating_add(mul(lobe_texels, BYTES_PER_LOBE_TEXEL)),
             framebuffer: mul(
@@ -291,6 +310,35 @@ impl RunNeed {
             limit,
         ))
     }
+}
+
+/// The bytes of `scene`'s meshes through a run: [`BYTES_PER_TRIANGLE`] and
+/// [`BYTES_PER_VERTEX`] each, plus [`BYTES_PER_BUMP_TRIANGLE`] per triangle of a bump-mapped
+/// mesh and [`BYTES_PER_BUMP_VERTEX`] per vertex when any mesh is bump mapped.
+#[must_use]
+pub fn mesh_bytes(scene: &Scene) -> u64 {
+    let bumped = |m: &crate::scene::Mesh| {
+        scene
+            .materials
+            .get(m.material)
+            .is_some_and(|mat| mat.bump.is_some())
+    };
+    let any_bump = scene.meshes.iter().any(bumped);
+    scene
+        .meshes
+        .iter()
+        .map(|m| {
+            let per_tri = BYTES_PER_TRIANGLE
+                + if bumped(m) {
+                    BYTES_PER_BUMP_TRIANGLE
+                } else {
+                    0
+                };
+            let per_vertex = BYTES_PER_VERTEX + if any_bump { BYTES_PER_BUMP_VERTEX } else { 0 };
+            mul(m.indices.len() as u64, per_tri)
+                .saturating_add(mul(m.positions.len() as u64, per_vertex))
+        })
+        .fold(0u64, u64::saturating_add)
 }
 
 /// Texture lookups per pixel of the scene's most demanding material on `hw` (at least 1):

@@ -381,7 +381,11 @@ fn build_shape(i: usize, c: &MeshCfg, shape: &str, tris_before: usize) -> Result
     crate::budget::check(
         &f("segments"),
         &format!("{total} triangles (this mesh: {tris})"),
-        crate::budget::mul(total, crate::budget::BYTES_PER_TRIANGLE),
+        // A shape has fewer vertices than triangles (a grid: about half as many).
+        crate::budget::mul(
+            total,
+            crate::budget::BYTES_PER_TRIANGLE + crate::budget::BYTES_PER_VERTEX,
+        ),
     )?;
     Ok(match shape {
         "plane" => shapes::plane(

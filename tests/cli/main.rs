@@ -7,6 +7,7 @@
 mod cli_common;
 
 mod as_cli;
+mod budget_cli;
 mod bump_cli;
 mod cli;
 mod filters_cli;
