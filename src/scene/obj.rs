@@ -3,7 +3,7 @@
 //! while texel row 0 is its top row.
 
 use std::cell::RefCell;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -284,10 +284,8 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
         match parse_mtl(&full) {
             Ok(entries) => {
                 let mut mats = Vec::with_capacity(entries.len());
-                let mut map = HashMap::new();
                 let mut store = mtl_entries.borrow_mut();
                 for e in entries {
-                    map.insert(e.name.clone(), mats.len());
                     mats.push(tobj::Material {
                         name: e.name.clone(),
                         ..tobj::Material::default()
@@ -297,6 +295,10 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                         .borrow_mut()
                         .push(full.parent().map(Path::to_path_buf).unwrap_or_default());
                 }
+                // Into tobj's own map type (a repeated name keeps its last index).
+                let map = (mats.iter().enumerate())
+                    .map(|(i, m)| (m.name.clone(), i))
+                    .collect();
                 Ok((mats, map))
             }
             Err(e) if !full.exists() => {
@@ -305,7 +307,7 @@ pub(crate) fn load_obj_parts(path: &Path) -> Result<ObjParts> {
                     path.display(),
                     full.display()
                 ));
-                Ok((Vec::new(), HashMap::new()))
+                Ok((Vec::new(), Default::default()))
             }
             Err(e) => {
                 mtl_error.borrow_mut().get_or_insert(e);
