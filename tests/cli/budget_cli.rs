@@ -31,6 +31,7 @@ fn grid_obj(dir: &Path, n: u32) -> std::path::PathBuf {
 
 /// Peak resident memory (bytes) of `texsim render OBJ` at 256x256, and its exit status.
 #[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes)] // `wait4` below reaps the child (and reads its usage).
 fn peak_rss(obj: &Path, out: &Path) -> (u64, i32) {
     let child = Command::new(env!("CARGO_BIN_EXE_texsim"))
         .args(["--threads", "2", "render"])
