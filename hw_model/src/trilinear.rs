@@ -222,7 +222,8 @@ fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
 }
 
 /// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
-/// (as footprint `index` of level `level_index`) when the sink keeps them.
+/// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: both
+/// coordinates [`fits_i64`] (the caller's test, once for every level of a sample).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
@@ -235,9 +236,10 @@ fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
     cfg: &TrilinearConfig,
     filter: &LaneLerp,
     index: usize,
+    narrow: bool,
     sink: &mut S,
 ) -> Lanes {
-    let (wx, wy) = if fits_i64(u, frac) && fits_i64(v, frac) {
+    let (wx, wy) = if narrow {
         let wb = cfg.weight_bits.min(16);
         (
             wrap_i64_in::<W>(u, frac, level.width, wrap_mode[0], wb),
@@ -296,12 +298,14 @@ pub fn bilinear(
         crate::with_rounding!(cfg.weight_rounding, W => match trace {
             None => {
                 let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-                bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, &mut ())
+                let narrow = fits_i64(u, frac) && fits_i64(v, frac);
+                bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut ())
             }
             Some(t) => {
                 let mut one = One(t);
                 let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-                bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, &mut one)
+                let narrow = fits_i64(u, frac) && fits_i64(v, frac);
+                bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut one)
             }
         }
         .channels())
@@ -448,14 +452,17 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
             ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
         };
         let (frac, wm, cfg, f) = (self.frac, self.wrap_mode, self.cfg, &self.filter);
-        let c0 = bilinear_lanes::<W, S>(&levels[l0], l0 as u32, u, v, frac, wm, cfg, f, 0, sink);
+        let nw = fits_i64(u, frac) && fits_i64(v, frac);
+        let c0 =
+            bilinear_lanes::<W, S>(&levels[l0], l0 as u32, u, v, frac, wm, cfg, f, 0, nw, sink);
         if lw == 0 {
             let out = c0.channels().map(|c| c as u16);
             sink.sample(1, 0, out);
             return out;
         }
         let l1 = l0 + 1;
-        let c1 = bilinear_lanes::<W, S>(&levels[l1], l1 as u32, u, v, frac, wm, cfg, f, 1, sink);
+        let c1 =
+            bilinear_lanes::<W, S>(&levels[l1], l1 as u32, u, v, frac, wm, cfg, f, 1, nw, sink);
         let out = if lf <= 16 {
             c0.lerp(c1, lw, &self.blend).channels().map(|c| c as u16)
         } else {

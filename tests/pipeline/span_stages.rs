@@ -7,9 +7,9 @@
 use crate::rng_common::Rng;
 use hw_model::config::{CoordArith, HwConfig, LodLog2};
 use hw_model::fixed::Rounding;
-use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
 use hw_model::wrap::WrapMode;
 use texsim::maps::{build_mip_chain, quantize_chain};
+use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
 use texsim::pipeline::{
     bary, lod, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls, StageKind,
 };
