@@ -199,8 +199,11 @@ const fn buckets() -> [u16; 1 << (MANT_BITS - BUCKET_BITS)] {
 #[inline(always)]
 #[must_use]
 pub fn table_log2_bits(m: u64) -> u32 {
+    debug_assert!(m >> MANT_BITS == 1, "mantissa {m:#x} outside [2^31, 2^32)");
     let off = (m as u32) ^ (1 << MANT_BITS);
-    let k0 = usize::from(LOG2_BUCKET[(off >> BUCKET_BITS) as usize]);
+    // `off < 2^31`: the mask only drops the bounds check.
+    let bucket = (off >> BUCKET_BITS) as usize & (LOG2_BUCKET.len() - 1);
+    let k0 = usize::from(LOG2_BUCKET[bucket]);
     // The bucket's candidates read at once (not one after the other): the thresholds
     // increase, so `off >= t[2]` implies `off >= t[1]` and `k = k0 + both`.
     let Some(&[t0, t1, t2, t3]) = LOG2_IDEAL.get(k0..k0 + 4) else {

@@ -222,7 +222,8 @@ fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
 }
 
 /// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
-/// (as footprint `index` of level `level_index`) when the sink keeps them.
+/// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: both
+/// coordinates [`fits_i64`] (the caller's test, once for every level of a sample).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
@@ -235,9 +236,10 @@ fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
     cfg: &TrilinearConfig,
     filter: &LaneLerp,
     index: usize,
+    narrow: bool,
     sink: &mut S,
 ) -> Lanes {
-    let (wx, wy) = if fits_i64(u, frac) && fits_i64(v, frac) {
+    let (wx, wy) = if narrow {
         let wb = cfg.weight_bits.min(16);
         (
             wrap_i64_in::<W>(u, frac, level.width, wrap_mode[0], wb),
@@ -296,12 +298,14 @@ pub fn bilinear(
         crate::with_rounding!(cfg.weight_rounding, W => match trace {
             None => {
                 let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-                bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, &mut ())
+                let narrow = fits_i64(u, frac) && fits_i64(v, frac);
+                bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut ())
             }
             Some(t) => {
                 let mut one = One(t);
                 let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-                bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, &mut one)
+                let narrow = fits_i64(u, frac) && fits_i64(v, frac);
+                bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut one)
             }
         }
         .channels())
@@ -377,59 +381,97 @@ fn trilinear_in<F: ConstRounding, W: ConstRounding, S: SampleSink>(
     cfg: &TrilinearConfig,
     sink: &mut S,
 ) -> [u16; 4] {
-    let n = levels.len();
-    if n == 0 {
-        return [0; 4];
+    TrilinearUnit::<F, W>::new(cfg, frac, lod_frac_bits, wrap_mode).sample(levels, u, v, lod, sink)
+}
+
+/// The trilinear unit set up once for a run of samples with one configuration, coordinate
+/// format, LOD format and wrap mode (the filter rounding `F` and the weight rounding `W` as
+/// types, the lerps' constants built): [`TrilinearUnit::sample`] gives the bits and the
+/// footprints of [`trilinear_to`] with the same arguments (it is what [`trilinear_to`] runs,
+/// and the unit tests check [`trilinear_to`] against the scalar filter it replaced).
+#[derive(Clone, Copy)]
+pub struct TrilinearUnit<'a, F, W> {
+    cfg: &'a TrilinearConfig,
+    frac: u32,
+    /// `lod_frac_bits`, at most 30.
+    lf: u32,
+    wrap_mode: [WrapMode; 2],
+    /// The bilinear lerps (`weight_bits`, at most 16).
+    filter: LaneLerp,
+    /// The level blend in lanes (`lf <= 16`).
+    blend: LaneLerp,
+    modes: std::marker::PhantomData<(F, W)>,
+}
+
+impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
+    /// The unit for `cfg` (its rounding modes must be `F` and `W`), coordinates with `frac`
+    /// fraction bits, LODs with `lod_frac_bits` and `wrap_mode`.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(
+        cfg: &'a TrilinearConfig,
+        frac: u32,
+        lod_frac_bits: u32,
+        wrap_mode: [WrapMode; 2],
+    ) -> Self {
+        debug_assert!(cfg.filter_rounding == F::MODE && cfg.weight_rounding == W::MODE);
+        let lf = lod_frac_bits.min(30);
+        Self {
+            cfg,
+            frac,
+            lf,
+            wrap_mode,
+            filter: LaneLerp::new::<F>(cfg.weight_bits.min(16)),
+            blend: LaneLerp::new::<F>(lf.min(16)),
+            modes: std::marker::PhantomData,
+        }
     }
-    let lf = lod_frac_bits.min(30);
-    let last = (n - 1) as i64;
-    let (l0, lw) = if lod <= 0 {
-        (0usize, 0u32)
-    } else if (lod >> lf) >= last {
-        (n - 1, 0)
-    } else {
-        ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
-    };
-    let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-    let c0 = bilinear_lanes::<W, S>(
-        &levels[l0],
-        l0 as u32,
-        u,
-        v,
-        frac,
-        wrap_mode,
-        cfg,
-        &f,
-        0,
-        sink,
-    );
-    if lw == 0 {
-        let out = c0.channels().map(|c| c as u16);
-        sink.sample(1, 0, out);
-        return out;
+
+    /// One sample of `levels` at (`u`, `v`) and LOD `lod`, its footprints reported to `sink`:
+    /// [`trilinear_to`].
+    #[inline(always)]
+    pub fn sample<S: SampleSink>(
+        &self,
+        levels: &[Level],
+        u: i64,
+        v: i64,
+        lod: i64,
+        sink: &mut S,
+    ) -> [u16; 4] {
+        let n = levels.len();
+        if n == 0 {
+            return [0; 4];
+        }
+        let lf = self.lf;
+        let last = (n - 1) as i64;
+        let (l0, lw) = if lod <= 0 {
+            (0usize, 0u32)
+        } else if (lod >> lf) >= last {
+            (n - 1, 0)
+        } else {
+            ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
+        };
+        let (frac, wm, cfg, f) = (self.frac, self.wrap_mode, self.cfg, &self.filter);
+        let nw = fits_i64(u, frac) && fits_i64(v, frac);
+        let c0 =
+            bilinear_lanes::<W, S>(&levels[l0], l0 as u32, u, v, frac, wm, cfg, f, 0, nw, sink);
+        if lw == 0 {
+            let out = c0.channels().map(|c| c as u16);
+            sink.sample(1, 0, out);
+            return out;
+        }
+        let l1 = l0 + 1;
+        let c1 =
+            bilinear_lanes::<W, S>(&levels[l1], l1 as u32, u, v, frac, wm, cfg, f, 1, nw, sink);
+        let out = if lf <= 16 {
+            c0.lerp(c1, lw, &self.blend).channels().map(|c| c as u16)
+        } else {
+            let (a, b) = (c0.channels(), c1.channels());
+            std::array::from_fn(|c| lerp(a[c], b[c], lw, lf, F::MODE) as u16)
+        };
+        sink.sample(2, lw, out);
+        out
     }
-    let l1 = l0 + 1;
-    let c1 = bilinear_lanes::<W, S>(
-        &levels[l1],
-        l1 as u32,
-        u,
-        v,
-        frac,
-        wrap_mode,
-        cfg,
-        &f,
-        1,
-        sink,
-    );
-    let out = if lf <= 16 {
-        let blend = LaneLerp::new::<F>(lf);
-        c0.lerp(c1, lw, &blend).channels().map(|c| c as u16)
-    } else {
-        let (a, b) = (c0.channels(), c1.channels());
-        std::array::from_fn(|c| lerp(a[c], b[c], lw, lf, F::MODE) as u16)
-    };
-    sink.sample(2, lw, out);
-    out
 }
 
 /// Cost of one trilinear sample using `levels_used` (1 or 2) levels: per level the two wraps,

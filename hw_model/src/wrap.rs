@@ -147,11 +147,17 @@ pub fn wrap_wide_in<W: crate::fixed::ConstRounding>(
 
 /// The wrapped indices `i0` and `i0 + 1` (saturating) of a level of `size >= 1` texels: both
 /// inside the level (the common case) need no wrap; with Repeat the second is the first's
-/// successor modulo the size; with ClampToEdge each is clamped.
+/// successor modulo the size (both masked for a power-of-two size, inside the level or not);
+/// with ClampToEdge each is clamped.
 #[inline(always)]
 fn finish(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
     let n = i64::from(size);
-    let (a, b) = if (i0 as u64) < (n - 1) as u64 {
+    let (a, b) = if mode == WrapMode::Repeat && size & (size - 1) == 0 && i0 < i64::MAX {
+        // A power-of-two size reduces both by a mask, inside the level or not (two's
+        // complement `&` is the Euclidean remainder; `i0 + 1` does not overflow).
+        let mask = n - 1;
+        ((i0 & mask) as u32, ((i0 + 1) & mask) as u32)
+    } else if (i0 as u64) < (n - 1) as u64 {
         (i0 as u32, i0 as u32 + 1)
     } else {
         match mode {

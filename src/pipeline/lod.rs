@@ -1,7 +1,7 @@
 //! `lod`: the level of detail of the material texture from the texture-coordinate derivatives
 //! (the OpenGL isotropic rule; `hw_model::lod`).
 
-use super::stages::{texel_derivs, texel_derivs_f64, Counters, Machine};
+use super::stages::{each_fragment, texel_derivs, texel_derivs_f64, Counters, Machine};
 use super::texcoord::quantize_uv;
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
@@ -28,6 +28,32 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     frag.lod_x = hw_model::lod::lod(d, fb, &m.hw.lod, sat);
     if px.carriers {
         frag.lod = from_raw(frag.lod_x, m.hw.lod.lod_frac_bits);
+    }
+}
+
+/// Fixed twin over a span: the texture's level-0 size, the formats and the configuration
+/// resolved once, then the squared lengths and log2 per fragment. The float32 coordinate
+/// path and a Float `texcoord` producer take [`fixed`] on each fragment.
+pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    let m = px.m;
+    if m.hw.interp.coord_arith == CoordArith::Float32 || !px.fixed(StageKind::Texcoord) {
+        return each_fragment(fixed, px, frags, c);
+    }
+    let Some(l0) = px.plan.texture.and_then(|t| m.tex_float[t].first()) else {
+        return;
+    };
+    let sat = &mut c.sat[StageKind::Lod.index()];
+    let (w, h) = (l0.width, l0.height);
+    let (fb, cfg) = (m.uv_fmt.frac_bits, &m.hw.lod);
+    for frag in frags.iter_mut() {
+        let d = texel_derivs(&frag.uv_x, w, h);
+        frag.lod_x = hw_model::lod::lod(d, fb, cfg, sat);
+    }
+    if px.carriers {
+        let lfb = cfg.lod_frac_bits;
+        for frag in frags.iter_mut() {
+            frag.lod = from_raw(frag.lod_x, lfb);
+        }
     }
 }
 

@@ -158,12 +158,13 @@ stage_table! {
     }
     /// LOD from the texture-coordinate derivatives.
     Lod "lod" {
-        fixed: lod::fixed, float: lod::float, cost: lod::cost, lookups: no_lookups
+        fixed: lod::fixed, fixed_span: lod::fixed_span, float: lod::float, cost: lod::cost,
+        lookups: no_lookups,
     }
     /// Wrap + trilinear MIP filtering (footprint assembly with `aniso_probes` > 1).
     Trilinear "trilinear" {
-        fixed: trilinear::fixed, float: trilinear::float, cost: trilinear::cost,
-        lookups: trilinear::lookups,
+        fixed: trilinear::fixed, fixed_span: trilinear::fixed_span, float: trilinear::float,
+        cost: trilinear::cost, lookups: trilinear::lookups,
     }
     /// Colour x texel.
     Modulate "modulate" {

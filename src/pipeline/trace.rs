@@ -11,7 +11,10 @@
 
 use super::StageKind;
 use hw_model::config::TrilinearConfig;
-use hw_model::trilinear::{trilinear_to, BilinearTrace, Level, SampleSink, TrilinearTrace};
+use hw_model::fixed::ConstRounding;
+use hw_model::trilinear::{
+    trilinear_to, BilinearTrace, Level, SampleSink, TrilinearTrace, TrilinearUnit,
+};
 use hw_model::wrap::WrapMode;
 use serde::Serialize;
 
@@ -150,6 +153,25 @@ pub fn trilinear_traced(
     }
     let mut sink = Recorder { trace, at };
     trilinear_to(levels, u, v, frac, lod, lod_frac_bits, wrap, cfg, &mut sink)
+}
+
+/// [`TrilinearUnit::sample`] of a stage's lookup (a unit set up once for a span), its
+/// footprints recorded into `trace` when tracing is on: [`trilinear_traced`] with the unit's
+/// configuration.
+#[inline(always)]
+pub fn unit_traced<F: ConstRounding, W: ConstRounding>(
+    unit: &TrilinearUnit<F, W>,
+    levels: &[Level],
+    u: i64,
+    v: i64,
+    lod: i64,
+    trace: &mut Trace,
+    at: Lookup,
+) -> [u16; 4] {
+    if !trace.on {
+        return unit.sample(levels, u, v, lod, &mut ());
+    }
+    unit.sample(levels, u, v, lod, &mut Recorder { trace, at })
 }
 
 /// The fragment's texture coordinates as the hardware sees them: the raw values when the

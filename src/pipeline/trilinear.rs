@@ -2,16 +2,16 @@
 //! `hw_model::trilinear`), or footprint assembly over `aniso_probes` probes along the major
 //! axis (`hw_model::footprint`) when the plan has derivatives.
 
-use super::stages::{unorm, Counters, Machine};
+use super::stages::{each_fragment, unorm, Counters, Machine};
 use super::texcoord::quantize_uv;
-use super::trace::{hardware_uv, trilinear_traced, Lookup, Trace};
+use super::trace::{hardware_uv, trilinear_traced, unit_traced, Lookup, Trace};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::to_raw;
 use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
 use crate::reference::trilinear_f64;
-use hw_model::fixed::SatCounter;
+use hw_model::fixed::{ConstRounding, SatCounter};
 use hw_model::footprint::{footprint, footprint_cost, footprint_filter, MAX_PROBES};
-use hw_model::trilinear::{trilinear_cost, TrilinearTrace};
+use hw_model::trilinear::{trilinear_cost, Level, TrilinearTrace, TrilinearUnit};
 use hw_model::{HwConfig, UnitCost};
 
 const KIND: StageKind = StageKind::Trilinear;
@@ -48,6 +48,55 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     if px.carriers {
         frag.texel = frag.texel_x.map(|x| unorm(x, tb));
         frag.out = frag.texel;
+    }
+}
+
+/// Fixed twin over a span: the unit set up once (rounding modes, lerp constants, coordinate
+/// and LOD formats, wrap mode, texture levels), then one sample per fragment. Footprint
+/// assembly and a Float `lod` producer take [`fixed`] on each fragment.
+pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    let Some(t) = px.plan.texture else { return };
+    if aniso(px) || !px.fixed(StageKind::Lod) {
+        return each_fragment(fixed, px, frags, c);
+    }
+    let m = px.m;
+    let hw = m.hw;
+    let cfg = &hw.trilinear;
+    let (fb, lfb, wrap) = (m.uv_fmt.frac_bits, hw.lod.lod_frac_bits, px.plan.wrap);
+    hw_model::with_rounding!(cfg.filter_rounding, F => {
+        hw_model::with_rounding!(cfg.weight_rounding, W => {
+            let unit = TrilinearUnit::<F, W>::new(cfg, fb, lfb, wrap);
+            span_lanes(&unit, &m.tex_fixed[t], t, cfg.texel_bits, px.carriers, frags);
+        })
+    });
+}
+
+/// The samples of [`fixed_span`]'s fast path: each fragment's lookup at its raw coordinates
+/// and raw LOD, its texel and output as [`fixed`] writes them.
+#[inline(always)]
+fn span_lanes<F: ConstRounding, W: ConstRounding>(
+    unit: &TrilinearUnit<F, W>,
+    levels: &[Level],
+    t: usize,
+    tb: u32,
+    carriers: bool,
+    frags: &mut [Frag],
+) {
+    let at = Lookup {
+        stage: KIND,
+        lookup: 0,
+        tex: t,
+    };
+    for frag in frags.iter_mut() {
+        let [u, v] = frag.uv_x[0];
+        let r = unit_traced(unit, levels, u, v, frag.lod_x, &mut frag.trace, at);
+        frag.texel_x = r.map(u32::from);
+        frag.out_x = frag.texel_x;
+        frag.out_bits = tb;
+        if carriers {
+            frag.texel = frag.texel_x.map(|x| unorm(x, tb));
+            frag.out = frag.texel;
+        }
     }
 }
 

@@ -1,16 +1,21 @@
-//! Stages over spans of fragments: the span twins of `bary` and `texcoord` against their
-//! per-fragment twins on seeded spans (values, carriers and saturation counts), and whole
+//! Stages over spans of fragments: the span twins of `bary` and `texcoord`, and of `lod` and
+//! `trilinear`, against their per-fragment twins on seeded spans (values, carriers, traced
+//! footprints, saturation counts and costs), and whole
 //! frames shaded in spans against the same frames shaded one fragment at a time (images,
 //! statistics, counters and cycle counts).
 
 use crate::rng_common::Rng;
-use hw_model::config::{CoordArith, HwConfig};
+use hw_model::config::{CoordArith, HwConfig, LodLog2};
 use hw_model::fixed::Rounding;
+use hw_model::wrap::WrapMode;
+use texsim::maps::{build_mip_chain, quantize_chain};
 use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
-use texsim::pipeline::{bary, plan, texcoord, Frag, Impl, Px, StageImpls, StageKind};
+use texsim::pipeline::{
+    bary, lod, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls, StageKind,
+};
 use texsim::raster::{ScreenTri, VertexSource};
 use texsim::render::{render, Maps, RenderOptions, Rendered};
-use texsim::scene::{self, Material};
+use texsim::scene::{self, Material, TextureImage};
 use texsim::timing::simulate;
 
 const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
@@ -186,6 +191,169 @@ fn span_twins_match_the_per_fragment_twins() {
             }
         }
     }
+}
+
+/// A texture of random size (powers of two and others, 1 to 80 texels a side) and texels,
+/// its MIP chain built by the renderer's rule.
+fn texture(rng: &mut Rng) -> TextureImage {
+    let side = |rng: &mut Rng| match rng.below(3) {
+        0 => 1u32 << rng.below(7),
+        _ => rng.int_in(1, 80) as u32,
+    };
+    let (width, height) = (side(rng), side(rng));
+    TextureImage {
+        name: "random".into(),
+        width,
+        height,
+        texels: (0..width * height)
+            .map(|_| [0; 4].map(|_| rng.next() as u16))
+            .collect(),
+        prebuilt_levels: None,
+    }
+}
+
+/// The fields `lod` and `trilinear` write (raw values, carriers' bits, footprints).
+fn written_lookup(f: &Frag) -> String {
+    format!(
+        "{} {:x} {:?} {:?} {} {:?} {:?} {:?}",
+        f.lod_x,
+        f.lod.to_bits(),
+        f.texel_x,
+        f.out_x,
+        f.out_bits,
+        f.texel.map(f64::to_bits),
+        f.out.map(f64::to_bits),
+        f.trace.footprints(),
+    )
+}
+
+/// 60k seeded spans of 1..=16 fragments: `lod` then `trilinear` over the span give, at every
+/// fragment, the raw values, carriers and traced footprints of their per-fragment twins, and
+/// the same saturation counts and costs; over the three rounding modes of the filter and of
+/// the weights, weight widths 0 to 16, LOD fraction widths 0 to 16 and both log2 units, texel
+/// widths, coordinate formats, every wrap-mode pair, textures of power-of-two and other sizes,
+/// coordinates inside, around and far outside the texture (the wide wrap path), tracing on
+/// and off, carriers on and off, and the per-fragment fallbacks (footprint assembly, a Float
+/// `texcoord` or `lod` producer).
+#[test]
+fn lookup_span_twins_match_the_per_fragment_twins() {
+    let mut rng = Rng(0x5a4e_1002);
+    let textured = Material {
+        texture: Some(0),
+        ..Material::default()
+    };
+    let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
+    let mut fast = 0u32;
+    for group in 0..300u32 {
+        let mut hw = HwConfig::texram16();
+        let t = &mut hw.trilinear;
+        t.filter_rounding = MODES[rng.below(3) as usize];
+        t.weight_rounding = MODES[rng.below(3) as usize];
+        t.weight_bits = rng.int_in(0, 16) as u32;
+        t.texel_bits = rng.int_in(1, 16) as u32;
+        t.aniso_probes = if rng.below(6) == 0 { 4 } else { 1 };
+        t.aniso_adaptive = rng.below(2) == 0;
+        hw.lod.lod_frac_bits = rng.int_in(0, 16) as u32;
+        hw.lod.lod_log2 = [LodLog2::Exact, LodLog2::PiecewiseLinear][rng.below(2) as usize];
+        hw.interp.texcoord_frac_bits = rng.int_in(4, 28) as u32;
+        hw.interp.texcoord_int_bits = rng.int_in(1, 16) as u32;
+        let chain = build_mip_chain(&texture(&mut rng));
+        let fixed_chain = quantize_chain(&chain, hw.trilinear.texel_bits);
+        let float_chains = [chain];
+        let fixed_chains = [fixed_chain];
+        let m = Machine::new(&hw, &float_chains, &fixed_chains);
+        let tri = triangle(&mut rng, 4);
+        let a = TriAttrs::default();
+        let fb = hw.interp.texcoord_frac_bits;
+        let levels = float_chains[0].levels.len() as f64;
+        for case in 0..200u32 {
+            let mut pl = plan(&textured, true);
+            pl.derivatives = rng.below(8) != 0;
+            pl.wrap = [0, 1].map(|_| modes[rng.below(3) as usize]);
+            let impls = match rng.below(10) {
+                0 => StageImpls::FIXED.with(StageKind::Texcoord, Impl::Float),
+                1 => StageImpls::FIXED.with(StageKind::Lod, Impl::Float),
+                _ => StageImpls::FIXED,
+            };
+            let aniso = hw.trilinear.aniso_probes > 1 && pl.derivatives;
+            let px = Px {
+                plan: &pl,
+                impls: &impls,
+                m: &m,
+                tri: &tri,
+                a: &a,
+                x: rng.int_in(-50, 50),
+                y: rng.int_in(-50, 50),
+                color_raw: false,
+                carriers: rng.below(2) == 0,
+            };
+            let n = rng.int_in(1, 16) as usize;
+            // Coordinates mostly within a few textures of the origin, some anywhere in the
+            // format's range; helper samples a texel-scale step away (LODs below, inside and
+            // past the chain).
+            let one = 1i64 << fb;
+            let lim = 1i64 << (fb + hw.interp.texcoord_int_bits);
+            let far = rng.below(8) == 0;
+            let trace_on = rng.below(2) == 0;
+            let mut span: Vec<Frag> = (0..n)
+                .map(|_| {
+                    let mut f = Frag::default();
+                    let c = |rng: &mut Rng| {
+                        if far {
+                            rng.int_in(-lim, lim)
+                        } else {
+                            rng.int_in(-2 * one, 3 * one)
+                        }
+                    };
+                    let uv0 = [c(&mut rng), c(&mut rng)];
+                    let step = 1i64 << rng.int_in(0, i64::from(fb));
+                    f.uv_x[0] = uv0;
+                    for s in 1..3 {
+                        f.uv_x[s] = uv0.map(|x| (x + rng.int_in(-step, step)).clamp(-lim, lim));
+                    }
+                    f.uv = f.uv_x.map(|s| s.map(|x| x as f64 / one as f64));
+                    f.lod = rng.range(-2.0, levels + 1.0);
+                    f.trace.on = trace_on;
+                    f
+                })
+                .collect();
+            let before = span.clone();
+            let lod_fixed = impls.of(StageKind::Lod) == Impl::Fixed;
+            let mut c_span = Counters::default();
+            if lod_fixed {
+                lod::fixed_span(&px, &mut span, &mut c_span);
+            }
+            trilinear::fixed_span(&px, &mut span, &mut c_span);
+            let mut c_one = Counters::default();
+            for (j, got) in span.iter().enumerate() {
+                let at = Px {
+                    x: px.x + j as i64,
+                    ..px
+                };
+                let mut f = before[j];
+                if lod_fixed {
+                    lod::fixed(&at, &mut f, &mut c_one);
+                }
+                trilinear::fixed(&at, &mut f, &mut c_one);
+                assert_eq!(
+                    written_lookup(got),
+                    written_lookup(&f),
+                    "group {group} case {case} fragment {j}"
+                );
+            }
+            for k in [StageKind::Lod, StageKind::Trilinear] {
+                assert_eq!(
+                    format!("{:?} {:?}", c_span.sat[k.index()], c_span.cost[k.index()]),
+                    format!("{:?} {:?}", c_one.sat[k.index()], c_one.cost[k.index()]),
+                    "group {group} case {case}: {k} counts"
+                );
+            }
+            if lod_fixed && impls.of(StageKind::Texcoord) == Impl::Fixed && !aniso {
+                fast += 1;
+            }
+        }
+    }
+    assert!(fast > 30_000, "{fast} spans on the span twins' own paths");
 }
 
 fn render_with(s: &scene::Scene, hw: &HwConfig, per_fragment: bool) -> Rendered {
