@@ -324,8 +324,8 @@ fn derivs_lane<M: ConstRounding>(
     perspective_bary_derivs_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat)
 }
 
-/// Lanes the span datapath works on at once (structure of arrays): a longer span is done in
-/// chunks of this many.
+/// A span length the span datapaths are tuned for (the row loop's spans have at most 16
+/// fragments); they take any length.
 pub const SPAN_LANES: usize = 16;
 
 /// [`perspective_bary_derivs_span`] compiled for the rounding mode `M` (`interp_rounding`).
@@ -375,78 +375,79 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
     let m_bits = recip.config().recip_mantissa_bits;
     let wide = i128::from;
     let y_step = [1, 2].map(|i| wide(b[i]) * wide(s) - wide(a[i]) * wide(t));
+    // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
+    // the per-lane `times_w` and `sum` test): they are linear in the lane, so they do when
+    // they do at the first and the last lane, and then they step by `a_1`, `a_2` and `S`
+    // (wrapping adds, exact). `None`: each lane tests its own.
+    let fits = |j: usize| {
+        let q = times_w(lane_edges(edge, edge_dx, j))?;
+        sum(q).map(|d| [q[1], q[2], d])
+    };
+    let mut stepped = match lanes {
+        0 => return,
+        _ => fits(0).filter(|_| fits(lanes - 1).is_some()),
+    };
     // From the first fast lane on: the x numerators' top bits (the same at every fast lane)
     // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
     // wrapping steps across the lanes between are exact modulo 2^128).
     let mut numerators: Option<([NumeratorTop; 2], [i128; 2])> = None;
-    for c in 0..lanes.div_ceil(SPAN_LANES) {
-        let base = c * SPAN_LANES;
-        let chunk = (lanes - base).min(SPAN_LANES);
-        // Per lane, stage by stage: `q` and `D` (fast when the scale shift is 0: `D`, positive,
-        // and `q_1`, `q_2` below 2^62 as the steps are), the reciprocal of `D`, the
-        // barycentrics (fast while no `p_i` needs the clamp) and the square.
-        let mut q = [[0i64; 3]; SPAN_LANES];
-        let mut d = [0i64; SPAN_LANES];
-        let mut fast = [false; SPAN_LANES];
-        for j in 0..chunk {
-            let lane =
-                times_w(lane_edges(edge, edge_dx, base + j)).and_then(|q| Some((q, sum(q)?)));
-            if let Some((qj, dj)) = lane {
-                (q[j], d[j]) = (qj, dj);
-                fast[j] = (dj as u64 | qj[1].unsigned_abs() | qj[2].unsigned_abs() | steps_mag)
-                    >> 62
-                    == 0
-                    && dj > 0;
-            }
+    for j in 0..lanes {
+        if let Some((_, ny)) = &mut numerators {
+            *ny = [ny[0].wrapping_add(y_step[0]), ny[1].wrapping_add(y_step[1])];
         }
-        let mut r = [Recip { mant: 0, shift: 0 }; SPAN_LANES];
-        for j in 0..chunk {
-            if fast[j] {
-                // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
-                r[j] = recip.eval(d[j] as u64, &mut SatCounter::default());
+        // The lane's `q_1`, `q_2`, `D`; fast when the scale shift is 0 (`D`, positive, and
+        // `q_1`, `q_2` below 2^62 as the steps are) and no `p_i` needs the clamp.
+        let lane = match &mut stepped {
+            Some(v) => {
+                let here = *v;
+                *v = [
+                    v[0].wrapping_add(a[1]),
+                    v[1].wrapping_add(a[2]),
+                    v[2].wrapping_add(s),
+                ];
+                Some(here)
             }
-        }
-        let mut p = [[0i64; 3]; SPAN_LANES];
-        for j in 0..chunk {
-            if fast[j] {
-                let p1 = apply_i64_in::<M>(r[j], q[j][1], bb);
-                let p2 = apply_i64_in::<M>(r[j], q[j][2], bb);
-                p[j] = [one - p1 - p2, p1, p2];
-                fast[j] = p1.unsigned_abs() <= BARY_LIMIT as u64
-                    && p2.unsigned_abs() <= BARY_LIMIT as u64;
-                // The reciprocal of the barycentrics is that of the derivatives: its square.
-                r[j] = square(r[j], m_bits, M::MODE);
+            None => fits(j),
+        };
+        let fast = lane.and_then(|[q1, q2, d]| {
+            let small = (d as u64 | q1.unsigned_abs() | q2.unsigned_abs() | steps_mag) >> 62 == 0;
+            if !small || d <= 0 {
+                return None;
             }
-        }
-        for j in 0..chunk {
-            if let Some((_, ny)) = &mut numerators {
-                *ny = [ny[0].wrapping_add(y_step[0]), ny[1].wrapping_add(y_step[1])];
-            }
-            if !fast[j] {
-                let e = lane_edges(edge, edge_dx, base + j);
-                out(
-                    base + j,
-                    derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
-                );
-                continue;
-            }
-            let (pj, qj, r2) = (p[j], q[j], r[j]);
-            let (nx, ny) = *numerators.get_or_insert_with(|| {
-                let dw = wide(d[j]);
+            // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+            let r = recip.eval(d as u64, &mut SatCounter::default());
+            let p1 = apply_i64_in::<M>(r, q1, bb);
+            let p2 = apply_i64_in::<M>(r, q2, bb);
+            let limit = BARY_LIMIT as u64;
+            // The reciprocal of the barycentrics is that of the derivatives: its square.
+            (p1.unsigned_abs() <= limit && p2.unsigned_abs() <= limit).then(|| {
                 (
-                    [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
-                    [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+                    [q1, q2, d],
+                    [one - p1 - p2, p1, p2],
+                    square(r, m_bits, M::MODE),
                 )
-            });
-            let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
-            let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
-            let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
-            let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
+            })
+        });
+        let Some(([q1, q2, d], pj, r2)) = fast else {
+            let e = lane_edges(edge, edge_dx, j);
             out(
-                base + j,
-                [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]],
+                j,
+                derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
             );
-        }
+            continue;
+        };
+        let (nx, ny) = *numerators.get_or_insert_with(|| {
+            let (dw, qj) = (wide(d), [0, q1, q2]);
+            (
+                [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
+                [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+            )
+        });
+        let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
+        let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
+        let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
+        let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
+        out(j, [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]]);
     }
 }
 
@@ -522,16 +523,30 @@ fn derivative_of_top<M: ConstRounding>(
 ) -> i64 {
     let sh = r2.shift - (bary_bits + ns) as i32;
     // `apply_in`'s exact product and rounding (|x| <= 2^94, a mantissa below 2^31).
-    let v = if sh >= 0 && r2.mant >> 31 == 0 {
+    let v = if r2.mant >> 31 == 0 && (64..126).contains(&sh) {
+        // The product is below 2^125: its top bits from bit 62 fit `i64`, and the 62 below
+        // fold into a sticky bit under the rounding position (`sh - 62` >= 2), as
+        // `round_shift_right_wide` does for these shifts.
+        let prod = x * i128::from(r2.mant as i64);
+        let top = (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0);
+        round_shift_right(top, (sh - 62) as u32, M::MODE)
+    } else if sh >= 0 && r2.mant >> 31 == 0 {
         round_shift_right_wide(x * i128::from(r2.mant as i64), sh as u32, M::MODE)
     } else {
         apply_in::<M>(r2, x, bary_bits + ns)
     };
-    let dp = v.clamp(-BARY_LIMIT, BARY_LIMIT);
-    if dp != v {
-        sat.saturated += 1;
+    if v.unsigned_abs() > BARY_LIMIT as u64 {
+        return clamp_counted(v, sat);
     }
-    dp
+    v
+}
+
+/// A derivative beyond +-[`BARY_LIMIT`]: the clamp, counted.
+#[cold]
+#[inline(never)]
+fn clamp_counted(v: i64, sat: &mut SatCounter) -> i64 {
+    sat.saturated += 1;
+    v.clamp(-BARY_LIMIT, BARY_LIMIT)
 }
 
 /// The same datapath as [`perspective_bary`] when every `q_i` and their sum fit `i64`
