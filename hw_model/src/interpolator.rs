@@ -1349,4 +1349,87 @@ mod tests {
         }
         assert!(fast > 500_000 && fallback > 500_000, "{fast} {fallback}");
     }
+
+    /// 400k seeded spans of 1 to 24 lanes over 5 configurations x 3 interpolator roundings,
+    /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
+    /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
+    /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
+    /// are many both in spans whose `q_1`, `q_2`, `D` step along the span (both ends fit
+    /// `i64`) and in spans whose lanes test their own.
+    #[test]
+    fn derivs_span_stepping_matches_per_lane_calls() {
+        let mut s = 0x5eed_0b47;
+        let (mut stepped, mut tested) = (0u64, 0u64);
+        let mut got = [[[0i64; 3]; 3]; 24];
+        for (c, hw0) in previous_configs().into_iter().enumerate() {
+            for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
+                let mut hw = hw0.clone();
+                hw.interp.interp_rounding = mode;
+                let (cfg, recip) = (&hw.interp, Reciprocal::new(&hw.reciprocal));
+                let wb = cfg.inv_w_bits;
+                for i in 0..(400_000 / 15) {
+                    let n = 1 + (next(&mut s) % 24) as usize;
+                    let eb = [20, 40, 62 - wb - 1, 62 - wb, 63 - wb, 62][(i % 6) as usize];
+                    // The last: steps that carry a span from the fast form out of `i64`.
+                    let (db, dsh) = [(4, 5), (30, 5), (eb.saturating_sub(3).max(1), 5), (eb, 5)]
+                        .into_iter()
+                        .chain([(60 - wb, 0)])
+                        .nth((i / 6 % 5) as usize)
+                        .unwrap_or((4, 5));
+                    let mut edge = [0; 3].map(|_| signed(&mut s, eb));
+                    if i % 3 != 0 {
+                        edge = edge.map(i64::abs);
+                    }
+                    let dx = [0; 3].map(|_| signed(&mut s, db) >> dsh);
+                    let dy = [0; 3].map(|_| signed(&mut s, db));
+                    let mut inv_w = [0; 3].map(|_| (next(&mut s) >> (64 - wb)) as i64 + 1);
+                    inv_w[(i as usize + c) % 3] = 1 << wb;
+                    let at = |j: usize| {
+                        [0, 1, 2].map(|k| i128::from(edge[k]) + j as i128 * i128::from(dx[k]))
+                    };
+                    if at(n - 1).iter().any(|e| i64::try_from(*e).is_err()) {
+                        continue;
+                    }
+                    let span = EdgeSpan {
+                        edge,
+                        dx,
+                        dy,
+                        lanes: n,
+                    };
+                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
+                    perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
+                        got[j] = b;
+                    });
+                    // Whether the ends' products and sums fit `i64` (the span steps them).
+                    let fits = |j: usize| {
+                        let q = [0, 1, 2].map(|k| at(j)[k] * i128::from(inv_w[k]));
+                        [q[0], q[1], q[2], q[0] + q[1], q[0] + q[1] + q[2]]
+                            .iter()
+                            .all(|v| i64::try_from(*v).is_ok())
+                    };
+                    let ends_fit = fits(0) && fits(n - 1);
+                    for (j, lane) in got[..n].iter().enumerate() {
+                        let e = at(j).map(|v| v as i64);
+                        let want = perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);
+                        let why = (e, dx, dy, inv_w, mode, c, j, n);
+                        assert_eq!(*lane, want, "{why:?}");
+                        let q = [0, 1, 2].map(|k| i128::from(e[k]) * i128::from(inv_w[k]));
+                        let d = q[0] + q[1] + q[2];
+                        if d > 0
+                            && (d.unsigned_abs() | q[1].unsigned_abs() | q[2].unsigned_abs()) >> 62
+                                == 0
+                        {
+                            if ends_fit {
+                                stepped += 1;
+                            } else {
+                                tested += 1;
+                            }
+                        }
+                    }
+                    assert_eq!(sa, sb, "{edge:?} {dx:?} {dy:?} {inv_w:?} {mode:?} {c} {n}");
+                }
+            }
+        }
+        assert!(stepped > 300_000 && tested > 20_000, "{stepped} {tested}");
+    }
 }
