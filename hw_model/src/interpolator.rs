@@ -508,8 +508,11 @@ type NumeratorTop = (i128, u32);
 /// The numerator of [`derivative`] kept to its top 94 bits ([`NumeratorTop`]).
 #[inline(always)]
 fn numerator_top(n: i128) -> NumeratorTop {
-    // |N| < 2^126, so `ns` <= 32 and `n >> ns` is a 64-bit funnel shift.
-    let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94) & 63;
+    // |N| < 2^126, so `ns` <= 32 and `n >> ns` is a 64-bit funnel shift. `ns` from the high
+    // word of |N| alone: at or above 2^64 the bit length of |N| is 64 plus that of its high
+    // word, below it `ns` is 0 either way.
+    let high = (n.unsigned_abs() >> 64) as u64;
+    let ns = (64 - high.leading_zeros()).saturating_sub(30) & 63;
     (n >> ns, ns)
 }
 
