@@ -324,8 +324,8 @@ fn derivs_lane<M: ConstRounding>(
     perspective_bary_derivs_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat)
 }
 
-/// Lanes the span datapath works on at once (structure of arrays): a longer span is done in
-/// chunks of this many.
+/// A span length the span datapaths are tuned for (the row loop's spans have at most 16
+/// fragments); they take any length.
 pub const SPAN_LANES: usize = 16;
 
 /// [`perspective_bary_derivs_span`] compiled for the rounding mode `M` (`interp_rounding`).
@@ -375,78 +375,79 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
     let m_bits = recip.config().recip_mantissa_bits;
     let wide = i128::from;
     let y_step = [1, 2].map(|i| wide(b[i]) * wide(s) - wide(a[i]) * wide(t));
+    // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
+    // the per-lane `times_w` and `sum` test): they are linear in the lane, so they do when
+    // they do at the first and the last lane, and then they step by `a_1`, `a_2` and `S`
+    // (wrapping adds, exact). `None`: each lane tests its own.
+    let fits = |j: usize| {
+        let q = times_w(lane_edges(edge, edge_dx, j))?;
+        sum(q).map(|d| [q[1], q[2], d])
+    };
+    let mut stepped = match lanes {
+        0 => return,
+        _ => fits(0).filter(|_| fits(lanes - 1).is_some()),
+    };
     // From the first fast lane on: the x numerators' top bits (the same at every fast lane)
     // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
     // wrapping steps across the lanes between are exact modulo 2^128).
     let mut numerators: Option<([NumeratorTop; 2], [i128; 2])> = None;
-    for c in 0..lanes.div_ceil(SPAN_LANES) {
-        let base = c * SPAN_LANES;
-        let chunk = (lanes - base).min(SPAN_LANES);
-        // Per lane, stage by stage: `q` and `D` (fast when the scale shift is 0: `D`, positive,
-        // and `q_1`, `q_2` below 2^62 as the steps are), the reciprocal of `D`, the
-        // barycentrics (fast while no `p_i` needs the clamp) and the square.
-        let mut q = [[0i64; 3]; SPAN_LANES];
-        let mut d = [0i64; SPAN_LANES];
-        let mut fast = [false; SPAN_LANES];
-        for j in 0..chunk {
-            let lane =
-                times_w(lane_edges(edge, edge_dx, base + j)).and_then(|q| Some((q, sum(q)?)));
-            if let Some((qj, dj)) = lane {
-                (q[j], d[j]) = (qj, dj);
-                fast[j] = (dj as u64 | qj[1].unsigned_abs() | qj[2].unsigned_abs() | steps_mag)
-                    >> 62
-                    == 0
-                    && dj > 0;
-            }
+    for j in 0..lanes {
+        if let Some((_, ny)) = &mut numerators {
+            *ny = [ny[0].wrapping_add(y_step[0]), ny[1].wrapping_add(y_step[1])];
         }
-        let mut r = [Recip { mant: 0, shift: 0 }; SPAN_LANES];
-        for j in 0..chunk {
-            if fast[j] {
-                // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
-                r[j] = recip.eval(d[j] as u64, &mut SatCounter::default());
+        // The lane's `q_1`, `q_2`, `D`; fast when the scale shift is 0 (`D`, positive, and
+        // `q_1`, `q_2` below 2^62 as the steps are) and no `p_i` needs the clamp.
+        let lane = match &mut stepped {
+            Some(v) => {
+                let here = *v;
+                *v = [
+                    v[0].wrapping_add(a[1]),
+                    v[1].wrapping_add(a[2]),
+                    v[2].wrapping_add(s),
+                ];
+                Some(here)
             }
-        }
-        let mut p = [[0i64; 3]; SPAN_LANES];
-        for j in 0..chunk {
-            if fast[j] {
-                let p1 = apply_i64_in::<M>(r[j], q[j][1], bb);
-                let p2 = apply_i64_in::<M>(r[j], q[j][2], bb);
-                p[j] = [one - p1 - p2, p1, p2];
-                fast[j] = p1.unsigned_abs() <= BARY_LIMIT as u64
-                    && p2.unsigned_abs() <= BARY_LIMIT as u64;
-                // The reciprocal of the barycentrics is that of the derivatives: its square.
-                r[j] = square(r[j], m_bits, M::MODE);
+            None => fits(j),
+        };
+        let fast = lane.and_then(|[q1, q2, d]| {
+            let small = (d as u64 | q1.unsigned_abs() | q2.unsigned_abs() | steps_mag) >> 62 == 0;
+            if !small || d <= 0 {
+                return None;
             }
-        }
-        for j in 0..chunk {
-            if let Some((_, ny)) = &mut numerators {
-                *ny = [ny[0].wrapping_add(y_step[0]), ny[1].wrapping_add(y_step[1])];
-            }
-            if !fast[j] {
-                let e = lane_edges(edge, edge_dx, base + j);
-                out(
-                    base + j,
-                    derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
-                );
-                continue;
-            }
-            let (pj, qj, r2) = (p[j], q[j], r[j]);
-            let (nx, ny) = *numerators.get_or_insert_with(|| {
-                let dw = wide(d[j]);
+            // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+            let r = recip.eval(d as u64, &mut SatCounter::default());
+            let p1 = apply_i64_in::<M>(r, q1, bb);
+            let p2 = apply_i64_in::<M>(r, q2, bb);
+            let limit = BARY_LIMIT as u64;
+            // The reciprocal of the barycentrics is that of the derivatives: its square.
+            (p1.unsigned_abs() <= limit && p2.unsigned_abs() <= limit).then(|| {
                 (
-                    [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
-                    [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+                    [q1, q2, d],
+                    [one - p1 - p2, p1, p2],
+                    square(r, m_bits, M::MODE),
                 )
-            });
-            let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
-            let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
-            let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
-            let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
+            })
+        });
+        let Some(([q1, q2, d], pj, r2)) = fast else {
+            let e = lane_edges(edge, edge_dx, j);
             out(
-                base + j,
-                [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]],
+                j,
+                derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
             );
-        }
+            continue;
+        };
+        let (nx, ny) = *numerators.get_or_insert_with(|| {
+            let (dw, qj) = (wide(d), [0, q1, q2]);
+            (
+                [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
+                [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+            )
+        });
+        let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
+        let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
+        let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
+        let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
+        out(j, [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]]);
     }
 }
 
@@ -507,8 +508,11 @@ type NumeratorTop = (i128, u32);
 /// The numerator of [`derivative`] kept to its top 94 bits ([`NumeratorTop`]).
 #[inline(always)]
 fn numerator_top(n: i128) -> NumeratorTop {
-    // |N| < 2^126, so `ns` <= 32 and `n >> ns` is a 64-bit funnel shift.
-    let ns = (128 - n.unsigned_abs().leading_zeros()).saturating_sub(94) & 63;
+    // |N| < 2^126, so `ns` <= 32 and `n >> ns` is a 64-bit funnel shift. `ns` from the high
+    // word of |N| alone: at or above 2^64 the bit length of |N| is 64 plus that of its high
+    // word, below it `ns` is 0 either way.
+    let high = (n.unsigned_abs() >> 64) as u64;
+    let ns = (64 - high.leading_zeros()).saturating_sub(30) & 63;
     (n >> ns, ns)
 }
 
@@ -522,16 +526,30 @@ fn derivative_of_top<M: ConstRounding>(
 ) -> i64 {
     let sh = r2.shift - (bary_bits + ns) as i32;
     // `apply_in`'s exact product and rounding (|x| <= 2^94, a mantissa below 2^31).
-    let v = if sh >= 0 && r2.mant >> 31 == 0 {
+    let v = if r2.mant >> 31 == 0 && (64..126).contains(&sh) {
+        // The product is below 2^125: its top bits from bit 62 fit `i64`, and the 62 below
+        // fold into a sticky bit under the rounding position (`sh - 62` >= 2), as
+        // `round_shift_right_wide` does for these shifts.
+        let prod = x * i128::from(r2.mant as i64);
+        let top = (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0);
+        round_shift_right(top, (sh - 62) as u32, M::MODE)
+    } else if sh >= 0 && r2.mant >> 31 == 0 {
         round_shift_right_wide(x * i128::from(r2.mant as i64), sh as u32, M::MODE)
     } else {
         apply_in::<M>(r2, x, bary_bits + ns)
     };
-    let dp = v.clamp(-BARY_LIMIT, BARY_LIMIT);
-    if dp != v {
-        sat.saturated += 1;
+    if v.unsigned_abs() > BARY_LIMIT as u64 {
+        return clamp_counted(v, sat);
     }
-    dp
+    v
+}
+
+/// A derivative beyond +-[`BARY_LIMIT`]: the clamp, counted.
+#[cold]
+#[inline(never)]
+fn clamp_counted(v: i64, sat: &mut SatCounter) -> i64 {
+    sat.saturated += 1;
+    v.clamp(-BARY_LIMIT, BARY_LIMIT)
 }
 
 /// The same datapath as [`perspective_bary`] when every `q_i` and their sum fit `i64`
@@ -1333,5 +1351,88 @@ mod tests {
             }
         }
         assert!(fast > 500_000 && fallback > 500_000, "{fast} {fallback}");
+    }
+
+    /// 400k seeded spans of 1 to 24 lanes over 5 configurations x 3 interpolator roundings,
+    /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
+    /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
+    /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
+    /// are many both in spans whose `q_1`, `q_2`, `D` step along the span (both ends fit
+    /// `i64`) and in spans whose lanes test their own.
+    #[test]
+    fn derivs_span_stepping_matches_per_lane_calls() {
+        let mut s = 0x5eed_0b47;
+        let (mut stepped, mut tested) = (0u64, 0u64);
+        let mut got = [[[0i64; 3]; 3]; 24];
+        for (c, hw0) in previous_configs().into_iter().enumerate() {
+            for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
+                let mut hw = hw0.clone();
+                hw.interp.interp_rounding = mode;
+                let (cfg, recip) = (&hw.interp, Reciprocal::new(&hw.reciprocal));
+                let wb = cfg.inv_w_bits;
+                for i in 0..(400_000 / 15) {
+                    let n = 1 + (next(&mut s) % 24) as usize;
+                    let eb = [20, 40, 62 - wb - 1, 62 - wb, 63 - wb, 62][(i % 6) as usize];
+                    // The last: steps that carry a span from the fast form out of `i64`.
+                    let (db, dsh) = [(4, 5), (30, 5), (eb.saturating_sub(3).max(1), 5), (eb, 5)]
+                        .into_iter()
+                        .chain([(60 - wb, 0)])
+                        .nth((i / 6 % 5) as usize)
+                        .unwrap_or((4, 5));
+                    let mut edge = [0; 3].map(|_| signed(&mut s, eb));
+                    if i % 3 != 0 {
+                        edge = edge.map(i64::abs);
+                    }
+                    let dx = [0; 3].map(|_| signed(&mut s, db) >> dsh);
+                    let dy = [0; 3].map(|_| signed(&mut s, db));
+                    let mut inv_w = [0; 3].map(|_| (next(&mut s) >> (64 - wb)) as i64 + 1);
+                    inv_w[(i as usize + c) % 3] = 1 << wb;
+                    let at = |j: usize| {
+                        [0, 1, 2].map(|k| i128::from(edge[k]) + j as i128 * i128::from(dx[k]))
+                    };
+                    if at(n - 1).iter().any(|e| i64::try_from(*e).is_err()) {
+                        continue;
+                    }
+                    let span = EdgeSpan {
+                        edge,
+                        dx,
+                        dy,
+                        lanes: n,
+                    };
+                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
+                    perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
+                        got[j] = b;
+                    });
+                    // Whether the ends' products and sums fit `i64` (the span steps them).
+                    let fits = |j: usize| {
+                        let q = [0, 1, 2].map(|k| at(j)[k] * i128::from(inv_w[k]));
+                        [q[0], q[1], q[2], q[0] + q[1], q[0] + q[1] + q[2]]
+                            .iter()
+                            .all(|v| i64::try_from(*v).is_ok())
+                    };
+                    let ends_fit = fits(0) && fits(n - 1);
+                    for (j, lane) in got[..n].iter().enumerate() {
+                        let e = at(j).map(|v| v as i64);
+                        let want = perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);
+                        let why = (e, dx, dy, inv_w, mode, c, j, n);
+                        assert_eq!(*lane, want, "{why:?}");
+                        let q = [0, 1, 2].map(|k| i128::from(e[k]) * i128::from(inv_w[k]));
+                        let d = q[0] + q[1] + q[2];
+                        if d > 0
+                            && (d.unsigned_abs() | q[1].unsigned_abs() | q[2].unsigned_abs()) >> 62
+                                == 0
+                        {
+                            if ends_fit {
+                                stepped += 1;
+                            } else {
+                                tested += 1;
+                            }
+                        }
+                    }
+                    assert_eq!(sa, sb, "{edge:?} {dx:?} {dy:?} {inv_w:?} {mode:?} {c} {n}");
+                }
+            }
+        }
+        assert!(stepped > 300_000 && tested > 20_000, "{stepped} {tested}");
     }
 }

@@ -2,7 +2,7 @@
 //! `interpolate_pairs_span`) against one call of the per-sample routine per lane: the same
 //! values and the same saturation counts, on seeded spans over random widths and rounding
 //! modes, from screen-sized to near-degenerate and huge triangles, tiny and large 1/w, lanes
-//! inside and outside the triangle, spans longer than the datapath's chunk.
+//! inside and outside the triangle, spans longer than `SPAN_LANES`.
 
 use crate::rng_common::Rng;
 use hw_model::config::HwConfig;
