@@ -151,6 +151,10 @@ impl Cache {
         };
         let s = set_index as usize * self.ways;
         let set = &mut self.tags[s..s + self.ways];
+        // The most recent line: nothing moves.
+        if set[0] == key {
+            return true;
+        }
         // Move the line to the front: ways are few, so shift them one by one.
         let (last, hit) = match set.iter().position(|&t| t == key) {
             Some(i) => (i, true),
@@ -199,26 +203,32 @@ const DUMMY_LEVEL: LevelAddr = LevelAddr {
 };
 
 /// Address map of the textures: level base indices for cache lines and DRAM pages (tiles are
-/// powers of two, so indices are shifts). The levels of every texture are in one list,
-/// texture `t`'s from `first[t]` to `first[t + 1]`.
+/// powers of two, so indices are shifts). The levels of every texture are in one table of
+/// `2^shift` entries per texture: texture `t`'s level `l` is entry `t << shift | l`, the
+/// entries beyond a texture's levels being the dummy level; `first` (texture `t`'s levels are
+/// `first[t]..first[t + 1]` in order) checks a lookup in debug builds.
+#[derive(Clone)]
 struct AddressMap {
-    levels: Vec<LevelAddr>,
+    table: Vec<LevelAddr>,
+    shift: u32,
     first: Vec<usize>,
 }
 
 impl AddressMap {
     fn new(textures: &[TextureLayout], tc: &TimingConfig) -> Self {
         let (mut lb, mut pb) = (0u64, 0u64);
-        let mut levels = Vec::new();
+        let most = textures.iter().map(|t| t.levels.len()).max().unwrap_or(0);
+        let shift = most.next_power_of_two().trailing_zeros();
+        let mut table = vec![DUMMY_LEVEL; textures.len() << shift];
         let mut first = vec![0];
-        for t in textures {
+        for (ti, t) in textures.iter().enumerate() {
             let bytes = t.texel_bytes.max(1);
             let lt = tile(tc.cache_line_bytes / bytes);
             let pt = tile(tc.dram_page_bytes / bytes);
-            for &(w, h) in &t.levels {
+            for (li, &(w, h)) in t.levels.iter().enumerate() {
                 let line_row = u64::from(w.div_ceil(lt.0));
                 let page_row = u64::from(w.div_ceil(pt.0));
-                levels.push(LevelAddr {
+                table[ti << shift | li] = LevelAddr {
                     width: w,
                     line_base: lb,
                     line_row,
@@ -227,31 +237,32 @@ impl AddressMap {
                     line_shift: (lt.0.trailing_zeros(), lt.1.trailing_zeros()),
                     page_shift: (pt.0.trailing_zeros(), pt.1.trailing_zeros()),
                     texel_bytes: bytes,
-                });
+                };
                 lb += line_row * u64::from(h.div_ceil(lt.1));
                 pb += page_row * u64::from(h.div_ceil(pt.1));
             }
-            first.push(levels.len());
+            first.push(first[ti] + t.levels.len());
         }
-        Self { levels, first }
+        Self {
+            table,
+            shift,
+            first,
+        }
     }
 
     /// The address record of a level (a dummy 1-texel level if out of range, which a
     /// render's event stream never produces: checked in debug builds).
     #[inline]
     fn level(&self, tex: u16, level: u8) -> &LevelAddr {
-        let t = usize::from(tex);
-        let i = self
-            .first
-            .get(t)
-            .map_or(usize::MAX, |&f| f + usize::from(level));
-        let end = self.first.get(t + 1).copied().unwrap_or(0);
+        let (t, l) = (usize::from(tex), usize::from(level));
         debug_assert!(
-            i < end,
+            self.first
+                .get(t + 1)
+                .is_some_and(|&end| self.first[t] + l < end),
             "footprint of texture {tex} level {level} outside the frame's textures"
         );
-        if i < end {
-            &self.levels[i]
+        if l >> self.shift == 0 {
+            self.table.get(t << self.shift | l).unwrap_or(&DUMMY_LEVEL)
         } else {
             &DUMMY_LEVEL
         }
@@ -305,8 +316,8 @@ fn texels(fp: &TexelFootprint) -> [(u32, u32); 4] {
 }
 
 /// Open-page state of the DRAM banks and the counters of the memory system.
-struct Memory<'a> {
-    tc: &'a TimingConfig,
+#[derive(Clone)]
+struct Memory {
     map: AddressMap,
     cache: Option<Cache>,
     open_page: Vec<u64>,
@@ -323,11 +334,16 @@ struct Memory<'a> {
     /// DRAM page hit and miss cycles.
     page_hit: u64,
     page_miss: u64,
+    /// Tiled interleave with a power-of-two bank count: a texel's bank is its tile bits (no
+    /// clamp), so a footprint whose columns and rows differ in those bits reads 4 banks.
+    quad_banks: bool,
+    /// Latency a cache adds to a footprint (`cache_hit_cycles`).
+    hit_latency: u64,
     counts: MemoryCounts,
 }
 
 /// The memory's running sums; [`MemoryCounts::report`] derives the rest of the report.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct MemoryCounts {
     footprints: u64,
     accesses: u64,
@@ -367,8 +383,8 @@ impl MemoryCounts {
     }
 }
 
-impl<'a> Memory<'a> {
-    fn new(textures: &[TextureLayout], tc: &'a TimingConfig) -> Self {
+impl Memory {
+    fn new(textures: &[TextureLayout], tc: &TimingConfig) -> Self {
         let cache = (tc.cache_bytes > 0).then(|| {
             let ways = tc.cache_ways.max(1);
             let sets = tc.cache_bytes / (tc.cache_line_bytes * ways);
@@ -377,7 +393,6 @@ impl<'a> Memory<'a> {
         let banks = tc.banks.max(1);
         let bank_tile = tile(banks);
         Self {
-            tc,
             map: AddressMap::new(textures, tc),
             cache,
             open_page: vec![EMPTY; banks as usize],
@@ -392,19 +407,96 @@ impl<'a> Memory<'a> {
             },
             page_hit: u64::from(tc.dram_page_hit_cycles),
             page_miss: u64::from(tc.dram_page_miss_cycles),
+            hit_latency: u64::from(tc.cache_hit_cycles),
+            quad_banks: tc.bank_interleave == BankInterleave::Tiled && banks.is_power_of_two(),
             counts: MemoryCounts::default(),
         }
     }
 
     /// Performs one footprint's accesses; returns (occupancy, latency) in cycles and the texel
-    /// bytes read. The distinct texels of the footprint, in the order (x0, y0), (x1, y0),
+    /// bytes read ([`Memory::footprint_any`], with a fast path for the common footprint: on a
+    /// tiled interleave with a power-of-two bank count, two columns and two rows whose bank
+    /// bits differ put the four texels in four banks, so there is no conflict and the bank
+    /// accesses are independent; a texel whose cache line is the previous texel's hits without
+    /// a lookup, that line being the most recent of its set). Checked against the general
+    /// path by `fast_footprints_match_the_general_path` and against the previous model.
+    #[inline(always)]
+    fn footprint<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        fp: &TexelFootprint,
+    ) -> (u64, u64, u64) {
+        let (m0, m1) = self.tile_mask;
+        if !(TILED
+            && self.quad_banks
+            && (fp.x[0] ^ fp.x[1]) & m0 != 0
+            && (fp.y[0] ^ fp.y[1]) & m1 != 0)
+        {
+            return self.footprint_any::<CACHED, TILED>(fp);
+        }
+        let lv = self.map.level(fp.tex, fp.level);
+        let sh = self.tile_shift;
+        let bank_col = fp.x.map(|x| (x & m0) as usize);
+        let bank_row = fp.y.map(|y| ((y & m1) << sh) as usize);
+        let (px, py) = lv.page_shift;
+        let (lx, ly) = lv.line_shift;
+        let page_col = fp.x.map(|x| u64::from(x >> px));
+        let page_row =
+            fp.y.map(|y| lv.page_base + u64::from(y >> py) * lv.page_row);
+        let line_col = fp.x.map(|x| u64::from(x >> lx));
+        let line_row =
+            fp.y.map(|y| lv.line_base + u64::from(y >> ly) * lv.line_row);
+        let texel_bytes = u64::from(lv.texel_bytes);
+        let (page_hit, page_miss) = (self.page_hit, self.page_miss);
+        let open_page = &mut self.open_page[..];
+        let mut cache = self.cache.as_mut();
+        let mut last_line = None;
+        let (mut hits, mut page_hits, mut slowest) = (0u64, 0u64, 0u64);
+        for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            let hit = CACHED && {
+                let line = line_row[r] + line_col[c];
+                let hit = last_line == Some(line)
+                    || cache.as_mut().is_some_and(|cache| cache.access(line));
+                last_line = Some(line);
+                hit
+            };
+            hits += u64::from(hit);
+            let occ = if hit {
+                1
+            } else {
+                let page = page_row[r] + page_col[c];
+                let open = &mut open_page[bank_col[c] | bank_row[r]];
+                if *open == page {
+                    page_hits += 1;
+                    page_hit
+                } else {
+                    *open = page;
+                    page_miss
+                }
+            };
+            slowest = slowest.max(occ);
+        }
+        let occ = slowest.max(1);
+        let bytes = 4 * texel_bytes;
+        let fastest = if CACHED { 1 } else { page_hit };
+        let k = &mut self.counts;
+        k.footprints += 1;
+        k.accesses += 4;
+        k.bytes += bytes;
+        k.cache_hits += hits;
+        k.page_hits += page_hits;
+        k.miss_cycles += slowest.saturating_sub(fastest);
+        (occ, occ + if CACHED { self.hit_latency } else { 0 }, bytes)
+    }
+
+    /// Performs one footprint's accesses, any footprint; returns (occupancy, latency) in
+    /// cycles and the texel bytes read. The distinct texels of the footprint, in the order (x0, y0), (x1, y0),
     /// (x0, y1), (x1, y1), are each one bank access (a footprint on a 1-texel-wide or -high
     /// level collapses its repeated columns or rows). Compiled with (`CACHED`) or without a
     /// texel cache, for the tiled (`TILED`) or linear bank interleave; a row's page (and line)
     /// index is computed once for its columns, and conflicts are counted as the accesses find
     /// their bank already used.
-    #[inline(always)]
-    fn footprint<const CACHED: bool, const TILED: bool>(
+    #[inline(never)]
+    fn footprint_any<const CACHED: bool, const TILED: bool>(
         &mut self,
         fp: &TexelFootprint,
     ) -> (u64, u64, u64) {
@@ -426,57 +518,79 @@ impl<'a> Memory<'a> {
             };
             b.min(last_bank)
         };
-        let cols = if fp.x[0] == fp.x[1] { 1 } else { 2 };
-        let rows = if fp.y[0] == fp.y[1] { 1 } else { 2 };
+        let two_cols = fp.x[0] != fp.x[1];
+        let two_rows = fp.y[0] != fp.y[1];
         let (px, py) = lv.page_shift;
         let (lx, ly) = lv.line_shift;
         let page_col = fp.x.map(|x| u64::from(x >> px));
         let line_col = fp.x.map(|x| u64::from(x >> lx));
         let mut cache = self.cache.as_mut();
         let open_page = &mut self.open_page[..];
-        let mut bank = [0usize; 4];
-        let mut occs = [0u64; 4];
-        let mut n = 0;
-        let mut slowest = 0u64;
-        let (mut hits, mut page_hits, mut used, mut conflicts) = (0u64, 0u64, 0u64, 0u64);
-        for &y in fp.y.iter().take(rows) {
-            let page_row = lv.page_base + u64::from(y >> py) * lv.page_row;
-            let line_row = lv.line_base + u64::from(y >> ly) * lv.line_row;
-            for c in 0..cols {
-                let b = bank_of_texel(fp.x[c], y);
-                let hit = CACHED
-                    && cache
-                        .as_mut()
-                        .is_some_and(|cache| cache.access(line_row + line_col[c]));
-                hits += u64::from(hit);
-                let occ = if hit {
-                    1
+        let mut acc = Accesses::default();
+        // One texel access: column `c` of row `y` (whose page and line rows are given).
+        let mut access = |c: usize, y: u32, page_row: u64, line_row: u64| {
+            let b = bank_of_texel(fp.x[c], y);
+            let hit = CACHED
+                && cache
+                    .as_mut()
+                    .is_some_and(|cache| cache.access(line_row + line_col[c]));
+            acc.hits += u64::from(hit);
+            let occ = if hit {
+                1
+            } else {
+                let page = page_row + page_col[c];
+                let open = &mut open_page[b];
+                if *open == page {
+                    acc.page_hits += 1;
+                    page_hit
                 } else {
-                    let page = page_row + page_col[c];
-                    let open = &mut open_page[b];
-                    if *open == page {
-                        page_hits += 1;
-                        page_hit
-                    } else {
-                        *open = page;
-                        page_miss
-                    }
-                };
-                // Banks number at most 64 (`TimingConfig::validate`).
-                let bit = 1u64 << (b & 63);
-                conflicts += u64::from(used & bit != 0);
-                used |= bit;
-                bank[n & 3] = b;
-                occs[n & 3] = occ;
-                n += 1;
-                slowest = slowest.max(occ);
+                    *open = page;
+                    page_miss
+                }
+            };
+            // Banks number at most 64 (`TimingConfig::validate`).
+            let bit = 1u64 << (b & 63);
+            acc.conflicts += u64::from(acc.used & bit != 0);
+            acc.used |= bit;
+            acc.bank[acc.n & 3] = b;
+            acc.occ[acc.n & 3] = occ;
+            acc.n += 1;
+            acc.slowest = acc.slowest.max(occ);
+        };
+        let rows_of = |y: u32| {
+            (
+                lv.page_base + u64::from(y >> py) * lv.page_row,
+                lv.line_base + u64::from(y >> ly) * lv.line_row,
+            )
+        };
+        let (p0, l0) = rows_of(fp.y[0]);
+        access(0, fp.y[0], p0, l0);
+        if two_cols {
+            access(1, fp.y[0], p0, l0);
+        }
+        if two_rows {
+            let (p1, l1) = rows_of(fp.y[1]);
+            access(0, fp.y[1], p1, l1);
+            if two_cols {
+                access(1, fp.y[1], p1, l1);
             }
         }
+        let Accesses {
+            bank,
+            occ: occs,
+            n,
+            slowest,
+            hits,
+            page_hits,
+            conflicts,
+            ..
+        } = acc;
         // Conflicts: accesses beyond the first in a bank. The footprint occupies the memory for
         // its busiest bank (the summed cycles of the bank's accesses; without a conflict, the
         // slowest access).
         let accesses = n as u64;
         let mut occ = slowest.max(1);
+        let k = &mut self.counts;
         if conflicts > 0 {
             for i in 0..n {
                 let busy: u64 = (i..n)
@@ -485,25 +599,39 @@ impl<'a> Memory<'a> {
                     .sum();
                 occ = occ.max(busy);
             }
+            k.bank_conflicts += conflicts;
+            k.conflicting_footprints += 1;
+            k.conflict_cycles += occ - slowest.max(1);
         }
         let bytes = accesses * u64::from(lv.texel_bytes);
         let (fastest, hit_latency) = if CACHED {
-            (1, u64::from(self.tc.cache_hit_cycles))
+            (1, self.hit_latency)
         } else {
             (page_hit, 0)
         };
-        let k = &mut self.counts;
         k.footprints += 1;
         k.accesses += accesses;
         k.bytes += bytes;
         k.cache_hits += hits;
         k.page_hits += page_hits;
-        k.bank_conflicts += conflicts;
-        k.conflicting_footprints += u64::from(conflicts > 0);
-        k.conflict_cycles += occ - slowest.max(1);
         k.miss_cycles += slowest.saturating_sub(fastest);
         (occ, occ + hit_latency, bytes)
     }
+}
+
+/// The bank accesses of one footprint so far ([`Memory::footprint`]): each one's bank and
+/// cycles, their count, the slowest, the cache and page hits, the banks used (a bit each)
+/// and the conflicts.
+#[derive(Default)]
+struct Accesses {
+    bank: [usize; 4],
+    occ: [u64; 4],
+    n: usize,
+    slowest: u64,
+    hits: u64,
+    page_hits: u64,
+    used: u64,
+    conflicts: u64,
 }
 
 /// A unit that serves requests in arrival order.
@@ -556,6 +684,16 @@ fn stage_footprints<'f>(
         .map_or(&[], run_from)
 }
 
+/// A filter unit's (occupancy, occupancy-or-latency) for a lookup of `nfp` footprints at
+/// `bpc` bilinear footprints per cycle: it is busy `ceil(nfp / bpc)` cycles and its result is
+/// ready `nfp` bilinear latencies plus the level blend's (two or more footprints) after it
+/// starts, or when it frees if later.
+fn filter_cost(nfp: u64, bpc: u64, bilinear_lat: u64, blend_lat: u64) -> (u64, u64) {
+    let occ = nfp.div_ceil(bpc);
+    let lat = nfp * bilinear_lat + if nfp > 1 { blend_lat } else { 0 };
+    (occ, lat.max(occ))
+}
+
 /// The counts of a frame's visibility pass (what the timing model needs beside its pixels).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FrameCounts {
@@ -575,22 +713,27 @@ pub struct FrameCounts {
 /// pixels in order gives exactly [`simulate`] of its events.
 pub struct Simulator<'a> {
     hw: &'a HwConfig,
-    /// Per plan, its stages as (kind index, cycles, arithmetic-unit occupancy).
-    steps: Vec<Vec<(usize, u64, u64)>>,
-    alu: Vec<Unit>,
-    stage_bytes: Vec<u64>,
+    /// Every plan's stages, plan after plan ([`PlanSteps`] says where each plan's are).
+    steps: Vec<Step>,
+    plans: Vec<PlanSteps>,
+    /// Per stage kind (index below [`KINDS`]) its arithmetic unit and the texel bytes its
+    /// lookups read.
+    alu: [Unit; KINDS],
+    stage_bytes: [u64; KINDS],
     mem_unit: Unit,
     filters: Vec<Unit>,
-    mem: Memory<'a>,
+    mem: Memory,
     tri_cycles: u64,
     bilinear_lat: u64,
     blend_lat: u64,
     bpc: u64,
+    /// [`filter_cost`] of a lookup of 0, 1, 2 and 3 footprints.
+    filter_cost: [(u64, u64); 4],
     ppc: u64,
     alu_pipelined: bool,
     /// Stall cycles by cause: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2
-    /// latency.
-    stall_by: Vec<u64>,
+    /// latency (nk = `StageKind::COUNT`; causes below [`CAUSES`]).
+    stall_by: [u64; CAUSES],
     /// Completion time and worst cause of the last `shade_pixels_in_flight` pixels.
     ring: Vec<(u64, usize)>,
     last_issue: u64,
@@ -604,9 +747,39 @@ pub struct Simulator<'a> {
     group: u64,
     in_group: u64,
     slot: usize,
-    /// Per plan: its stage kinds are distinct, so a pixel's footprints (recorded in the
-    /// plan's order) are matched to its stages by one cursor ([`Simulator::pixel`]).
-    distinct: Vec<bool>,
+    /// [`Simulator::issue_in`] compiled for this machine's memory (cache or not, bank
+    /// interleave), chosen once.
+    issue: IssueFn<'a>,
+}
+
+/// A compiled [`Simulator::issue_in`].
+type IssueFn<'a> = fn(&mut Simulator<'a>, u32, &[TexelFootprint]);
+
+/// Slots of the per-stage-kind arrays (stage kinds number at most 64), indexed by
+/// `kind & (KINDS - 1)`.
+const KINDS: usize = 64;
+/// Slots of the stall causes (stage kinds, memory, filters, latency), indexed by
+/// `cause & (CAUSES - 1)`.
+const CAUSES: usize = 128;
+const _: () = assert!(StageKind::COUNT + 3 <= CAUSES);
+
+/// One stage of a plan as the model walks it: its kind index, cycles and arithmetic-unit
+/// occupancy.
+#[derive(Clone, Copy, Debug)]
+struct Step {
+    k: usize,
+    cycles: u64,
+    occ: u64,
+}
+
+/// Where a plan's stages are in [`Simulator::steps`] (`start..end`), and whether its stage
+/// kinds are distinct: then a pixel's footprints (recorded in the plan's order) are matched
+/// to its stages by one cursor ([`stage_footprints`]).
+#[derive(Clone, Copy, Debug)]
+struct PlanSteps {
+    start: usize,
+    end: usize,
+    distinct: bool,
 }
 
 impl<'a> Simulator<'a> {
@@ -614,7 +787,6 @@ impl<'a> Simulator<'a> {
     #[must_use]
     pub fn new(plans: &[PlanTiming], textures: &[TextureLayout], hw: &'a HwConfig) -> Self {
         let tc = &hw.timing;
-        let nk = StageKind::ALL.len();
         let glpc = tc.gate_levels_per_cycle;
         let tri_cost = trilinear_cost(&hw.trilinear, 2, glpc);
         let (bilinear_lat, blend_lat) = hw_model::trilinear::filter_latencies(&hw.trilinear, glpc);
@@ -625,42 +797,55 @@ impl<'a> Simulator<'a> {
                 cycles
             }
         };
-        let steps = plans
+        let mut steps = Vec::new();
+        let plans = plans
             .iter()
             .map(|p| {
-                p.stages
-                    .iter()
-                    .map(|&(kind, cost)| {
-                        let c = u64::from(cost.cycles);
-                        (kind.index(), c, alu_occ(c))
-                    })
-                    .collect()
-            })
-            .collect();
-        let distinct = plans
-            .iter()
-            .map(|p| {
+                let start = steps.len();
+                steps.extend(p.stages.iter().map(|&(kind, cost)| {
+                    let c = u64::from(cost.cycles);
+                    Step {
+                        k: kind.index(),
+                        cycles: c,
+                        occ: alu_occ(c),
+                    }
+                }));
                 let kinds = p.stages.iter().fold(0u64, |m, &(k, _)| m | 1 << k.index());
-                kinds.count_ones() as usize == p.stages.len()
+                PlanSteps {
+                    start,
+                    end: steps.len(),
+                    distinct: kinds.count_ones() as usize == p.stages.len(),
+                }
             })
             .collect();
         let win = tc.shade_pixels_in_flight.max(1) as usize;
+        let (bilinear_lat, blend_lat) = (u64::from(bilinear_lat), u64::from(blend_lat));
+        let bpc = u64::from(tc.bilinear_per_cycle.max(1));
+        let tiled = tc.bank_interleave == BankInterleave::Tiled;
+        let issue: IssueFn<'a> = match (tc.cache_bytes > 0, tiled) {
+            (true, true) => Self::issue_in::<true, true>,
+            (true, false) => Self::issue_in::<true, false>,
+            (false, true) => Self::issue_in::<false, true>,
+            (false, false) => Self::issue_in::<false, false>,
+        };
         Self {
             hw,
             steps,
-            alu: vec![Unit::default(); nk],
-            stage_bytes: vec![0; nk],
+            plans,
+            alu: [Unit::default(); KINDS],
+            stage_bytes: [0; KINDS],
             mem_unit: Unit::default(),
             filters: vec![Unit::default(); tc.trilinear_units.max(1) as usize],
             mem: Memory::new(textures, tc),
             tri_cycles: u64::from(tri_cost.cycles),
-            bilinear_lat: u64::from(bilinear_lat),
-            blend_lat: u64::from(blend_lat),
-            bpc: u64::from(tc.bilinear_per_cycle.max(1)),
+            bilinear_lat,
+            blend_lat,
+            bpc,
+            filter_cost: [0, 1, 2, 3].map(|n| filter_cost(n, bpc, bilinear_lat, blend_lat)),
             ppc: u64::from(tc.shade_pixels_per_cycle.max(1)),
             alu_pipelined: tc.alu_pipelined,
-            stall_by: vec![0; nk + 3],
-            ring: vec![(0, nk + 2); win],
+            stall_by: [0; CAUSES],
+            ring: vec![(0, StageKind::COUNT + 2); win],
             last_issue: 0,
             end: 0,
             pixels: 0,
@@ -668,7 +853,7 @@ impl<'a> Simulator<'a> {
             group: 0,
             in_group: 0,
             slot: 0,
-            distinct,
+            issue,
         }
     }
 
@@ -680,10 +865,11 @@ impl<'a> Simulator<'a> {
     /// Feeds `pixels` in order; their `fp_end` index `footprints`, the previous pixel's end
     /// (0 for the first) being each one's start.
     fn pixels_of(&mut self, pixels: &[PixelEvent], footprints: &[TexelFootprint]) {
+        let issue = self.issue;
         let mut fp_start = 0usize;
         for px in pixels {
             let fp_end = (px.fp_end as usize).min(footprints.len());
-            self.issue(px.plan, &footprints[fp_start.min(fp_end)..fp_end]);
+            issue(self, px.plan, &footprints[fp_start.min(fp_end)..fp_end]);
             fp_start = fp_end;
         }
         self.footprints += footprints.len() as u64;
@@ -693,31 +879,18 @@ impl<'a> Simulator<'a> {
     /// stages fetched in `fps` (counted as events), e.g. straight from the fragment's trace.
     #[inline]
     pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
-        self.issue(plan, fps);
+        (self.issue)(self, plan, fps);
         self.footprints += fps.len() as u64;
     }
 
-    /// [`Simulator::pixel`] without counting the footprints (the caller counts its list's).
-    #[inline]
-    fn issue(&mut self, plan: u32, fps: &[TexelFootprint]) {
-        let tiled = self.mem.tc.bank_interleave == BankInterleave::Tiled;
-        match (self.mem.cache.is_some(), tiled) {
-            (true, true) => self.issue_in::<true, true>(plan, fps),
-            (true, false) => self.issue_in::<true, false>(plan, fps),
-            (false, true) => self.issue_in::<false, true>(plan, fps),
-            (false, false) => self.issue_in::<false, false>(plan, fps),
-        }
-    }
-
-    /// [`Simulator::issue`] with the memory's [`Memory::footprint`] compiled for the machine.
-    #[inline(always)]
+    /// Issues the next covered pixel without counting its footprints (the caller counts),
+    /// with the memory's [`Memory::footprint`] compiled for the machine.
     fn issue_in<const CACHED: bool, const TILED: bool>(
         &mut self,
         plan: u32,
         fps: &[TexelFootprint],
     ) {
-        let nk = self.alu.len();
-        let (c_mem, c_filt, c_lat) = (nk, nk + 1, nk + 2);
+        const C_LAT: usize = StageKind::COUNT + 2;
         // Pixel i issues in group i / ppc, one cycle after the previous group's last pixel
         // when it opens a group (i % ppc == 0, i > 0), and waits for the pixel `win` places
         // before it (ring slot i % win) to complete.
@@ -728,7 +901,7 @@ impl<'a> Simulator<'a> {
         if self.pixels >= self.ring.len() as u64 {
             let (done, cause) = self.ring[slot];
             if done > t {
-                self.stall_by[cause] += done - t;
+                self.stall_by[cause & (CAUSES - 1)] += done - t;
                 t = done;
             }
         }
@@ -744,88 +917,108 @@ impl<'a> Simulator<'a> {
             slot + 1
         };
         self.last_issue = t;
-        let mut worst = (0u64, c_lat);
-        let pi = plan as usize;
-        let Some(plan) = self.steps.get(pi) else {
-            self.ring[slot] = (t, c_lat);
+        let mut worst = (0u64, C_LAT);
+        let Some(&PlanSteps {
+            start,
+            end,
+            distinct,
+        }) = self.plans.get(plan as usize)
+        else {
+            self.ring[slot] = (t, C_LAT);
             return;
         };
         // The stage kinds that fetched (stage kinds number fewer than 64).
         let fetched = fps.iter().fold(0u64, |m, f| m | 1u64 << (f.stage & 63));
-        let cursor_ok = self.distinct[pi];
         let mut cursor = 0usize;
-        for &(k, cycles, occ) in plan {
-            let mine = if fetched & (1u64 << k) == 0 {
-                &[][..]
-            } else {
-                stage_footprints(fps, &mut cursor, k, cursor_ok)
-            };
-            if mine.is_empty() {
-                let s = self.alu[k].take(t, occ);
-                if s - t > worst.0 {
-                    worst = (s - t, k);
+        for i in start..end {
+            let Step { k, cycles, occ } = self.steps[i];
+            if fetched & (1u64 << (k & 63)) != 0 {
+                let mine = stage_footprints(fps, &mut cursor, k, distinct);
+                if !mine.is_empty() {
+                    t = self.texture_stage::<CACHED, TILED>(k, cycles, t, mine, &mut worst);
+                    continue;
                 }
-                t = s + cycles;
-                continue;
             }
-            // Texture stage: address/footprint unit, then each lookup through memory + filter.
-            let lookups = u64::from(mine[mine.len() - 1].lookup) + 1;
-            let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
-            let setup_occ = if self.alu_pipelined {
-                setup.min(1)
-            } else {
-                setup
-            };
-            let s = self.alu[k].take(t, setup_occ);
+            let s = self.alu[k & (KINDS - 1)].take(t, occ);
             if s - t > worst.0 {
                 worst = (s - t, k);
             }
-            let ready = s + setup;
-            let mut done = ready;
-            let mut bytes = 0u64;
-            // The footprints of one lookup are consecutive: `i` walks them lookup by lookup.
-            let mut i = 0;
-            while let Some(first) = mine.get(i) {
-                let l = first.lookup;
-                let mut data = ready;
-                let mut nfp = 0u64;
-                while let Some(f) = mine.get(i).filter(|f| f.lookup == l) {
-                    let (occ, lat, b) = self.mem.footprint::<CACHED, TILED>(f);
-                    bytes += b;
-                    let ms = self.mem_unit.take(ready, occ);
-                    if ms - ready > worst.0 {
-                        worst = (ms - ready, c_mem);
-                    }
-                    data = data.max(ms + lat);
-                    nfp += 1;
-                    i += 1;
-                }
-                // `ceil(nfp / bpc)`; a shift when `bpc` is a power of two (no division).
-                let occ = if self.bpc.is_power_of_two() {
-                    (nfp + self.bpc - 1) >> self.bpc.trailing_zeros()
-                } else {
-                    nfp.div_ceil(self.bpc)
-                };
-                let lat = nfp * self.bilinear_lat + if nfp > 1 { self.blend_lat } else { 0 };
-                let filters = &mut self.filters;
-                let fu = if filters.len() == 1 {
-                    0
-                } else {
-                    (0..filters.len())
-                        .min_by_key(|&j| (filters[j].free.max(data), j))
-                        .unwrap_or(0)
-                };
-                let fs = filters[fu].take(data, occ);
-                if fs - data > worst.0 {
-                    worst = (fs - data, c_filt);
-                }
-                done = done.max(fs + lat.max(occ));
-            }
-            self.stage_bytes[k] += bytes;
-            t = done;
+            t = s + cycles;
         }
         self.ring[slot] = (t, worst.1);
         self.end = self.end.max(t);
+    }
+
+    /// A texture stage of kind `k` (`cycles` per invocation) reached at `t` with its
+    /// footprints `mine` (not empty): its address/footprint unit, then each lookup through
+    /// the memory and a filter unit; returns its completion and updates the pixel's worst
+    /// wait (cycles, cause).
+    #[inline(never)]
+    fn texture_stage<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        k: usize,
+        cycles: u64,
+        t: u64,
+        mine: &[TexelFootprint],
+        worst: &mut (u64, usize),
+    ) -> u64 {
+        const C_MEM: usize = StageKind::COUNT;
+        const C_FILT: usize = StageKind::COUNT + 1;
+        let lookups = u64::from(mine[mine.len() - 1].lookup) + 1;
+        let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
+        let setup_occ = if self.alu_pipelined {
+            setup.min(1)
+        } else {
+            setup
+        };
+        let s = self.alu[k & (KINDS - 1)].take(t, setup_occ);
+        if s - t > worst.0 {
+            *worst = (s - t, k);
+        }
+        let ready = s + setup;
+        let mut done = ready;
+        let mut bytes = 0u64;
+        // The footprints of one lookup are consecutive: `rest` walks them lookup by lookup.
+        let mut rest = mine;
+        while let Some(first) = rest.first() {
+            let l = first.lookup;
+            let n = rest
+                .iter()
+                .position(|f| f.lookup != l)
+                .unwrap_or(rest.len());
+            let (lookup, tail) = rest.split_at(n);
+            rest = tail;
+            let mut data = ready;
+            for f in lookup {
+                let (occ, lat, b) = self.mem.footprint::<CACHED, TILED>(f);
+                bytes += b;
+                let ms = self.mem_unit.take(ready, occ);
+                if ms - ready > worst.0 {
+                    *worst = (ms - ready, C_MEM);
+                }
+                data = data.max(ms + lat);
+            }
+            // The filter's occupancy and its occupancy-or-latency for `n` footprints.
+            let (occ, lat) = match self.filter_cost.get(n) {
+                Some(&c) => c,
+                None => filter_cost(n as u64, self.bpc, self.bilinear_lat, self.blend_lat),
+            };
+            let filters = &mut self.filters[..];
+            let fu = if filters.len() == 1 {
+                0
+            } else {
+                (0..filters.len())
+                    .min_by_key(|&j| (filters[j].free.max(data), j))
+                    .unwrap_or(0)
+            };
+            let fs = filters[fu].take(data, occ);
+            if fs - data > worst.0 {
+                *worst = (fs - data, C_FILT);
+            }
+            done = done.max(fs + lat);
+        }
+        self.stage_bytes[k & (KINDS - 1)] += bytes;
+        done
     }
 
     /// Adds the visibility pass of the frame (`f`) and reports.
@@ -834,7 +1027,7 @@ impl<'a> Simulator<'a> {
         let hw = self.hw;
         let tc = &hw.timing;
         let rc = &hw.raster;
-        let nk = self.alu.len();
+        let nk = StageKind::COUNT;
         let c_lat = nk + 2;
         let (c_mem, c_filt) = (nk, nk + 1);
         let (alu, stall_by, mem_unit, filters, stage_bytes) = (
@@ -965,4 +1158,94 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
     let mut sim = Simulator::new(&ev.plans, &ev.textures, hw);
     sim.pixels_of(&ev.pixels, &ev.footprints);
     sim.finish(&ev.counts(), scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Memory, TexelFootprint, TextureLayout};
+    use crate::rng_common::Rng;
+    use hw_model::timing_config::BankInterleave;
+    use hw_model::HwConfig;
+
+    /// [`Memory::footprint`] (with its four-bank fast path) against [`Memory::footprint_any`]
+    /// (the general path) on seeded random machines and footprints, most of them 2x2 on
+    /// neighbouring texels: the same cycles and bytes, counters, open pages and cache lines
+    /// after every footprint.
+    #[test]
+    fn fast_footprints_match_the_general_path() {
+        let mut r = Rng(0x0f00_7b12);
+        let pick = |r: &mut Rng, xs: &[u32]| xs[r.below(xs.len() as u64) as usize];
+        for case in 0..300 {
+            let mut tc = HwConfig::texram16().timing;
+            tc.banks = pick(&mut r, &[1, 2, 4, 6, 8, 16, 64]);
+            tc.bank_interleave = if r.below(4) == 0 {
+                BankInterleave::Linear
+            } else {
+                BankInterleave::Tiled
+            };
+            tc.cache_bytes = pick(&mut r, &[0, 256, 4096]);
+            tc.cache_line_bytes = pick(&mut r, &[8, 16, 64]);
+            tc.cache_ways = pick(&mut r, &[1, 2, 4]);
+            tc.cache_hit_cycles = pick(&mut r, &[0, 3]);
+            tc.dram_page_bytes = pick(&mut r, &[64, 512, 2048]);
+            tc.dram_page_hit_cycles = pick(&mut r, &[1, 2]);
+            tc.dram_page_miss_cycles = pick(&mut r, &[1, 9, 40]);
+            let textures: Vec<TextureLayout> = (0..1 + r.below(3))
+                .map(|_| {
+                    let (w, h) = (1 + r.below(70) as u32, 1 + r.below(70) as u32);
+                    TextureLayout {
+                        levels: vec![(w, h), ((w / 2).max(1), (h / 2).max(1))],
+                        texel_bytes: pick(&mut r, &[1, 2, 4, 8]),
+                    }
+                })
+                .collect();
+            let mut fast = Memory::new(&textures, &tc);
+            let mut general = fast.clone();
+            for i in 0..400 {
+                let tex = r.below(textures.len() as u64) as usize;
+                let level = r.below(2) as usize;
+                let (w, h) = textures[tex].levels[level];
+                let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
+                let x1 = if r.below(10) == 0 { x0 } else { (x0 + 1) % w };
+                let y1 = if r.below(10) == 0 { y0 } else { (y0 + 1) % h };
+                let fp = TexelFootprint {
+                    stage: 0,
+                    lookup: 0,
+                    level: level as u8,
+                    tex: tex as u16,
+                    x: [x0, x1],
+                    y: [y0, y1],
+                };
+                let (want, got) = match (tc.cache_bytes > 0, tc.bank_interleave) {
+                    (true, BankInterleave::Tiled) => (
+                        general.footprint_any::<true, true>(&fp),
+                        fast.footprint::<true, true>(&fp),
+                    ),
+                    (false, BankInterleave::Tiled) => (
+                        general.footprint_any::<false, true>(&fp),
+                        fast.footprint::<false, true>(&fp),
+                    ),
+                    (true, BankInterleave::Linear) => (
+                        general.footprint_any::<true, false>(&fp),
+                        fast.footprint::<true, false>(&fp),
+                    ),
+                    (false, BankInterleave::Linear) => (
+                        general.footprint_any::<false, false>(&fp),
+                        fast.footprint::<false, false>(&fp),
+                    ),
+                };
+                assert_eq!(got, want, "case {case} footprint {i}: {fp:?}");
+                assert_eq!(fast.counts, general.counts, "case {case} footprint {i}");
+                assert_eq!(
+                    fast.open_page, general.open_page,
+                    "case {case} footprint {i}"
+                );
+                assert_eq!(
+                    fast.cache.as_ref().map(|c| &c.tags),
+                    general.cache.as_ref().map(|c| &c.tags),
+                    "case {case} footprint {i}"
+                );
+            }
+        }
+    }
 }
