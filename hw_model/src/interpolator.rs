@@ -299,7 +299,9 @@ pub fn perspective_bary_derivs_span(
     out: impl FnMut(usize, [[i64; 3]; 3]),
 ) {
     crate::with_rounding!(cfg.interp_rounding, M => {
-        perspective_bary_derivs_span_in::<M>(span, inv_w, cfg, recip, sat, out)
+        crate::with_rounding!(recip.config().recip_rounding, R => {
+            perspective_bary_derivs_span_in::<M, R>(span, inv_w, cfg, recip, sat, out)
+        })
     })
 }
 
@@ -328,9 +330,10 @@ fn derivs_lane<M: ConstRounding>(
 /// fragments); they take any length.
 pub const SPAN_LANES: usize = 16;
 
-/// [`perspective_bary_derivs_span`] compiled for the rounding mode `M` (`interp_rounding`).
+/// [`perspective_bary_derivs_span`] compiled for the rounding modes `M` (`interp_rounding`)
+/// and `R` (the reciprocal's `recip_rounding`).
 #[inline(always)]
-fn perspective_bary_derivs_span_in<M: ConstRounding>(
+fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     &EdgeSpan {
         edge,
         dx: edge_dx,
@@ -373,6 +376,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
     };
     let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
     let m_bits = recip.config().recip_mantissa_bits;
+    let lane_recip = recip.lane::<R>();
     let wide = i128::from;
     let y_step = [1, 2].map(|i| wide(b[i]) * wide(s) - wide(a[i]) * wide(t));
     // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
@@ -415,7 +419,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding>(
                 return None;
             }
             // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
-            let r = recip.eval(d as u64, &mut SatCounter::default());
+            let r = lane_recip.eval(d as u64, &mut SatCounter::default());
             let p1 = apply_i64_in::<M>(r, q1, bb);
             let p2 = apply_i64_in::<M>(r, q2, bb);
             let limit = BARY_LIMIT as u64;

@@ -28,6 +28,7 @@ use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::{round_shift_right_wide, ConstRounding, Rounding, SatCounter};
+use std::marker::PhantomData;
 
 #[cfg(test)]
 pub(crate) mod previous;
@@ -89,13 +90,63 @@ impl Reciprocal {
     #[inline]
     #[must_use]
     pub fn eval(&self, x: u64, sat: &mut SatCounter) -> Recip {
-        crate::with_rounding!(self.cfg.recip_rounding, M => self.eval_in::<M>(x, sat))
+        crate::with_rounding!(self.cfg.recip_rounding, R => self.lane::<R>().eval(x, sat))
     }
 
-    /// [`Reciprocal::eval`] compiled for the rounding mode `M` (`recip_rounding`).
+    /// The unit resolved for many evaluations: `R` must be the type of `recip_rounding`
+    /// (resolve it once with [`crate::with_rounding!`]).
     #[inline(always)]
-    fn eval_in<M: ConstRounding>(&self, x: u64, sat: &mut SatCounter) -> Recip {
-        let m_bits = self.cfg.recip_mantissa_bits;
+    #[must_use]
+    pub fn lane<R: ConstRounding>(&self) -> RecipLane<'_, R> {
+        debug_assert_eq!(R::MODE, self.cfg.recip_rounding);
+        RecipLane {
+            lut: &self.lut,
+            p: self.p,
+            l: self.cfg.recip_lut_bits,
+            iterations: self.cfg.recip_iterations,
+            m_bits: self.cfg.recip_mantissa_bits,
+            mode: PhantomData,
+        }
+    }
+
+    /// Cost of one evaluation: normalize, LUT, 3 ops per iteration, final round; cycles from
+    /// [`datapath`] at `gate_levels_per_cycle`.
+    #[must_use]
+    pub fn cost(&self, gate_levels_per_cycle: u32) -> UnitCost {
+        UnitCost {
+            ops: 3 + 3 * self.cfg.recip_iterations,
+            cycles: datapath(&self.cfg).latency(gate_levels_per_cycle),
+            texels: 0,
+        }
+    }
+}
+
+/// A [`Reciprocal`] with its rounding mode as the type `R` and its widths and seed table
+/// loaded once ([`Reciprocal::lane`]): a span evaluates it per lane without dispatching on the
+/// mode or reloading the config. [`RecipLane::eval`] is [`Reciprocal::eval`]'s datapath
+/// (checked against the previous routine and `eval` in the tests below).
+#[derive(Clone, Copy, Debug)]
+pub struct RecipLane<'a, R> {
+    /// Seed entries with P fraction bits.
+    lut: &'a [u64],
+    /// Working fraction bits P.
+    p: u32,
+    /// `recip_lut_bits` L.
+    l: u32,
+    /// `recip_iterations` N.
+    iterations: u32,
+    /// `recip_mantissa_bits` M.
+    m_bits: u32,
+    /// The rounding mode `R` (`recip_rounding`).
+    mode: PhantomData<R>,
+}
+
+impl<R: ConstRounding> RecipLane<'_, R> {
+    /// [`Reciprocal::eval`]: `1/x`, `x == 0` saturated and counted.
+    #[inline(always)]
+    #[must_use]
+    pub fn eval(&self, x: u64, sat: &mut SatCounter) -> Recip {
+        let m_bits = self.m_bits;
         if x == 0 {
             sat.saturated += 1;
             return Recip {
@@ -104,7 +155,7 @@ impl Reciprocal {
             };
         }
         let p = self.p;
-        let rnd = M::MODE;
+        let rnd = R::MODE;
         let mut n = 63 - x.leading_zeros();
         // m with P fraction bits, in [2^P, 2^(P+1)).
         let mut m: i64 = if n <= p {
@@ -118,7 +169,7 @@ impl Reciprocal {
             m >>= 1;
             n += 1;
         }
-        let l = self.cfg.recip_lut_bits;
+        let l = self.l;
         // Top L fraction bits of m (m has only P; a wider index sees zeros below them).
         let top = if l <= p { m >> (p - l) } else { m << (l - p) };
         let idx = (top & ((1i64 << l) - 1)) as usize;
@@ -126,12 +177,12 @@ impl Reciprocal {
         let two = 2i64 << p;
         if (1..=29).contains(&p) {
             // `nr_step`'s 64-bit products, the test on `p` out of the loop.
-            for _ in 0..self.cfg.recip_iterations {
+            for _ in 0..self.iterations {
                 let t = crate::fixed::round_shift_right(m * y, p, rnd);
                 y = crate::fixed::round_shift_right(y * (two - t), p, rnd);
             }
         } else {
-            for _ in 0..self.cfg.recip_iterations {
+            for _ in 0..self.iterations {
                 y = nr_step(m, y, two, p, rnd);
             }
         }
@@ -145,17 +196,6 @@ impl Reciprocal {
             shift -= 1;
         }
         Recip { mant, shift }
-    }
-
-    /// Cost of one evaluation: normalize, LUT, 3 ops per iteration, final round; cycles from
-    /// [`datapath`] at `gate_levels_per_cycle`.
-    #[must_use]
-    pub fn cost(&self, gate_levels_per_cycle: u32) -> UnitCost {
-        UnitCost {
-            ops: 3 + 3 * self.cfg.recip_iterations,
-            cycles: datapath(&self.cfg).latency(gate_levels_per_cycle),
-            texels: 0,
-        }
     }
 }
 
@@ -473,5 +513,43 @@ mod tests {
             }
         }
         assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
+    }
+
+    /// About 1.1M seeded arguments over 12 configurations (every mode; LUT, iteration and
+    /// mantissa widths varied, the 30-bit mantissa's 128-bit products included; 0, 1, 2^63,
+    /// 2^64 - 1 and arguments of 1 to 64 bits): `RecipLane::eval`, resolved once per unit,
+    /// gives `eval`'s and the previous routine's bits and saturation counts.
+    #[test]
+    fn lane_eval_matches_eval() {
+        let mut s = 0x5eed_0007;
+        let base = HwConfig::texram16().reciprocal;
+        let edges = [0, 1, 1 << 63, u64::MAX];
+        for mode in MODES {
+            for (l, n, mb) in [(8, 2, 24), (10, 1, 20), (4, 3, 30), (16, 0, 8)] {
+                let cfg = ReciprocalConfig {
+                    recip_lut_bits: l,
+                    recip_iterations: n,
+                    recip_mantissa_bits: mb,
+                    recip_rounding: mode,
+                    ..base.clone()
+                };
+                let u = Reciprocal::new(&cfg);
+                crate::with_rounding!(mode, R => {
+                    let lane = u.lane::<R>();
+                    for i in 0..92_000u32 {
+                        let x = match edges.get(i as usize) {
+                            Some(&e) => e,
+                            None => next(&mut s) >> (i % 64),
+                        };
+                        let (mut sa, mut sb, mut sc) =
+                            (SatCounter::default(), SatCounter::default(), SatCounter::default());
+                        let got = lane.eval(x, &mut sa);
+                        assert_eq!((got, sa), (u.eval(x, &mut sb), sb), "1/{x} {cfg:?}");
+                        let want = previous::eval(&u, x, &mut sc);
+                        assert_eq!((got, sa), (want, sc), "1/{x} {cfg:?}");
+                    }
+                });
+            }
+        }
     }
 }
