@@ -455,18 +455,26 @@ mod tests {
         }
     }
 
-    /// 3M seeded cases over 15 configurations (every mode; LUT, iteration and mantissa widths
-    /// varied, the 30-bit mantissa's 128-bit Newton-Raphson products included; arguments of 0
-    /// to 64 bits): `eval`, `apply` and `apply_i64_in` give the previous routines' bits and
-    /// counts, `apply` on both its one-multiply path and the general one (a mantissa of 31 or
-    /// more bits, `|x| >= 2^96`, a negative scale).
+    /// 3.6M seeded cases over 18 configurations (every mode; LUT, iteration and mantissa widths
+    /// varied, the 30-bit mantissa's 128-bit Newton-Raphson products included; arguments 0, 1,
+    /// 2^63, 2^64 - 1 and of 1 to 64 bits): `eval`, the span's `RecipLane::eval`, `apply` and
+    /// `apply_i64_in` give the previous routines' bits and counts, `apply` on both its
+    /// one-multiply path and the general one (a mantissa of 31 or more bits, `|x| >= 2^96`, a
+    /// negative scale).
     #[test]
     fn eval_and_apply_match_the_previous_routines() {
         let mut s = 0x5eed_0006;
         let base = HwConfig::texram16().reciprocal;
         let (mut fast, mut general) = (0u64, 0u64);
         for mode in MODES {
-            for (l, n, mb) in [(8, 2, 24), (8, 1, 24), (4, 3, 30), (12, 1, 16), (16, 0, 8)] {
+            for (l, n, mb) in [
+                (8, 2, 24),
+                (8, 1, 24),
+                (4, 3, 30),
+                (12, 1, 16),
+                (16, 0, 8),
+                (10, 1, 20),
+            ] {
                 let cfg = ReciprocalConfig {
                     recip_lut_bits: l,
                     recip_iterations: n,
@@ -476,14 +484,17 @@ mod tests {
                 };
                 let u = Reciprocal::new(&cfg);
                 for i in 0..200_000u32 {
-                    let x = if i == 0 { 0 } else { next(&mut s) >> (i % 64) };
+                    let x = match [0, 1, 1 << 63, u64::MAX].get(i as usize) {
+                        Some(&e) => e,
+                        None => next(&mut s) >> (i % 64),
+                    };
                     let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
                     let r = u.eval(x, &mut sa);
-                    assert_eq!(
-                        (r, sa),
-                        (previous::eval(&u, x, &mut sb), sb),
-                        "1/{x} {cfg:?}"
-                    );
+                    let want = previous::eval(&u, x, &mut sb);
+                    assert_eq!((r, sa), (want, sb), "1/{x} {cfg:?}");
+                    let mut sl = SatCounter::default();
+                    let rl = crate::with_rounding!(mode, R => u.lane::<R>().eval(x, &mut sl));
+                    assert_eq!((rl, sl), (want, sb), "lane 1/{x} {cfg:?}");
                     let r = if i % 16 == 1 {
                         Recip {
                             mant: next(&mut s) >> (next(&mut s) % 40),
@@ -513,43 +524,5 @@ mod tests {
             }
         }
         assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
-    }
-
-    /// About 1.1M seeded arguments over 12 configurations (every mode; LUT, iteration and
-    /// mantissa widths varied, the 30-bit mantissa's 128-bit products included; 0, 1, 2^63,
-    /// 2^64 - 1 and arguments of 1 to 64 bits): `RecipLane::eval`, resolved once per unit,
-    /// gives `eval`'s and the previous routine's bits and saturation counts.
-    #[test]
-    fn lane_eval_matches_eval() {
-        let mut s = 0x5eed_0007;
-        let base = HwConfig::texram16().reciprocal;
-        let edges = [0, 1, 1 << 63, u64::MAX];
-        for mode in MODES {
-            for (l, n, mb) in [(8, 2, 24), (10, 1, 20), (4, 3, 30), (16, 0, 8)] {
-                let cfg = ReciprocalConfig {
-                    recip_lut_bits: l,
-                    recip_iterations: n,
-                    recip_mantissa_bits: mb,
-                    recip_rounding: mode,
-                    ..base.clone()
-                };
-                let u = Reciprocal::new(&cfg);
-                crate::with_rounding!(mode, R => {
-                    let lane = u.lane::<R>();
-                    for i in 0..92_000u32 {
-                        let x = match edges.get(i as usize) {
-                            Some(&e) => e,
-                            None => next(&mut s) >> (i % 64),
-                        };
-                        let (mut sa, mut sb, mut sc) =
-                            (SatCounter::default(), SatCounter::default(), SatCounter::default());
-                        let got = lane.eval(x, &mut sa);
-                        assert_eq!((got, sa), (u.eval(x, &mut sb), sb), "1/{x} {cfg:?}");
-                        let want = previous::eval(&u, x, &mut sc);
-                        assert_eq!((got, sa), (want, sc), "1/{x} {cfg:?}");
-                    }
-                });
-            }
-        }
     }
 }
