@@ -224,6 +224,15 @@ pub fn round_shift_right(x: i64, shift: u32, mode: Rounding) -> i64 {
     round_shift_right_narrow(x, shift, mode)
 }
 
+/// [`round_shift_right`] with the mode `M` as a type, for a `shift` in 1..=63 that the caller
+/// has checked once (e.g. per span): the same value without the tests for 0 and 64 or more.
+#[inline(always)]
+#[must_use]
+pub fn round_shift_right_mid<M: ConstRounding>(x: i64, shift: u32) -> i64 {
+    debug_assert!((1..64).contains(&shift), "shift {shift}");
+    round_shift_right_narrow(x, shift, M::MODE)
+}
+
 /// [`round_shift_right`] for a `shift` in 1..=63: the floor plus the carry out of the dropped
 /// bits, left-aligned in 64 bits (one half = 2^63), when [`round_bias`] is added to them.
 #[inline(always)]
@@ -384,6 +393,29 @@ mod tests {
             Rounding::HalfUp => twice >= den,
             Rounding::HalfEven => twice > den || (twice == den && q & 1 == 1),
         })
+    }
+
+    /// 300k seeded values (with the ends of `i64` and exact halves) at every shift 1 to 63 and
+    /// every mode: `round_shift_right_mid` gives `round_shift_right`.
+    #[test]
+    fn mid_shift_matches_round_shift_right() {
+        let mut s = 0x5eed_f1d0;
+        for i in 0..300_000u32 {
+            let shift = 1 + i % 63;
+            let x = match i % 5 {
+                0 => [i64::MIN, i64::MAX, -1, 0, 1][(i / 5 % 5) as usize],
+                1 => ((next(&mut s) as i64) >> shift << shift) + (1i64 << (shift - 1)),
+                _ => next(&mut s) as i64 >> (i % 64),
+            };
+            for mode in MODES {
+                let got = crate::with_rounding!(mode, M => round_shift_right_mid::<M>(x, shift));
+                assert_eq!(
+                    got,
+                    round_shift_right(x, shift, mode),
+                    "{x} {shift} {mode:?}"
+                );
+            }
+        }
     }
 
     /// `round_shift_right` as it was before the carry formulation (the decision of

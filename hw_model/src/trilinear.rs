@@ -28,7 +28,7 @@ use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, ConstRounding, Rounding};
-use crate::wrap::{fits_i64, wrap_i64_in, wrap_in, WrapMode, WrapOut};
+use crate::wrap::{fits_i64, wrap_i64_with, wrap_in, WrapMode, WrapOut, WrapShifts};
 
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
@@ -223,7 +223,8 @@ fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
 
 /// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
 /// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: both
-/// coordinates [`fits_i64`] (the caller's test, once for every level of a sample).
+/// coordinates [`fits_i64`] (the caller's test, once for every level of a sample), wrapped
+/// with the shifts `k` of `frac` and `weight_bits`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
@@ -236,14 +237,13 @@ fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
     cfg: &TrilinearConfig,
     filter: &LaneLerp,
     index: usize,
-    narrow: bool,
+    narrow: Option<&WrapShifts>,
     sink: &mut S,
 ) -> Lanes {
-    let (wx, wy) = if narrow {
-        let wb = cfg.weight_bits.min(16);
+    let (wx, wy) = if let Some(k) = narrow {
         (
-            wrap_i64_in::<W>(u, frac, level.width, wrap_mode[0], wb),
-            wrap_i64_in::<W>(v, frac, level.height, wrap_mode[1], wb),
+            wrap_i64_with::<W>(u, level.width, wrap_mode[0], k),
+            wrap_i64_with::<W>(v, level.height, wrap_mode[1], k),
         )
     } else {
         (
@@ -298,13 +298,15 @@ pub fn bilinear(
         crate::with_rounding!(cfg.weight_rounding, W => match trace {
             None => {
                 let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-                let narrow = fits_i64(u, frac) && fits_i64(v, frac);
+                let k = WrapShifts::new(frac, cfg.weight_bits.min(16));
+                let narrow = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&k);
                 bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut ())
             }
             Some(t) => {
                 let mut one = One(t);
                 let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
-                let narrow = fits_i64(u, frac) && fits_i64(v, frac);
+                let k = WrapShifts::new(frac, cfg.weight_bits.min(16));
+                let narrow = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&k);
                 bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut one)
             }
         }
@@ -400,6 +402,8 @@ pub struct TrilinearUnit<'a, F, W> {
     filter: LaneLerp,
     /// The level blend in lanes (`lf <= 16`).
     blend: LaneLerp,
+    /// The wrap's shifts (`frac`, `weight_bits`) for coordinates that [`fits_i64`].
+    shifts: WrapShifts,
     modes: std::marker::PhantomData<(F, W)>,
 }
 
@@ -423,6 +427,7 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
             wrap_mode,
             filter: LaneLerp::new::<F>(cfg.weight_bits.min(16)),
             blend: LaneLerp::new::<F>(lf.min(16)),
+            shifts: WrapShifts::new(frac, cfg.weight_bits.min(16)),
             modes: std::marker::PhantomData,
         }
     }
@@ -452,7 +457,7 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
             ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
         };
         let (frac, wm, cfg, f) = (self.frac, self.wrap_mode, self.cfg, &self.filter);
-        let nw = fits_i64(u, frac) && fits_i64(v, frac);
+        let nw = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&self.shifts);
         let c0 =
             bilinear_lanes::<W, S>(&levels[l0], l0 as u32, u, v, frac, wm, cfg, f, 0, nw, sink);
         if lw == 0 {

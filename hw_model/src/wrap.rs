@@ -87,16 +87,62 @@ pub fn wrap_i64_in<W: crate::fixed::ConstRounding>(
     mode: WrapMode,
     wb: u32,
 ) -> WrapOut {
+    wrap_i64_with::<W>(coord, size, mode, &WrapShifts::new(frac, wb))
+}
+
+/// The shifts of [`wrap_i64_in`] for one coordinate format (`frac <= 30`) and weight width
+/// (`wb <= 16`), resolved once for a run of wraps ([`wrap_i64_with`]).
+#[derive(Clone, Copy, Debug)]
+pub struct WrapShifts {
+    frac: u32,
+    /// Fraction bits of `s`: `frac + 1`.
+    sf: u32,
+    /// Weight width.
+    wb: u32,
+    /// Dropped fraction bits of `s` (`sf - wb`, or 0).
+    down: u32,
+    /// Bits the fraction is widened by (`wb - sf`, or 0).
+    up: u32,
+}
+
+impl WrapShifts {
+    /// The shifts for coordinates with `frac` fraction bits and weights of `wb` bits.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(frac: u32, wb: u32) -> Self {
+        let sf = frac.saturating_add(1);
+        Self {
+            frac,
+            sf,
+            wb,
+            down: sf.saturating_sub(wb),
+            up: wb.saturating_sub(sf),
+        }
+    }
+}
+
+/// [`wrap_i64_in`] with its shifts resolved in `k` (what [`wrap_i64_in`] runs): a coordinate
+/// that [`fits_i64`].
+#[inline(always)]
+#[must_use]
+pub fn wrap_i64_with<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    size: u32,
+    mode: WrapMode,
+    k: &WrapShifts,
+) -> WrapOut {
     let size = size.max(1);
-    let sf = frac + 1;
-    let s = 2 * coord * i64::from(size) - (1i64 << frac);
-    let i0 = s >> sf;
-    let fr = s - (i0 << sf);
-    // Reduced to `wb` fraction bits when `sf >= wb`, else widened (exact).
-    let w = crate::fixed::round_shift_right(fr, sf.saturating_sub(wb), W::MODE)
-        << wb.saturating_sub(sf);
+    let s = 2 * coord * i64::from(size) - (1i64 << k.frac);
+    let i0 = s >> k.sf;
+    let fr = s - (i0 << k.sf);
+    // Reduced to `wb` fraction bits when `sf > wb`, else widened (exact).
+    let w = if k.down == 0 {
+        fr << k.up
+    } else {
+        crate::fixed::round_shift_right_mid::<W>(fr, k.down)
+    };
     // Truncation cannot carry (`fr < 2^sf`, so `w < 2^wb`).
-    let carry = W::MODE != crate::fixed::Rounding::Truncate && w >> wb != 0;
+    let carry = W::MODE != crate::fixed::Rounding::Truncate && w >> k.wb != 0;
     let (i0, w) = if carry { (i0 + 1, 0) } else { (i0, w) };
     finish(i0, w as u32, size, mode)
 }
