@@ -8,13 +8,13 @@
 //! repeated squaring of the normalized mantissa
 //! `m` in [1, 2) (`m <- m^2`; a bit is 1 iff `m >= 2`, then `m <- m/2`), with `m` kept to
 //! [`MANT_BITS`] fraction bits by truncation so each square fits a `u64`. The output is
-//! floor-rounded. The simulator takes the loop's bits from a table ([`table_log2_bits`]), the
-//! loop itself only within a few mantissas of a result's threshold. The loop's result is
-//! monotone in `m` (squaring with truncation and the conditional halving keep the order), so
-//! the table is exact wherever the tested premise holds: every threshold lies within the
-//! table's slack of its ideal value (the unit tests check it for all 2^15 thresholds, with
+//! floor-rounded. The simulator takes the loop's bits from a quadratic per segment of the
+//! mantissa range ([`table_log2_bits`], a 4 KiB table), the loop itself only where that
+//! value lies near an integer (about 1 in 500 mantissas). The loop's result is monotone in
+//! `m` (squaring with truncation and the conditional halving keep the order) and its
+//! thresholds lie within a few mantissas of the exact ones (the unit tests check all 2^15,
 //! their neighbourhoods and 10^7 mantissas; all 2^31 mantissas were also compared once, in
-//! 73 s, when the table was built).
+//! 47 s on two threads, when the quadratics replaced the 192 KiB threshold tables).
 //!
 //! ERROR BOUND: truncation only ever lowers `m`, and each squaring step's truncation error
 //! (< 2^-31 relative) contributes < 2^-30 to `log2(L)`; so the result is `floor(lambda * 2^F)`
@@ -37,7 +37,7 @@
 use crate::config::{LodConfig, LodLog2};
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
-use crate::fixed::SatCounter;
+use crate::fixed::{round_shift_right_mid, SatCounter, TruncateMode};
 
 /// Fraction bits of the mantissa in the squaring loop.
 pub const MANT_BITS: u32 = 31;
@@ -139,50 +139,59 @@ pub fn serial_log2_bits(mut m: u64, steps: u32) -> u32 {
     bits
 }
 
-/// Number of 15-bit results of the bit-serial log2.
-const RESULTS: usize = 1 << SERIAL_STEPS;
-/// Bits per bucket of [`LOG2_BUCKET`].
-const BUCKET_BITS: u32 = 16;
-/// How far (in mantissas) a threshold of the bit-serial log2 may lie from [`LOG2_IDEAL`]'s.
-const THRESHOLD_SLACK: u32 = 4;
+/// Segments of the mantissa range in [`LOG2_QUAD`] (`2^SEG_BITS`).
+const SEG_BITS: u32 = 8;
+/// Mantissa offsets per segment: `2^SHIFT`.
+const SEG_SHIFT: u32 = MANT_BITS - SEG_BITS;
+/// Distance (in units of `2^-16` of a result) that the quadratic's value must keep from an
+/// integer for [`table_log2_bits`] to take its floor: the floor differs from the loop's
+/// result only within 4 units of an integer (all 2^31 mantissas, measured), so 16 times that.
+pub const LOG2_MARGIN: u32 = 64;
 
-/// `ceil(2^31 2^(k / 2^15)) - 2^31` for k = 0..=2^15 (within one: the powers are formed by
-/// repeated multiplication by `2^(2^-15)` on 32 fraction bits, `(2^(2^-15) - 1) 2^64` =
-/// 390211300099399.33), then `u32::MAX` (three times, so that a bucket's four candidates can
-/// be read at once): where the exact log2 of the mantissa reaches `k / 2^15`.
-pub static LOG2_IDEAL: [u32; RESULTS + 4] = ideal_thresholds();
-/// For each bucket of 2^16 mantissa offsets, how many of `LOG2_IDEAL[1..]` are at or below
-/// its first offset.
-static LOG2_BUCKET: [u16; 1 << (MANT_BITS - BUCKET_BITS)] = buckets();
-
-const fn ideal_thresholds() -> [u32; RESULTS + 4] {
-    let mut t = [0u32; RESULTS + 4];
-    let mut x: u128 = 1 << 63; // 2^31 with 32 fraction bits
-    let mut k = 1;
-    while k < RESULTS {
-        x += (x * 390_211_300_099_399) >> 64;
-        t[k] = (((x + (1 << 32) - 1) >> 32) - (1 << MANT_BITS)) as u32;
-        k += 1;
+/// `floor(2^31 log2(1 + x / 2^31))` for `x` in `[0, 2^31]`: the first 31 bits of the exact
+/// log2 by the bit-serial squaring of [`serial_log2_bits`] on 62 fraction bits (each
+/// truncation lowers the state by less than `2^-61` relative, far below the last bit kept;
+/// `x = 2^31` gives `2^31`).
+const fn log2_q31(x: u64) -> u64 {
+    if x >= 1 << MANT_BITS {
+        return 1 << 31;
     }
-    t[RESULTS] = 1 << MANT_BITS;
-    t[RESULTS + 1] = u32::MAX;
-    t[RESULTS + 2] = u32::MAX;
-    t[RESULTS + 3] = u32::MAX;
-    t
-}
-
-const fn buckets() -> [u16; 1 << (MANT_BITS - BUCKET_BITS)] {
-    let ideal = ideal_thresholds();
-    let mut b = [0u16; 1 << (MANT_BITS - BUCKET_BITS)];
-    let (mut i, mut k) = (0usize, 0usize);
-    while i < b.len() {
-        while ideal[k + 1] <= (i as u32) << BUCKET_BITS {
-            k += 1;
-        }
-        b[i] = k as u16;
+    let mut m: u128 = ((1u128 << MANT_BITS) + x as u128) << 31; // Q1.62
+    let mut bits = 0u64;
+    let mut i = 0;
+    while i < 31 {
+        m = (m * m) >> 62;
+        let b = (m >> 63) as u64;
+        bits = (bits << 1) | b;
+        m >>= b;
         i += 1;
     }
-    b
+    bits
+}
+
+/// Per segment `j` of `2^SEG_SHIFT` mantissa offsets, the quadratic through
+/// `z(t) = 2^31 log2(1 + (j 2^SEG_SHIFT + t) / 2^31)` at `t` = 0, half and the whole segment
+/// (each to `2^-31`): `[z0, a, b]` with `z(t) ~= z0 + a tau + b tau^2`, `tau = t / 2^SEG_SHIFT`
+/// (`a = 4 z_mid - 3 z0 - z1`, `b = 2 (z0 + z1 - 2 z_mid)`).
+static LOG2_QUAD: [[i32; 4]; 1 << SEG_BITS] = quadratics();
+
+const fn quadratics() -> [[i32; 4]; 1 << SEG_BITS] {
+    let mut q = [[0i32; 4]; 1 << SEG_BITS];
+    let mut j = 0;
+    while j < q.len() {
+        let at = (j as u64) << SEG_SHIFT;
+        let z0 = log2_q31(at) as i64;
+        let zm = log2_q31(at + (1 << (SEG_SHIFT - 1))) as i64;
+        let z1 = log2_q31(at + (1 << SEG_SHIFT)) as i64;
+        q[j] = [
+            z0 as i32,
+            (4 * zm - 3 * z0 - z1) as i32,
+            (2 * (z0 + z1 - 2 * zm)) as i32,
+            0,
+        ];
+        j += 1;
+    }
+    q
 }
 
 /// [`serial_log2_bits`] with [`SERIAL_STEPS`] steps of `m` in `[2^31, 2^32)`, the same bits,
@@ -190,46 +199,43 @@ const fn buckets() -> [u16; 1 << (MANT_BITS - BUCKET_BITS)] {
 /// `m` squares to a larger or equal state; while the bits agree the states stay ordered, and
 /// the first bit that differs is 1 for the larger), so its result is `k` for `T_k <= m <
 /// T_(k+1)`, `T_k` the least mantissa with a result `>= k`; truncation only lowers the
-/// result, so `T_k` is at or a little above the exact `2^31 2^(k/2^15)`, within
-/// [`THRESHOLD_SLACK`] of [`LOG2_IDEAL`] (checked for every `k` by the tests). `k` with
-/// `LOG2_IDEAL[k] <= m - 2^31 < LOG2_IDEAL[k+1]` comes from the bucket of `m` and two
-/// compares (the ideal thresholds are over 45,000 apart, at most two per bucket of 2^16);
-/// when `m` lies farther than the slack from both, that is the result, otherwise (about 1 in
-/// 5,000 mantissas) the loop runs.
+/// result, so `T_k` is at or a few mantissas above the exact `2^31 2^(k/2^15)` (checked for
+/// every `k` by the tests). So where the exact `2^15 log2(m / 2^31)` lies farther than those
+/// few mantissas from an integer, the result is its floor. That value comes, to 16 fraction
+/// bits, from a quadratic per segment of `2^23` mantissas ([`LOG2_QUAD`], 4 KiB); when it
+/// lies within [`LOG2_MARGIN`] of an integer (about 1 in 500 mantissas) the loop runs.
+/// Checked against the loop for all 2^31 mantissas once (when it was built) and, in the unit
+/// tests, for the neighbourhood of every threshold and 10^7 seeded mantissas.
 #[inline(always)]
 #[must_use]
 pub fn table_log2_bits(m: u64) -> u32 {
     debug_assert!(m >> MANT_BITS == 1, "mantissa {m:#x} outside [2^31, 2^32)");
     let off = (m as u32) ^ (1 << MANT_BITS);
     // `off < 2^31`: the mask only drops the bounds check.
-    let bucket = (off >> BUCKET_BITS) as usize & (LOG2_BUCKET.len() - 1);
-    let k0 = usize::from(LOG2_BUCKET[bucket]);
-    // The bucket's candidates read at once (not one after the other): the thresholds
-    // increase, so `off >= t[2]` implies `off >= t[1]` and `k = k0 + both`.
-    let Some(&[t0, t1, t2, t3]) = LOG2_IDEAL.get(k0..k0 + 4) else {
-        return serial_log2_bits(m, SERIAL_STEPS);
-    };
-    let (a, b) = (off >= t1, off >= t2);
-    let (lo, hi) = match (a, b) {
-        (false, _) => (t0, t1),
-        (true, false) => (t1, t2),
-        (true, true) => (t2, t3),
-    };
-    if off - lo >= THRESHOLD_SLACK && hi - off > THRESHOLD_SLACK {
-        (k0 + usize::from(a) + usize::from(b)) as u32
+    let [z0, a, b, _] = LOG2_QUAD[(off >> SEG_SHIFT) as usize & (LOG2_QUAD.len() - 1)];
+    let t = i64::from(off & ((1 << SEG_SHIFT) - 1));
+    let tb = round_shift_right_mid::<TruncateMode>(t * i64::from(b), SEG_SHIFT);
+    let z =
+        i64::from(z0) + round_shift_right_mid::<TruncateMode>(t * (i64::from(a) + tb), SEG_SHIFT);
+    // z (16 fraction bits) within `[0, 2^31)`: the floor and the distance to an integer.
+    let f = (z as u32) & 0xffff;
+    if f.wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN {
+        (z >> 16) as u32
     } else {
         serial_log2_bits(m, SERIAL_STEPS)
     }
 }
 
-/// Whether [`table_log2_bits`] takes the table's value for `m` (else it runs the loop).
+/// Whether [`table_log2_bits`] takes the quadratic's value for `m` (else it runs the loop).
 #[must_use]
 pub fn table_log2_is_direct(m: u64) -> bool {
     let off = (m as u32) ^ (1 << MANT_BITS);
-    let mut k = usize::from(LOG2_BUCKET[(off >> BUCKET_BITS) as usize]);
-    k += usize::from(off >= LOG2_IDEAL[k + 1]);
-    k += usize::from(off >= LOG2_IDEAL[k + 1]);
-    off - LOG2_IDEAL[k] >= THRESHOLD_SLACK && LOG2_IDEAL[k + 1] - off > THRESHOLD_SLACK
+    let [z0, a, b, _] = LOG2_QUAD[(off >> SEG_SHIFT) as usize];
+    let t = i64::from(off & ((1 << SEG_SHIFT) - 1));
+    let tb = round_shift_right_mid::<TruncateMode>(t * i64::from(b), SEG_SHIFT);
+    let z =
+        i64::from(z0) + round_shift_right_mid::<TruncateMode>(t * (i64::from(a) + tb), SEG_SHIFT);
+    ((z as u32) & 0xffff).wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN
 }
 
 /// Cost: cycles from [`datapath`] (`lod_cycles + lod_cycles_per_bit * lod_frac_bits` when both
@@ -354,30 +360,45 @@ mod tests {
         v
     }
 
-    /// The table's premise for every result `k`: the bit-serial threshold `T_k` lies within
-    /// the slack of `LOG2_IDEAL[k]` (the result is `>= k` at `ideal + slack` and `< k` one
-    /// below `ideal - slack`); the ideal thresholds are more than 2^15 apart (at most two per
-    /// bucket). Then 10^7 seeded mantissas and the neighbourhood of every threshold give the
-    /// bit-serial result for every step count 0 to 15, with both the table's value and the
-    /// loop taken (counted).
+    /// Number of 15-bit results of the bit-serial log2.
+    const RESULTS: usize = 1 << SERIAL_STEPS;
+    /// How far (in mantissas) a threshold of the bit-serial log2 may lie from the ideal one.
+    const THRESHOLD_SLACK: u64 = 4;
+
+    /// `ceil(2^31 2^(k / 2^15)) - 2^31` for k = 1..2^15 (within one: the powers are formed by
+    /// repeated multiplication by `2^(2^-15)` on 32 fraction bits, `(2^(2^-15) - 1) 2^64` =
+    /// 390211300099399.33): where the exact log2 of the mantissa reaches `k / 2^15`.
+    fn ideal_thresholds() -> Vec<u64> {
+        let mut t = vec![0u64; RESULTS];
+        let mut x: u128 = 1 << 63; // 2^31 with 32 fraction bits
+        for t in t.iter_mut().skip(1) {
+            x += (x * 390_211_300_099_399) >> 64;
+            *t = (((x + (1 << 32) - 1) >> 32) - (1 << MANT_BITS)) as u64;
+        }
+        t
+    }
+
+    /// The premise of [`table_log2_bits`] for every result `k`: the bit-serial threshold
+    /// `T_k` lies within the slack of the ideal one (the result is `>= k` at `ideal + slack`
+    /// and `< k` one below `ideal - slack`). Then the neighbourhood (+-8) of every threshold,
+    /// the ends and 10^7 seeded mantissas give the bit-serial result for every step count 0
+    /// to 15, with both the quadratic's value and the loop taken (counted).
     #[test]
     fn log2_table_matches_the_serial_log2() {
         let top = 1u64 << MANT_BITS;
-        let slack = u64::from(THRESHOLD_SLACK);
-        let mut gap = u32::MAX;
-        for k in 1..RESULTS {
-            let ideal = top + u64::from(LOG2_IDEAL[k]);
+        let slack = THRESHOLD_SLACK;
+        let ideal = ideal_thresholds();
+        for (k, &t) in ideal.iter().enumerate().skip(1) {
+            let at = top + t;
             assert!(
-                serial_log2_bits(ideal + slack, SERIAL_STEPS) >= k as u32,
+                serial_log2_bits(at + slack, SERIAL_STEPS) >= k as u32,
                 "{k}"
             );
             assert!(
-                serial_log2_bits(ideal - slack - 1, SERIAL_STEPS) < k as u32,
+                serial_log2_bits(at - slack - 1, SERIAL_STEPS) < k as u32,
                 "{k}"
             );
-            gap = gap.min(LOG2_IDEAL[k] - LOG2_IDEAL[k - 1]);
         }
-        assert!(gap > 1 << SERIAL_STEPS, "{gap}");
         let (mut direct, mut looped) = (0u32, 0u32);
         let mut check = |m: u64| {
             let b = table_log2_bits(m);
@@ -394,20 +415,22 @@ mod tests {
                 looped += 1;
             }
         };
-        for &t in &LOG2_IDEAL[1..RESULTS] {
-            let ideal = top + u64::from(t);
-            for m in ideal - slack - 2..=ideal + slack + 2 {
+        for &t in &ideal[1..] {
+            for m in top + t - slack - 8..=top + t + slack + 8 {
                 check(m);
             }
         }
-        for m in [top, top + 1, 2 * top - 2, 2 * top - 1] {
-            check(m);
+        for j in 0..=1u64 << SEG_BITS {
+            let at = top + (j << SEG_SHIFT);
+            for m in at.saturating_sub(2).max(top)..(at + 3).min(2 * top) {
+                check(m);
+            }
         }
         let mut s = 0x5eed_0013;
         for _ in 0..10_000_000 {
             check(top | (next(&mut s) & (top - 1)));
         }
-        assert!(direct > 9_000_000 && looped > 200_000, "{direct} {looped}");
+        assert!(direct > 9_900_000 && looped > 500_000, "{direct} {looped}");
     }
 
     /// 4M seeded derivative sets (every `lod_frac_bits` 0 to 16, both log2 modes, coordinate
