@@ -404,6 +404,8 @@ pub struct TrilinearUnit<'a, F, W> {
     blend: LaneLerp,
     /// The wrap's shifts (`frac`, `weight_bits`) for coordinates that [`fits_i64`].
     shifts: WrapShifts,
+    /// `frac <= 30`: coordinates below 2^29 in magnitude [`fits_i64`].
+    narrow_frac: bool,
     modes: std::marker::PhantomData<(F, W)>,
 }
 
@@ -428,6 +430,7 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
             filter: LaneLerp::new::<F>(cfg.weight_bits.min(16)),
             blend: LaneLerp::new::<F>(lf.min(16)),
             shifts: WrapShifts::new(frac, cfg.weight_bits.min(16)),
+            narrow_frac: fits_i64(0, frac),
             modes: std::marker::PhantomData,
         }
     }
@@ -457,7 +460,9 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
             ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
         };
         let (frac, wm, cfg, f) = (self.frac, self.wrap_mode, self.cfg, &self.filter);
-        let nw = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&self.shifts);
+        // `fits_i64(u, frac) && fits_i64(v, frac)`.
+        let nw = (self.narrow_frac && (u.unsigned_abs() | v.unsigned_abs()) < 1 << 29)
+            .then_some(&self.shifts);
         let c0 =
             bilinear_lanes::<W, S>(&levels[l0], l0 as u32, u, v, frac, wm, cfg, f, 0, nw, sink);
         if lw == 0 {

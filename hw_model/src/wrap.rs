@@ -144,7 +144,23 @@ pub fn wrap_i64_with<W: crate::fixed::ConstRounding>(
     // Truncation cannot carry (`fr < 2^sf`, so `w < 2^wb`).
     let carry = W::MODE != crate::fixed::Rounding::Truncate && w >> k.wb != 0;
     let (i0, w) = if carry { (i0 + 1, 0) } else { (i0, w) };
-    finish(i0, w as u32, size, mode)
+    finish_narrow(i0, w as u32, size, mode)
+}
+
+/// [`finish`] of an index `|i0| < 2^62` (that of a coordinate that [`fits_i64`]): the same
+/// pair without the test for `i64::MAX`.
+#[inline(always)]
+fn finish_narrow(i0: i64, weight: u32, size: u32, mode: WrapMode) -> WrapOut {
+    debug_assert!(i0.unsigned_abs() < 1 << 62, "{i0}");
+    if mode == WrapMode::Repeat && size & (size - 1) == 0 {
+        let mask = i64::from(size) - 1;
+        return WrapOut {
+            i0: (i0 & mask) as u32,
+            i1: ((i0 + 1) & mask) as u32,
+            weight,
+        };
+    }
+    finish(i0, weight, size, mode)
 }
 
 /// [`wrap_in`] in `i128` (any coordinate).
@@ -407,7 +423,8 @@ pub(crate) mod tests {
     /// level sizes 1, 2, 3, powers of two and others up to 70,000, coordinates mostly in
     /// [-2, 3) and some far outside or at the ends of `i64`): `wrap` gives the previous
     /// result through each of its paths (counted); and `finish` gives the previous pair of
-    /// wrapped indices for 3M seeded indices including the ends of `i64`.
+    /// wrapped indices for 3M seeded indices including the ends of `i64` (`finish_narrow`
+    /// for those below 2^62).
     #[test]
     fn shortcuts_match_the_previous_wrap() {
         let mut s = 0x5eed_0015;
@@ -467,6 +484,13 @@ pub(crate) mod tests {
                 finish_before(i0, 7, size, mode),
                 "{i0} {size} {mode:?}"
             );
+            if i0.unsigned_abs() < 1 << 62 {
+                assert_eq!(
+                    finish_narrow(i0, 7, size, mode),
+                    finish_before(i0, 7, size, mode),
+                    "{i0} {size} {mode:?}"
+                );
+            }
         }
     }
 }
