@@ -378,7 +378,11 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
     let wide = i128::from;
-    let y_step = [1, 2].map(|i| wide(b[i]) * wide(s) - wide(a[i]) * wide(t));
+    // Written out: an array `map` here is a call per span.
+    let y_step = [
+        wide(b[1]) * wide(s) - wide(a[1]) * wide(t),
+        wide(b[2]) * wide(s) - wide(a[2]) * wide(t),
+    ];
     // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
     // the per-lane `times_w` and `sum` test): they are linear in the lane, so they do when
     // they do at the first and the last lane, and then they step by `a_1`, `a_2` and `S`
@@ -465,10 +469,16 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
             continue;
         };
         let (nx, ny) = *numerators.get_or_insert_with(|| {
-            let (dw, qj) = (wide(d), [0, q1, q2]);
+            let dw = wide(d);
             (
-                [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
-                [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+                [
+                    numerator_top(wide(a[1]) * dw - wide(q1) * wide(s)),
+                    numerator_top(wide(a[2]) * dw - wide(q2) * wide(s)),
+                ],
+                [
+                    wide(b[1]) * dw - wide(q1) * wide(t),
+                    wide(b[2]) * dw - wide(q2) * wide(t),
+                ],
             )
         });
         let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
@@ -513,9 +523,15 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
     let [mut q1, mut q2, mut d] = st.first;
     // The x numerators are the same at every lane; the y numerators step (exact at every
     // lane, below 2^125; the wrapping steps are exact modulo 2^128).
-    let (dw, qj) = (wide(d), [0, q1, q2]);
-    let nx = [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s)));
-    let mut ny = [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t));
+    let dw = wide(d);
+    let nx = [
+        numerator_top(wide(a[1]) * dw - wide(q1) * wide(s)),
+        numerator_top(wide(a[2]) * dw - wide(q2) * wide(s)),
+    ];
+    let mut ny = [
+        wide(b[1]) * dw - wide(q1) * wide(t),
+        wide(b[2]) * dw - wide(q2) * wide(t),
+    ];
     let limit = BARY_LIMIT as u64;
     for j in 0..span.lanes {
         // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
