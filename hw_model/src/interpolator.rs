@@ -381,7 +381,11 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
     let wide = i128::from;
-    let y_step = [1, 2].map(|i| wide(b[i]) * wide(s) - wide(a[i]) * wide(t));
+    // Written out: an array `map` here is a call per span.
+    let y_step = [
+        wide(b[1]) * wide(s) - wide(a[1]) * wide(t),
+        wide(b[2]) * wide(s) - wide(a[2]) * wide(t),
+    ];
     // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
     // the per-lane `times_w` and `sum` test): they are linear in the lane, so they do when
     // they do at the first and the last lane, and then they step by `a_1`, `a_2` and `S`
@@ -390,10 +394,34 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
         let q = times_w(lane_edges(edge, edge_dx, j))?;
         sum(q).map(|d| [q[1], q[2], d])
     };
-    let mut stepped = match lanes {
+    let ends = match lanes {
         0 => return,
-        _ => fits(0).filter(|_| fits(lanes - 1).is_some()),
+        _ => fits(0).zip(fits(lanes - 1)),
     };
+    // Every lane of the fast form (up to the clamp of `p_i`) when both ends are: `q_1`, `q_2`
+    // and `D` are linear in the lane, so their magnitudes are at most those at the ends and
+    // `D` is positive between two positive ends.
+    let small_end = |[q1, q2, d]: [i64; 3]| {
+        d > 0 && (d as u64 | q1.unsigned_abs() | q2.unsigned_abs() | steps_mag) >> 62 == 0
+    };
+    if let Some((first, _)) = ends.filter(|&(f, l)| small_end(f) && small_end(l)) {
+        let steady = Steady {
+            first,
+            a,
+            b,
+            s,
+            t,
+            y_step,
+        };
+        let lanes_at = EdgeSpan {
+            edge,
+            dx: edge_dx,
+            dy: edge_dy,
+            lanes,
+        };
+        return derivs_span_steady::<M, R>(&lanes_at, &steady, inv_w, cfg, recip, sat, out);
+    }
+    let mut stepped = ends.map(|(f, _)| f);
     // From the first fast lane on: the x numerators' top bits (the same at every fast lane)
     // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
     // wrapping steps across the lanes between are exact modulo 2^128).
@@ -444,10 +472,16 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
             continue;
         };
         let (nx, ny) = *numerators.get_or_insert_with(|| {
-            let (dw, qj) = (wide(d), [0, q1, q2]);
+            let dw = wide(d);
             (
-                [1, 2].map(|i| numerator_top(wide(a[i]) * dw - wide(qj[i]) * wide(s))),
-                [1, 2].map(|i| wide(b[i]) * dw - wide(qj[i]) * wide(t)),
+                [
+                    numerator_top(wide(a[1]) * dw - wide(q1) * wide(s)),
+                    numerator_top(wide(a[2]) * dw - wide(q2) * wide(s)),
+                ],
+                [
+                    wide(b[1]) * dw - wide(q1) * wide(t),
+                    wide(b[2]) * dw - wide(q2) * wide(t),
+                ],
             )
         });
         let x1 = pj[1] + derivative_of_top::<M>(nx[0], r2, bb, sat);
@@ -455,6 +489,81 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
         let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
         let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
         out(j, [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]]);
+    }
+}
+
+/// The lane-independent operands of a span whose lanes all take the fast form
+/// ([`derivs_span_steady`]): `q_1`, `q_2`, `D` at its first lane, `a_i` and `b_i` (the x and
+/// y steps of `q_i`), `S`, `T`, and the y numerators' step.
+struct Steady {
+    first: [i64; 3],
+    a: [i64; 3],
+    b: [i64; 3],
+    s: i64,
+    t: i64,
+    y_step: [i128; 2],
+}
+
+/// [`perspective_bary_derivs_span_in`] for a span whose `q_1`, `q_2` and `D` are below 2^62
+/// (and `D` positive) at both ends, hence at every lane: the lane loop without the per-lane
+/// tests of the general form; a lane whose `p_i` needs the clamp takes the per-sample
+/// datapath. Checked against one call per lane in `derivs_span_stepping_matches_per_lane_calls`.
+#[inline(always)]
+fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
+    span: &EdgeSpan,
+    st: &Steady,
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    mut out: impl FnMut(usize, [[i64; 3]; 3]),
+) {
+    let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
+    let m_bits = recip.config().recip_mantissa_bits;
+    let lane_recip = recip.lane::<R>();
+    let wide = i128::from;
+    let (a, b, s, t) = (st.a, st.b, st.s, st.t);
+    let [mut q1, mut q2, mut d] = st.first;
+    // The x numerators are the same at every lane; the y numerators step (exact at every
+    // lane, below 2^125; the wrapping steps are exact modulo 2^128).
+    let dw = wide(d);
+    let nx = [
+        numerator_top(wide(a[1]) * dw - wide(q1) * wide(s)),
+        numerator_top(wide(a[2]) * dw - wide(q2) * wide(s)),
+    ];
+    let mut ny = [
+        wide(b[1]) * dw - wide(q1) * wide(t),
+        wide(b[2]) * dw - wide(q2) * wide(t),
+    ];
+    let limit = BARY_LIMIT as u64;
+    for j in 0..span.lanes {
+        // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+        let r = lane_recip.eval(d as u64, &mut SatCounter::default());
+        let p1 = apply_i64_in::<M>(r, q1, bb);
+        let p2 = apply_i64_in::<M>(r, q2, bb);
+        if p1.unsigned_abs() <= limit && p2.unsigned_abs() <= limit {
+            // The reciprocal of the barycentrics is that of the derivatives: its square.
+            let r2 = square(r, m_bits, M::MODE);
+            let x1 = p1 + derivative_of_top::<M>(nx[0], r2, bb, sat);
+            let x2 = p2 + derivative_of_top::<M>(nx[1], r2, bb, sat);
+            let y1 = p1 + derivative::<M>(ny[0], r2, bb, sat);
+            let y2 = p2 + derivative::<M>(ny[1], r2, bb, sat);
+            let x = [one - x1 - x2, x1, x2];
+            out(j, [[one - p1 - p2, p1, p2], x, [one - y1 - y2, y1, y2]]);
+        } else {
+            let e = lane_edges(span.edge, span.dx, j);
+            out(
+                j,
+                derivs_lane::<M>(e, span.dx, span.dy, inv_w, cfg, recip, sat),
+            );
+        }
+        q1 = q1.wrapping_add(a[1]);
+        q2 = q2.wrapping_add(a[2]);
+        d = d.wrapping_add(s);
+        ny = [
+            ny[0].wrapping_add(st.y_step[0]),
+            ny[1].wrapping_add(st.y_step[1]),
+        ];
     }
 }
 
@@ -1435,12 +1544,13 @@ mod tests {
     /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
     /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
     /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
-    /// are many both in spans whose `q_1`, `q_2`, `D` step along the span (both ends fit
-    /// `i64`) and in spans whose lanes test their own.
+    /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
+    /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
+    /// whose lanes test their own.
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
-        let (mut stepped, mut tested) = (0u64, 0u64);
+        let (mut steady_lanes, mut stepped, mut tested) = (0u64, 0u64, 0u64);
         let mut got = [[[0i64; 3]; 3]; 24];
         for (c, hw0) in previous_configs().into_iter().enumerate() {
             for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
@@ -1489,6 +1599,22 @@ mod tests {
                             .all(|v| i64::try_from(*v).is_ok())
                     };
                     let ends_fit = fits(0) && fits(n - 1);
+                    // Whether the span takes the steady loop: its steps and both ends below 2^62.
+                    let below = |v: &[i128]| v.iter().all(|x| x.unsigned_abs() >> 62 == 0);
+                    let step_terms = |de: [i64; 3]| {
+                        let v = [0, 1, 2].map(|k| i128::from(de[k]) * i128::from(inv_w[k]));
+                        [v[1], v[2], v[0] + v[1] + v[2]]
+                    };
+                    let small_end = |j: usize| {
+                        let q = [0, 1, 2].map(|k| at(j)[k] * i128::from(inv_w[k]));
+                        let d = q[0] + q[1] + q[2];
+                        d > 0 && below(&[q[1], q[2], d])
+                    };
+                    let steady = ends_fit
+                        && below(&step_terms(dx))
+                        && below(&step_terms(dy))
+                        && small_end(0)
+                        && small_end(n - 1);
                     for (j, lane) in got[..n].iter().enumerate() {
                         let e = at(j).map(|v| v as i64);
                         let want = perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);
@@ -1500,7 +1626,9 @@ mod tests {
                             && (d.unsigned_abs() | q[1].unsigned_abs() | q[2].unsigned_abs()) >> 62
                                 == 0
                         {
-                            if ends_fit {
+                            if steady {
+                                steady_lanes += 1;
+                            } else if ends_fit {
                                 stepped += 1;
                             } else {
                                 tested += 1;
@@ -1511,6 +1639,9 @@ mod tests {
                 }
             }
         }
-        assert!(stepped > 300_000 && tested > 20_000, "{stepped} {tested}");
+        assert!(
+            steady_lanes > 1_000_000 && stepped > 100_000 && tested > 40_000,
+            "{steady_lanes} {stepped} {tested}"
+        );
     }
 }

@@ -102,7 +102,9 @@ impl Reciprocal {
         RecipLane {
             lut: &self.lut,
             p: self.p,
-            l: self.cfg.recip_lut_bits,
+            idx_up: self.cfg.recip_lut_bits.saturating_sub(self.p),
+            idx_down: self.p.saturating_sub(self.cfg.recip_lut_bits),
+            idx_mask: (1i64 << self.cfg.recip_lut_bits) - 1,
             iterations: self.cfg.recip_iterations,
             m_bits: self.cfg.recip_mantissa_bits,
             mode: PhantomData,
@@ -131,8 +133,14 @@ pub struct RecipLane<'a, R> {
     lut: &'a [u64],
     /// Working fraction bits P.
     p: u32,
-    /// `recip_lut_bits` L.
-    l: u32,
+    /// The seed index of `m` (P fraction bits, below 2^(P+1)) is its top L fraction bits:
+    /// `(m << idx_up) >> idx_down` (`L - P` and `P - L`, whichever is positive; a wider index
+    /// sees zeros below `m`'s bits) masked by `idx_mask` (`2^L - 1`).
+    idx_up: u32,
+    /// See `idx_up`.
+    idx_down: u32,
+    /// See `idx_up`.
+    idx_mask: i64,
     /// `recip_iterations` N.
     iterations: u32,
     /// `recip_mantissa_bits` M.
@@ -169,10 +177,9 @@ impl<R: ConstRounding> RecipLane<'_, R> {
             m >>= 1;
             n += 1;
         }
-        let l = self.l;
-        // Top L fraction bits of m (m has only P; a wider index sees zeros below them).
-        let top = if l <= p { m >> (p - l) } else { m << (l - p) };
-        let idx = (top & ((1i64 << l) - 1)) as usize;
+        // Top L fraction bits of m (m has only P; a wider index sees zeros below them); m is
+        // below 2^34 and L - P at most 5, so the left shift is exact.
+        let idx = (((m << self.idx_up) >> self.idx_down) & self.idx_mask) as usize;
         let mut y = self.lut[idx] as i64;
         let two = 2i64 << p;
         if (1..=29).contains(&p) {
