@@ -232,6 +232,26 @@ pub(super) fn shade_row(
     trace: bool,
     mut on_pixel: impl FnMut(u32, u32, &Frag),
 ) {
+    shade_row_spans(inp, progs, y, row, frags, c, trace, |pi, t, span| {
+        for frag in span {
+            on_pixel(pi, t, frag);
+        }
+    });
+}
+
+/// [`shade_row`] with `on_span(plan index, triangle, fragments)` seeing the shaded fragments a
+/// span at a time (consecutive pixels of one triangle, in raster order).
+#[allow(clippy::too_many_arguments)]
+fn shade_row_spans(
+    inp: &ShadeInput,
+    progs: &[Program],
+    y: usize,
+    row: &mut [[u16; 4]],
+    frags: &mut [Frag],
+    c: &mut Counters,
+    trace: bool,
+    mut on_span: impl FnMut(u32, u32, &[Frag]),
+) {
     let w = inp.vis.width as usize;
     let cap = if inp.per_fragment { 1 } else { SPAN_MAX };
     let frags = &mut frags[..cap];
@@ -273,8 +293,8 @@ pub(super) fn shade_row(
         }
         for (frag, out) in span.iter().zip(&mut row[x..x + n]) {
             *out = output16(frag);
-            on_pixel(a.plan, t, frag);
         }
+        on_span(a.plan, t, span);
         x += n;
     }
     if let Some((p, k)) = run_of {
@@ -345,10 +365,12 @@ pub(super) fn shade<'h>(
         let mut frags = frag_scratch();
         for (y, row) in img.px.chunks_mut(w.max(1)).enumerate() {
             let c = &mut counters;
-            shade_row(inp, progs, y, row, &mut frags, c, true, |pi, t, frag| {
-                sim.pixel(pi, frag.trace.footprints());
+            shade_row_spans(inp, progs, y, row, &mut frags, c, true, |pi, t, span| {
+                sim.span(pi, span.iter().map(|frag| frag.trace.footprints()));
                 if keep_events {
-                    record_pixel(pi, t, frag, &mut ev);
+                    for frag in span {
+                        record_pixel(pi, t, frag, &mut ev);
+                    }
                 }
             });
             if keep_events {

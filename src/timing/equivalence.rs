@@ -3,7 +3,8 @@
 //! counts that are not powers of two, several filter units, pipelined or not), textures of
 //! every texel size and plans with repeated stage kinds, pixels with thin, wrapped and
 //! out-of-plan footprints. Every report must be identical, fed as a frame ([`simulate`]),
-//! row by row ([`Simulator::row`]) or pixel by pixel ([`Simulator::pixel`]).
+//! row by row ([`Simulator::row`]), span by span ([`Simulator::span`]: runs of one plan) or
+//! pixel by pixel ([`Simulator::pixel`]).
 
 use super::events::{
     FrameEvents, PixelEvent, PlanTiming, RowEvents, TexelFootprint, TextureLayout,
@@ -137,6 +138,7 @@ fn model_matches_previous_on_random_streams() {
         // Row by row (rows of 1..40 pixels, `fp_end` rebased) and pixel by pixel.
         let mut rows = Simulator::new(&ev.plans, &ev.textures, &hw);
         let mut pixels = Simulator::new(&ev.plans, &ev.textures, &hw);
+        let mut spans = Simulator::new(&ev.plans, &ev.textures, &hw);
         let start = |i: usize| {
             if i == 0 {
                 0
@@ -163,6 +165,17 @@ fn model_matches_previous_on_random_streams() {
                 let fps = &ev.footprints[start(i)..start(i + 1)];
                 pixels.pixel(ev.pixels[i].plan, fps);
             }
+            // Spans: runs of up to 1..12 pixels of one plan.
+            let mut s = p;
+            while s < end {
+                let plan = ev.pixels[s].plan;
+                let most = (s + 1 + r.below(12) as usize).min(end);
+                let e = (s + 1..most)
+                    .find(|&i| ev.pixels[i].plan != plan)
+                    .unwrap_or(most);
+                spans.span(plan, (s..e).map(|i| &ev.footprints[start(i)..start(i + 1)]));
+                s = e;
+            }
             p = end;
         }
         assert_eq!(rows.finish(&ev.counts(), "t"), want, "case {case}: rows");
@@ -171,5 +184,6 @@ fn model_matches_previous_on_random_streams() {
             want,
             "case {case}: pixels"
         );
+        assert_eq!(spans.finish(&ev.counts(), "t"), want, "case {case}: spans");
     }
 }

@@ -395,7 +395,8 @@ impl Memory {
         Self {
             map: AddressMap::new(textures, tc),
             cache,
-            open_page: vec![EMPTY; banks as usize],
+            // At least 64 entries, so the four-bank path indexes a fixed-size array.
+            open_page: vec![EMPTY; (banks as usize).max(64)],
             banks,
             last_bank: banks as usize - 1,
             tile_mask: (bank_tile.0 - 1, bank_tile.1 - 1),
@@ -408,7 +409,9 @@ impl Memory {
             page_hit: u64::from(tc.dram_page_hit_cycles),
             page_miss: u64::from(tc.dram_page_miss_cycles),
             hit_latency: u64::from(tc.cache_hit_cycles),
-            quad_banks: tc.bank_interleave == BankInterleave::Tiled && banks.is_power_of_two(),
+            quad_banks: tc.bank_interleave == BankInterleave::Tiled
+                && banks.is_power_of_two()
+                && banks <= 64,
             counts: MemoryCounts::default(),
         }
     }
@@ -432,6 +435,9 @@ impl Memory {
             && (fp.y[0] ^ fp.y[1]) & m1 != 0)
         {
             return self.footprint_any::<CACHED, TILED>(fp);
+        }
+        if !CACHED {
+            return self.quad_dram(fp);
         }
         let lv = self.map.level(fp.tex, fp.level);
         let sh = self.tile_shift;
@@ -486,6 +492,55 @@ impl Memory {
         k.page_hits += page_hits;
         k.miss_cycles += slowest.saturating_sub(fastest);
         (occ, occ + if CACHED { self.hit_latency } else { 0 }, bytes)
+    }
+
+    /// [`Memory::footprint`]'s four-bank footprint without a cache: each texel a DRAM access
+    /// to its own bank (hit if the bank's open page is the texel's, which it opens), the
+    /// footprint as long as its slowest access.
+    #[inline(always)]
+    fn quad_dram(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
+        let (m0, m1) = self.tile_mask;
+        let sh = self.tile_shift;
+        let lv = self.map.level(fp.tex, fp.level);
+        let (px, py) = lv.page_shift;
+        let [x0, x1] = fp.x;
+        let [y0, y1] = fp.y;
+        let (c0, c1) = (u64::from(x0 >> px), u64::from(x1 >> px));
+        let r0 = lv.page_base + u64::from(y0 >> py) * lv.page_row;
+        let r1 = lv.page_base + u64::from(y1 >> py) * lv.page_row;
+        let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
+        let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
+        let texel_bytes = u64::from(lv.texel_bytes);
+        // Quad banks are fewer than 64 and `open_page` has at least 64 entries.
+        let Some(open) = self.open_page.first_chunk_mut::<64>() else {
+            return self.footprint_any::<false, true>(fp);
+        };
+        let mut hits = 0u64;
+        for (bank, page) in [
+            (b0 | s0, r0 + c0),
+            (b1 | s0, r0 + c1),
+            (b0 | s1, r1 + c0),
+            (b1 | s1, r1 + c1),
+        ] {
+            let o = &mut open[bank & 63];
+            hits += u64::from(*o == page);
+            *o = page;
+        }
+        let (page_hit, page_miss) = (self.page_hit, self.page_miss);
+        let slowest = match hits {
+            4 => page_hit,
+            0 => page_miss,
+            _ => page_hit.max(page_miss),
+        };
+        let occ = slowest.max(1);
+        let bytes = 4 * texel_bytes;
+        let k = &mut self.counts;
+        k.footprints += 1;
+        k.accesses += 4;
+        k.bytes += bytes;
+        k.page_hits += hits;
+        k.miss_cycles += slowest.saturating_sub(page_hit);
+        (occ, occ, bytes)
     }
 
     /// Performs one footprint's accesses, any footprint; returns (occupancy, latency) in
@@ -642,12 +697,20 @@ struct Unit {
 }
 
 impl Unit {
-    /// A request ready at `ready` occupying `occ` cycles: returns its start.
+    /// A request ready at `ready` occupying `occ` cycles: returns its start. (`busy` wraps: an
+    /// arithmetic unit's is a sum of signed corrections until [`Simulator::finish`] adds its
+    /// plans' steps, exact modulo 2^64 like the true sum.)
     #[inline]
     fn take(&mut self, ready: u64, occ: u64) -> u64 {
+        self.busy = self.busy.wrapping_add(occ);
+        self.take_free(ready, occ)
+    }
+
+    /// [`Unit::take`] without counting the busy cycles (the caller counts them).
+    #[inline]
+    fn take_free(&mut self, ready: u64, occ: u64) -> u64 {
         let start = ready.max(self.free);
         self.free = start + occ;
-        self.busy += occ;
         start
     }
 }
@@ -684,6 +747,15 @@ fn stage_footprints<'f>(
         .map_or(&[], run_from)
 }
 
+/// The unit among `units` (not empty) that can start a request ready at `data` first (the
+/// lowest index among equals).
+#[inline(never)]
+fn earliest(units: &[Unit], data: u64) -> usize {
+    (0..units.len())
+        .min_by_key(|&j| (units[j].free.max(data), j))
+        .unwrap_or(0)
+}
+
 /// A filter unit's (occupancy, occupancy-or-latency) for a lookup of `nfp` footprints at
 /// `bpc` bilinear footprints per cycle: it is busy `ceil(nfp / bpc)` cycles and its result is
 /// ready `nfp` bilinear latencies plus the level blend's (two or more footprints) after it
@@ -707,53 +779,103 @@ pub struct FrameCounts {
     pub fragments: u64,
 }
 
-/// The shading pass of the timing model fed pixel by pixel in raster order ([`Simulator::row`]
-/// or [`Simulator::pixel`]), so a render can run it on the rows it has shaded while it shades
-/// the next ones; [`Simulator::finish`] adds the visibility pass and reports. Feeding a frame's
-/// pixels in order gives exactly [`simulate`] of its events.
+/// The shading pass of the timing model fed pixel by pixel in raster order ([`Simulator::row`],
+/// [`Simulator::span`] or [`Simulator::pixel`]), so a render can run it on the rows it has
+/// shaded while it shades the next ones; [`Simulator::finish`] adds the visibility pass and
+/// reports. Feeding a frame's pixels in order gives exactly [`simulate`] of its events.
 pub struct Simulator<'a> {
     hw: &'a HwConfig,
     /// Every plan's stages, plan after plan ([`PlanSteps`] says where each plan's are).
     steps: Vec<Step>,
     plans: Vec<PlanSteps>,
-    /// Per stage kind (index below [`KINDS`]) its arithmetic unit and the texel bytes its
-    /// lookups read.
+    /// Per stage kind (index below [`KINDS`]) its arithmetic unit. Its busy cycles are those
+    /// of the texture stages that ran on it minus their steps' arithmetic occupancy; every
+    /// pixel of a plan is counted in `plan_pixels`, and [`Simulator::finish`] adds each plan's
+    /// steps' occupancy that many times.
     alu: [Unit; KINDS],
-    stage_bytes: [u64; KINDS],
+    plan_pixels: Vec<u64>,
+    /// The texture side: memory, filter units and their costs.
+    tex: Texturing,
+    ppc: u64,
+    /// Stall cycles by cause: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2
+    /// latency (nk = `StageKind::COUNT`; causes below [`CAUSES`]).
+    stall_by: [u64; CAUSES],
+    /// Completion time and worst cause of the last `shade_pixels_in_flight` pixels.
+    ring: Vec<(u64, usize)>,
+    /// Where the issue stands (kept in locals while a batch of pixels is fed).
+    at: IssueState,
+    /// Footprints fed so far.
+    footprints: u64,
+    /// The machine's memory compiled into the walk: a texel cache, a tiled interleave.
+    cached: bool,
+    tiled: bool,
+}
+
+/// The issue's running state: pixels fed, the next pixel's issue group (`pixels /
+/// shade_pixels_per_cycle`), its place in that group (`pixels % shade_pixels_per_cycle`) and
+/// its ring slot (`pixels % ring.len()`), kept incrementally so the per-pixel step divides
+/// nothing; the last issue and the latest completion.
+#[derive(Clone, Copy, Debug, Default)]
+struct IssueState {
+    pixels: u64,
+    group: u64,
+    in_group: u64,
+    slot: usize,
+    last_issue: u64,
+    end: u64,
+}
+
+impl IssueState {
+    /// Issues the next pixel: returns its ring slot and issue cycle (held back by the pixel
+    /// `ring.len()` places before it, whose wait is charged to its worst cause in `stall_by`).
+    #[inline(always)]
+    fn issue(
+        &mut self,
+        ring: &[(u64, usize)],
+        stall_by: &mut [u64; CAUSES],
+        ppc: u64,
+    ) -> (usize, u64) {
+        // Pixel i issues in group i / ppc, one cycle after the previous group's last pixel
+        // when it opens a group (i % ppc == 0, i > 0), and waits for the pixel `win` places
+        // before it (ring slot i % win) to complete.
+        let next_slot = u64::from(self.pixels > 0 && self.in_group == 0);
+        let slot = self.slot;
+        let mut t = self.group.max(self.last_issue + next_slot);
+        if self.pixels >= ring.len() as u64 {
+            let (done, cause) = ring[slot];
+            if done > t {
+                stall_by[cause & (CAUSES - 1)] += done - t;
+                t = done;
+            }
+        }
+        self.pixels += 1;
+        self.in_group += 1;
+        if self.in_group == ppc {
+            self.in_group = 0;
+            self.group += 1;
+        }
+        self.slot = if slot + 1 == ring.len() { 0 } else { slot + 1 };
+        self.last_issue = t;
+        (slot, t)
+    }
+}
+
+/// The texture side of the shading pass: the memory, its unit, the filter units, the texel
+/// bytes per stage kind and the costs a texture stage needs.
+struct Texturing {
+    mem: Memory,
     mem_unit: Unit,
     filters: Vec<Unit>,
-    mem: Memory,
+    /// Per stage kind (index below [`KINDS`]) the texel bytes its lookups read.
+    stage_bytes: [u64; KINDS],
     tri_cycles: u64,
     bilinear_lat: u64,
     blend_lat: u64,
     bpc: u64,
     /// [`filter_cost`] of a lookup of 0, 1, 2 and 3 footprints.
     filter_cost: [(u64, u64); 4],
-    ppc: u64,
     alu_pipelined: bool,
-    /// Stall cycles by cause: 0..nk arithmetic units, nk memory, nk + 1 filters, nk + 2
-    /// latency (nk = `StageKind::COUNT`; causes below [`CAUSES`]).
-    stall_by: [u64; CAUSES],
-    /// Completion time and worst cause of the last `shade_pixels_in_flight` pixels.
-    ring: Vec<(u64, usize)>,
-    last_issue: u64,
-    end: u64,
-    /// Pixels and footprints fed so far.
-    pixels: u64,
-    footprints: u64,
-    /// The next pixel's issue group (`pixels / shade_pixels_per_cycle`), its place in that
-    /// group (`pixels % shade_pixels_per_cycle`) and its ring slot (`pixels % ring.len()`),
-    /// kept incrementally so the per-pixel step divides nothing.
-    group: u64,
-    in_group: u64,
-    slot: usize,
-    /// [`Simulator::issue_in`] compiled for this machine's memory (cache or not, bank
-    /// interleave), chosen once.
-    issue: IssueFn<'a>,
 }
-
-/// A compiled [`Simulator::issue_in`].
-type IssueFn<'a> = fn(&mut Simulator<'a>, u32, &[TexelFootprint]);
 
 /// Slots of the per-stage-kind arrays (stage kinds number at most 64), indexed by
 /// `kind & (KINDS - 1)`.
@@ -798,7 +920,7 @@ impl<'a> Simulator<'a> {
             }
         };
         let mut steps = Vec::new();
-        let plans = plans
+        let plans: Vec<PlanSteps> = plans
             .iter()
             .map(|p| {
                 let start = steps.len();
@@ -818,42 +940,35 @@ impl<'a> Simulator<'a> {
                 }
             })
             .collect();
+        let plan_pixels = vec![0; plans.len()];
         let win = tc.shade_pixels_in_flight.max(1) as usize;
         let (bilinear_lat, blend_lat) = (u64::from(bilinear_lat), u64::from(blend_lat));
         let bpc = u64::from(tc.bilinear_per_cycle.max(1));
-        let tiled = tc.bank_interleave == BankInterleave::Tiled;
-        let issue: IssueFn<'a> = match (tc.cache_bytes > 0, tiled) {
-            (true, true) => Self::issue_in::<true, true>,
-            (true, false) => Self::issue_in::<true, false>,
-            (false, true) => Self::issue_in::<false, true>,
-            (false, false) => Self::issue_in::<false, false>,
-        };
         Self {
             hw,
             steps,
             plans,
             alu: [Unit::default(); KINDS],
-            stage_bytes: [0; KINDS],
-            mem_unit: Unit::default(),
-            filters: vec![Unit::default(); tc.trilinear_units.max(1) as usize],
-            mem: Memory::new(textures, tc),
-            tri_cycles: u64::from(tri_cost.cycles),
-            bilinear_lat,
-            blend_lat,
-            bpc,
-            filter_cost: [0, 1, 2, 3].map(|n| filter_cost(n, bpc, bilinear_lat, blend_lat)),
+            plan_pixels,
+            tex: Texturing {
+                mem: Memory::new(textures, tc),
+                mem_unit: Unit::default(),
+                filters: vec![Unit::default(); tc.trilinear_units.max(1) as usize],
+                stage_bytes: [0; KINDS],
+                tri_cycles: u64::from(tri_cost.cycles),
+                bilinear_lat,
+                blend_lat,
+                bpc,
+                filter_cost: [0, 1, 2, 3].map(|n| filter_cost(n, bpc, bilinear_lat, blend_lat)),
+                alu_pipelined: tc.alu_pipelined,
+            },
             ppc: u64::from(tc.shade_pixels_per_cycle.max(1)),
-            alu_pipelined: tc.alu_pipelined,
             stall_by: [0; CAUSES],
             ring: vec![(0, StageKind::COUNT + 2); win],
-            last_issue: 0,
-            end: 0,
-            pixels: 0,
+            at: IssueState::default(),
             footprints: 0,
-            group: 0,
-            in_group: 0,
-            slot: 0,
-            issue,
+            cached: tc.cache_bytes > 0,
+            tiled: tc.bank_interleave == BankInterleave::Tiled,
         }
     }
 
@@ -865,97 +980,135 @@ impl<'a> Simulator<'a> {
     /// Feeds `pixels` in order; their `fp_end` index `footprints`, the previous pixel's end
     /// (0 for the first) being each one's start.
     fn pixels_of(&mut self, pixels: &[PixelEvent], footprints: &[TexelFootprint]) {
-        let issue = self.issue;
         let mut fp_start = 0usize;
-        for px in pixels {
+        self.feed(pixels.iter().map(|px| {
             let fp_end = (px.fp_end as usize).min(footprints.len());
-            issue(self, px.plan, &footprints[fp_start.min(fp_end)..fp_end]);
+            let fps = &footprints[fp_start.min(fp_end)..fp_end];
             fp_start = fp_end;
-        }
-        self.footprints += footprints.len() as u64;
+            (px.plan, fps)
+        }));
     }
 
     /// Issues the next covered pixel (raster order): plan index `plan`, the footprints its
-    /// stages fetched in `fps` (counted as events), e.g. straight from the fragment's trace.
+    /// stages fetched in `fps`, e.g. straight from the fragment's trace.
     #[inline]
     pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
-        (self.issue)(self, plan, fps);
-        self.footprints += fps.len() as u64;
+        self.feed(std::iter::once((plan, fps)));
     }
 
-    /// Issues the next covered pixel without counting its footprints (the caller counts),
-    /// with the memory's [`Memory::footprint`] compiled for the machine.
-    fn issue_in<const CACHED: bool, const TILED: bool>(
+    /// Issues the next covered pixels (raster order), all of plan `plan`, each with the
+    /// footprints its stages fetched: [`Simulator::pixel`] of each in turn, with the plan
+    /// resolved and the issue state in locals once for the batch (checked against pixel by
+    /// pixel feeding in `timing::equivalence`).
+    pub fn span<'f>(&mut self, plan: u32, pixels: impl IntoIterator<Item = &'f [TexelFootprint]>) {
+        self.feed(pixels.into_iter().map(|fps| (plan, fps)));
+    }
+
+    /// Issues pixels given as (plan, footprints) in raster order, through the walk compiled
+    /// for the machine's memory.
+    #[inline]
+    fn feed<'f>(&mut self, pixels: impl Iterator<Item = (u32, &'f [TexelFootprint])>) {
+        match (self.cached, self.tiled) {
+            (true, true) => self.feed_in::<true, true>(pixels),
+            (true, false) => self.feed_in::<true, false>(pixels),
+            (false, true) => self.feed_in::<false, true>(pixels),
+            (false, false) => self.feed_in::<false, false>(pixels),
+        }
+    }
+
+    /// Issues each pixel (plan index, the footprints its stages fetched) in turn, with the
+    /// memory's [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache, for
+    /// the tiled (`TILED`) or linear interleave. The issue state lives in locals for the batch
+    /// and the last pixel's plan is reused when the next one has the same.
+    #[inline(always)]
+    fn feed_in<'f, const CACHED: bool, const TILED: bool>(
         &mut self,
-        plan: u32,
-        fps: &[TexelFootprint],
+        pixels: impl Iterator<Item = (u32, &'f [TexelFootprint])>,
     ) {
         const C_LAT: usize = StageKind::COUNT + 2;
-        // Pixel i issues in group i / ppc, one cycle after the previous group's last pixel
-        // when it opens a group (i % ppc == 0, i > 0), and waits for the pixel `win` places
-        // before it (ring slot i % win) to complete.
-        let next_slot = u64::from(self.pixels > 0 && self.in_group == 0);
-        let ideal = self.group.max(self.last_issue + next_slot);
-        let slot = self.slot;
-        let mut t = ideal;
-        if self.pixels >= self.ring.len() as u64 {
-            let (done, cause) = self.ring[slot];
-            if done > t {
-                self.stall_by[cause & (CAUSES - 1)] += done - t;
-                t = done;
-            }
-        }
-        self.pixels += 1;
-        self.in_group += 1;
-        if self.in_group == self.ppc {
-            self.in_group = 0;
-            self.group += 1;
-        }
-        self.slot = if slot + 1 == self.ring.len() {
-            0
-        } else {
-            slot + 1
-        };
-        self.last_issue = t;
-        let mut worst = (0u64, C_LAT);
-        let Some(&PlanSteps {
-            start,
-            end,
-            distinct,
-        }) = self.plans.get(plan as usize)
-        else {
-            self.ring[slot] = (t, C_LAT);
-            return;
-        };
-        // The stage kinds that fetched (stage kinds number fewer than 64).
-        let fetched = fps.iter().fold(0u64, |m, f| m | 1u64 << (f.stage & 63));
-        let mut cursor = 0usize;
-        for i in start..end {
-            let Step { k, cycles, occ } = self.steps[i];
-            if fetched & (1u64 << (k & 63)) != 0 {
-                let mine = stage_footprints(fps, &mut cursor, k, distinct);
-                if !mine.is_empty() {
-                    t = self.texture_stage::<CACHED, TILED>(k, cycles, t, mine, &mut worst);
-                    continue;
+        let Self {
+            steps: all_steps,
+            plans,
+            alu,
+            plan_pixels,
+            tex,
+            ppc,
+            stall_by,
+            ring,
+            at,
+            footprints,
+            ..
+        } = self;
+        let ppc = *ppc;
+        let mut st = *at;
+        let mut fed = 0u64;
+        // The plan of the previous pixel: its index, stages and whether they are distinct
+        // (`None` for a plan the frame does not have).
+        // Its pixels since it became the current plan are `run` (added to `plan_pixels` when
+        // the plan changes and at the end).
+        let mut cur: (u32, Option<(&[Step], bool)>) = (u32::MAX, None);
+        let mut run = 0u64;
+        for (plan, fps) in pixels {
+            fed += fps.len() as u64;
+            let (slot, mut t) = st.issue(ring, stall_by, ppc);
+            if plan != cur.0 || cur.1.is_none() {
+                if let Some(n) = plan_pixels.get_mut(cur.0 as usize) {
+                    *n += run;
                 }
+                run = 0;
+                cur = (
+                    plan,
+                    plans
+                        .get(plan as usize)
+                        .map(|p| (&all_steps[p.start..p.end], p.distinct)),
+                );
             }
-            let s = self.alu[k & (KINDS - 1)].take(t, occ);
-            if s - t > worst.0 {
-                worst = (s - t, k);
+            let Some((steps, distinct)) = cur.1 else {
+                ring[slot] = (t, C_LAT);
+                continue;
+            };
+            run += 1;
+            let mut worst = (0u64, C_LAT);
+            // The stage kinds that fetched (stage kinds number fewer than 64).
+            let fetched = fps.iter().fold(0u64, |m, f| m | 1u64 << (f.stage & 63));
+            let mut cursor = 0usize;
+            for &Step { k, cycles, occ } in steps {
+                if fetched & (1u64 << (k & 63)) != 0 {
+                    let mine = stage_footprints(fps, &mut cursor, k, distinct);
+                    if !mine.is_empty() {
+                        let unit = &mut alu[k & (KINDS - 1)];
+                        // The plan's count charges this step's arithmetic occupancy.
+                        unit.busy = unit.busy.wrapping_sub(occ);
+                        t = tex.stage::<CACHED, TILED>(unit, k, cycles, t, mine, &mut worst);
+                        continue;
+                    }
+                }
+                let s = alu[k & (KINDS - 1)].take_free(t, occ);
+                if s - t > worst.0 {
+                    worst = (s - t, k);
+                }
+                t = s + cycles;
             }
-            t = s + cycles;
+            ring[slot] = (t, worst.1);
+            st.end = st.end.max(t);
         }
-        self.ring[slot] = (t, worst.1);
-        self.end = self.end.max(t);
+        if let Some(n) = plan_pixels.get_mut(cur.0 as usize) {
+            *n += run;
+        }
+        *at = st;
+        *footprints += fed;
     }
+}
 
-    /// A texture stage of kind `k` (`cycles` per invocation) reached at `t` with its
-    /// footprints `mine` (not empty): its address/footprint unit, then each lookup through
-    /// the memory and a filter unit; returns its completion and updates the pixel's worst
-    /// wait (cycles, cause).
+impl Texturing {
+    /// A texture stage of kind `k` (`cycles` per invocation, `alu` its address/footprint
+    /// unit) reached at `t` with its footprints `mine` (not empty): its address/footprint
+    /// unit, then each lookup through the memory and a filter unit; returns its completion
+    /// and updates the pixel's worst wait (cycles, cause).
     #[inline(never)]
-    fn texture_stage<const CACHED: bool, const TILED: bool>(
+    fn stage<const CACHED: bool, const TILED: bool>(
         &mut self,
+        alu: &mut Unit,
         k: usize,
         cycles: u64,
         t: u64,
@@ -963,7 +1116,6 @@ impl<'a> Simulator<'a> {
         worst: &mut (u64, usize),
     ) -> u64 {
         const C_MEM: usize = StageKind::COUNT;
-        const C_FILT: usize = StageKind::COUNT + 1;
         let lookups = u64::from(mine[mine.len() - 1].lookup) + 1;
         let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
         let setup_occ = if self.alu_pipelined {
@@ -971,25 +1123,20 @@ impl<'a> Simulator<'a> {
         } else {
             setup
         };
-        let s = self.alu[k & (KINDS - 1)].take(t, setup_occ);
+        let s = alu.take(t, setup_occ);
         if s - t > worst.0 {
             *worst = (s - t, k);
         }
         let ready = s + setup;
         let mut done = ready;
         let mut bytes = 0u64;
-        // The footprints of one lookup are consecutive: `rest` walks them lookup by lookup.
-        let mut rest = mine;
-        while let Some(first) = rest.first() {
-            let l = first.lookup;
-            let n = rest
-                .iter()
-                .position(|f| f.lookup != l)
-                .unwrap_or(rest.len());
-            let (lookup, tail) = rest.split_at(n);
-            rest = tail;
+        // The footprints of one lookup are consecutive: each run of one lookup number goes
+        // through the memory, then to a filter unit.
+        let mut i = 0;
+        while let Some(first) = mine.get(i) {
+            let (lookup, from) = (first.lookup, i);
             let mut data = ready;
-            for f in lookup {
+            while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
                 let (occ, lat, b) = self.mem.footprint::<CACHED, TILED>(f);
                 bytes += b;
                 let ms = self.mem_unit.take(ready, occ);
@@ -997,30 +1144,39 @@ impl<'a> Simulator<'a> {
                     *worst = (ms - ready, C_MEM);
                 }
                 data = data.max(ms + lat);
+                i += 1;
             }
-            // The filter's occupancy and its occupancy-or-latency for `n` footprints.
-            let (occ, lat) = match self.filter_cost.get(n) {
-                Some(&c) => c,
-                None => filter_cost(n as u64, self.bpc, self.bilinear_lat, self.blend_lat),
-            };
-            let filters = &mut self.filters[..];
-            let fu = if filters.len() == 1 {
-                0
-            } else {
-                (0..filters.len())
-                    .min_by_key(|&j| (filters[j].free.max(data), j))
-                    .unwrap_or(0)
-            };
-            let fs = filters[fu].take(data, occ);
-            if fs - data > worst.0 {
-                *worst = (fs - data, C_FILT);
-            }
-            done = done.max(fs + lat);
+            done = done.max(self.filter(data, i - from, worst));
         }
         self.stage_bytes[k & (KINDS - 1)] += bytes;
         done
     }
 
+    /// A lookup of `n` footprints whose data is ready at `data` on the earliest free filter
+    /// unit: returns when its result is ready and updates the pixel's worst wait.
+    #[inline(always)]
+    fn filter(&mut self, data: u64, n: usize, worst: &mut (u64, usize)) -> u64 {
+        const C_FILT: usize = StageKind::COUNT + 1;
+        // The filter's occupancy and its occupancy-or-latency for `n` footprints.
+        let (occ, lat) = match self.filter_cost.get(n) {
+            Some(&c) => c,
+            None => filter_cost(n as u64, self.bpc, self.bilinear_lat, self.blend_lat),
+        };
+        let fs = match &mut self.filters[..] {
+            [one] => one.take(data, occ),
+            filters => {
+                let fu = earliest(filters, data);
+                filters[fu].take(data, occ)
+            }
+        };
+        if fs - data > worst.0 {
+            *worst = (fs - data, C_FILT);
+        }
+        fs + lat
+    }
+}
+
+impl Simulator<'_> {
     /// Adds the visibility pass of the frame (`f`) and reports.
     #[must_use]
     pub fn finish(self, f: &FrameCounts, scene: &str) -> TimingReport {
@@ -1030,14 +1186,20 @@ impl<'a> Simulator<'a> {
         let nk = StageKind::COUNT;
         let c_lat = nk + 2;
         let (c_mem, c_filt) = (nk, nk + 1);
-        let (alu, stall_by, mem_unit, filters, stage_bytes) = (
-            self.alu,
-            self.stall_by,
-            self.mem_unit,
-            self.filters,
-            self.stage_bytes,
-        );
-        let mem = self.mem;
+        let (mut alu, stall_by) = (self.alu, self.stall_by);
+        for (p, &n) in self.plans.iter().zip(&self.plan_pixels) {
+            for s in &self.steps[p.start..p.end] {
+                let u = &mut alu[s.k & (KINDS - 1)];
+                u.busy = u.busy.wrapping_add(n.wrapping_mul(s.occ));
+            }
+        }
+        let Texturing {
+            mem,
+            mem_unit,
+            filters,
+            stage_bytes,
+            ..
+        } = self.tex;
         // Visibility pass.
         let setup_busy = f.triangles * u64::from(rc.setup_cycles);
         let traverse_busy = f.spans * u64::from(rc.span_cycles)
@@ -1047,9 +1209,9 @@ impl<'a> Simulator<'a> {
             None => 0,
             Some(avg) => (setup_busy + avg).max(u64::from(rc.setup_cycles) + traverse_busy),
         };
-        let events = self.pixels + self.footprints + f.triangles + f.spans;
-        let covered = self.pixels;
-        let shade = self.end;
+        let events = self.at.pixels + self.footprints + f.triangles + f.spans;
+        let covered = self.at.pixels;
+        let shade = self.at.end;
         let total = vis + shade;
         let util = |b: u64| {
             if total == 0 {
