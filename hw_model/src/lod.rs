@@ -210,6 +210,17 @@ const fn quadratics() -> [[i32; 4]; 1 << SEG_BITS] {
 #[must_use]
 pub fn table_log2_bits(m: u64) -> u32 {
     debug_assert!(m >> MANT_BITS == 1, "mantissa {m:#x} outside [2^31, 2^32)");
+    match log2_quadratic(m) {
+        Some(bits) => bits,
+        None => serial_log2_bits(m, SERIAL_STEPS),
+    }
+}
+
+/// The quadratic's floor of `2^15 log2(m / 2^31)` for `m` in `[2^31, 2^32)` ([`LOG2_QUAD`],
+/// 16 fraction bits), or `None` where its value lies within [`LOG2_MARGIN`] of an integer
+/// (there [`table_log2_bits`] runs the loop).
+#[inline(always)]
+fn log2_quadratic(m: u64) -> Option<u32> {
     let off = (m as u32) ^ (1 << MANT_BITS);
     // `off < 2^31`: the mask only drops the bounds check.
     let [z0, a, b, _] = LOG2_QUAD[(off >> SEG_SHIFT) as usize & (LOG2_QUAD.len() - 1)];
@@ -219,23 +230,13 @@ pub fn table_log2_bits(m: u64) -> u32 {
         i64::from(z0) + round_shift_right_mid::<TruncateMode>(t * (i64::from(a) + tb), SEG_SHIFT);
     // z (16 fraction bits) within `[0, 2^31)`: the floor and the distance to an integer.
     let f = (z as u32) & 0xffff;
-    if f.wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN {
-        (z >> 16) as u32
-    } else {
-        serial_log2_bits(m, SERIAL_STEPS)
-    }
+    (f.wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN).then_some((z >> 16) as u32)
 }
 
 /// Whether [`table_log2_bits`] takes the quadratic's value for `m` (else it runs the loop).
 #[must_use]
 pub fn table_log2_is_direct(m: u64) -> bool {
-    let off = (m as u32) ^ (1 << MANT_BITS);
-    let [z0, a, b, _] = LOG2_QUAD[(off >> SEG_SHIFT) as usize];
-    let t = i64::from(off & ((1 << SEG_SHIFT) - 1));
-    let tb = round_shift_right_mid::<TruncateMode>(t * i64::from(b), SEG_SHIFT);
-    let z =
-        i64::from(z0) + round_shift_right_mid::<TruncateMode>(t * (i64::from(a) + tb), SEG_SHIFT);
-    ((z as u32) & 0xffff).wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN
+    log2_quadratic(m).is_some()
 }
 
 /// Cost: cycles from [`datapath`] (`lod_cycles + lod_cycles_per_bit * lod_frac_bits` when both
