@@ -3,7 +3,11 @@
 # (shared/anchors/mesa: W1 plane, W2 mesh, 1024x1024, same texture and geometry).
 # Needs the anchor built once: (cd ../shared/anchors/mesa && ./build.sh), which needs
 #   apt-get install -y gcc pkg-config libosmesa6-dev libpng-dev
-# Usage: scripts/compare_mesa.sh [REPEATS]    (prints one line per run and the medians)
+# Usage: scripts/compare_mesa.sh [REPEATS]    (prints one line per configuration: the median
+# of REPEATS runs, then the issue-12 ratios at equal thread counts)
+# Thread counts: llvmpipe-t1 rasterises in the calling thread (LP_NUM_THREADS=0), llvmpipe-t2
+# on two rasteriser threads (LP_NUM_THREADS=2); texsim-*-tT is `texsim --threads T`. Within a
+# repeat the configurations alternate, so a slow spell of a shared machine falls on all of them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 REPEATS=${1:-5}
@@ -11,20 +15,44 @@ ANCHOR=${MESA_ANCHOR:-../shared/anchors/mesa/build/mesa_anchor}
 [ -x "$ANCHOR" ] || { echo "build the Mesa anchor first (see the header of this script)"; exit 1; }
 cargo build --release -q
 median() { sort -n | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
-for w in plane:w1-plane mesh:w2-mesh; do
-    mesa=${w%%:*}; scene=${w##*:}
-    for drv in softpipe llvmpipe; do
-        for _ in $(seq "$REPEATS"); do
-            GALLIUM_DRIVER=$drv "$ANCHOR" --workload "$mesa" --frames 5 --warmup 1 | grep -o 'median_ms=[0-9.]*' | cut -d= -f2
-        done | median | xargs printf "%-9s %-9s %8.1f ms\n" "$scene" "$drv"
-    done
-    for threads in 1 2; do
-        for path in hw ref; do
-            for _ in $(seq "$REPEATS"); do
-                if [ $path = hw ]; then extra=(--no-reference --no-cycles); else extra=(--float bary,texcoord,lod,trilinear,color,modulate --no-reference --no-cycles); fi
-                ./target/release/texsim --threads $threads render --scene "$scene" "${extra[@]}" --out target/compare-out 2>/dev/null \
-                    | grep -o 'hardware path [0-9.]*' | awk '{print $3}'
-            done | median | xargs printf "%-9s %-9s %8.1f ms\n" "$scene" "texsim-$path-t$threads"
+raw=$(mktemp)
+trap 'rm -f "$raw"' EXIT
+mesa() { # $1 workload, $2 driver, $3 LP_NUM_THREADS (empty: unset)
+    if [ -n "$3" ]; then export LP_NUM_THREADS=$3; else unset LP_NUM_THREADS; fi
+    GALLIUM_DRIVER=$2 "$ANCHOR" --workload "$1" --frames 5 --warmup 1 | grep -o 'median_ms=[0-9.]*' | cut -d= -f2
+    unset LP_NUM_THREADS
+}
+texsim() { # $1 scene, $2 threads, $3 path (hw: bit-accurate, ref: the float stages)
+    local extra=(--no-reference --no-cycles)
+    [ "$3" = ref ] && extra+=(--float bary,texcoord,lod,trilinear,color,modulate)
+    ./target/release/texsim --threads "$2" render --scene "$1" "${extra[@]}" --out target/compare-out 2>/dev/null |
+        grep -o 'hardware path [0-9.]*' | awk '{print $3}'
+}
+for _ in $(seq "$REPEATS"); do
+    for w in plane:w1-plane mesh:w2-mesh; do
+        m=${w%%:*}; s=${w##*:}
+        echo "$s softpipe $(mesa "$m" softpipe '')" >>"$raw"
+        echo "$s llvmpipe-t1 $(mesa "$m" llvmpipe 0)" >>"$raw"
+        echo "$s llvmpipe-t2 $(mesa "$m" llvmpipe 2)" >>"$raw"
+        for t in 1 2; do
+            for p in hw ref; do
+                echo "$s texsim-$p-t$t $(texsim "$s" "$t" "$p")" >>"$raw"
+            done
         done
+    done
+done
+declare -A med
+for s in w1-plane w2-mesh; do
+    for c in softpipe llvmpipe-t1 llvmpipe-t2 texsim-hw-t1 texsim-ref-t1 texsim-hw-t2 texsim-ref-t2; do
+        med[$s/$c]=$(awk -v s="$s" -v c="$c" '$1 == s && $2 == c {print $3}' "$raw" | median)
+        printf "%-9s %-14s %8.1f ms\n" "$s" "$c" "${med[$s/$c]}"
+    done
+done
+echo "ratios (issue 12 asks bit-accurate <= 3x llvmpipe on W1, <= 1.5x on W2, and <= the float path):"
+for s in w1-plane w2-mesh; do
+    for t in 1 2; do
+        awk -v s="$s" -v t="$t" -v hw="${med[$s/texsim-hw-t$t]}" -v lp="${med[$s/llvmpipe-t$t]}" \
+            -v ref="${med[$s/texsim-ref-t$t]}" \
+            'BEGIN {printf "%-9s %d thread(s): bit-accurate / llvmpipe %5.2fx, bit-accurate / float path %5.2fx\n", s, t, hw / lp, hw / ref}'
     done
 done
