@@ -28,7 +28,9 @@ use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, ConstRounding, Rounding};
-use crate::wrap::{fits_i64, wrap_i64_with, wrap_in, WrapMode, WrapOut, WrapShifts};
+use crate::wrap::{
+    fits_i64, wrap_i64_with, wrap_in, wrap_pow2_repeat, WrapMode, WrapOut, WrapShifts,
+};
 
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
@@ -166,8 +168,8 @@ impl Lanes {
 /// w`, non-negative and below 2^32 per lane, and the rounding of [`round_shift_right`] adds
 /// its carry per lane: `floor + 1` iff the dropped part reaches one half (HalfUp, a bias of
 /// one half) or exceeds it, or equals it with an odd floor (HalfEven, a bias of one half less
-/// one plus the floor's lowest bit). Built once per sample.
-#[derive(Clone, Copy)]
+/// one plus the floor's lowest bit). Built once per [`UnitSetup`].
+#[derive(Clone, Copy, Debug)]
 struct LaneLerp {
     wb: u32,
     one: u32,
@@ -179,9 +181,9 @@ struct LaneLerp {
 
 impl LaneLerp {
     #[inline(always)]
-    fn new<M: ConstRounding>(wb: u32) -> Self {
+    fn new(wb: u32, mode: Rounding) -> Self {
         let half = (1u64 << wb) >> 1;
-        let (bias, odd) = match M::MODE {
+        let (bias, odd) = match mode {
             Rounding::Truncate => (0, 0),
             Rounding::HalfUp => (half * LANE_LSB, 0),
             Rounding::HalfEven if wb > 0 => ((half - 1) * LANE_LSB, LANE_LSB),
@@ -224,10 +226,11 @@ fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
 /// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
 /// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: both
 /// coordinates [`fits_i64`] (the caller's test, once for every level of a sample), wrapped
-/// with the shifts `k` of `frac` and `weight_bits`.
+/// with the shifts `k` of `frac` and `weight_bits`; `POW2_REPEAT`: both axes Repeat and both
+/// sides of the level powers of two (the caller's test, once per span), wrapped by masks.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
+fn bilinear_lanes<W: ConstRounding, S: SampleSink, const POW2_REPEAT: bool>(
     level: &Level,
     level_index: u32,
     u: i64,
@@ -240,7 +243,12 @@ fn bilinear_lanes<W: ConstRounding, S: SampleSink>(
     narrow: Option<&WrapShifts>,
     sink: &mut S,
 ) -> Lanes {
-    let (wx, wy) = if let Some(k) = narrow {
+    let (wx, wy) = if let (Some(k), true) = (narrow, POW2_REPEAT) {
+        (
+            wrap_pow2_repeat::<W>(u, level.width, k),
+            wrap_pow2_repeat::<W>(v, level.height, k),
+        )
+    } else if let Some(k) = narrow {
         (
             wrap_i64_with::<W>(u, level.width, wrap_mode[0], k),
             wrap_i64_with::<W>(v, level.height, wrap_mode[1], k),
@@ -297,17 +305,17 @@ pub fn bilinear(
     crate::with_rounding!(cfg.filter_rounding, F => {
         crate::with_rounding!(cfg.weight_rounding, W => match trace {
             None => {
-                let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
+                let f = LaneLerp::new(cfg.weight_bits.min(16), F::MODE);
                 let k = WrapShifts::new(frac, cfg.weight_bits.min(16));
                 let narrow = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&k);
-                bilinear_lanes::<W, ()>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut ())
+                bilinear_lanes::<W, (), false>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut ())
             }
             Some(t) => {
                 let mut one = One(t);
-                let f = LaneLerp::new::<F>(cfg.weight_bits.min(16));
+                let f = LaneLerp::new(cfg.weight_bits.min(16), F::MODE);
                 let k = WrapShifts::new(frac, cfg.weight_bits.min(16));
                 let narrow = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&k);
-                bilinear_lanes::<W, One>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut one)
+                bilinear_lanes::<W, One, false>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut one)
             }
         }
         .channels())
@@ -383,60 +391,84 @@ fn trilinear_in<F: ConstRounding, W: ConstRounding, S: SampleSink>(
     cfg: &TrilinearConfig,
     sink: &mut S,
 ) -> [u16; 4] {
-    TrilinearUnit::<F, W>::new(cfg, frac, lod_frac_bits, wrap_mode).sample(levels, u, v, lod, sink)
+    let setup = UnitSetup::new(cfg, frac, lod_frac_bits);
+    let out = TrilinearUnit::<F, W>::new(cfg, &setup, wrap_mode).sample(levels, u, v, lod, sink);
+    out.map(|c| c as u16)
 }
 
-/// The trilinear unit set up once for a run of samples with one configuration, coordinate
-/// format, LOD format and wrap mode (the filter rounding `F` and the weight rounding `W` as
-/// types, the lerps' constants built): [`TrilinearUnit::sample`] gives the bits and the
-/// footprints of [`trilinear_to`] with the same arguments (it is what [`trilinear_to`] runs,
-/// and the unit tests check [`trilinear_to`] against the scalar filter it replaced).
-#[derive(Clone, Copy)]
-pub struct TrilinearUnit<'a, F, W> {
-    cfg: &'a TrilinearConfig,
+/// The constants of a [`TrilinearUnit`] for one configuration, coordinate format and LOD
+/// format (the lerps' rounding constants, the wrap's shifts), built once, e.g. per render,
+/// for the units of every span.
+#[derive(Clone, Copy, Debug)]
+pub struct UnitSetup {
     frac: u32,
     /// `lod_frac_bits`, at most 30.
     lf: u32,
-    wrap_mode: [WrapMode; 2],
+    /// The LOD's fraction bits: `2^lf - 1`.
+    lod_mask: i64,
     /// The bilinear lerps (`weight_bits`, at most 16).
     filter: LaneLerp,
     /// The level blend in lanes (`lf <= 16`).
     blend: LaneLerp,
     /// The wrap's shifts (`frac`, `weight_bits`) for coordinates that [`fits_i64`].
     shifts: WrapShifts,
-    /// `frac <= 30`: coordinates below 2^29 in magnitude [`fits_i64`].
+    /// `frac <= 30`: coordinates in [-2^29, 2^29) [`fits_i64`].
     narrow_frac: bool,
+    /// The filter and weight roundings it was built for.
+    modes: (Rounding, Rounding),
+}
+
+impl UnitSetup {
+    /// The constants for `cfg`, coordinates with `frac` fraction bits and LODs with
+    /// `lod_frac_bits`.
+    #[must_use]
+    pub fn new(cfg: &TrilinearConfig, frac: u32, lod_frac_bits: u32) -> Self {
+        let lf = lod_frac_bits.min(30);
+        let wb = cfg.weight_bits.min(16);
+        Self {
+            frac,
+            lf,
+            lod_mask: (1 << lf) - 1,
+            filter: LaneLerp::new(wb, cfg.filter_rounding),
+            blend: LaneLerp::new(lf.min(16), cfg.filter_rounding),
+            shifts: WrapShifts::new(frac, wb),
+            narrow_frac: fits_i64(0, frac),
+            modes: (cfg.filter_rounding, cfg.weight_rounding),
+        }
+    }
+}
+
+/// The trilinear unit set up for a run of samples with one configuration, coordinate
+/// format, LOD format ([`UnitSetup`]) and wrap mode, the filter rounding `F` and the weight
+/// rounding `W` as types: [`TrilinearUnit::sample`] gives the bits and the footprints of
+/// [`trilinear_to`] with the same arguments (it is what [`trilinear_to`] runs, and the unit
+/// tests check [`trilinear_to`] against the scalar filter it replaced).
+#[derive(Clone, Copy)]
+pub struct TrilinearUnit<'a, F, W> {
+    cfg: &'a TrilinearConfig,
+    setup: &'a UnitSetup,
+    wrap_mode: [WrapMode; 2],
     modes: std::marker::PhantomData<(F, W)>,
 }
 
 impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
-    /// The unit for `cfg` (its rounding modes must be `F` and `W`), coordinates with `frac`
-    /// fraction bits, LODs with `lod_frac_bits` and `wrap_mode`.
+    /// The unit for `cfg` (its rounding modes must be `F` and `W`) with the constants `setup`
+    /// built for `cfg`, and `wrap_mode`.
     #[inline(always)]
     #[must_use]
-    pub fn new(
-        cfg: &'a TrilinearConfig,
-        frac: u32,
-        lod_frac_bits: u32,
-        wrap_mode: [WrapMode; 2],
-    ) -> Self {
+    pub fn new(cfg: &'a TrilinearConfig, setup: &'a UnitSetup, wrap_mode: [WrapMode; 2]) -> Self {
         debug_assert!(cfg.filter_rounding == F::MODE && cfg.weight_rounding == W::MODE);
-        let lf = lod_frac_bits.min(30);
+        debug_assert!(setup.modes == (F::MODE, W::MODE));
         Self {
             cfg,
-            frac,
-            lf,
+            setup,
             wrap_mode,
-            filter: LaneLerp::new::<F>(cfg.weight_bits.min(16)),
-            blend: LaneLerp::new::<F>(lf.min(16)),
-            shifts: WrapShifts::new(frac, cfg.weight_bits.min(16)),
-            narrow_frac: fits_i64(0, frac),
             modes: std::marker::PhantomData,
         }
     }
 
     /// One sample of `levels` at (`u`, `v`) and LOD `lod`, its footprints reported to `sink`:
-    /// [`trilinear_to`].
+    /// the channels of [`trilinear_to`] (each below 2^16).
     #[inline(always)]
     pub fn sample<S: SampleSink>(
         &self,
@@ -445,43 +477,118 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
         v: i64,
         lod: i64,
         sink: &mut S,
-    ) -> [u16; 4] {
+    ) -> [u32; 4] {
+        self.sample_in::<S, false>(levels, u, v, lod, sink)
+    }
+
+    /// Whether [`TrilinearUnit::sample_pow2_repeat`] may sample `levels`: both axes Repeat
+    /// and [`pow2_chain`] (decided once per span).
+    #[inline]
+    #[must_use]
+    pub fn pow2_repeat(&self, levels: &[Level]) -> bool {
+        self.repeats() && pow2_chain(levels)
+    }
+
+    /// Both axes wrap by Repeat.
+    #[inline(always)]
+    #[must_use]
+    pub fn repeats(&self) -> bool {
+        self.wrap_mode == [WrapMode::Repeat; 2]
+    }
+
+    /// [`TrilinearUnit::sample`] for `levels` that [`TrilinearUnit::pow2_repeat`] accepts:
+    /// the same bits and footprints, each axis's two indices masked (no test of the wrap mode
+    /// or the level's size).
+    #[inline(always)]
+    pub fn sample_pow2_repeat<S: SampleSink>(
+        &self,
+        levels: &[Level],
+        u: i64,
+        v: i64,
+        lod: i64,
+        sink: &mut S,
+    ) -> [u32; 4] {
+        debug_assert!(self.pow2_repeat(levels));
+        self.sample_in::<S, true>(levels, u, v, lod, sink)
+    }
+
+    /// [`TrilinearUnit::sample`], with `POW2_REPEAT` as for [`bilinear_lanes`].
+    #[inline(always)]
+    fn sample_in<S: SampleSink, const POW2_REPEAT: bool>(
+        &self,
+        levels: &[Level],
+        u: i64,
+        v: i64,
+        lod: i64,
+        sink: &mut S,
+    ) -> [u32; 4] {
         let n = levels.len();
         if n == 0 {
             return [0; 4];
         }
-        let lf = self.lf;
+        let k = self.setup;
+        let lf = k.lf;
         let last = (n - 1) as i64;
         let (l0, lw) = if lod <= 0 {
             (0usize, 0u32)
         } else if (lod >> lf) >= last {
             (n - 1, 0)
         } else {
-            ((lod >> lf) as usize, (lod & ((1i64 << lf) - 1)) as u32)
+            ((lod >> lf) as usize, (lod & k.lod_mask) as u32)
         };
-        let (frac, wm, cfg, f) = (self.frac, self.wrap_mode, self.cfg, &self.filter);
-        // `fits_i64(u, frac) && fits_i64(v, frac)`.
-        let nw = (self.narrow_frac && (u.unsigned_abs() | v.unsigned_abs()) < 1 << 29)
-            .then_some(&self.shifts);
-        let c0 =
-            bilinear_lanes::<W, S>(&levels[l0], l0 as u32, u, v, frac, wm, cfg, f, 0, nw, sink);
+        let (frac, wm, cfg, f) = (k.frac, self.wrap_mode, self.cfg, &k.filter);
+        // `fits_i64(u, frac) && fits_i64(v, frac)`: both in [-2^29, 2^29).
+        let both = (u as u64).wrapping_add(1 << 29) | (v as u64).wrapping_add(1 << 29);
+        let nw = (k.narrow_frac && both < 1 << 30).then_some(&k.shifts);
+        let c0 = bilinear_lanes::<W, S, POW2_REPEAT>(
+            &levels[l0],
+            l0 as u32,
+            u,
+            v,
+            frac,
+            wm,
+            cfg,
+            f,
+            0,
+            nw,
+            sink,
+        );
         if lw == 0 {
-            let out = c0.channels().map(|c| c as u16);
-            sink.sample(1, 0, out);
+            let out = c0.channels();
+            sink.sample(1, 0, out.map(|c| c as u16));
             return out;
         }
         let l1 = l0 + 1;
-        let c1 =
-            bilinear_lanes::<W, S>(&levels[l1], l1 as u32, u, v, frac, wm, cfg, f, 1, nw, sink);
+        let c1 = bilinear_lanes::<W, S, POW2_REPEAT>(
+            &levels[l1],
+            l1 as u32,
+            u,
+            v,
+            frac,
+            wm,
+            cfg,
+            f,
+            1,
+            nw,
+            sink,
+        );
         let out = if lf <= 16 {
-            c0.lerp(c1, lw, &self.blend).channels().map(|c| c as u16)
+            c0.lerp(c1, lw, &k.blend).channels()
         } else {
             let (a, b) = (c0.channels(), c1.channels());
-            std::array::from_fn(|c| lerp(a[c], b[c], lw, lf, F::MODE) as u16)
+            std::array::from_fn(|c| lerp(a[c], b[c], lw, lf, F::MODE))
         };
-        sink.sample(2, lw, out);
+        sink.sample(2, lw, out.map(|c| c as u16));
         out
     }
+}
+
+/// Every level's width and height are powers of two (Repeat of such a chain wraps by masks).
+#[must_use]
+pub fn pow2_chain(levels: &[Level]) -> bool {
+    levels
+        .iter()
+        .all(|l| l.width.is_power_of_two() && l.height.is_power_of_two())
 }
 
 /// Cost of one trilinear sample using `levels_used` (1 or 2) levels: per level the two wraps,
@@ -941,6 +1048,137 @@ mod tests {
         assert!(
             inside > 500_000 && wrapped > 500_000 && missing > 10_000,
             "{inside} {wrapped} {missing}"
+        );
+    }
+
+    /// 2M seeded samples: a unit's `sample_pow2_repeat`, where `pow2_repeat` accepts the
+    /// chain (Repeat on both axes, power-of-two sides), gives the bits and the whole trace of
+    /// its general `sample` and of the scalar filter it replaced; the nine rounding pairs,
+    /// weight widths 0 to 16, LOD fractions 0 to 30, coordinate formats with 4 to 30 fraction
+    /// bits and wider ones (the 128-bit wrap), coordinates inside and far outside [0, 1] and at
+    /// the ends of the 64-bit path; square, non-square, 1xN and short power-of-two chains, and
+    /// non-power-of-two chains and other wrap modes (refused, counted).
+    #[test]
+    fn pow2_repeat_matches_the_general_sample() {
+        let mut s = 0x5eed_0016;
+        let texels: Vec<[u16; 4]> = (0..6000)
+            .map(|_| [0; 4].map(|_| next(&mut s) as u16))
+            .collect();
+        let sizes: [&[(u32, u32)]; 6] = [
+            &[(32, 32), (16, 16), (8, 8), (4, 4), (2, 2), (1, 1)],
+            &[(16, 4), (8, 2), (4, 1), (2, 1), (1, 1)],
+            &[(1, 1)],
+            &[(1, 64), (1, 32), (1, 16)],
+            // Short: the 64x64 level's last rows read zeros.
+            &[(64, 64), (32, 32)],
+            // Not powers of two: refused.
+            &[(12, 8), (6, 4), (3, 2), (1, 1)],
+        ];
+        let chains: Vec<Vec<Level>> = sizes
+            .iter()
+            .map(|c| {
+                let mut at = 0usize;
+                c.iter()
+                    .map(|&(width, height)| {
+                        let n = (width * height) as usize;
+                        let end = (at + n).min(texels.len());
+                        let l = Level {
+                            width,
+                            height,
+                            texels: &texels[at..end],
+                        };
+                        at = end % 4096;
+                        l
+                    })
+                    .collect()
+            })
+            .collect();
+        let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
+        let (mut fast, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
+        for i in 0..2_000_000u32 {
+            let mut cfg = HwConfig::texram16().trilinear;
+            cfg.filter_rounding = MODES[(i % 3) as usize];
+            cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
+            cfg.weight_bits = i / 9 % 17;
+            let levels = &chains[(i / 153 % 6) as usize];
+            let wm = if i % 8 == 0 {
+                [modes[(i / 8 % 3) as usize], modes[(i / 24 % 3) as usize]]
+            } else {
+                [WrapMode::Repeat; 2]
+            };
+            let frac = if i % 16 == 0 {
+                31 + i / 16 % 30
+            } else {
+                4 + i / 11 % 27
+            };
+            let lfb = i / 17 % 31;
+            let one = 1i64 << frac.min(62);
+            let (u, v) = match i % 5 {
+                0 => {
+                    let sh = (next(&mut s) % 64) as u32;
+                    ((next(&mut s) as i64) >> sh, (next(&mut s) as i64) >> sh)
+                }
+                1 => {
+                    let edge = [-(1i64 << 29) - 1, -(1 << 29), 1 << 29, (1 << 29) - 1];
+                    let e = |x: u64| edge[(x % 4) as usize] + (x % 3) as i64 - 1;
+                    (e(next(&mut s)), e(next(&mut s)))
+                }
+                _ => {
+                    let r = |x: u64| (x % (4 * one as u64)) as i64 - 3 * one / 2;
+                    (r(next(&mut s)), r(next(&mut s)))
+                }
+            };
+            let lod = (next(&mut s) % ((levels.len() as u64 + 1) << lfb)) as i64 - (1 << lfb >> 1);
+            let setup = UnitSetup::new(&cfg, frac, lfb);
+            let want = trilinear_before(levels, u, v, frac, lod, lfb, wm, &cfg, None);
+            let mut want_trace = TrilinearTrace::default();
+            let _ = trilinear_before(
+                levels,
+                u,
+                v,
+                frac,
+                lod,
+                lfb,
+                wm,
+                &cfg,
+                Some(&mut want_trace),
+            );
+            crate::with_rounding!(cfg.filter_rounding, F => {
+                crate::with_rounding!(cfg.weight_rounding, W => {
+                    let unit = TrilinearUnit::<F, W>::new(&cfg, &setup, wm);
+                    let want = want.map(u32::from);
+                    assert_eq!(unit.sample(levels, u, v, lod, &mut ()), want);
+                    if unit.pow2_repeat(levels) {
+                        fast += 1;
+                        let got = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
+                        assert_eq!(got, want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
+                        let mut got_trace = TrilinearTrace {
+                            levels_used: 2,
+                            level: [BilinearTrace {
+                                level: 9,
+                                ..BilinearTrace::default()
+                            }; 2],
+                            ..TrilinearTrace::default()
+                        };
+                        let got = unit.sample_pow2_repeat(levels, u, v, lod, &mut got_trace);
+                        assert_eq!(got, want);
+                        assert_eq!(got_trace, want_trace, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
+                        if !(fits_i64(u, frac) && fits_i64(v, frac)) {
+                            wide += 1;
+                        }
+                        if want_trace.levels_used == 2 {
+                            two += 1;
+                        }
+                    } else {
+                        assert!(wm != [WrapMode::Repeat; 2] || !pow2_chain(levels));
+                        refused += 1;
+                    }
+                })
+            });
+        }
+        assert!(
+            fast > 1_400_000 && refused > 300_000 && wide > 300_000 && two > 400_000,
+            "{fast} {refused} {wide} {two}"
         );
     }
 }

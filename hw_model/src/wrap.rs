@@ -30,8 +30,8 @@ pub struct WrapOut {
 /// Texel address of one axis (texel centres at half-integers, see `trilinear`).
 ///
 /// `coord` is a normalized coordinate with `frac` fraction bits (1.0 = the full texture).
-/// `s = coord * size - 1/2` is formed exactly (`frac + 1` fraction bits; `i64`, or `i128` for
-/// |coord| >= 2^29; `frac` is clamped to 62);
+/// `s = coord * size - 1/2` is formed exactly (`frac + 1` fraction bits; `i64` when
+/// [`fits_i64`], else `i128`; `frac` is clamped to 62);
 /// `i0 = floor(s)`, and the fraction of `s` is reduced to `weight_bits` by `weight_rounding`
 /// (exact when `frac + 1 <= weight_bits`). If rounding carries to `2^weight_bits`, then
 /// `i0 += 1` and `weight = 0` (the same filtered value), so `weight < 2^weight_bits` always;
@@ -70,11 +70,12 @@ pub fn wrap_in<W: crate::fixed::ConstRounding>(
     }
 }
 
-/// Whether [`wrap`] of `coord` takes its 64-bit path (`|s| < 2^63`).
+/// Whether [`wrap`] of `coord` takes its 64-bit path: `frac <= 30` and `coord` in
+/// `[-2^29, 2^29)` (then `|s| < 2^63` for any `u32` size).
 #[inline(always)]
 #[must_use]
 pub fn fits_i64(coord: i64, frac: u32) -> bool {
-    frac <= 30 && coord.unsigned_abs() < (1u64 << 29)
+    frac <= 30 && (coord as u64).wrapping_add(1 << 29) < 1 << 30
 }
 
 /// [`wrap_in`] of a coordinate that [`fits_i64`], `wb` = `weight_bits.min(16)`.
@@ -94,9 +95,12 @@ pub fn wrap_i64_in<W: crate::fixed::ConstRounding>(
 /// (`wb <= 16`), resolved once for a run of wraps ([`wrap_i64_with`]).
 #[derive(Clone, Copy, Debug)]
 pub struct WrapShifts {
-    frac: u32,
+    /// One half in the fraction bits of `s` (`2^frac`).
+    half: i64,
     /// Fraction bits of `s`: `frac + 1`.
     sf: u32,
+    /// The fraction bits of `s`: `2^sf - 1`.
+    fmask: i64,
     /// Weight width.
     wb: u32,
     /// Dropped fraction bits of `s` (`sf - wb`, or 0).
@@ -111,9 +115,12 @@ impl WrapShifts {
     #[must_use]
     pub fn new(frac: u32, wb: u32) -> Self {
         let sf = frac.saturating_add(1);
+        // Only a `frac <= 30` is used; larger ones are kept in range.
+        let f = frac.min(62);
         Self {
-            frac,
+            half: 1 << f,
             sf,
+            fmask: ((1u64 << (f + 1)) - 1) as i64,
             wb,
             down: sf.saturating_sub(wb),
             up: wb.saturating_sub(sf),
@@ -132,9 +139,37 @@ pub fn wrap_i64_with<W: crate::fixed::ConstRounding>(
     k: &WrapShifts,
 ) -> WrapOut {
     let size = size.max(1);
-    let s = 2 * coord * i64::from(size) - (1i64 << k.frac);
+    let (i0, w) = address::<W>(coord, size, k);
+    finish_narrow(i0, w, size, mode)
+}
+
+/// [`wrap_i64_with`] of an axis with Repeat on a level whose `size` is a power of two (the
+/// caller's test, once per span): both indices masked, no test of the mode or the size.
+#[inline(always)]
+#[must_use]
+pub fn wrap_pow2_repeat<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    size: u32,
+    k: &WrapShifts,
+) -> WrapOut {
+    debug_assert!(size.is_power_of_two(), "{size}");
+    let (i0, weight) = address::<W>(coord, size, k);
+    let mask = i64::from(size) - 1;
+    WrapOut {
+        i0: (i0 & mask) as u32,
+        i1: ((i0 + 1) & mask) as u32,
+        weight,
+    }
+}
+
+/// The unwrapped first index `floor(s)` and the weight of a coordinate that [`fits_i64`] on
+/// an axis of `size >= 1` texels ([`wrap`]'s rule, the rounding carry applied).
+#[inline(always)]
+fn address<W: crate::fixed::ConstRounding>(coord: i64, size: u32, k: &WrapShifts) -> (i64, u32) {
+    let s = 2 * coord * i64::from(size) - k.half;
     let i0 = s >> k.sf;
-    let fr = s - (i0 << k.sf);
+    // `s - i0 2^sf`, in [0, 2^sf).
+    let fr = s & k.fmask;
     // Reduced to `wb` fraction bits when `sf > wb`, else widened (exact).
     let w = if k.down == 0 {
         fr << k.up
@@ -143,8 +178,11 @@ pub fn wrap_i64_with<W: crate::fixed::ConstRounding>(
     };
     // Truncation cannot carry (`fr < 2^sf`, so `w < 2^wb`).
     let carry = W::MODE != crate::fixed::Rounding::Truncate && w >> k.wb != 0;
-    let (i0, w) = if carry { (i0 + 1, 0) } else { (i0, w) };
-    finish_narrow(i0, w as u32, size, mode)
+    if carry {
+        (i0 + 1, 0)
+    } else {
+        (i0, w as u32)
+    }
 }
 
 /// [`finish`] of an index `|i0| < 2^62` (that of a coordinate that [`fits_i64`]): the same
@@ -411,6 +449,23 @@ pub(crate) mod tests {
             let frac = (next(&mut s) % 64) as u32;
             let coord = (next(&mut s) as i64) >> (next(&mut s) % 64);
             let size = (next(&mut s) % 5000) as u32;
+            assert_eq!(
+                wrap(coord, frac, size, mode, &cfg),
+                wrap_before(coord, frac, size, mode, rnd, cfg.weight_bits),
+                "{coord} {frac} {size} {mode:?} {cfg:?}"
+            );
+        }
+        // The ends of the 64-bit path ([-2^29, 2^29)) and the largest sizes.
+        for i in 0..200_000u32 {
+            let rnd = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven][(i % 3) as usize];
+            let mode =
+                [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror][(i / 3 % 3) as usize];
+            cfg.weight_rounding = rnd;
+            cfg.weight_bits = i / 9 % 17;
+            let frac = (next(&mut s) % 32) as u32;
+            let edge = [-(1i64 << 29), 1 << 29][(i / 153 % 2) as usize];
+            let coord = edge + (next(&mut s) % 5) as i64 - 2;
+            let size = [u32::MAX, 1 << 31, 65_536, 3, 1][(next(&mut s) % 5) as usize];
             assert_eq!(
                 wrap(coord, frac, size, mode, &cfg),
                 wrap_before(coord, frac, size, mode, rnd, cfg.weight_bits),

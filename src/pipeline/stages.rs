@@ -21,7 +21,7 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::frame::len_format;
 use hw_model::modulate::unorm_convert;
 use hw_model::reciprocal::Reciprocal;
-use hw_model::trilinear::Level;
+use hw_model::trilinear::{Level, UnitSetup};
 use hw_model::vector::vector_format;
 use hw_model::UnitCost;
 
@@ -78,6 +78,10 @@ pub struct Machine<'a> {
     pub bary_fmt: Format,
     /// Per texture: fixed levels and float levels.
     pub tex_fixed: Vec<Vec<Level<'a>>>,
+    /// Per texture: every fixed level's sides are powers of two (`trilinear::pow2_chain`).
+    pub tex_pow2: Vec<bool>,
+    /// The constants of the `trilinear` stage's unit (`hw.trilinear`, `uv_fmt`, `hw.lod`).
+    pub trilinear_setup: UnitSetup,
     pub tex_float: Vec<Vec<LevelF<'a>>>,
     /// Bump/shading units (rsqrt and pow tables built once).
     pub units: ShadingUnits,
@@ -139,6 +143,9 @@ impl<'a> Machine<'a> {
     #[must_use]
     pub fn new(hw: &'a HwConfig, float: &'a [MipChain], fixed: &'a [FixedMipChain]) -> Self {
         let i = &hw.interp;
+        let tex_fixed: Vec<Vec<Level<'a>>> = fixed.iter().map(FixedMipChain::views).collect();
+        let uv_fmt = Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
+            .with_overflow(i.texcoord_overflow);
         Self {
             hw,
             recip: Reciprocal::new(&hw.reciprocal),
@@ -150,13 +157,17 @@ impl<'a> Machine<'a> {
                     hw.timing.gate_levels_per_cycle,
                 )
             }),
-            uv_fmt: Format::signed(i.texcoord_int_bits, i.texcoord_frac_bits, i.interp_rounding)
-                .with_overflow(i.texcoord_overflow),
+            trilinear_setup: UnitSetup::new(&hw.trilinear, uv_fmt.frac_bits, hw.lod.lod_frac_bits),
+            uv_fmt,
             color_fmt: Format::unsigned(0, hw.color.color_bits, hw.color.color_rounding)
                 .with_overflow(hw.color.color_overflow),
             lod_fmt: Format::signed(8, hw.lod.lod_frac_bits, Rounding::Truncate),
             bary_fmt: Format::signed(16, i.bary_bits, i.interp_rounding),
-            tex_fixed: fixed.iter().map(FixedMipChain::views).collect(),
+            tex_pow2: tex_fixed
+                .iter()
+                .map(|c| hw_model::trilinear::pow2_chain(c))
+                .collect(),
+            tex_fixed,
             tex_float: float.iter().map(MipChain::views).collect(),
             units: ShadingUnits::new(&hw.shading),
             vec_fmt: vector_format(&hw.shading.vector),

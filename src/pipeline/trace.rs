@@ -157,9 +157,10 @@ pub fn trilinear_traced(
 
 /// [`TrilinearUnit::sample`] of a stage's lookup (a unit set up once for a span), its
 /// footprints recorded into `trace` when tracing is on: [`trilinear_traced`] with the unit's
-/// configuration.
+/// configuration. `POW2_REPEAT`: the caller has checked [`TrilinearUnit::pow2_repeat`] of
+/// `levels`, and [`TrilinearUnit::sample_pow2_repeat`] samples them.
 #[inline(always)]
-pub fn unit_traced<F: ConstRounding, W: ConstRounding>(
+pub fn unit_traced<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     unit: &TrilinearUnit<F, W>,
     levels: &[Level],
     u: i64,
@@ -167,11 +168,20 @@ pub fn unit_traced<F: ConstRounding, W: ConstRounding>(
     lod: i64,
     trace: &mut Trace,
     at: Lookup,
-) -> [u16; 4] {
+) -> [u32; 4] {
     if !trace.on {
-        return unit.sample(levels, u, v, lod, &mut ());
+        return if POW2_REPEAT {
+            unit.sample_pow2_repeat(levels, u, v, lod, &mut ())
+        } else {
+            unit.sample(levels, u, v, lod, &mut ())
+        };
     }
-    unit.sample(levels, u, v, lod, &mut Recorder { trace, at })
+    let sink = &mut Recorder { trace, at };
+    if POW2_REPEAT {
+        unit.sample_pow2_repeat(levels, u, v, lod, sink)
+    } else {
+        unit.sample(levels, u, v, lod, sink)
+    }
 }
 
 /// The fragment's texture coordinates as the hardware sees them: the raw values when the

@@ -51,9 +51,10 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     }
 }
 
-/// Fixed twin over a span: the unit set up once (rounding modes, lerp constants, coordinate
-/// and LOD formats, wrap mode, texture levels), then one sample per fragment. Footprint
-/// assembly and a Float `lod` producer take [`fixed`] on each fragment.
+/// Fixed twin over a span: the unit set up once (rounding modes, wrap mode, texture levels;
+/// the lerp constants and the coordinate and LOD formats of `Machine::trilinear_setup`), then
+/// one sample per fragment. Footprint assembly and a Float `lod` producer take [`fixed`] on
+/// each fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let Some(t) = px.plan.texture else { return };
     if aniso(px) || !px.fixed(StageKind::Lod) {
@@ -62,19 +63,26 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let m = px.m;
     let hw = m.hw;
     let cfg = &hw.trilinear;
-    let (fb, lfb, wrap) = (m.uv_fmt.frac_bits, hw.lod.lod_frac_bits, px.plan.wrap);
+    let (setup, wrap) = (&m.trilinear_setup, px.plan.wrap);
     hw_model::with_rounding!(cfg.filter_rounding, F => {
         hw_model::with_rounding!(cfg.weight_rounding, W => {
-            let unit = TrilinearUnit::<F, W>::new(cfg, fb, lfb, wrap);
-            span_lanes(&unit, &m.tex_fixed[t], t, cfg.texel_bits, px.carriers, frags);
+            let unit = TrilinearUnit::<F, W>::new(cfg, setup, wrap);
+            let levels = &m.tex_fixed[t];
+            if unit.repeats() && m.tex_pow2[t] {
+                span_lanes::<F, W, true>(&unit, levels, t, cfg.texel_bits, px.carriers, frags);
+            } else {
+                span_lanes::<F, W, false>(&unit, levels, t, cfg.texel_bits, px.carriers, frags);
+            }
         })
     });
 }
 
 /// The samples of [`fixed_span`]'s fast path: each fragment's lookup at its raw coordinates
-/// and raw LOD, its texel and output as [`fixed`] writes them.
+/// and raw LOD, its texel and output as [`fixed`] writes them. `POW2_REPEAT`: the unit's
+/// wrap is Repeat and the texture's levels have power-of-two sides (`Machine::tex_pow2`), so
+/// [`TrilinearUnit::sample_pow2_repeat`] samples them.
 #[inline(always)]
-fn span_lanes<F: ConstRounding, W: ConstRounding>(
+fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     unit: &TrilinearUnit<F, W>,
     levels: &[Level],
     t: usize,
@@ -89,8 +97,8 @@ fn span_lanes<F: ConstRounding, W: ConstRounding>(
     };
     for frag in frags.iter_mut() {
         let [u, v] = frag.uv_x[0];
-        let r = unit_traced(unit, levels, u, v, frag.lod_x, &mut frag.trace, at);
-        frag.texel_x = r.map(u32::from);
+        frag.texel_x =
+            unit_traced::<F, W, POW2_REPEAT>(unit, levels, u, v, frag.lod_x, &mut frag.trace, at);
         frag.out_x = frag.texel_x;
         frag.out_bits = tb;
         if carriers {
