@@ -315,6 +315,19 @@ fn lane_edges(edge: [i64; 3], edge_dx: [i64; 3], j: usize) -> [i64; 3] {
     [0, 1, 2].map(|i| edge[i].wrapping_add(j.wrapping_mul(edge_dx[i])))
 }
 
+/// `[q_1, q_2, D]` of a lane with the edges `e` when each product `q_i = E_i invw_i` and
+/// their sum fit `i64` (the tests of [`perspective_bary_derivs_narrow`]), else `None`.
+#[inline(always)]
+fn lane_q(e: [i64; 3], inv_w: [i64; 3]) -> Option<[i64; 3]> {
+    let q = [
+        e[0].checked_mul(inv_w[0])?,
+        e[1].checked_mul(inv_w[1])?,
+        e[2].checked_mul(inv_w[2])?,
+    ];
+    let d = q[0].checked_add(q[1])?.checked_add(q[2])?;
+    Some([q[1], q[2], d])
+}
+
 /// [`perspective_bary_derivs_in`] out of line: a span lane outside the fast form.
 #[inline(never)]
 fn derivs_lane<M: ConstRounding>(
@@ -381,22 +394,24 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
     let wide = i128::from;
-    // Written out: an array `map` here is a call per span.
-    let y_step = [
-        wide(b[1]) * wide(s) - wide(a[1]) * wide(t),
-        wide(b[2]) * wide(s) - wide(a[2]) * wide(t),
-    ];
+    // Written out: an array `map` here is a call per span. A lone lane does not step.
+    let y_step = if lanes > 1 {
+        [
+            wide(b[1]) * wide(s) - wide(a[1]) * wide(t),
+            wide(b[2]) * wide(s) - wide(a[2]) * wide(t),
+        ]
+    } else {
+        [0; 2]
+    };
     // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
     // the per-lane `times_w` and `sum` test): they are linear in the lane, so they do when
     // they do at the first and the last lane, and then they step by `a_1`, `a_2` and `S`
     // (wrapping adds, exact). `None`: each lane tests its own.
-    let fits = |j: usize| {
-        let q = times_w(lane_edges(edge, edge_dx, j))?;
-        sum(q).map(|d| [q[1], q[2], d])
-    };
+    let first = lane_q(edge, inv_w);
     let ends = match lanes {
         0 => return,
-        _ => fits(0).zip(fits(lanes - 1)),
+        1 => first.map(|f| (f, f)),
+        _ => first.zip(lane_q(lane_edges(edge, edge_dx, lanes - 1), inv_w)),
     };
     // Every lane of the fast form (up to the clamp of `p_i`) when both ends are: `q_1`, `q_2`
     // and `D` are linear in the lane, so their magnitudes are at most those at the ends and
@@ -442,7 +457,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
                 ];
                 Some(here)
             }
-            None => fits(j),
+            None => lane_q(lane_edges(edge, edge_dx, j), inv_w),
         };
         let fast = lane.and_then(|[q1, q2, d]| {
             let small = (d as u64 | q1.unsigned_abs() | q2.unsigned_abs() | steps_mag) >> 62 == 0;
@@ -535,6 +550,24 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
         wide(b[1]) * dw - wide(q1) * wide(t),
         wide(b[2]) * dw - wide(q2) * wide(t),
     ];
+    // Every mantissa below 2^31 (`Reciprocal` results and their squares have
+    // `recip_mantissa_bits + 1` bits) and the y numerators' drops held along the span.
+    let last = span.lanes.saturating_sub(1);
+    let held = if m_bits <= 30 {
+        match (
+            held_drop(ny[0], st.y_step[0], last),
+            held_drop(ny[1], st.y_step[1], last),
+        ) {
+            (Some(n1), Some(n2)) => Some((n1, n2)),
+            _ => None,
+        }
+    } else {
+        None
+    };
+    if let Some(ns_y) = held {
+        let tops = Tops { nx, ny, ns_y };
+        return derivs_span_held::<M, R>(span, st, &tops, inv_w, cfg, recip, sat, out);
+    }
     let limit = BARY_LIMIT as u64;
     for j in 0..span.lanes {
         // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
@@ -548,6 +581,101 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
             let x2 = p2 + derivative_of_top::<M>(nx[1], r2, bb, sat);
             let y1 = p1 + derivative::<M>(ny[0], r2, bb, sat);
             let y2 = p2 + derivative::<M>(ny[1], r2, bb, sat);
+            let x = [one - x1 - x2, x1, x2];
+            out(j, [[one - p1 - p2, p1, p2], x, [one - y1 - y2, y1, y2]]);
+        } else {
+            let e = lane_edges(span.edge, span.dx, j);
+            out(
+                j,
+                derivs_lane::<M>(e, span.dx, span.dy, inv_w, cfg, recip, sat),
+            );
+        }
+        q1 = q1.wrapping_add(a[1]);
+        q2 = q2.wrapping_add(a[2]);
+        d = d.wrapping_add(s);
+        ny = [
+            ny[0].wrapping_add(st.y_step[0]),
+            ny[1].wrapping_add(st.y_step[1]),
+        ];
+    }
+}
+
+/// The drop `ns` of [`numerator_top`] at every lane of a numerator `n + j step` (`j` up to
+/// `last`, every value exact below 2^125) when it is the same at both ends and they have the
+/// same sign: the numerator is linear in the lane, so its magnitude is monotonic between
+/// them. `None` otherwise.
+#[inline(always)]
+fn held_drop(n: i128, step: i128, last: usize) -> Option<u32> {
+    let ns = numerator_top(n).1;
+    if last == 0 {
+        return Some(ns);
+    }
+    let end = n.wrapping_add(step.wrapping_mul(last as i128));
+    ((n < 0) == (end < 0) && numerator_top(end).1 == ns).then_some(ns)
+}
+
+/// The derivative numerators of a span in [`derivs_span_held`]: the x numerators' tops (the
+/// same at every lane), the y numerators at the first lane and their drops (the same at
+/// every lane).
+struct Tops {
+    nx: [NumeratorTop; 2],
+    ny: [i128; 2],
+    ns_y: (u32, u32),
+}
+
+/// [`derivs_span_steady`] when every mantissa is below 2^31 and the y numerators keep one
+/// drop along the span ([`held_drop`]): per lane the y tops are a shift of the stepped
+/// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
+/// [`derivative_of_top`]'s 64-bit rounding (else each takes [`derivative_of_top`]). Checked
+/// against one call per lane in `derivs_span_stepping_matches_per_lane_calls`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn derivs_span_held<M: ConstRounding, R: ConstRounding>(
+    span: &EdgeSpan,
+    st: &Steady,
+    tops: &Tops,
+    inv_w: [i64; 3],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    mut out: impl FnMut(usize, [[i64; 3]; 3]),
+) {
+    let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
+    let m_bits = recip.config().recip_mantissa_bits;
+    let lane_recip = recip.lane::<R>();
+    let (a, s) = (st.a, st.s);
+    let [mut q1, mut q2, mut d] = st.first;
+    let (nx, mut ny, (ny1, ny2)) = (tops.nx, tops.ny, tops.ns_y);
+    // `sh = r2.shift - (bary_bits + ns)` is in 64..126 for all four when it is for the
+    // largest and the smallest drop.
+    let ns_max = nx[0].1.max(nx[1].1).max(ny1.max(ny2));
+    let ns_min = nx[0].1.min(nx[1].1).min(ny1.min(ny2));
+    let lo = 64 + (bb + ns_max) as i32;
+    let hi = 126 + (bb + ns_min) as i32;
+    let limit = BARY_LIMIT as u64;
+    for j in 0..span.lanes {
+        // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+        let r = lane_recip.eval(d as u64, &mut SatCounter::default());
+        let p1 = apply_i64_in::<M>(r, q1, bb);
+        let p2 = apply_i64_in::<M>(r, q2, bb);
+        if p1.unsigned_abs() <= limit && p2.unsigned_abs() <= limit {
+            let r2 = square(r, m_bits, M::MODE);
+            let ty = [(ny[0] >> (ny1 & 63), ny1), (ny[1] >> (ny2 & 63), ny2)];
+            let (x1, x2, y1, y2) = if (lo..hi).contains(&r2.shift) {
+                (
+                    p1 + derivative_short::<M>(nx[0], r2, bb, sat),
+                    p2 + derivative_short::<M>(nx[1], r2, bb, sat),
+                    p1 + derivative_short::<M>(ty[0], r2, bb, sat),
+                    p2 + derivative_short::<M>(ty[1], r2, bb, sat),
+                )
+            } else {
+                (
+                    p1 + derivative_of_top::<M>(nx[0], r2, bb, sat),
+                    p2 + derivative_of_top::<M>(nx[1], r2, bb, sat),
+                    p1 + derivative_of_top::<M>(ty[0], r2, bb, sat),
+                    p2 + derivative_of_top::<M>(ty[1], r2, bb, sat),
+                )
+            };
             let x = [one - x1 - x2, x1, x2];
             out(j, [[one - p1 - p2, p1, p2], x, [one - y1 - y2, y1, y2]]);
         } else {
@@ -642,18 +770,37 @@ fn derivative_of_top<M: ConstRounding>(
 ) -> i64 {
     let sh = r2.shift - (bary_bits + ns) as i32;
     // `apply_in`'s exact product and rounding (|x| <= 2^94, a mantissa below 2^31).
-    let v = if r2.mant >> 31 == 0 && (64..126).contains(&sh) {
-        // The product is below 2^125: its top bits from bit 62 fit `i64`, and the 62 below
-        // fold into a sticky bit under the rounding position (`sh - 62` >= 2), as
-        // `round_shift_right_wide` does for these shifts.
-        let prod = x * i128::from(r2.mant as i64);
-        let top = (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0);
-        round_shift_right(top, (sh - 62) as u32, M::MODE)
-    } else if sh >= 0 && r2.mant >> 31 == 0 {
+    if r2.mant >> 31 == 0 && (64..126).contains(&sh) {
+        return derivative_short::<M>((x, ns), r2, bary_bits, sat);
+    }
+    let v = if sh >= 0 && r2.mant >> 31 == 0 {
         round_shift_right_wide(x * i128::from(r2.mant as i64), sh as u32, M::MODE)
     } else {
         apply_in::<M>(r2, x, bary_bits + ns)
     };
+    if v.unsigned_abs() > BARY_LIMIT as u64 {
+        return clamp_counted(v, sat);
+    }
+    v
+}
+
+/// [`derivative_of_top`] when `r2`'s mantissa is below 2^31 and `sh = r2.shift - (bary_bits +
+/// ns)` is in 64..126: the product is below 2^125, its top bits from bit 62 fit `i64`, and
+/// the 62 below fold into a sticky bit under the rounding position (`sh - 62` >= 2), as
+/// `round_shift_right_wide` does for these shifts; then the clamp.
+#[inline(always)]
+fn derivative_short<M: ConstRounding>(
+    (x, ns): NumeratorTop,
+    r2: Recip,
+    bary_bits: u32,
+    sat: &mut SatCounter,
+) -> i64 {
+    let sh = r2.shift - (bary_bits + ns) as i32;
+    debug_assert!(r2.mant >> 31 == 0 && (64..126).contains(&sh));
+    // The mantissa as `u32`: the product's high word is one multiply.
+    let prod = x * i128::from(r2.mant as u32);
+    let top = (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0);
+    let v = round_shift_right_mid::<M>(top, (sh - 62) as u32);
     if v.unsigned_abs() > BARY_LIMIT as u64 {
         return clamp_counted(v, sat);
     }
@@ -1540,6 +1687,42 @@ mod tests {
         assert!(fast > 500_000 && fallback > 500_000, "{fast} {fallback}");
     }
 
+    /// `held_drop` against `numerator_top` at every lane: 200k seeded numerators below 2^125
+    /// and steps (many crossing zero inside the span with large ends); when it holds a drop,
+    /// every lane has that drop, and it holds one for many spans with a nonzero drop.
+    #[test]
+    fn held_drop_matches_every_lane() {
+        let mut s = 0x5eed_0d40;
+        let (mut held, mut nonzero) = (0u64, 0u64);
+        for i in 0..200_000u32 {
+            let last = (next(&mut s) % 24) as usize;
+            let nb = 62 + (next(&mut s) % 63) as u32;
+            let n = i128::from(signed(&mut s, 62)) << (nb - 62);
+            // Steps that reach, cross or stay clear of zero across the span.
+            let step = match i % 3 {
+                0 => -n / (last.max(1) as i128) + i128::from(signed(&mut s, 20)),
+                1 => i128::from(signed(&mut s, 62)) << (nb.saturating_sub(66)),
+                _ => -2 * n / (last.max(1) as i128),
+            };
+            let lanes = (0..=last).map(|j| step.checked_mul(j as i128)?.checked_add(n));
+            if lanes
+                .clone()
+                .any(|v| v.is_none_or(|v| v.unsigned_abs() >> 125 != 0))
+            {
+                continue;
+            }
+            let lanes = lanes.flatten();
+            if let Some(ns) = held_drop(n, step, last) {
+                held += 1;
+                nonzero += u64::from(ns > 0);
+                for v in lanes {
+                    assert_eq!(numerator_top(v).1, ns, "{n} {step} {last}");
+                }
+            }
+        }
+        assert!(held > 50_000 && nonzero > 10_000, "{held} {nonzero}");
+    }
+
     /// 400k seeded spans of 1 to 24 lanes over 5 configurations x 3 interpolator roundings,
     /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
     /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
@@ -1550,7 +1733,8 @@ mod tests {
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
-        let (mut steady_lanes, mut stepped, mut tested) = (0u64, 0u64, 0u64);
+        let (mut held_lanes, mut steady_lanes) = (0u64, 0u64);
+        let (mut stepped, mut tested) = (0u64, 0u64);
         let mut got = [[[0i64; 3]; 3]; 24];
         for (c, hw0) in previous_configs().into_iter().enumerate() {
             for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
@@ -1615,6 +1799,21 @@ mod tests {
                         && below(&step_terms(dy))
                         && small_end(0)
                         && small_end(n - 1);
+                    // Whether a steady span holds its y numerators' drops: the numerators
+                    // `b_i D - q_i T` have one sign and one drop at both ends.
+                    let y_numerators = |j: usize| {
+                        let q = [0, 1, 2].map(|k| at(j)[k] * i128::from(inv_w[k]));
+                        let b = step_terms(dy);
+                        let d = q[0] + q[1] + q[2];
+                        [1, 2].map(|k| b[k - 1] * d - q[k] * b[2])
+                    };
+                    let held = steady && {
+                        let (f, l) = (y_numerators(0), y_numerators(n - 1));
+                        (0..2).all(|k| {
+                            (f[k] < 0) == (l[k] < 0)
+                                && numerator_top(f[k]).1 == numerator_top(l[k]).1
+                        })
+                    };
                     for (j, lane) in got[..n].iter().enumerate() {
                         let e = at(j).map(|v| v as i64);
                         let want = perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);
@@ -1626,7 +1825,9 @@ mod tests {
                             && (d.unsigned_abs() | q[1].unsigned_abs() | q[2].unsigned_abs()) >> 62
                                 == 0
                         {
-                            if steady {
+                            if held {
+                                held_lanes += 1;
+                            } else if steady {
                                 steady_lanes += 1;
                             } else if ends_fit {
                                 stepped += 1;
@@ -1639,9 +1840,11 @@ mod tests {
                 }
             }
         }
+        println!("held {held_lanes} steady {steady_lanes} stepped {stepped} tested {tested}");
         assert!(
-            steady_lanes > 1_000_000 && stepped > 100_000 && tested > 40_000,
-            "{steady_lanes} {stepped} {tested}"
+            held_lanes > 500_000 && steady_lanes > 100_000,
+            "{held_lanes} {steady_lanes}"
         );
+        assert!(stepped > 100_000 && tested > 40_000, "{stepped} {tested}");
     }
 }

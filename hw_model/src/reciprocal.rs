@@ -27,7 +27,9 @@
 use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, ConstRounding, Rounding, SatCounter};
+use crate::fixed::{
+    round_shift_right_mid, round_shift_right_wide, ConstRounding, Rounding, SatCounter,
+};
 use std::marker::PhantomData;
 
 #[cfg(test)]
@@ -169,7 +171,8 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         let mut m: i64 = if n <= p {
             (x << (p - n)) as i64
         } else if n < 63 {
-            crate::fixed::round_shift_right(x as i64, n - p, rnd)
+            // `n - p` in 1..=62.
+            round_shift_right_mid::<R>(x as i64, n - p)
         } else {
             round_shift_right_wide(i128::from(x), n - p, rnd)
         };
@@ -183,10 +186,10 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         let mut y = self.lut[idx] as i64;
         let two = 2i64 << p;
         if (1..=29).contains(&p) {
-            // `nr_step`'s 64-bit products, the test on `p` out of the loop.
+            // `nr_step`'s 64-bit products, the tests on `p` out of the loop.
             for _ in 0..self.iterations {
-                let t = crate::fixed::round_shift_right(m * y, p, rnd);
-                y = crate::fixed::round_shift_right(y * (two - t), p, rnd);
+                let t = round_shift_right_mid::<R>(m * y, p);
+                y = round_shift_right_mid::<R>(y * (two - t), p);
             }
         } else {
             for _ in 0..self.iterations {
@@ -196,7 +199,11 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         // Normalize y (positive, about 2^P / m) to M + 1 significant bits.
         let b = 64 - (y as u64).leading_zeros();
         let drop = b - (m_bits + 1);
-        let mut mant = crate::fixed::round_shift_right(y, drop, rnd) as u64;
+        let mut mant = if (1..64).contains(&drop) {
+            round_shift_right_mid::<R>(y, drop)
+        } else {
+            crate::fixed::round_shift_right(y, drop, rnd)
+        } as u64;
         let mut shift = (p + n) as i32 - drop as i32;
         if mant >> (m_bits + 1) != 0 {
             mant >>= 1;
