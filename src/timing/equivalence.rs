@@ -2,12 +2,14 @@
 //! seeded random event streams: random machines (cache or not, tiled or linear interleave, bank
 //! counts that are not powers of two, several filter units, pipelined or not), textures of
 //! every texel size and plans with repeated stage kinds, pixels with thin, wrapped and
-//! out-of-plan footprints. Every report must be identical, fed as a frame ([`simulate`]),
+//! out-of-plan footprints; and streams whose footprints come only from the plans' fetching
+//! stages in plan order, as a render's do (so plans with one fetching stage take the
+//! model's one-stage walk). Every report must be identical, fed as a frame ([`simulate`]),
 //! row by row ([`Simulator::row`]), span by span ([`Simulator::span`]: runs of one plan) or
 //! pixel by pixel ([`Simulator::pixel`]).
 
 use super::events::{
-    FrameEvents, PixelEvent, PlanTiming, RowEvents, TexelFootprint, TextureLayout,
+    lookups, FrameEvents, PixelEvent, PlanTiming, RowEvents, TexelFootprint, TextureLayout,
 };
 use super::model::{simulate, Simulator};
 use super::previous;
@@ -40,7 +42,11 @@ fn machine(r: &mut Rng) -> HwConfig {
     hw
 }
 
-fn frame(r: &mut Rng, pixels: usize) -> FrameEvents {
+/// A random frame of `pixels` pixels. With `fetching` (the machine), a pixel's footprints
+/// are those of its plan's stages that make lookups on it, each stage fetching with
+/// probability 3/4, in plan order; else of random stages of its plan, now and then of a
+/// stage outside it or out of order.
+fn frame(r: &mut Rng, pixels: usize, fetching: Option<&HwConfig>) -> FrameEvents {
     let textures: Vec<TextureLayout> = (0..1 + r.below(3))
         .map(|_| {
             let (mut w, mut h) = (1 + r.below(80) as u32, 1 + r.below(80) as u32);
@@ -90,12 +96,21 @@ fn frame(r: &mut Rng, pixels: usize) -> FrameEvents {
                 p.stages.iter().map(|s| s.0).collect()
             });
         // Footprints in plan order (now and then a stage outside the plan, or out of order).
-        let mut order: Vec<StageKind> =
-            stages.iter().filter(|_| r.below(3) == 0).copied().collect();
-        if r.below(30) == 0 {
-            order.push(pick(r, &kinds));
-            order.reverse();
-        }
+        let order: Vec<StageKind> = if let Some(hw) = fetching {
+            stages
+                .iter()
+                .filter(|&&k| lookups(k, hw) > 0 && r.below(4) != 0)
+                .copied()
+                .collect()
+        } else {
+            let mut order: Vec<StageKind> =
+                stages.iter().filter(|_| r.below(3) == 0).copied().collect();
+            if r.below(30) == 0 {
+                order.push(pick(r, &kinds));
+                order.reverse();
+            }
+            order
+        };
         for kind in order {
             for lookup in 0..1 + r.below(3) as u8 {
                 let tex = r.below(ev.textures.len() as u64) as usize;
@@ -132,58 +147,86 @@ fn model_matches_previous_on_random_streams() {
     for case in 0..400 {
         let hw = machine(&mut r);
         let n = 1 + r.below(3000) as usize;
-        let ev = frame(&mut r, n);
-        let want = previous::simulate(&ev, &hw, "t");
-        assert_eq!(simulate(&ev, &hw, "t"), want, "case {case}: frame");
-        // Row by row (rows of 1..40 pixels, `fp_end` rebased) and pixel by pixel.
-        let mut rows = Simulator::new(&ev.plans, &ev.textures, &hw);
-        let mut pixels = Simulator::new(&ev.plans, &ev.textures, &hw);
-        let mut spans = Simulator::new(&ev.plans, &ev.textures, &hw);
-        let start = |i: usize| {
-            if i == 0 {
-                0
-            } else {
-                ev.pixels[i - 1].fp_end as usize
-            }
-        };
-        let mut p = 0;
-        while p < ev.pixels.len() {
-            let end = (p + 1 + r.below(40) as usize).min(ev.pixels.len());
-            let f = start(p);
-            let row = RowEvents {
-                pixels: ev.pixels[p..end]
-                    .iter()
-                    .map(|&e| PixelEvent {
-                        fp_end: e.fp_end - f as u32,
-                        ..e
-                    })
-                    .collect(),
-                footprints: ev.footprints[f..start(end)].to_vec(),
-            };
-            rows.row(&row);
-            for i in p..end {
-                let fps = &ev.footprints[start(i)..start(i + 1)];
-                pixels.pixel(ev.pixels[i].plan, fps);
-            }
-            // Spans: runs of up to 1..12 pixels of one plan.
-            let mut s = p;
-            while s < end {
-                let plan = ev.pixels[s].plan;
-                let most = (s + 1 + r.below(12) as usize).min(end);
-                let e = (s + 1..most)
-                    .find(|&i| ev.pixels[i].plan != plan)
-                    .unwrap_or(most);
-                spans.span(plan, (s..e).map(|i| &ev.footprints[start(i)..start(i + 1)]));
-                s = e;
-            }
-            p = end;
-        }
-        assert_eq!(rows.finish(&ev.counts(), "t"), want, "case {case}: rows");
-        assert_eq!(
-            pixels.finish(&ev.counts(), "t"),
-            want,
-            "case {case}: pixels"
-        );
-        assert_eq!(spans.finish(&ev.counts(), "t"), want, "case {case}: spans");
+        let ev = frame(&mut r, n, None);
+        check(&mut r, case, &hw, &ev);
     }
+}
+
+/// As [`model_matches_previous_on_random_streams`], footprints only from fetching stages:
+/// plans with one fetching stage (the one-stage walk) and with several, repeated or not.
+#[test]
+fn model_matches_previous_on_fetching_streams() {
+    let mut r = Rng(0x5eed_f7c4);
+    let mut mono = 0;
+    for case in 0..300 {
+        let hw = machine(&mut r);
+        let n = 1 + r.below(3000) as usize;
+        let ev = frame(&mut r, n, Some(&hw));
+        mono += usize::from(ev.plans.iter().any(|p| {
+            let fetching = p.stages.iter().filter(|s| lookups(s.0, &hw) > 0);
+            fetching.count() == 1
+        }));
+        check(&mut r, case, &hw, &ev);
+    }
+    assert!(
+        mono > 100,
+        "only {mono} frames with a one-fetching-stage plan"
+    );
+}
+
+/// The model's reports on `ev` (as a frame, rows, pixels and spans cut at random) against
+/// the previous model's.
+fn check(r: &mut Rng, case: usize, hw: &HwConfig, ev: &FrameEvents) {
+    let want = previous::simulate(ev, hw, "t");
+    assert_eq!(simulate(ev, hw, "t"), want, "case {case}: frame");
+    // Row by row (rows of 1..40 pixels, `fp_end` rebased) and pixel by pixel.
+    let mut rows = Simulator::new(&ev.plans, &ev.textures, hw);
+    let mut pixels = Simulator::new(&ev.plans, &ev.textures, hw);
+    let mut spans = Simulator::new(&ev.plans, &ev.textures, hw);
+    let start = |i: usize| {
+        if i == 0 {
+            0
+        } else {
+            ev.pixels[i - 1].fp_end as usize
+        }
+    };
+    let mut p = 0;
+    while p < ev.pixels.len() {
+        let end = (p + 1 + r.below(40) as usize).min(ev.pixels.len());
+        let f = start(p);
+        let row = RowEvents {
+            pixels: ev.pixels[p..end]
+                .iter()
+                .map(|&e| PixelEvent {
+                    fp_end: e.fp_end - f as u32,
+                    ..e
+                })
+                .collect(),
+            footprints: ev.footprints[f..start(end)].to_vec(),
+        };
+        rows.row(&row);
+        for i in p..end {
+            let fps = &ev.footprints[start(i)..start(i + 1)];
+            pixels.pixel(ev.pixels[i].plan, fps);
+        }
+        // Spans: runs of up to 1..12 pixels of one plan.
+        let mut s = p;
+        while s < end {
+            let plan = ev.pixels[s].plan;
+            let most = (s + 1 + r.below(12) as usize).min(end);
+            let e = (s + 1..most)
+                .find(|&i| ev.pixels[i].plan != plan)
+                .unwrap_or(most);
+            spans.span(plan, (s..e).map(|i| &ev.footprints[start(i)..start(i + 1)]));
+            s = e;
+        }
+        p = end;
+    }
+    assert_eq!(rows.finish(&ev.counts(), "t"), want, "case {case}: rows");
+    assert_eq!(
+        pixels.finish(&ev.counts(), "t"),
+        want,
+        "case {case}: pixels"
+    );
+    assert_eq!(spans.finish(&ev.counts(), "t"), want, "case {case}: spans");
 }

@@ -339,7 +339,28 @@ struct Memory {
     quad_banks: bool,
     /// Latency a cache adds to a footprint (`cache_hit_cycles`).
     hit_latency: u64,
+    /// [`Memory::quad_dram`]'s occupancy by the number of its page hits (0..=4; 8 slots so a
+    /// mask indexes it).
+    quad_occ: [u64; 8],
     counts: MemoryCounts,
+    /// The counts of [`Memory::quad_dram`]'s footprints (added to `counts` by
+    /// [`MemoryCounts::total`]).
+    quads: QuadCounts,
+}
+
+/// The four-bank footprints without a cache ([`Memory::quad_dram`]; 4 DRAM accesses each)
+/// by their number of page hits (0..=4; 8 slots so a mask indexes them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct QuadCounts {
+    by_hits: [u64; 8],
+}
+
+impl QuadCounts {
+    fn add(&mut self, q: &QuadCounts) {
+        for (a, b) in self.by_hits.iter_mut().zip(q.by_hits) {
+            *a += b;
+        }
+    }
 }
 
 /// The memory's running sums; [`MemoryCounts::report`] derives the rest of the report.
@@ -347,8 +368,6 @@ struct Memory {
 struct MemoryCounts {
     footprints: u64,
     accesses: u64,
-    /// Bytes of the texel accesses.
-    bytes: u64,
     cache_hits: u64,
     page_hits: u64,
     bank_conflicts: u64,
@@ -358,9 +377,27 @@ struct MemoryCounts {
 }
 
 impl MemoryCounts {
-    /// The memory report: every access that misses the cache (all of them without one) goes
-    /// to DRAM, and a DRAM access that does not hit its bank's open page misses it.
-    fn report(&self, tc: &TimingConfig, cached: bool) -> MemoryReport {
+    /// These counts with the four-bank footprints `q` added (`page_hit`, `page_miss`: the
+    /// DRAM's page hit and miss cycles).
+    fn total(&self, q: &QuadCounts, page_hit: u64, page_miss: u64) -> MemoryCounts {
+        let footprints: u64 = q.by_hits.iter().sum();
+        let page_hits: u64 = (0u64..).zip(q.by_hits).map(|(h, n)| h * n).sum();
+        // A footprint with a page miss lasts a miss: `page_miss - page_hit` (at least 0)
+        // cycles beyond a hit's.
+        let missing = footprints - q.by_hits[4];
+        MemoryCounts {
+            footprints: self.footprints + footprints,
+            accesses: self.accesses + 4 * footprints,
+            page_hits: self.page_hits + page_hits,
+            miss_cycles: self.miss_cycles + missing * page_miss.saturating_sub(page_hit),
+            ..*self
+        }
+    }
+
+    /// The memory report (`bytes`: the texel accesses' bytes): every access that misses the
+    /// cache (all of them without one) goes to DRAM, and a DRAM access that does not hit its
+    /// bank's open page misses it.
+    fn report(&self, tc: &TimingConfig, cached: bool, bytes: u64) -> MemoryReport {
         let dram = self.accesses - self.cache_hits;
         MemoryReport {
             footprints: self.footprints,
@@ -373,11 +410,11 @@ impl MemoryCounts {
             dram_accesses: dram,
             dram_page_hits: self.page_hits,
             dram_page_misses: dram - self.page_hits,
-            texture_bytes: self.bytes,
+            texture_bytes: bytes,
             dram_bytes: if cached {
                 dram * u64::from(tc.cache_line_bytes)
             } else {
-                self.bytes
+                bytes
             },
         }
     }
@@ -392,6 +429,17 @@ impl Memory {
         });
         let banks = tc.banks.max(1);
         let bank_tile = tile(banks);
+        // A four-bank footprint is as long as its slowest access, at least 1 cycle.
+        let (hit, miss) = (tc.dram_page_hit_cycles, tc.dram_page_miss_cycles);
+        let some = u64::from(hit.max(miss).max(1));
+        let mut quad_occ = [0; 8];
+        quad_occ[..5].copy_from_slice(&[
+            u64::from(miss.max(1)),
+            some,
+            some,
+            some,
+            u64::from(hit.max(1)),
+        ]);
         Self {
             map: AddressMap::new(textures, tc),
             cache,
@@ -409,25 +457,28 @@ impl Memory {
             page_hit: u64::from(tc.dram_page_hit_cycles),
             page_miss: u64::from(tc.dram_page_miss_cycles),
             hit_latency: u64::from(tc.cache_hit_cycles),
+            quad_occ,
             quad_banks: tc.bank_interleave == BankInterleave::Tiled
                 && banks.is_power_of_two()
                 && banks <= 64,
             counts: MemoryCounts::default(),
+            quads: QuadCounts::default(),
         }
     }
 
-    /// Performs one footprint's accesses; returns (occupancy, latency) in cycles and the texel
-    /// bytes read ([`Memory::footprint_any`], with a fast path for the common footprint: on a
-    /// tiled interleave with a power-of-two bank count, two columns and two rows whose bank
-    /// bits differ put the four texels in four banks, so there is no conflict and the bank
-    /// accesses are independent; a texel whose cache line is the previous texel's hits without
-    /// a lookup, that line being the most recent of its set). Checked against the general
-    /// path by `fast_footprints_match_the_general_path` and against the previous model.
+    /// Performs one footprint's accesses; returns its occupancy in cycles (its latency adds
+    /// `hit_latency` with a cache) and the texel bytes read ([`Memory::footprint_any`], with a fast
+    /// path for the common footprint: on a tiled interleave with a power-of-two bank count, two
+    /// columns and two rows whose bank bits differ put the four texels in four banks, so there is
+    /// no conflict and the bank accesses are independent; a texel whose cache line is the previous
+    /// texel's hits without a lookup, that line being the most recent of its set). Checked against
+    /// the general path by `fast_footprints_match_the_general_path` and against the previous model.
     #[inline(always)]
     fn footprint<const CACHED: bool, const TILED: bool>(
         &mut self,
         fp: &TexelFootprint,
-    ) -> (u64, u64, u64) {
+        quads: &mut QuadCounts,
+    ) -> (u64, u64) {
         let (m0, m1) = self.tile_mask;
         if !(TILED
             && self.quad_banks
@@ -437,7 +488,7 @@ impl Memory {
             return self.footprint_any::<CACHED, TILED>(fp);
         }
         if !CACHED {
-            return self.quad_dram(fp);
+            return self.quad_dram(fp, quads);
         }
         let lv = self.map.level(fp.tex, fp.level);
         let sh = self.tile_shift;
@@ -487,18 +538,17 @@ impl Memory {
         let k = &mut self.counts;
         k.footprints += 1;
         k.accesses += 4;
-        k.bytes += bytes;
         k.cache_hits += hits;
         k.page_hits += page_hits;
         k.miss_cycles += slowest.saturating_sub(fastest);
-        (occ, occ + if CACHED { self.hit_latency } else { 0 }, bytes)
+        (occ, bytes)
     }
 
     /// [`Memory::footprint`]'s four-bank footprint without a cache: each texel a DRAM access
     /// to its own bank (hit if the bank's open page is the texel's, which it opens), the
-    /// footprint as long as its slowest access.
+    /// footprint as long as its slowest access; counted in `quads`.
     #[inline(always)]
-    fn quad_dram(&mut self, fp: &TexelFootprint) -> (u64, u64, u64) {
+    fn quad_dram(&mut self, fp: &TexelFootprint, quads: &mut QuadCounts) -> (u64, u64) {
         let (m0, m1) = self.tile_mask;
         let sh = self.tile_shift;
         let lv = self.map.level(fp.tex, fp.level);
@@ -510,7 +560,7 @@ impl Memory {
         let r1 = lv.page_base + u64::from(y1 >> py) * lv.page_row;
         let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
         let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
-        let texel_bytes = u64::from(lv.texel_bytes);
+        let bytes = 4 * u64::from(lv.texel_bytes);
         // Quad banks are fewer than 64 and `open_page` has at least 64 entries.
         let Some(open) = self.open_page.first_chunk_mut::<64>() else {
             return self.footprint_any::<false, true>(fp);
@@ -526,35 +576,23 @@ impl Memory {
             hits += u64::from(*o == page);
             *o = page;
         }
-        let (page_hit, page_miss) = (self.page_hit, self.page_miss);
-        let slowest = match hits {
-            4 => page_hit,
-            0 => page_miss,
-            _ => page_hit.max(page_miss),
-        };
-        let occ = slowest.max(1);
-        let bytes = 4 * texel_bytes;
-        let k = &mut self.counts;
-        k.footprints += 1;
-        k.accesses += 4;
-        k.bytes += bytes;
-        k.page_hits += hits;
-        k.miss_cycles += slowest.saturating_sub(page_hit);
-        (occ, occ, bytes)
+        let occ = self.quad_occ[(hits & 7) as usize];
+        quads.by_hits[(hits & 7) as usize] += 1;
+        (occ, bytes)
     }
 
-    /// Performs one footprint's accesses, any footprint; returns (occupancy, latency) in
-    /// cycles and the texel bytes read. The distinct texels of the footprint, in the order (x0, y0), (x1, y0),
-    /// (x0, y1), (x1, y1), are each one bank access (a footprint on a 1-texel-wide or -high
-    /// level collapses its repeated columns or rows). Compiled with (`CACHED`) or without a
-    /// texel cache, for the tiled (`TILED`) or linear bank interleave; a row's page (and line)
-    /// index is computed once for its columns, and conflicts are counted as the accesses find
-    /// their bank already used.
+    /// Performs one footprint's accesses, any footprint; returns its occupancy in cycles (its
+    /// latency adds `hit_latency` with a cache) and the texel bytes read. The distinct texels of
+    /// the footprint, in the order (x0, y0), (x1, y0), (x0, y1), (x1, y1), are each one bank access
+    /// (a footprint on a 1-texel-wide or -high level collapses its repeated columns or rows).
+    /// Compiled with (`CACHED`) or without a texel cache, for the tiled (`TILED`) or linear bank
+    /// interleave; a row's page (and line) index is computed once for its columns, and conflicts
+    /// are counted as the accesses find their bank already used.
     #[inline(never)]
     fn footprint_any<const CACHED: bool, const TILED: bool>(
         &mut self,
         fp: &TexelFootprint,
-    ) -> (u64, u64, u64) {
+    ) -> (u64, u64) {
         let (page_hit, page_miss) = (self.page_hit, self.page_miss);
         let lv = *self.map.level(fp.tex, fp.level);
         let (tile_mask, tile_shift) = (self.tile_mask, self.tile_shift);
@@ -659,18 +697,13 @@ impl Memory {
             k.conflict_cycles += occ - slowest.max(1);
         }
         let bytes = accesses * u64::from(lv.texel_bytes);
-        let (fastest, hit_latency) = if CACHED {
-            (1, self.hit_latency)
-        } else {
-            (page_hit, 0)
-        };
+        let fastest = if CACHED { 1 } else { page_hit };
         k.footprints += 1;
         k.accesses += accesses;
-        k.bytes += bytes;
         k.cache_hits += hits;
         k.page_hits += page_hits;
         k.miss_cycles += slowest.saturating_sub(fastest);
-        (occ, occ + hit_latency, bytes)
+        (occ, bytes)
     }
 }
 
@@ -811,15 +844,14 @@ pub struct Simulator<'a> {
     tiled: bool,
 }
 
-/// The issue's running state: pixels fed, the next pixel's issue group (`pixels /
-/// shade_pixels_per_cycle`), its place in that group (`pixels % shade_pixels_per_cycle`) and
-/// its ring slot (`pixels % ring.len()`), kept incrementally so the per-pixel step divides
-/// nothing; the last issue and the latest completion.
+/// The issue's running state: pixels fed, the pixels left in the current issue group (0:
+/// the next pixel opens one) and the next pixel's ring slot (`pixels % ring.len()`), kept
+/// incrementally so the per-pixel step divides nothing; the last issue and the latest
+/// completion.
 #[derive(Clone, Copy, Debug, Default)]
 struct IssueState {
     pixels: u64,
-    group: u64,
-    in_group: u64,
+    left: u64,
     slot: usize,
     last_issue: u64,
     end: u64,
@@ -835,25 +867,25 @@ impl IssueState {
         stall_by: &mut [u64; CAUSES],
         ppc: u64,
     ) -> (usize, u64) {
-        // Pixel i issues in group i / ppc, one cycle after the previous group's last pixel
-        // when it opens a group (i % ppc == 0, i > 0), and waits for the pixel `win` places
-        // before it (ring slot i % win) to complete.
-        let next_slot = u64::from(self.pixels > 0 && self.in_group == 0);
+        // Pixel i issues at cycle i / ppc at the earliest, one cycle after the previous
+        // group's last pixel when it opens a group (i % ppc == 0, i > 0), and waits for the
+        // pixel `win` places before it (ring slot i % win) to complete. Every pixel issues no
+        // earlier than its group's cycle, so the previous pixel's issue (plus 1 when this one
+        // opens a group) is never earlier than this one's group: it alone bounds the issue.
+        // The ring starts with completions at 0, which hold no pixel back.
         let slot = self.slot;
-        let mut t = self.group.max(self.last_issue + next_slot);
-        if self.pixels >= ring.len() as u64 {
-            let (done, cause) = ring[slot];
-            if done > t {
-                stall_by[cause & (CAUSES - 1)] += done - t;
-                t = done;
-            }
+        let opens = self.left == 0;
+        if opens {
+            self.left = ppc;
+        }
+        self.left -= 1;
+        let mut t = self.last_issue + u64::from(opens);
+        let (done, cause) = ring[slot];
+        if done > t {
+            stall_by[cause & (CAUSES - 1)] += done - t;
+            t = done;
         }
         self.pixels += 1;
-        self.in_group += 1;
-        if self.in_group == ppc {
-            self.in_group = 0;
-            self.group += 1;
-        }
         self.slot = if slot + 1 == ring.len() { 0 } else { slot + 1 };
         self.last_issue = t;
         (slot, t)
@@ -896,12 +928,14 @@ struct Step {
 
 /// Where a plan's stages are in [`Simulator::steps`] (`start..end`), and whether its stage
 /// kinds are distinct: then a pixel's footprints (recorded in the plan's order) are matched
-/// to its stages by one cursor ([`stage_footprints`]).
+/// to its stages by one cursor ([`stage_footprints`]). `mono`: with distinct kinds of which
+/// exactly one makes texture lookups on the machine, that stage's place in the plan.
 #[derive(Clone, Copy, Debug)]
 struct PlanSteps {
     start: usize,
     end: usize,
     distinct: bool,
+    mono: Option<usize>,
 }
 
 impl<'a> Simulator<'a> {
@@ -933,10 +967,21 @@ impl<'a> Simulator<'a> {
                     }
                 }));
                 let kinds = p.stages.iter().fold(0u64, |m, &(k, _)| m | 1 << k.index());
+                let distinct = kinds.count_ones() as usize == p.stages.len();
+                let mut fetching = p
+                    .stages
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &(k, _))| super::events::lookups(k, hw) > 0);
+                let mono = match (fetching.next(), fetching.next()) {
+                    (Some((at, _)), None) if distinct => Some(at),
+                    _ => None,
+                };
                 PlanSteps {
                     start,
                     end: steps.len(),
-                    distinct: kinds.count_ones() as usize == p.stages.len(),
+                    distinct,
+                    mono,
                 }
             })
             .collect();
@@ -965,7 +1010,11 @@ impl<'a> Simulator<'a> {
             ppc: u64::from(tc.shade_pixels_per_cycle.max(1)),
             stall_by: [0; CAUSES],
             ring: vec![(0, StageKind::COUNT + 2); win],
-            at: IssueState::default(),
+            // The first pixel is in the first group, which it does not open.
+            at: IssueState {
+                left: u64::from(tc.shade_pixels_per_cycle.max(1)),
+                ..IssueState::default()
+            },
             footprints: 0,
             cached: tc.cache_bytes > 0,
             tiled: tc.bank_interleave == BankInterleave::Tiled,
@@ -977,23 +1026,35 @@ impl<'a> Simulator<'a> {
         self.pixels_of(&row.pixels, &row.footprints);
     }
 
-    /// Feeds `pixels` in order; their `fp_end` index `footprints`, the previous pixel's end
-    /// (0 for the first) being each one's start.
+    /// Feeds `pixels` in order, a run of one plan at a time; their `fp_end` index
+    /// `footprints`, the previous pixel's end (0 for the first) being each one's start.
     fn pixels_of(&mut self, pixels: &[PixelEvent], footprints: &[TexelFootprint]) {
         let mut fp_start = 0usize;
-        self.feed(pixels.iter().map(|px| {
-            let fp_end = (px.fp_end as usize).min(footprints.len());
-            let fps = &footprints[fp_start.min(fp_end)..fp_end];
-            fp_start = fp_end;
-            (px.plan, fps)
-        }));
+        let mut rest = pixels;
+        while let Some(first) = rest.first() {
+            let n = rest
+                .iter()
+                .position(|p| p.plan != first.plan)
+                .unwrap_or(rest.len());
+            let (run, after) = rest.split_at(n);
+            self.run(
+                first.plan,
+                run.iter().map(|px| {
+                    let fp_end = (px.fp_end as usize).min(footprints.len());
+                    let fps = &footprints[fp_start.min(fp_end)..fp_end];
+                    fp_start = fp_end;
+                    fps
+                }),
+            );
+            rest = after;
+        }
     }
 
     /// Issues the next covered pixel (raster order): plan index `plan`, the footprints its
     /// stages fetched in `fps`, e.g. straight from the fragment's trace.
     #[inline]
     pub fn pixel(&mut self, plan: u32, fps: &[TexelFootprint]) {
-        self.feed(std::iter::once((plan, fps)));
+        self.run(plan, std::iter::once(fps));
     }
 
     /// Issues the next covered pixels (raster order), all of plan `plan`, each with the
@@ -1001,31 +1062,34 @@ impl<'a> Simulator<'a> {
     /// resolved and the issue state in locals once for the batch (checked against pixel by
     /// pixel feeding in `timing::equivalence`).
     pub fn span<'f>(&mut self, plan: u32, pixels: impl IntoIterator<Item = &'f [TexelFootprint]>) {
-        self.feed(pixels.into_iter().map(|fps| (plan, fps)));
+        self.run(plan, pixels.into_iter());
     }
 
-    /// Issues pixels given as (plan, footprints) in raster order, through the walk compiled
-    /// for the machine's memory.
+    /// Issues pixels of plan `plan` (each given by its footprints) in raster order, through
+    /// the walk compiled for the machine's memory.
     #[inline]
-    fn feed<'f>(&mut self, pixels: impl Iterator<Item = (u32, &'f [TexelFootprint])>) {
+    fn run<'f>(&mut self, plan: u32, pixels: impl Iterator<Item = &'f [TexelFootprint]>) {
         match (self.cached, self.tiled) {
-            (true, true) => self.feed_in::<true, true>(pixels),
-            (true, false) => self.feed_in::<true, false>(pixels),
-            (false, true) => self.feed_in::<false, true>(pixels),
-            (false, false) => self.feed_in::<false, false>(pixels),
+            (true, true) => self.run_in::<true, true>(plan, pixels),
+            (true, false) => self.run_in::<true, false>(plan, pixels),
+            (false, true) => self.run_in::<false, true>(plan, pixels),
+            (false, false) => self.run_in::<false, false>(plan, pixels),
         }
     }
 
-    /// Issues each pixel (plan index, the footprints its stages fetched) in turn, with the
+    /// Issues each pixel of plan `plan` (the footprints its stages fetched) in turn, with the
     /// memory's [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache, for
-    /// the tiled (`TILED`) or linear interleave. The issue state lives in locals for the batch
-    /// and the last pixel's plan is reused when the next one has the same.
+    /// the tiled (`TILED`) or linear interleave. The plan is resolved once; the issue state
+    /// and the four-bank footprint counts live in locals for the batch. A plan with one
+    /// fetching stage ([`PlanSteps::mono`]) walks a pixel whose footprints are all that
+    /// stage's without matching footprints to stages ([`walk_mono`]); any other pixel takes
+    /// the general walk ([`walk`]).
     #[inline(always)]
-    fn feed_in<'f, const CACHED: bool, const TILED: bool>(
+    fn run_in<'f, const CACHED: bool, const TILED: bool>(
         &mut self,
-        pixels: impl Iterator<Item = (u32, &'f [TexelFootprint])>,
+        plan: u32,
+        pixels: impl Iterator<Item = &'f [TexelFootprint]>,
     ) {
-        const C_LAT: usize = StageKind::COUNT + 2;
         let Self {
             steps: all_steps,
             plans,
@@ -1040,72 +1104,146 @@ impl<'a> Simulator<'a> {
             ..
         } = self;
         let ppc = *ppc;
+        let ring = &mut ring[..];
         let mut st = *at;
         let mut fed = 0u64;
-        // The plan of the previous pixel: its index, stages and whether they are distinct
-        // (`None` for a plan the frame does not have).
-        // Its pixels since it became the current plan are `run` (added to `plan_pixels` when
-        // the plan changes and at the end).
-        let mut cur: (u32, Option<(&[Step], bool)>) = (u32::MAX, None);
-        let mut run = 0u64;
-        for (plan, fps) in pixels {
-            fed += fps.len() as u64;
-            let (slot, mut t) = st.issue(ring, stall_by, ppc);
-            if plan != cur.0 || cur.1.is_none() {
-                if let Some(n) = plan_pixels.get_mut(cur.0 as usize) {
-                    *n += run;
+        let mut quads = QuadCounts::default();
+        let first = st.pixels;
+        match plans.get(plan as usize) {
+            // A plan the frame does not have: the pixel issues and completes at once.
+            None => {
+                for fps in pixels {
+                    fed += fps.len() as u64;
+                    let (slot, t) = st.issue(ring, stall_by, ppc);
+                    ring[slot] = (t, C_LAT);
                 }
-                run = 0;
-                cur = (
-                    plan,
-                    plans
-                        .get(plan as usize)
-                        .map(|p| (&all_steps[p.start..p.end], p.distinct)),
-                );
             }
-            let Some((steps, distinct)) = cur.1 else {
-                ring[slot] = (t, C_LAT);
-                continue;
-            };
-            run += 1;
-            let mut worst = (0u64, C_LAT);
-            // The stage kinds that fetched (stage kinds number fewer than 64).
-            let fetched = fps.iter().fold(0u64, |m, f| m | 1u64 << (f.stage & 63));
-            let mut cursor = 0usize;
-            for &Step { k, cycles, occ } in steps {
-                if fetched & (1u64 << (k & 63)) != 0 {
-                    let mine = stage_footprints(fps, &mut cursor, k, distinct);
-                    if !mine.is_empty() {
-                        let unit = &mut alu[k & (KINDS - 1)];
-                        // The plan's count charges this step's arithmetic occupancy.
-                        unit.busy = unit.busy.wrapping_sub(occ);
-                        t = tex.stage::<CACHED, TILED>(unit, k, cycles, t, mine, &mut worst);
-                        continue;
-                    }
+            Some(&PlanSteps {
+                start,
+                end,
+                distinct,
+                mono,
+            }) => {
+                let steps = &all_steps[start..end];
+                // The one fetching stage, with the steps before and after it.
+                let one = mono.and_then(|at| {
+                    let (pre, rest) = steps.split_at(at.min(steps.len()));
+                    rest.split_first()
+                        .map(|(&step, post)| OneStage { pre, step, post })
+                });
+                for fps in pixels {
+                    fed += fps.len() as u64;
+                    let (slot, t) = st.issue(ring, stall_by, ppc);
+                    let (t, cause) = match one {
+                        Some(ref one) if fps.iter().all(|f| usize::from(f.stage) == one.step.k) => {
+                            walk_mono::<CACHED, TILED>(alu, tex, one, fps, t, &mut quads)
+                        }
+                        _ => walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads),
+                    };
+                    ring[slot] = (t, cause);
+                    st.end = st.end.max(t);
                 }
-                let s = alu[k & (KINDS - 1)].take_free(t, occ);
-                if s - t > worst.0 {
-                    worst = (s - t, k);
-                }
-                t = s + cycles;
             }
-            ring[slot] = (t, worst.1);
-            st.end = st.end.max(t);
         }
-        if let Some(n) = plan_pixels.get_mut(cur.0 as usize) {
-            *n += run;
+        if let Some(p) = plan_pixels.get_mut(plan as usize) {
+            *p += st.pixels - first;
         }
+        tex.mem.quads.add(&quads);
         *at = st;
         *footprints += fed;
     }
 }
 
+/// The latency stall cause (a pixel that never waited for a busy unit).
+const C_LAT: usize = StageKind::COUNT + 2;
+
+/// Runs the arithmetic `steps` in order from `t`, each on its kind's unit: returns when the
+/// last completes and updates the pixel's worst wait (cycles, cause).
+#[inline(always)]
+fn arith(alu: &mut [Unit; KINDS], steps: &[Step], mut t: u64, worst: &mut (u64, usize)) -> u64 {
+    for &Step { k, cycles, occ } in steps {
+        let s = alu[k & (KINDS - 1)].take_free(t, occ);
+        if s - t > worst.0 {
+            *worst = (s - t, k);
+        }
+        t = s + cycles;
+    }
+    t
+}
+
+/// One pixel issued at `t` through a plan's `steps` (`distinct`: its stage kinds are),
+/// its footprints `fps` matched to its texture stages by [`stage_footprints`]: returns its
+/// completion and worst cause.
+#[inline(always)]
+fn walk<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    steps: &[Step],
+    distinct: bool,
+    fps: &[TexelFootprint],
+    mut t: u64,
+    quads: &mut QuadCounts,
+) -> (u64, usize) {
+    let mut worst = (0u64, C_LAT);
+    // The stage kinds that fetched (stage kinds number fewer than 64).
+    let fetched = fps.iter().fold(0u64, |m, f| m | 1u64 << (f.stage & 63));
+    let mut cursor = 0usize;
+    for step in steps {
+        let k = step.k;
+        if fetched & (1u64 << (k & 63)) != 0 {
+            let mine = stage_footprints(fps, &mut cursor, k, distinct);
+            if !mine.is_empty() {
+                let unit = &mut alu[k & (KINDS - 1)];
+                // The plan's count charges this step's arithmetic occupancy.
+                unit.busy = unit.busy.wrapping_sub(step.occ);
+                t = tex.stage::<CACHED, TILED>(unit, k, step.cycles, t, mine, &mut worst, quads);
+                continue;
+            }
+        }
+        t = arith(alu, std::slice::from_ref(step), t, &mut worst);
+    }
+    (t, worst.1)
+}
+
+/// A plan's one fetching stage as [`walk_mono`] walks it: the steps before it, its step and
+/// the steps after it.
+#[derive(Clone, Copy)]
+struct OneStage<'s> {
+    pre: &'s [Step],
+    step: Step,
+    post: &'s [Step],
+}
+
+/// [`walk`] of a pixel of a plan with distinct stage kinds whose footprints `fps` are all of
+/// its one fetching stage (`one`): the general walk gives that stage all of them and runs the
+/// others as arithmetic, and so does this, inlined.
+#[inline(always)]
+fn walk_mono<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    one: &OneStage,
+    fps: &[TexelFootprint],
+    t: u64,
+    quads: &mut QuadCounts,
+) -> (u64, usize) {
+    let mut worst = (0u64, C_LAT);
+    let step = one.step;
+    let mut t = arith(alu, one.pre, t, &mut worst);
+    if fps.is_empty() {
+        t = arith(alu, std::slice::from_ref(&step), t, &mut worst);
+    } else {
+        let unit = &mut alu[step.k & (KINDS - 1)];
+        unit.busy = unit.busy.wrapping_sub(step.occ);
+        let w = &mut worst;
+        t = tex.stage_in::<CACHED, TILED>(unit, step.k, step.cycles, t, fps, w, quads);
+    }
+    (arith(alu, one.post, t, &mut worst), worst.1)
+}
+
 impl Texturing {
-    /// A texture stage of kind `k` (`cycles` per invocation, `alu` its address/footprint
-    /// unit) reached at `t` with its footprints `mine` (not empty): its address/footprint
-    /// unit, then each lookup through the memory and a filter unit; returns its completion
-    /// and updates the pixel's worst wait (cycles, cause).
+    /// [`Texturing::stage_in`], not inlined (the general walk's texture stage).
     #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
     fn stage<const CACHED: bool, const TILED: bool>(
         &mut self,
         alu: &mut Unit,
@@ -1114,15 +1252,47 @@ impl Texturing {
         t: u64,
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
+        quads: &mut QuadCounts,
     ) -> u64 {
-        const C_MEM: usize = StageKind::COUNT;
-        let lookups = u64::from(mine[mine.len() - 1].lookup) + 1;
+        self.stage_in::<CACHED, TILED>(alu, k, cycles, t, mine, worst, quads)
+    }
+
+    /// The address/footprint unit's (cycles, occupancy) in a texture stage of `cycles` per
+    /// invocation making `lookups` lookups: the cycles beyond the lookups' trilinear samples,
+    /// at least 1.
+    #[inline(always)]
+    fn setup(&self, cycles: u64, lookups: u64) -> (u64, u64) {
         let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
         let setup_occ = if self.alu_pipelined {
             setup.min(1)
         } else {
             setup
         };
+        (setup, setup_occ)
+    }
+
+    /// A texture stage of kind `k` (`cycles` per invocation, `alu` its address/footprint
+    /// unit) reached at `t` with its footprints `mine` (not empty): its address/footprint
+    /// unit, then each lookup through the memory and a filter unit; returns its completion
+    /// and updates the pixel's worst wait (cycles, cause). One or two footprints of one
+    /// lookup (a bilinear or trilinear lookup) skip the search for the lookups' runs.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn stage_in<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        alu: &mut Unit,
+        k: usize,
+        cycles: u64,
+        t: u64,
+        mine: &[TexelFootprint],
+        worst: &mut (u64, usize),
+        quads: &mut QuadCounts,
+    ) -> u64 {
+        const C_MEM: usize = StageKind::COUNT;
+        let (Some(first), Some(last)) = (mine.first(), mine.last()) else {
+            return t;
+        };
+        let (setup, setup_occ) = self.setup(cycles, u64::from(last.lookup) + 1);
         let s = alu.take(t, setup_occ);
         if s - t > worst.0 {
             *worst = (s - t, k);
@@ -1132,21 +1302,37 @@ impl Texturing {
         let mut bytes = 0u64;
         // The footprints of one lookup are consecutive: each run of one lookup number goes
         // through the memory, then to a filter unit.
-        let mut i = 0;
-        while let Some(first) = mine.get(i) {
-            let (lookup, from) = (first.lookup, i);
+        if mine.len() <= 2 && first.lookup == last.lookup {
             let mut data = ready;
-            while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
-                let (occ, lat, b) = self.mem.footprint::<CACHED, TILED>(f);
+            for f in mine {
+                let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
+                let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
                 bytes += b;
                 let ms = self.mem_unit.take(ready, occ);
                 if ms - ready > worst.0 {
                     *worst = (ms - ready, C_MEM);
                 }
                 data = data.max(ms + lat);
-                i += 1;
             }
-            done = done.max(self.filter(data, i - from, worst));
+            done = done.max(self.filter(data, mine.len(), worst));
+        } else {
+            let mut i = 0;
+            while let Some(first) = mine.get(i) {
+                let (lookup, from) = (first.lookup, i);
+                let mut data = ready;
+                while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
+                    let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
+                    let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
+                    bytes += b;
+                    let ms = self.mem_unit.take(ready, occ);
+                    if ms - ready > worst.0 {
+                        *worst = (ms - ready, C_MEM);
+                    }
+                    data = data.max(ms + lat);
+                    i += 1;
+                }
+                done = done.max(self.filter(data, i - from, worst));
+            }
         }
         self.stage_bytes[k & (KINDS - 1)] += bytes;
         done
@@ -1291,7 +1477,10 @@ impl Simulator<'_> {
                 cycles: stall_by[i],
             });
         }
-        let memory = mem.counts.report(tc, mem.cache.is_some());
+        let counts = mem.counts.total(&mem.quads, mem.page_hit, mem.page_miss);
+        // Every texel access is a texture stage's.
+        let bytes = stage_bytes.iter().sum();
+        let memory = counts.report(tc, mem.cache.is_some(), bytes);
         TimingReport {
             scene: scene.to_string(),
             hw: hw.name.clone(),
@@ -1305,8 +1494,8 @@ impl Simulator<'_> {
             units,
             stalls,
             memory,
-            bank_conflict_cycles: mem.counts.conflict_cycles,
-            miss_cycles: mem.counts.miss_cycles,
+            bank_conflict_cycles: counts.conflict_cycles,
+            miss_cycles: counts.miss_cycles,
             bottleneck,
             bottleneck_cycles,
             events,
@@ -1324,7 +1513,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
 
 #[cfg(test)]
 mod tests {
-    use super::{Memory, TexelFootprint, TextureLayout};
+    use super::{Memory, QuadCounts, TexelFootprint, TextureLayout};
     use crate::rng_common::Rng;
     use hw_model::timing_config::BankInterleave;
     use hw_model::HwConfig;
@@ -1363,6 +1552,7 @@ mod tests {
                 .collect();
             let mut fast = Memory::new(&textures, &tc);
             let mut general = fast.clone();
+            let mut fast_quads = QuadCounts::default();
             for i in 0..400 {
                 let tex = r.below(textures.len() as u64) as usize;
                 let level = r.below(2) as usize;
@@ -1378,26 +1568,32 @@ mod tests {
                     x: [x0, x1],
                     y: [y0, y1],
                 };
+                let q = &mut fast_quads;
                 let (want, got) = match (tc.cache_bytes > 0, tc.bank_interleave) {
                     (true, BankInterleave::Tiled) => (
                         general.footprint_any::<true, true>(&fp),
-                        fast.footprint::<true, true>(&fp),
+                        fast.footprint::<true, true>(&fp, q),
                     ),
                     (false, BankInterleave::Tiled) => (
                         general.footprint_any::<false, true>(&fp),
-                        fast.footprint::<false, true>(&fp),
+                        fast.footprint::<false, true>(&fp, q),
                     ),
                     (true, BankInterleave::Linear) => (
                         general.footprint_any::<true, false>(&fp),
-                        fast.footprint::<true, false>(&fp),
+                        fast.footprint::<true, false>(&fp, q),
                     ),
                     (false, BankInterleave::Linear) => (
                         general.footprint_any::<false, false>(&fp),
-                        fast.footprint::<false, false>(&fp),
+                        fast.footprint::<false, false>(&fp, q),
                     ),
                 };
                 assert_eq!(got, want, "case {case} footprint {i}: {fp:?}");
-                assert_eq!(fast.counts, general.counts, "case {case} footprint {i}");
+                let (hit, miss) = (general.page_hit, general.page_miss);
+                assert_eq!(
+                    fast.counts.total(&fast_quads, hit, miss),
+                    general.counts.total(&general.quads, hit, miss),
+                    "case {case} footprint {i}"
+                );
                 assert_eq!(
                     fast.open_page, general.open_page,
                     "case {case} footprint {i}"
