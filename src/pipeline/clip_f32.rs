@@ -67,7 +67,8 @@ fn interp(t: u32, out: &ShadedVertex, inn: &ShadedVertex, half: [u32; 2]) -> Sha
 }
 
 /// The planes vertex `v` is outside of (bit i for plane i).
-fn outcode(v: &ShadedVertex) -> u32 {
+#[must_use]
+pub fn outcode(v: &ShadedVertex) -> u32 {
     (0..6).fold(0, |m, p| {
         if negative(dot4(&v.clip, &PLANES[p])) {
             m | 1 << p
@@ -82,11 +83,22 @@ fn outcode(v: &ShadedVertex) -> u32 {
 /// the triangle itself when no vertex is outside.
 #[must_use]
 pub fn clip_triangle(v: [ShadedVertex; 3], half: [u32; 2]) -> Vec<[Vertex; 3]> {
-    let setup_vertex = |s: &ShadedVertex| [s.window[0], s.window[1], s.window[2], s.st[0], s.st[1]];
-    let mut mask = v.iter().fold(0, |m, x| m | outcode(x));
+    let mask = v.iter().fold(0, |m, x| m | outcode(x));
     if mask == 0 {
         return vec![v.map(|s| setup_vertex(&s))];
     }
+    clip_outside(v, mask, half)
+}
+
+/// A vertex as the setup reads it: window x, y, `1/w`, s, t.
+#[must_use]
+pub fn setup_vertex(s: &ShadedVertex) -> Vertex {
+    [s.window[0], s.window[1], s.window[2], s.st[0], s.st[1]]
+}
+
+/// [`clip_triangle`] of a triangle whose vertices' outcodes OR to `mask` (not 0).
+#[must_use]
+pub fn clip_outside(v: [ShadedVertex; 3], mut mask: u32, half: [u32; 2]) -> Vec<[Vertex; 3]> {
     let mut poly: Vec<ShadedVertex> = v.to_vec();
     while mask != 0 && poly.len() >= 3 {
         let p = mask.trailing_zeros() as usize;

@@ -21,7 +21,7 @@
 //! the coordinates as fixed point on `texcoord_frac_bits` (28 in the `llvmpipe` preset, exact
 //! for every binary32 coordinate of magnitude 1/32 or more).
 
-use super::clip_f32::{clip_triangle, ShadedVertex};
+use super::clip_f32::{clip_outside, clip_triangle, setup_vertex, ShadedVertex};
 use super::stages::{texcoord_offset, Counters, Machine};
 use super::{Frag, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
@@ -187,6 +187,24 @@ impl F32Tri {
     #[must_use]
     pub fn new(src: [ShadedVertex; 3], half: [u32; 2]) -> Self {
         let fan = clip_triangle(src, half)
+            .into_iter()
+            .map(|t| (t, setup(llvmpipe_order(t))))
+            .collect();
+        Self { fan }
+    }
+
+    /// [`Self::new`] of vertices whose [`outcode`](super::clip_f32::outcode)s OR to `mask`
+    /// (computed once per shared vertex by the caller); one allocation when nothing is
+    /// clipped.
+    #[must_use]
+    pub fn with_mask(src: [ShadedVertex; 3], mask: u32, half: [u32; 2]) -> Self {
+        if mask == 0 {
+            let t = src.map(|s| setup_vertex(&s));
+            return Self {
+                fan: vec![(t, setup(llvmpipe_order(t)))],
+            };
+        }
+        let fan = clip_outside(src, mask, half)
             .into_iter()
             .map(|t| (t, setup(llvmpipe_order(t))))
             .collect();

@@ -8,6 +8,7 @@
 //! per-pixel divide `1 / sum(E_i invw_i)` of perspective-correct interpolation, the one a
 //! texture pipeline pays for every fragment.
 
+use crate::fixedpoint::floor_exact;
 use hw_model::config::RasterConfig;
 use rayon::prelude::*;
 
@@ -505,9 +506,10 @@ fn pixel_range_fixed(min: i64, max: i64, s: u32, limit: u32) -> (i64, i64) {
 
 /// Pixel range [lo, hi) whose centres may lie in [min, max] (pixels).
 fn pixel_range_float(min: f64, max: f64, limit: u32) -> (i64, i64) {
-    // Finite and within the guard band, so the casts are exact.
-    let lo = (min - 0.5).ceil() as i64;
-    let hi = (max - 0.5).floor() as i64 + 1;
+    // Finite and within the guard band, so the casts are exact (`ceil(x) = -floor(-x)`;
+    // `floor_exact` is `floor` without the libm call).
+    let lo = -floor_exact(-(min - 0.5)) as i64;
+    let hi = floor_exact(max - 0.5) as i64 + 1;
     (lo.max(0), hi.min(i64::from(limit)))
 }
 

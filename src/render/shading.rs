@@ -4,11 +4,13 @@
 
 use super::Geometry;
 use crate::pipeline::bump::{BumpAttrs, BumpVertex};
-use crate::pipeline::clip_f32::ShadedVertex;
+use crate::pipeline::clip_f32::{outcode, ShadedVertex};
 use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{output16, run, run_span, Counters, Machine, TriAttrs, SPAN_MAX};
 use crate::pipeline::{Frag, Program, StageImpls};
-use crate::raster::{ScreenTri, VertexSource};
+#[cfg(test)]
+use crate::raster::ScreenTri;
+use crate::raster::VertexSource;
 use crate::raster::{Setup, VisBuffer, NO_TRI};
 use crate::report::Image;
 use crate::timing::events::{record_pixel, FrameEvents, RowEvents};
@@ -18,56 +20,61 @@ use hw_model::config::CoordArith;
 use hw_model::f32_convert::from_i32;
 use hw_model::fixed::SatCounter;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Bump data of every screen triangle of a bump plan (clipped vertices blended from their
-/// source vertices); sets `TriAttrs::bump`.
+/// source vertices), computed in parallel and stored in triangle order; sets
+/// `TriAttrs::bump`.
 pub(super) fn bump_attrs(
     setup: &Setup,
     geo: &Geometry,
     m: &Machine,
     attrs: &mut [TriAttrs],
 ) -> (Vec<BumpAttrs>, SatCounter) {
-    let mut out = Vec::new();
     let mut sat = SatCounter::default();
     if geo.bump.is_empty() {
-        return (out, sat);
+        return (Vec::new(), sat);
     }
-    for (i, (t, a)) in setup.tris.iter().zip(attrs.iter_mut()).enumerate() {
-        let plan = &geo.plans[a.plan as usize];
-        if plan.bump.is_none() {
-            continue;
-        }
-        let d = &geo.draws[t.src as usize];
-        let src_bary = setup.src_bary(i);
-        let blend = |k: usize| -> BumpVertex {
-            let w = src_bary[k];
-            let mut r = BumpVertex::default();
-            for (&wj, &vi) in w.iter().zip(&d.v) {
-                let Some(b) = geo.bump.get(vi as usize) else {
-                    continue;
-                };
-                for c in 0..3 {
-                    r.n[c] += wj * b.n[c];
-                    r.du[c] += wj * b.du[c];
-                    r.dv[c] += wj * b.dv[c];
-                    r.m[c] += wj * b.m[c];
-                    r.p[c] += wj * b.p[c];
+    let bumped: Vec<(usize, BumpAttrs, SatCounter)> = setup
+        .tris
+        .par_iter()
+        .zip(attrs.par_iter())
+        .enumerate()
+        .filter(|(_, (_, a))| geo.plans[a.plan as usize].bump.is_some())
+        .map(|(i, (t, _))| {
+            let d = &geo.draws[t.src as usize];
+            let src_bary = setup.src_bary(i);
+            let blend = |k: usize| -> BumpVertex {
+                let w = src_bary[k];
+                let mut r = BumpVertex::default();
+                for (&wj, &vi) in w.iter().zip(&d.v) {
+                    let Some(b) = geo.bump.get(vi as usize) else {
+                        continue;
+                    };
+                    for c in 0..3 {
+                        r.n[c] += wj * b.n[c];
+                        r.du[c] += wj * b.du[c];
+                        r.dv[c] += wj * b.dv[c];
+                        r.m[c] += wj * b.m[c];
+                        r.p[c] += wj * b.p[c];
+                    }
+                    for c in 0..2 {
+                        r.len[c] += wj * b.len[c];
+                    }
                 }
-                for c in 0..2 {
-                    r.len[c] += wj * b.len[c];
-                }
-            }
-            r
-        };
-        let verts = [blend(0), blend(1), blend(2)];
-        a.bump = out.len() as u32;
-        out.push(BumpAttrs::new(
-            m,
-            &verts,
-            geo.eye,
-            &geo.point_lights,
-            &mut sat,
-        ));
+                r
+            };
+            let verts = [blend(0), blend(1), blend(2)];
+            let mut s = SatCounter::default();
+            let b = BumpAttrs::new(m, &verts, geo.eye, &geo.point_lights, &mut s);
+            (i, b, s)
+        })
+        .collect();
+    let mut out = Vec::with_capacity(bumped.len());
+    for (i, b, s) in bumped {
+        attrs[i].bump = out.len() as u32;
+        out.push(b);
+        sat.add(&s);
     }
     (out, sat)
 }
@@ -159,15 +166,52 @@ pub(super) fn f32_tris(
     if m.hw.interp.coord_arith != CoordArith::Float32 {
         return Vec::new();
     }
-    for (i, a) in attrs.iter_mut().enumerate() {
-        a.f32_tri = i as u32;
-    }
+    attrs
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(i, a)| a.f32_tri = i as u32);
+    f32_setups(setup, geo)
+}
+
+/// [`F32Tri`] of every screen triangle: its source triangle's vertices as llvmpipe's vertex
+/// shader leaves them ([`shade_vertices`], each shared vertex shaded once), clipped and set
+/// up (the same as [`F32Tri::new`] of [`llvmpipe_source`]).
+fn f32_setups(setup: &Setup, geo: &Geometry) -> Vec<F32Tri> {
+    let verts = shade_vertices(setup, geo);
+    let half = viewport_half(setup.width, setup.height);
     setup
         .tris
         .par_iter()
         .map(|t| {
-            let (src, half) = llvmpipe_source(t, geo, setup.width, setup.height);
-            F32Tri::new(src, half)
+            let v = geo.draws[t.src as usize].v.map(|vi| &verts[vi as usize]);
+            let mask = v[0].1 | v[1].1 | v[2].1;
+            F32Tri::with_mask(v.map(|x| x.0), mask, half)
+        })
+        .collect()
+}
+
+/// Every vertex the screen triangles use through [`coord_f32::shade_vertex`] with its
+/// texture coordinates, with its outcode ([`outcode`]); default for unused vertices.
+fn shade_vertices(setup: &Setup, geo: &Geometry) -> Vec<(ShadedVertex, u32)> {
+    let used: Vec<AtomicBool> = geo.object.iter().map(|_| AtomicBool::new(false)).collect();
+    setup.tris.par_iter().for_each(|t| {
+        for &vi in &geo.draws[t.src as usize].v {
+            used[vi as usize].store(true, Ordering::Relaxed);
+        }
+    });
+    let mvp = llvmpipe_mvp(geo);
+    let (width, height) = (setup.width, setup.height);
+    geo.object
+        .par_iter()
+        .zip(&geo.uv)
+        .zip(&used)
+        .map(|((&p, uv), used)| {
+            if !used.load(Ordering::Relaxed) {
+                return (ShadedVertex::default(), 0);
+            }
+            let st = uv.map(|x| (x as f32).to_bits());
+            let v = coord_f32::shade_vertex(&mvp, p, st, width, height);
+            (v, outcode(&v))
         })
         .collect()
 }
@@ -178,9 +222,25 @@ fn matrix_f32(vp: &DMat4) -> [[u32; 4]; 4] {
     std::array::from_fn(|r| std::array::from_fn(|k| (c[k][r] as f32).to_bits()))
 }
 
+/// The model-view-projection llvmpipe's vertex shader applies: the camera's binary32 GL
+/// matrix when it has one, else the view-projection rounded to binary32.
+fn llvmpipe_mvp(geo: &Geometry) -> [[u32; 4]; 4] {
+    geo.mesa_mvp.map_or_else(
+        || matrix_f32(&geo.view_projection),
+        |m| m.map(|row| row.map(f32::to_bits)),
+    )
+}
+
+/// The viewport's half sizes in binary32.
+fn viewport_half(width: u32, height: u32) -> [u32; 2] {
+    [width / 2, height / 2].map(|h| from_i32(h as i32))
+}
+
 /// The source triangle of screen triangle `tri` as llvmpipe's vertex shader leaves it (each
-/// vertex through [`shade_vertex`] with its texture coordinates, in draw order) and the
-/// viewport's half sizes: what [`F32Tri::new`] clips and sets up.
+/// vertex through [`coord_f32::shade_vertex`] with its texture coordinates, in draw order)
+/// and the viewport's half sizes: what [`F32Tri::new`] clips and sets up (the reference of
+/// [`f32_setups`]).
+#[cfg(test)]
 fn llvmpipe_source(
     tri: &ScreenTri,
     geo: &Geometry,
@@ -189,17 +249,13 @@ fn llvmpipe_source(
 ) -> ([ShadedVertex; 3], [u32; 2]) {
     let f = |x: f64| (x as f32).to_bits();
     let d = &geo.draws[tri.src as usize];
-    let mvp = geo.mesa_mvp.map_or_else(
-        || matrix_f32(&geo.view_projection),
-        |m| m.map(|row| row.map(f32::to_bits)),
-    );
+    let mvp = llvmpipe_mvp(geo);
     let src = d.v.map(|vi| {
         let vi = vi as usize;
         let st = [f(geo.uv[vi][0]), f(geo.uv[vi][1])];
         coord_f32::shade_vertex(&mvp, geo.object[vi], st, width, height)
     });
-    let half = [width / 2, height / 2].map(|h| from_i32(h as i32));
-    (src, half)
+    (src, viewport_half(width, height))
 }
 
 /// What the shading pass reads: the visible triangles and everything prepared for them.
@@ -439,4 +495,84 @@ pub(super) fn shade<'h>(
     }
     consume(pending);
     (img, counters, Some((fe, sim)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::raster::DrawTri;
+    use crate::rng_common::Rng;
+    use glam::DVec3;
+
+    /// A seeded mesh of `n` vertices shared by `3 n` triangles, seen by a perspective camera
+    /// with some vertices behind it, beside it and beyond its far plane (clipped triangles).
+    fn random_geometry(r: &mut Rng, n: usize, mesa: bool) -> Geometry {
+        let eye = DVec3::new(r.range(-3.0, 3.0), r.range(-3.0, 3.0), r.range(4.0, 9.0));
+        let view = DMat4::look_at_rh(eye, DVec3::ZERO, DVec3::Y);
+        let vp = DMat4::perspective_rh_gl(r.range(0.5, 1.5), 4.0 / 3.0, 0.5, 20.0) * view;
+        let object: Vec<[f32; 3]> = (0..n)
+            .map(|_| {
+                [r.range(-6.0, 6.0), r.range(-6.0, 6.0), r.range(-12.0, 8.0)].map(|c| c as f32)
+            })
+            .collect();
+        let clip = object
+            .iter()
+            .map(|p| (vp * DVec3::from(p.map(f64::from)).extend(1.0)).to_array())
+            .collect();
+        let draws: Vec<DrawTri> = (0..3 * n)
+            .map(|_| DrawTri {
+                v: std::array::from_fn(|_| r.below(n as u64) as u32),
+                cull_back: r.below(4) == 0,
+            })
+            .collect();
+        Geometry {
+            clip,
+            mesa_mvp: mesa.then(|| {
+                std::array::from_fn(|row| {
+                    std::array::from_fn(|col| vp.col(col)[row] as f32 * r.range(0.99, 1.01) as f32)
+                })
+            }),
+            object,
+            view_projection: vp,
+            color: vec![[0.5; 3]; n],
+            uv: (0..n)
+                .map(|_| [r.range(-4.0, 4.0), r.range(-4.0, 4.0)])
+                .collect(),
+            bump: Vec::new(),
+            eye: eye.to_array(),
+            point_lights: Vec::new(),
+            draw_plan: vec![0; draws.len()],
+            draws,
+            plans: Vec::new(),
+        }
+    }
+
+    /// The float32 setups from vertices shaded once each ([`f32_setups`]) are those of every
+    /// triangle's own vertices ([`llvmpipe_source`], [`F32Tri::new`]), on 200 seeded meshes
+    /// (clipped triangles, both matrices, odd and even viewports).
+    #[test]
+    fn shared_vertex_setups_match_per_triangle_setups() {
+        let mut r = Rng(0xF32_5E7);
+        let cfg = hw_model::config::RasterConfig {
+            subpixel_bits: 8,
+            depth_bits: 24,
+            setup_cycles: 1,
+            span_cycles: 1,
+        };
+        let (mut tris, mut clipped) = (0, 0);
+        for i in 0..200 {
+            let geo = random_geometry(&mut r, 30 + i % 50, i % 3 == 0);
+            let (w, h) = (64 + r.below(512) as u32, 48 + r.below(512) as u32);
+            let setup = crate::raster::setup(&geo.clip, &geo.draws, w, h, &cfg);
+            let got = f32_setups(&setup, &geo);
+            assert_eq!(got.len(), setup.tris.len());
+            for (t, g) in setup.tris.iter().zip(&got) {
+                let (src, half) = llvmpipe_source(t, &geo, w, h);
+                assert_eq!(g.fan, F32Tri::new(src, half).fan, "mesh {i}");
+                clipped += usize::from(g.fan.len() != 1);
+            }
+            tris += got.len();
+        }
+        assert!(tris > 10_000 && clipped > 500, "{tris} {clipped}");
+    }
 }
