@@ -414,7 +414,7 @@ fn renders_a_real_textured_obj_with_its_mtl() {
 }
 
 /// Time limit of the 100k-triangle render below (test profile, opt-level 2). Measured on the
-/// 2-core machine: see README "Performance".
+/// 2-core machine: see docs/PERFORMANCE_LOG.md, "Large meshes".
 const BIG_OBJ_LIMIT_S: f64 = 5.0;
 
 #[test]
