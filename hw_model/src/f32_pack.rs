@@ -14,7 +14,7 @@
 
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::fixed::{round_shift_right_sticky, Rounding};
+use crate::fixed::{round_shift_right_mid, round_shift_right_sticky, HalfEvenMode, Rounding};
 
 /// Sign bit of an encoding.
 pub const SIGN: u32 = 0x8000_0000;
@@ -114,7 +114,7 @@ pub fn round_pack(neg: bool, exp: i32, sig: u128, sticky: bool) -> u32 {
     }
     // Keep a sticky bit of our own below the significand, so a dropped f is never lost.
     let (sig, exp) = (sig << 1 | u128::from(sticky), exp - 1);
-    if let Ok(narrow) = u64::try_from(sig) {
+    if let Ok(narrow) = i64::try_from(sig) {
         if let Some(r) = pack_narrow(neg, exp, narrow) {
             return r;
         }
@@ -122,10 +122,11 @@ pub fn round_pack(neg: bool, exp: i32, sig: u128, sticky: bool) -> u32 {
     pack_wide(neg, exp, sig)
 }
 
-/// [`pack_wide`] in `u64` (a significand below 2^64, the multiplier's always): `None` when
-/// the rounding would drop 64 bits or more (results far below 2^-149), left to [`pack_wide`].
+/// [`pack_wide`] in 64 bits (a positive significand below 2^63, the multiplier's always),
+/// rounded by the one 64-bit rounding routine: `None` when the rounding would drop 64 bits or
+/// more (results far below 2^-149), left to [`pack_wide`].
 #[inline]
-fn pack_narrow(neg: bool, exp: i32, sig: u64) -> Option<u32> {
+fn pack_narrow(neg: bool, exp: i32, sig: i64) -> Option<u32> {
     let top = exp + (64 - sig.leading_zeros() as i32) - 1;
     let mut lsb = (top - FRAC_BITS as i32).max(MIN_LSB_EXP);
     let mut q = if lsb > exp {
@@ -133,10 +134,7 @@ fn pack_narrow(neg: bool, exp: i32, sig: u64) -> Option<u32> {
         if shift >= 64 {
             return None;
         }
-        let floor = sig >> shift;
-        let rem = sig & ((1u64 << shift) - 1);
-        let half = 1u64 << (shift - 1);
-        floor + u64::from(rem > half || (rem == half && floor & 1 == 1))
+        round_shift_right_mid::<HalfEvenMode>(sig, shift)
     } else {
         // At most 24 significant bits after the shift: no overflow.
         sig << (exp - lsb)
@@ -269,7 +267,7 @@ mod tests {
                 want,
                 "{neg} {exp} {sig} {sticky}"
             );
-            narrow += usize::from(bits < 63);
+            narrow += usize::from(bits < 62);
         }
         assert!(narrow > 400_000, "{narrow}");
     }
