@@ -1131,17 +1131,49 @@ impl<'a> Simulator<'a> {
                     rest.split_first()
                         .map(|(&step, post)| OneStage { pre, step, post })
                 });
+                // Its address/footprint unit's (cycles, occupancy) for one lookup.
+                let one = one.map(|one| (one, tex.setup(one.step.cycles, 1)));
+                // One pixel issued per cycle and the steps before the fetching stage
+                // occupying their units at most 1 cycle: see [`settle`].
+                let (lazy_ok, pre_cycles) = one.map_or((false, 0), |(one, _)| {
+                    let fits = ppc == 1 && one.pre.iter().all(|s| s.occ <= 1);
+                    (fits, one.pre.iter().map(|s| s.cycles).sum::<u64>())
+                });
+                let mut lazy = None;
                 for fps in pixels {
                     fed += fps.len() as u64;
                     let (slot, t) = st.issue(ring, stall_by, ppc);
                     let (t, cause) = match one {
-                        Some(ref one) if fps.iter().all(|f| usize::from(f.stage) == one.step.k) => {
+                        Some((ref one, setup)) if one_lookup(fps, one.step.k) => {
+                            let mut worst = (0u64, C_LAT);
+                            let pre_end = match lazy {
+                                Some(_) => t + pre_cycles,
+                                None => arith(alu, one.pre, t, &mut worst),
+                            };
+                            lazy = (lazy_ok && pre_end == t + pre_cycles).then_some(t);
+                            let q = &mut quads;
+                            walk_lookup::<CACHED, TILED>(
+                                alu, tex, one, setup, fps, pre_end, worst, q,
+                            )
+                        }
+                        Some((ref one, _))
+                            if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
+                        {
+                            settle(alu, one.pre, &mut lazy);
                             walk_mono::<CACHED, TILED>(alu, tex, one, fps, t, &mut quads)
                         }
-                        _ => walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads),
+                        _ => {
+                            if let Some((ref one, _)) = one {
+                                settle(alu, one.pre, &mut lazy);
+                            }
+                            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads)
+                        }
                     };
                     ring[slot] = (t, cause);
                     st.end = st.end.max(t);
+                }
+                if let Some((ref one, _)) = one {
+                    settle(alu, one.pre, &mut lazy);
                 }
             }
         }
@@ -1240,6 +1272,60 @@ fn walk_mono<const CACHED: bool, const TILED: bool>(
     (arith(alu, one.post, t, &mut worst), worst.1)
 }
 
+/// Whether footprints `fps` are one or two of lookup 0 of stage kind `k` (one lookup, as
+/// [`walk_lookup`] walks it).
+#[inline(always)]
+fn one_lookup(fps: &[TexelFootprint], k: usize) -> bool {
+    let of = |f: &TexelFootprint| usize::from(f.stage) == k && f.lookup == 0;
+    match fps {
+        [a] => of(a),
+        [a, b] => of(a) && of(b),
+        _ => false,
+    }
+}
+
+/// [`walk_mono`] of a pixel whose footprints `fps` are one lookup ([`one_lookup`]) of the
+/// plan's one fetching stage, from `t`, when the steps before that stage are done, with the
+/// pixel's worst wait so far: the stage goes straight to [`Texturing::lookup_in`] (`setup`:
+/// its address/footprint unit's (cycles, occupancy) for one lookup), then the steps after it.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn walk_lookup<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    one: &OneStage,
+    setup: (u64, u64),
+    fps: &[TexelFootprint],
+    t: u64,
+    mut worst: (u64, usize),
+    quads: &mut QuadCounts,
+) -> (u64, usize) {
+    let step = one.step;
+    let unit = &mut alu[step.k & (KINDS - 1)];
+    unit.busy = unit.busy.wrapping_sub(step.occ);
+    let w = &mut worst;
+    let t = tex.lookup_in::<CACHED, TILED>(unit, step.k, setup, t, fps, w, quads);
+    (arith(alu, one.post, t, &mut worst), worst.1)
+}
+
+/// The arithmetic units of the steps `pre` (before a plan's fetching stage, distinct kinds)
+/// as they stand after a pixel issued at `lazy` that waited for none of them: each freed at
+/// its start (issue plus the cycles of the steps before it) plus its occupancy. With one
+/// pixel issued per cycle and occupancies of at most 1, the next pixel issues later and
+/// reaches each of these units when it is free again, so it waits for none of them either:
+/// [`Simulator::run_in`] skips the steps for such pixels (their waits are 0, their units'
+/// frees are those of the last one) and settles the units here before anything else uses
+/// them.
+#[inline]
+fn settle(alu: &mut [Unit; KINDS], pre: &[Step], lazy: &mut Option<u64>) {
+    if let Some(mut t) = lazy.take() {
+        for s in pre {
+            alu[s.k & (KINDS - 1)].free = t + s.occ;
+            t += s.cycles;
+        }
+    }
+}
+
 impl Texturing {
     /// [`Texturing::stage_in`], not inlined (the general walk's texture stage).
     #[inline(never)]
@@ -1292,7 +1378,11 @@ impl Texturing {
         let (Some(first), Some(last)) = (mine.first(), mine.last()) else {
             return t;
         };
-        let (setup, setup_occ) = self.setup(cycles, u64::from(last.lookup) + 1);
+        let setup = self.setup(cycles, u64::from(last.lookup) + 1);
+        if mine.len() <= 2 && first.lookup == last.lookup {
+            return self.lookup_in::<CACHED, TILED>(alu, k, setup, t, mine, worst, quads);
+        }
+        let (setup, setup_occ) = setup;
         let s = alu.take(t, setup_occ);
         if s - t > worst.0 {
             *worst = (s - t, k);
@@ -1302,9 +1392,11 @@ impl Texturing {
         let mut bytes = 0u64;
         // The footprints of one lookup are consecutive: each run of one lookup number goes
         // through the memory, then to a filter unit.
-        if mine.len() <= 2 && first.lookup == last.lookup {
+        let mut i = 0;
+        while let Some(first) = mine.get(i) {
+            let (lookup, from) = (first.lookup, i);
             let mut data = ready;
-            for f in mine {
+            while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
                 let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
                 let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
                 bytes += b;
@@ -1313,27 +1405,48 @@ impl Texturing {
                     *worst = (ms - ready, C_MEM);
                 }
                 data = data.max(ms + lat);
+                i += 1;
             }
-            done = done.max(self.filter(data, mine.len(), worst));
-        } else {
-            let mut i = 0;
-            while let Some(first) = mine.get(i) {
-                let (lookup, from) = (first.lookup, i);
-                let mut data = ready;
-                while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
-                    let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
-                    let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
-                    bytes += b;
-                    let ms = self.mem_unit.take(ready, occ);
-                    if ms - ready > worst.0 {
-                        *worst = (ms - ready, C_MEM);
-                    }
-                    data = data.max(ms + lat);
-                    i += 1;
-                }
-                done = done.max(self.filter(data, i - from, worst));
-            }
+            done = done.max(self.filter(data, i - from, worst));
         }
+        self.stage_bytes[k & (KINDS - 1)] += bytes;
+        done
+    }
+
+    /// [`Texturing::stage_in`] of a stage whose footprints `mine` (one or two) are all of one
+    /// lookup, `setup` its address/footprint unit's (cycles, occupancy): the unit, the
+    /// footprints through the memory, then the lookup on a filter unit.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn lookup_in<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        alu: &mut Unit,
+        k: usize,
+        (setup, setup_occ): (u64, u64),
+        t: u64,
+        mine: &[TexelFootprint],
+        worst: &mut (u64, usize),
+        quads: &mut QuadCounts,
+    ) -> u64 {
+        const C_MEM: usize = StageKind::COUNT;
+        let s = alu.take(t, setup_occ);
+        if s - t > worst.0 {
+            *worst = (s - t, k);
+        }
+        let ready = s + setup;
+        let mut bytes = 0u64;
+        let mut data = ready;
+        for f in mine {
+            let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
+            let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
+            bytes += b;
+            let ms = self.mem_unit.take(ready, occ);
+            if ms - ready > worst.0 {
+                *worst = (ms - ready, C_MEM);
+            }
+            data = data.max(ms + lat);
+        }
+        let done = ready.max(self.filter(data, mine.len(), worst));
         self.stage_bytes[k & (KINDS - 1)] += bytes;
         done
     }
