@@ -1133,10 +1133,10 @@ impl<'a> Simulator<'a> {
                 });
                 // Its address/footprint unit's (cycles, occupancy) for one lookup.
                 let one = one.map(|one| (one, tex.setup(one.step.cycles, 1)));
-                // One pixel issued per cycle and the steps before the fetching stage
-                // occupying their units at most 1 cycle: see [`settle`].
-                let (lazy_ok, pre_cycles) = one.map_or((false, 0), |(one, _)| {
-                    let fits = ppc == 1 && one.pre.iter().all(|s| s.occ <= 1);
+                // One pixel issued per cycle, the steps before the fetching stage and its
+                // address/footprint unit occupying their units at most 1 cycle: see [`settle`].
+                let (lazy_ok, pre_cycles) = one.map_or((false, 0), |(one, (_, setup_occ))| {
+                    let fits = ppc == 1 && setup_occ <= 1 && one.pre.iter().all(|s| s.occ <= 1);
                     (fits, one.pre.iter().map(|s| s.cycles).sum::<u64>())
                 });
                 let mut lazy = None;
@@ -1146,25 +1146,42 @@ impl<'a> Simulator<'a> {
                     let (t, cause) = match one {
                         Some((ref one, setup)) if one_lookup(fps, one.step.k) => {
                             let mut worst = (0u64, C_LAT);
-                            let pre_end = match lazy {
-                                Some(_) => t + pre_cycles,
-                                None => arith(alu, one.pre, t, &mut worst),
+                            let arrive = t + pre_cycles;
+                            let (s, skipped) = match lazy {
+                                Some((_, n)) => (arrive, n + 1),
+                                None => {
+                                    let pre_end = arith(alu, one.pre, t, &mut worst);
+                                    let (k, occ) = (one.step.k, one.step.occ);
+                                    let unit = &mut alu[k & (KINDS - 1)];
+                                    // The plan's count charges the step's arithmetic occupancy.
+                                    unit.busy = unit.busy.wrapping_sub(occ);
+                                    let s = unit.take(pre_end, setup.1);
+                                    if s - pre_end > worst.0 {
+                                        worst = (s - pre_end, k);
+                                    }
+                                    (s, 0)
+                                }
                             };
-                            lazy = (lazy_ok && pre_end == t + pre_cycles).then_some(t);
+                            lazy = (lazy_ok && s == arrive).then_some((t, skipped));
                             let q = &mut quads;
-                            walk_lookup::<CACHED, TILED>(
-                                alu, tex, one, setup, fps, pre_end, worst, q,
-                            )
+                            let done = tex.lookup_from::<CACHED, TILED>(
+                                one.step.k,
+                                s + setup.0,
+                                fps,
+                                &mut worst,
+                                q,
+                            );
+                            (arith(alu, one.post, done, &mut worst), worst.1)
                         }
-                        Some((ref one, _))
+                        Some((ref one, setup))
                             if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
                         {
-                            settle(alu, one.pre, &mut lazy);
+                            settle(alu, one, setup.1, &mut lazy);
                             walk_mono::<CACHED, TILED>(alu, tex, one, fps, t, &mut quads)
                         }
                         _ => {
-                            if let Some((ref one, _)) = one {
-                                settle(alu, one.pre, &mut lazy);
+                            if let Some((ref one, setup)) = one {
+                                settle(alu, one, setup.1, &mut lazy);
                             }
                             walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads)
                         }
@@ -1172,8 +1189,8 @@ impl<'a> Simulator<'a> {
                     ring[slot] = (t, cause);
                     st.end = st.end.max(t);
                 }
-                if let Some((ref one, _)) = one {
-                    settle(alu, one.pre, &mut lazy);
+                if let Some((ref one, setup)) = one {
+                    settle(alu, one, setup.1, &mut lazy);
                 }
             }
         }
@@ -1273,7 +1290,7 @@ fn walk_mono<const CACHED: bool, const TILED: bool>(
 }
 
 /// Whether footprints `fps` are one or two of lookup 0 of stage kind `k` (one lookup, as
-/// [`walk_lookup`] walks it).
+/// [`Simulator::run_in`] walks it without [`walk_mono`]).
 #[inline(always)]
 fn one_lookup(fps: &[TexelFootprint], k: usize) -> bool {
     let of = |f: &TexelFootprint| usize::from(f.stage) == k && f.lookup == 0;
@@ -1284,45 +1301,28 @@ fn one_lookup(fps: &[TexelFootprint], k: usize) -> bool {
     }
 }
 
-/// [`walk_mono`] of a pixel whose footprints `fps` are one lookup ([`one_lookup`]) of the
-/// plan's one fetching stage, from `t`, when the steps before that stage are done, with the
-/// pixel's worst wait so far: the stage goes straight to [`Texturing::lookup_in`] (`setup`:
-/// its address/footprint unit's (cycles, occupancy) for one lookup), then the steps after it.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn walk_lookup<const CACHED: bool, const TILED: bool>(
-    alu: &mut [Unit; KINDS],
-    tex: &mut Texturing,
-    one: &OneStage,
-    setup: (u64, u64),
-    fps: &[TexelFootprint],
-    t: u64,
-    mut worst: (u64, usize),
-    quads: &mut QuadCounts,
-) -> (u64, usize) {
-    let step = one.step;
-    let unit = &mut alu[step.k & (KINDS - 1)];
-    unit.busy = unit.busy.wrapping_sub(step.occ);
-    let w = &mut worst;
-    let t = tex.lookup_in::<CACHED, TILED>(unit, step.k, setup, t, fps, w, quads);
-    (arith(alu, one.post, t, &mut worst), worst.1)
-}
-
-/// The arithmetic units of the steps `pre` (before a plan's fetching stage, distinct kinds)
-/// as they stand after a pixel issued at `lazy` that waited for none of them: each freed at
-/// its start (issue plus the cycles of the steps before it) plus its occupancy. With one
-/// pixel issued per cycle and occupancies of at most 1, the next pixel issues later and
-/// reaches each of these units when it is free again, so it waits for none of them either:
-/// [`Simulator::run_in`] skips the steps for such pixels (their waits are 0, their units'
-/// frees are those of the last one) and settles the units here before anything else uses
-/// them.
+/// The arithmetic units of a plan's one fetching stage `one` (distinct kinds) as they stand
+/// after a pixel issued at `p` that waited for none of the steps before the stage nor for the
+/// stage's address/footprint unit (occupancy `setup_occ`), followed by `n` pixels that skipped
+/// them: each of those units freed at its start (issue plus the cycles of the steps before it)
+/// plus its occupancy, and the address/footprint unit busy for the `n` pixels. With one pixel
+/// issued per cycle and occupancies of at most 1, the next pixel issues later and reaches each
+/// of these units when it is free again, so it waits for none of them either:
+/// [`Simulator::run_in`] skips them for such pixels (their waits are 0, their units' frees are
+/// the last pixel's) and settles the units here before anything else uses them.
 #[inline]
-fn settle(alu: &mut [Unit; KINDS], pre: &[Step], lazy: &mut Option<u64>) {
-    if let Some(mut t) = lazy.take() {
-        for s in pre {
+fn settle(alu: &mut [Unit; KINDS], one: &OneStage, setup_occ: u64, lazy: &mut Option<(u64, u64)>) {
+    if let Some((mut t, n)) = lazy.take() {
+        for s in one.pre {
             alu[s.k & (KINDS - 1)].free = t + s.occ;
             t += s.cycles;
         }
+        let unit = &mut alu[one.step.k & (KINDS - 1)];
+        unit.free = t + setup_occ;
+        let owed = n
+            .wrapping_mul(setup_occ)
+            .wrapping_sub(n.wrapping_mul(one.step.occ));
+        unit.busy = unit.busy.wrapping_add(owed);
     }
 }
 
@@ -1414,8 +1414,8 @@ impl Texturing {
     }
 
     /// [`Texturing::stage_in`] of a stage whose footprints `mine` (one or two) are all of one
-    /// lookup, `setup` its address/footprint unit's (cycles, occupancy): the unit, the
-    /// footprints through the memory, then the lookup on a filter unit.
+    /// lookup, `setup` its address/footprint unit's (cycles, occupancy): the unit, then
+    /// [`Texturing::lookup_from`].
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn lookup_in<const CACHED: bool, const TILED: bool>(
@@ -1428,12 +1428,26 @@ impl Texturing {
         worst: &mut (u64, usize),
         quads: &mut QuadCounts,
     ) -> u64 {
-        const C_MEM: usize = StageKind::COUNT;
         let s = alu.take(t, setup_occ);
         if s - t > worst.0 {
             *worst = (s - t, k);
         }
-        let ready = s + setup;
+        self.lookup_from::<CACHED, TILED>(k, s + setup, mine, worst, quads)
+    }
+
+    /// The memory and filter part of [`Texturing::lookup_in`] for stage kind `k` from `ready`
+    /// (its address/footprint unit done): the footprints `mine` through the memory, then the
+    /// lookup on a filter unit; returns the stage's completion.
+    #[inline(always)]
+    fn lookup_from<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        k: usize,
+        ready: u64,
+        mine: &[TexelFootprint],
+        worst: &mut (u64, usize),
+        quads: &mut QuadCounts,
+    ) -> u64 {
+        const C_MEM: usize = StageKind::COUNT;
         let mut bytes = 0u64;
         let mut data = ready;
         for f in mine {
