@@ -223,8 +223,8 @@ fn model_matches_previous_on_one_lookup_streams() {
                 let tex = r.below(ev.textures.len() as u64) as usize;
                 let lv = &ev.textures[tex].levels;
                 let level = r.below(lv.len() as u64) as usize;
-                for l in level..(level + 1 + r.below(2) as usize).min(lv.len()) {
-                    let (w, h) = lv[l];
+                let levels = 1 + r.below(2) as usize;
+                for (l, &(w, h)) in lv.iter().enumerate().skip(level).take(levels) {
                     let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
                     let x1 = if r.below(8) == 0 { x0 } else { (x0 + 1) % w };
                     let y1 = if r.below(8) == 0 { y0 } else { (y0 + 1) % h };
