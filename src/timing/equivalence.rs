@@ -174,6 +174,80 @@ fn model_matches_previous_on_fetching_streams() {
     );
 }
 
+/// As [`model_matches_previous_on_fetching_streams`] on frames as a plain textured render
+/// makes them: machines issuing mostly one pixel per cycle with pipelined arithmetic, plans
+/// of distinct stage kinds with one fetching stage (trilinear) and pixels that mostly make
+/// one lookup of one or two footprints, now and then none, several lookups or a footprint
+/// of another stage: the one-lookup walk, with and without its steps before the fetching
+/// stage skipped (`settle`), cached and uncached, tiled and linear, 1 to 3 filter units.
+#[test]
+fn model_matches_previous_on_one_lookup_streams() {
+    let mut r = Rng(0x1100_4b7e);
+    let trilinear = StageKind::Trilinear;
+    for case in 0..300 {
+        let mut hw = machine(&mut r);
+        hw.timing.shade_pixels_per_cycle = pick(&mut r, &[1, 1, 1, 2]);
+        hw.timing.alu_pipelined = r.below(8) != 0;
+        let mut ev = frame(&mut r, 0, None);
+        let plain = [0, 1, 2, 3, 5, 6];
+        for p in &mut ev.plans {
+            // Distinct kinds in pipeline order around the trilinear stage.
+            let mut kinds: Vec<StageKind> = plain
+                .iter()
+                .filter(|_| r.below(2) == 0)
+                .map(|&i| StageKind::ALL[i])
+                .collect();
+            kinds.push(trilinear);
+            kinds.sort_by_key(|k| k.index());
+            p.stages = kinds
+                .into_iter()
+                .map(|k| {
+                    let cost = UnitCost {
+                        cycles: pick(&mut r, &[0, 1, 1, 2, 5, 12]),
+                        ..UnitCost::default()
+                    };
+                    (k, cost)
+                })
+                .collect();
+        }
+        let n = 1 + r.below(3000) as usize;
+        for _ in 0..n {
+            let plan = r.below(ev.plans.len() as u64) as u32;
+            let (lookups, stage) = match r.below(40) {
+                0 => (0, trilinear),
+                1 => (2, trilinear),
+                2 => (1, StageKind::BumpFetch),
+                _ => (1, trilinear),
+            };
+            for lookup in 0..lookups {
+                let tex = r.below(ev.textures.len() as u64) as usize;
+                let lv = &ev.textures[tex].levels;
+                let level = r.below(lv.len() as u64) as usize;
+                let levels = 1 + r.below(2) as usize;
+                for (l, &(w, h)) in lv.iter().enumerate().skip(level).take(levels) {
+                    let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
+                    let x1 = if r.below(8) == 0 { x0 } else { (x0 + 1) % w };
+                    let y1 = if r.below(8) == 0 { y0 } else { (y0 + 1) % h };
+                    ev.footprints.push(TexelFootprint {
+                        stage: stage.index() as u8,
+                        lookup,
+                        level: l as u8,
+                        tex: tex as u16,
+                        x: [x0, x1],
+                        y: [y0, y1],
+                    });
+                }
+            }
+            ev.pixels.push(PixelEvent {
+                plan,
+                tri: 0,
+                fp_end: ev.footprints.len() as u32,
+            });
+        }
+        check(&mut r, case, &hw, &ev);
+    }
+}
+
 /// The model's reports on `ev` (as a frame, rows, pixels and spans cut at random) against
 /// the previous model's.
 fn check(r: &mut Rng, case: usize, hw: &HwConfig, ev: &FrameEvents) {

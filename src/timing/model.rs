@@ -1131,17 +1131,66 @@ impl<'a> Simulator<'a> {
                     rest.split_first()
                         .map(|(&step, post)| OneStage { pre, step, post })
                 });
+                // Its address/footprint unit's (cycles, occupancy) for one lookup.
+                let one = one.map(|one| (one, tex.setup(one.step.cycles, 1)));
+                // One pixel issued per cycle, the steps before the fetching stage and its
+                // address/footprint unit occupying their units at most 1 cycle: see [`settle`].
+                let (lazy_ok, pre_cycles) = one.map_or((false, 0), |(one, (_, setup_occ))| {
+                    let fits = ppc == 1 && setup_occ <= 1 && one.pre.iter().all(|s| s.occ <= 1);
+                    (fits, one.pre.iter().map(|s| s.cycles).sum::<u64>())
+                });
+                let mut lazy = None;
                 for fps in pixels {
                     fed += fps.len() as u64;
                     let (slot, t) = st.issue(ring, stall_by, ppc);
                     let (t, cause) = match one {
-                        Some(ref one) if fps.iter().all(|f| usize::from(f.stage) == one.step.k) => {
+                        Some((ref one, setup)) if one_lookup(fps, one.step.k) => {
+                            let mut worst = (0u64, C_LAT);
+                            let arrive = t + pre_cycles;
+                            let (s, skipped) = match lazy {
+                                Some((_, n)) => (arrive, n + 1),
+                                None => {
+                                    let pre_end = arith(alu, one.pre, t, &mut worst);
+                                    let (k, occ) = (one.step.k, one.step.occ);
+                                    let unit = &mut alu[k & (KINDS - 1)];
+                                    // The plan's count charges the step's arithmetic occupancy.
+                                    unit.busy = unit.busy.wrapping_sub(occ);
+                                    let s = unit.take(pre_end, setup.1);
+                                    if s - pre_end > worst.0 {
+                                        worst = (s - pre_end, k);
+                                    }
+                                    (s, 0)
+                                }
+                            };
+                            lazy = (lazy_ok && s == arrive).then_some((t, skipped));
+                            let q = &mut quads;
+                            let done = tex.lookup_from::<CACHED, TILED>(
+                                one.step.k,
+                                s + setup.0,
+                                fps,
+                                &mut worst,
+                                q,
+                            );
+                            (arith(alu, one.post, done, &mut worst), worst.1)
+                        }
+                        Some((ref one, setup))
+                            if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
+                        {
+                            settle(alu, one, setup.1, &mut lazy);
                             walk_mono::<CACHED, TILED>(alu, tex, one, fps, t, &mut quads)
                         }
-                        _ => walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads),
+                        _ => {
+                            if let Some((ref one, setup)) = one {
+                                settle(alu, one, setup.1, &mut lazy);
+                            }
+                            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads)
+                        }
                     };
                     ring[slot] = (t, cause);
                     st.end = st.end.max(t);
+                }
+                if let Some((ref one, setup)) = one {
+                    settle(alu, one, setup.1, &mut lazy);
                 }
             }
         }
@@ -1240,6 +1289,43 @@ fn walk_mono<const CACHED: bool, const TILED: bool>(
     (arith(alu, one.post, t, &mut worst), worst.1)
 }
 
+/// Whether footprints `fps` are one or two of lookup 0 of stage kind `k` (one lookup, as
+/// [`Simulator::run_in`] walks it without [`walk_mono`]).
+#[inline(always)]
+fn one_lookup(fps: &[TexelFootprint], k: usize) -> bool {
+    let of = |f: &TexelFootprint| usize::from(f.stage) == k && f.lookup == 0;
+    match fps {
+        [a] => of(a),
+        [a, b] => of(a) && of(b),
+        _ => false,
+    }
+}
+
+/// The arithmetic units of a plan's one fetching stage `one` (distinct kinds) as they stand
+/// after a pixel issued at `p` that waited for none of the steps before the stage nor for the
+/// stage's address/footprint unit (occupancy `setup_occ`), followed by `n` pixels that skipped
+/// them: each of those units freed at its start (issue plus the cycles of the steps before it)
+/// plus its occupancy, and the address/footprint unit busy for the `n` pixels. With one pixel
+/// issued per cycle and occupancies of at most 1, the next pixel issues later and reaches each
+/// of these units when it is free again, so it waits for none of them either:
+/// [`Simulator::run_in`] skips them for such pixels (their waits are 0, their units' frees are
+/// the last pixel's) and settles the units here before anything else uses them.
+#[inline]
+fn settle(alu: &mut [Unit; KINDS], one: &OneStage, setup_occ: u64, lazy: &mut Option<(u64, u64)>) {
+    if let Some((mut t, n)) = lazy.take() {
+        for s in one.pre {
+            alu[s.k & (KINDS - 1)].free = t + s.occ;
+            t += s.cycles;
+        }
+        let unit = &mut alu[one.step.k & (KINDS - 1)];
+        unit.free = t + setup_occ;
+        let owed = n
+            .wrapping_mul(setup_occ)
+            .wrapping_sub(n.wrapping_mul(one.step.occ));
+        unit.busy = unit.busy.wrapping_add(owed);
+    }
+}
+
 impl Texturing {
     /// [`Texturing::stage_in`], not inlined (the general walk's texture stage).
     #[inline(never)]
@@ -1292,7 +1378,11 @@ impl Texturing {
         let (Some(first), Some(last)) = (mine.first(), mine.last()) else {
             return t;
         };
-        let (setup, setup_occ) = self.setup(cycles, u64::from(last.lookup) + 1);
+        let setup = self.setup(cycles, u64::from(last.lookup) + 1);
+        if mine.len() <= 2 && first.lookup == last.lookup {
+            return self.lookup_in::<CACHED, TILED>(alu, k, setup, t, mine, worst, quads);
+        }
+        let (setup, setup_occ) = setup;
         let s = alu.take(t, setup_occ);
         if s - t > worst.0 {
             *worst = (s - t, k);
@@ -1302,9 +1392,11 @@ impl Texturing {
         let mut bytes = 0u64;
         // The footprints of one lookup are consecutive: each run of one lookup number goes
         // through the memory, then to a filter unit.
-        if mine.len() <= 2 && first.lookup == last.lookup {
+        let mut i = 0;
+        while let Some(first) = mine.get(i) {
+            let (lookup, from) = (first.lookup, i);
             let mut data = ready;
-            for f in mine {
+            while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
                 let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
                 let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
                 bytes += b;
@@ -1313,27 +1405,62 @@ impl Texturing {
                     *worst = (ms - ready, C_MEM);
                 }
                 data = data.max(ms + lat);
+                i += 1;
             }
-            done = done.max(self.filter(data, mine.len(), worst));
-        } else {
-            let mut i = 0;
-            while let Some(first) = mine.get(i) {
-                let (lookup, from) = (first.lookup, i);
-                let mut data = ready;
-                while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
-                    let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
-                    let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
-                    bytes += b;
-                    let ms = self.mem_unit.take(ready, occ);
-                    if ms - ready > worst.0 {
-                        *worst = (ms - ready, C_MEM);
-                    }
-                    data = data.max(ms + lat);
-                    i += 1;
-                }
-                done = done.max(self.filter(data, i - from, worst));
-            }
+            done = done.max(self.filter(data, i - from, worst));
         }
+        self.stage_bytes[k & (KINDS - 1)] += bytes;
+        done
+    }
+
+    /// [`Texturing::stage_in`] of a stage whose footprints `mine` (one or two) are all of one
+    /// lookup, `setup` its address/footprint unit's (cycles, occupancy): the unit, then
+    /// [`Texturing::lookup_from`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn lookup_in<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        alu: &mut Unit,
+        k: usize,
+        (setup, setup_occ): (u64, u64),
+        t: u64,
+        mine: &[TexelFootprint],
+        worst: &mut (u64, usize),
+        quads: &mut QuadCounts,
+    ) -> u64 {
+        let s = alu.take(t, setup_occ);
+        if s - t > worst.0 {
+            *worst = (s - t, k);
+        }
+        self.lookup_from::<CACHED, TILED>(k, s + setup, mine, worst, quads)
+    }
+
+    /// The memory and filter part of [`Texturing::lookup_in`] for stage kind `k` from `ready`
+    /// (its address/footprint unit done): the footprints `mine` through the memory, then the
+    /// lookup on a filter unit; returns the stage's completion.
+    #[inline(always)]
+    fn lookup_from<const CACHED: bool, const TILED: bool>(
+        &mut self,
+        k: usize,
+        ready: u64,
+        mine: &[TexelFootprint],
+        worst: &mut (u64, usize),
+        quads: &mut QuadCounts,
+    ) -> u64 {
+        const C_MEM: usize = StageKind::COUNT;
+        let mut bytes = 0u64;
+        let mut data = ready;
+        for f in mine {
+            let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
+            let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
+            bytes += b;
+            let ms = self.mem_unit.take(ready, occ);
+            if ms - ready > worst.0 {
+                *worst = (ms - ready, C_MEM);
+            }
+            data = data.max(ms + lat);
+        }
+        let done = ready.max(self.filter(data, mine.len(), worst));
         self.stage_bytes[k & (KINDS - 1)] += bytes;
         done
     }
