@@ -251,24 +251,28 @@ pub fn round_shift_right_small<M: ConstRounding>(x: i64, shift: u32) -> i64 {
 }
 
 /// [`round_shift_right_wide`] for `|x| < 2^126` and a `shift` in 1..=63, the bias added
-/// before the shift as in [`round_shift_right_small`] (a 128-bit add and a 64-bit funnel
-/// shift); `None` when the result does not fit `i64` (where `round_shift_right_wide`
+/// before the shift as in [`round_shift_right_small`] (a 128-bit add of a 64-bit bias and a
+/// 64-bit funnel shift); `None` when the result does not fit `i64` (where `round_shift_right_wide`
 /// saturates).
 #[inline(always)]
 #[must_use]
 pub fn round_shift_right_wide_small<M: ConstRounding>(x: i128, shift: u32) -> Option<i64> {
     debug_assert!((1..64).contains(&shift), "shift {shift}");
     debug_assert!(x.unsigned_abs() >> 126 == 0, "x {x}");
-    // `shift` < 64: the floor's last bit is in the low word, and `& 63` keeps it.
-    let shift = shift & 63;
-    let half = 1i128 << (shift - 1);
-    let odd = i128::from((x as u64) >> shift & 1);
-    let v = match M::MODE {
-        Rounding::Truncate => x >> shift,
-        Rounding::HalfUp => (x + half) >> shift,
-        Rounding::HalfEven => (x + (half - 1) + odd) >> shift,
+    // `shift` < 64: the floor's last bit and the bias are in the low word, and the result
+    // is the low word of a 64-bit funnel shift, which fits when the high word's rest is its
+    // sign.
+    let s = shift & 63;
+    let half = 1u64 << (s - 1);
+    let bias = match M::MODE {
+        Rounding::Truncate => 0,
+        Rounding::HalfUp => half,
+        Rounding::HalfEven => half - 1 + ((x as u64) >> s & 1),
     };
-    i64::try_from(v).ok()
+    let v = x + i128::from(bias);
+    let (hi, lo) = ((v >> 64) as i64, v as u64);
+    let q = (lo >> s | (hi as u64) << (64 - s)) as i64;
+    (hi >> s == q >> 63).then_some(q)
 }
 
 /// [`round_shift_right`] for a `shift` in 1..=63: the floor plus the carry out of the dropped

@@ -832,7 +832,8 @@ fn derivative_held<M: ConstRounding>(
     let sh = r2.shift - (bary_bits + ns) as i32;
     debug_assert!(r2.mant >> 29 == 0 && (64..126).contains(&sh));
     let v = round_shift_right_small::<M>(product_top(x, r2), (sh - 62) as u32);
-    if v.unsigned_abs() > BARY_LIMIT as u64 {
+    // |v| <= 2^60 as one unsigned compare (|v| < 2^61).
+    if v.wrapping_add(BARY_LIMIT) as u64 > 2 * BARY_LIMIT as u64 {
         return clamp_counted(v, sat);
     }
     v
