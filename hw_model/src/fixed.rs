@@ -233,6 +233,48 @@ pub fn round_shift_right_mid<M: ConstRounding>(x: i64, shift: u32) -> i64 {
     round_shift_right_narrow(x, shift, M::MODE)
 }
 
+/// [`round_shift_right_mid`] for `|x| < 2^62` and a `shift` in 1..=63: the rounding bias
+/// added before the shift (`x + h` for HalfUp, `x + h - 1 + odd` for HalfEven with
+/// `h = 2^(shift-1)` and `odd` the floor's last bit), which cannot overflow at these
+/// magnitudes; the same value with fewer operations.
+#[inline(always)]
+#[must_use]
+pub fn round_shift_right_small<M: ConstRounding>(x: i64, shift: u32) -> i64 {
+    debug_assert!((1..64).contains(&shift), "shift {shift}");
+    debug_assert!(x.unsigned_abs() >> 62 == 0, "x {x}");
+    let half = 1i64 << (shift - 1);
+    match M::MODE {
+        Rounding::Truncate => x >> shift,
+        Rounding::HalfUp => (x + half) >> shift,
+        Rounding::HalfEven => (x + (half - 1) + ((x >> shift) & 1)) >> shift,
+    }
+}
+
+/// [`round_shift_right_wide`] for `|x| < 2^126` and a `shift` in 1..=63, the bias added
+/// before the shift as in [`round_shift_right_small`] (a 128-bit add of a 64-bit bias and a
+/// 64-bit funnel shift); `None` when the result does not fit `i64` (where `round_shift_right_wide`
+/// saturates).
+#[inline(always)]
+#[must_use]
+pub fn round_shift_right_wide_small<M: ConstRounding>(x: i128, shift: u32) -> Option<i64> {
+    debug_assert!((1..64).contains(&shift), "shift {shift}");
+    debug_assert!(x.unsigned_abs() >> 126 == 0, "x {x}");
+    // `shift` < 64: the floor's last bit and the bias are in the low word, and the result
+    // is the low word of a 64-bit funnel shift, which fits when the high word's rest is its
+    // sign.
+    let s = shift & 63;
+    let half = 1u64 << (s - 1);
+    let bias = match M::MODE {
+        Rounding::Truncate => 0,
+        Rounding::HalfUp => half,
+        Rounding::HalfEven => half - 1 + ((x as u64) >> s & 1),
+    };
+    let v = x + i128::from(bias);
+    let (hi, lo) = ((v >> 64) as i64, v as u64);
+    let q = (lo >> s | (hi as u64) << (64 - s)) as i64;
+    (hi >> s == q >> 63).then_some(q)
+}
+
 /// [`round_shift_right`] for a `shift` in 1..=63: the floor plus the carry out of the dropped
 /// bits, left-aligned in 64 bits (one half = 2^63), when [`round_bias`] is added to them.
 #[inline(always)]
@@ -416,6 +458,75 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// 300k seeded values below 2^62 in magnitude (with the ends of that range and exact
+    /// halves) at every shift 1 to 63 and every mode: `round_shift_right_small` gives
+    /// `round_shift_right`.
+    #[test]
+    fn small_shift_matches_round_shift_right() {
+        let mut s = 0x5eed_5a11;
+        let end = (1i64 << 62) - 1;
+        for i in 0..300_000u32 {
+            let shift = 1 + i % 63;
+            let x = match i % 5 {
+                0 => [-end, end, -1, 0, 1][(i / 5 % 5) as usize],
+                1 => (next(&mut s) as i64 >> 2 >> shift << shift).wrapping_add(1i64 << (shift - 1)),
+                _ => next(&mut s) as i64 >> (2 + i % 62),
+            };
+            if x.unsigned_abs() >> 62 != 0 {
+                continue;
+            }
+            for mode in MODES {
+                let got = crate::with_rounding!(mode, M => round_shift_right_small::<M>(x, shift));
+                assert_eq!(
+                    got,
+                    round_shift_right(x, shift, mode),
+                    "{x} {shift} {mode:?}"
+                );
+            }
+        }
+    }
+
+    /// 400k seeded values below 2^126 in magnitude (with the ends of that range, exact halves
+    /// and results at the ends of `i64`) at every shift 1 to 63 and every mode:
+    /// `round_shift_right_wide_small` gives `round_shift_right_wide` where it fits `i64`, and
+    /// `None` where that saturates.
+    #[test]
+    fn wide_small_shift_matches_round_shift_right_wide() {
+        let mut s = 0x5eed_5a12;
+        let end = (1i128 << 126) - 1;
+        let (mut fit, mut over) = (0u32, 0u32);
+        for i in 0..400_000u32 {
+            let shift = 1 + i % 63;
+            let wide = |s: &mut u64| i128::from(next(s)) << 64 | i128::from(next(s));
+            let x = match i % 6 {
+                0 => [-end, end, -1, 0, 1][(i / 6 % 5) as usize],
+                1 => (wide(&mut s) >> 2 >> shift << shift).wrapping_add(1i128 << (shift - 1)),
+                2 => (i128::from(next(&mut s) as i64) << shift) + i128::from(i % 7) - 3,
+                _ => wide(&mut s) >> (2 + i % 126),
+            };
+            if x.unsigned_abs() >> 126 != 0 {
+                continue;
+            }
+            for mode in MODES {
+                let got =
+                    crate::with_rounding!(mode, M => round_shift_right_wide_small::<M>(x, shift));
+                let want = round_shift_right_wide(x, shift, mode);
+                let exact = round_div_i128(x, 1i128 << shift, mode);
+                match got {
+                    Some(v) => {
+                        fit += 1;
+                        assert_eq!(v, want, "{x} {shift} {mode:?}");
+                    }
+                    None => {
+                        over += 1;
+                        assert!(i64::try_from(exact).is_err(), "{x} {shift} {mode:?}");
+                    }
+                }
+            }
+        }
+        assert!(fit > 500_000 && over > 100_000, "{fit} {over}");
     }
 
     /// `round_shift_right` as it was before the carry formulation (the decision of

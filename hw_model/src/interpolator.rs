@@ -20,10 +20,10 @@ use crate::config::{InterpConfig, ReciprocalConfig};
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{
-    round_shift_right, round_shift_right_mid, round_shift_right_wide, ConstRounding, Format,
-    SatCounter,
+    round_shift_right, round_shift_right_mid, round_shift_right_small, round_shift_right_wide,
+    ConstRounding, Format, SatCounter,
 };
-use crate::reciprocal::{apply_i64_in, apply_in, square, Recip, Reciprocal};
+use crate::reciprocal::{apply_i64_in, apply_i64_small_in, apply_in, square, Recip, Reciprocal};
 
 /// Clamp of `p_1`, `p_2` (raw), far beyond any sample near the triangle.
 pub const BARY_LIMIT: i64 = 1 << 60;
@@ -550,10 +550,10 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
         wide(b[1]) * dw - wide(q1) * wide(t),
         wide(b[2]) * dw - wide(q2) * wide(t),
     ];
-    // Every mantissa below 2^31 (`Reciprocal` results and their squares have
+    // Every mantissa below 2^29 (`Reciprocal` results and their squares have
     // `recip_mantissa_bits + 1` bits) and the y numerators' drops held along the span.
     let last = span.lanes.saturating_sub(1);
-    let held = if m_bits <= 30 {
+    let held = if m_bits <= 28 {
         match (
             held_drop(ny[0], st.y_step[0], last),
             held_drop(ny[1], st.y_step[1], last),
@@ -623,10 +623,11 @@ struct Tops {
     ns_y: (u32, u32),
 }
 
-/// [`derivs_span_steady`] when every mantissa is below 2^31 and the y numerators keep one
-/// drop along the span ([`held_drop`]): per lane the y tops are a shift of the stepped
+/// [`derivs_span_steady`] when every mantissa is below 2^29 and the y numerators keep one
+/// drop along the span ([`held_drop`]): per lane the barycentrics take
+/// [`apply_i64_small_in`] (else [`apply_i64_in`]), the y tops are a shift of the stepped
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
-/// [`derivative_of_top`]'s 64-bit rounding (else each takes [`derivative_of_top`]). Checked
+/// [`derivative_held`]'s 64-bit rounding (else each takes [`derivative_of_top`]). Checked
 /// against one call per lane in `derivs_span_stepping_matches_per_lane_calls`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -656,17 +657,23 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding>(
     for j in 0..span.lanes {
         // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
         let r = lane_recip.eval(d as u64, &mut SatCounter::default());
-        let p1 = apply_i64_in::<M>(r, q1, bb);
-        let p2 = apply_i64_in::<M>(r, q2, bb);
+        // `q_1`, `q_2` below 2^62 and the mantissa below 2^29.
+        let (p1, p2) = match (
+            apply_i64_small_in::<M>(r, q1, bb),
+            apply_i64_small_in::<M>(r, q2, bb),
+        ) {
+            (Some(p1), Some(p2)) => (p1, p2),
+            _ => (apply_i64_in::<M>(r, q1, bb), apply_i64_in::<M>(r, q2, bb)),
+        };
         if p1.unsigned_abs() <= limit && p2.unsigned_abs() <= limit {
             let r2 = square(r, m_bits, M::MODE);
             let ty = [(ny[0] >> (ny1 & 63), ny1), (ny[1] >> (ny2 & 63), ny2)];
             let (x1, x2, y1, y2) = if (lo..hi).contains(&r2.shift) {
                 (
-                    p1 + derivative_short::<M>(nx[0], r2, bb, sat),
-                    p2 + derivative_short::<M>(nx[1], r2, bb, sat),
-                    p1 + derivative_short::<M>(ty[0], r2, bb, sat),
-                    p2 + derivative_short::<M>(ty[1], r2, bb, sat),
+                    p1 + derivative_held::<M>(nx[0], r2, bb, sat),
+                    p2 + derivative_held::<M>(nx[1], r2, bb, sat),
+                    p1 + derivative_held::<M>(ty[0], r2, bb, sat),
+                    p2 + derivative_held::<M>(ty[1], r2, bb, sat),
                 )
             } else {
                 (
@@ -797,11 +804,36 @@ fn derivative_short<M: ConstRounding>(
 ) -> i64 {
     let sh = r2.shift - (bary_bits + ns) as i32;
     debug_assert!(r2.mant >> 31 == 0 && (64..126).contains(&sh));
+    let v = round_shift_right_mid::<M>(product_top(x, r2), (sh - 62) as u32);
+    if v.unsigned_abs() > BARY_LIMIT as u64 {
+        return clamp_counted(v, sat);
+    }
+    v
+}
+
+/// `x * r2.mant` (|x| <= 2^94, a mantissa below 2^31) from bit 62 up, the 62 bits below
+/// folded into a sticky bit: below 2^63 in magnitude, below 2^61 for a mantissa below 2^29.
+#[inline(always)]
+fn product_top(x: i128, r2: Recip) -> i64 {
     // The mantissa as `u32`: the product's high word is one multiply.
     let prod = x * i128::from(r2.mant as u32);
-    let top = (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0);
-    let v = round_shift_right_mid::<M>(top, (sh - 62) as u32);
-    if v.unsigned_abs() > BARY_LIMIT as u64 {
+    (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0)
+}
+
+/// [`derivative_short`] for a mantissa below 2^29 (the span lanes of [`derivs_span_held`]):
+/// the top bits are below 2^61, so the rounding is [`round_shift_right_small`]'s.
+#[inline(always)]
+fn derivative_held<M: ConstRounding>(
+    (x, ns): NumeratorTop,
+    r2: Recip,
+    bary_bits: u32,
+    sat: &mut SatCounter,
+) -> i64 {
+    let sh = r2.shift - (bary_bits + ns) as i32;
+    debug_assert!(r2.mant >> 29 == 0 && (64..126).contains(&sh));
+    let v = round_shift_right_small::<M>(product_top(x, r2), (sh - 62) as u32);
+    // |v| <= 2^60 as one unsigned compare (|v| < 2^61).
+    if v.wrapping_add(BARY_LIMIT) as u64 > 2 * BARY_LIMIT as u64 {
         return clamp_counted(v, sat);
     }
     v
@@ -1723,7 +1755,7 @@ mod tests {
         assert!(held > 50_000 && nonzero > 10_000, "{held} {nonzero}");
     }
 
-    /// 400k seeded spans of 1 to 24 lanes over 5 configurations x 3 interpolator roundings,
+    /// 480k seeded spans of 1 to 24 lanes over 6 configurations x 3 interpolator roundings,
     /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
     /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
     /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
@@ -1734,9 +1766,18 @@ mod tests {
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
         let (mut held_lanes, mut steady_lanes) = (0u64, 0u64);
-        let (mut stepped, mut tested) = (0u64, 0u64);
+        let (mut stepped, mut tested, mut held_small) = (0u64, 0u64, 0u64);
         let mut got = [[[0i64; 3]; 3]; 24];
-        for (c, hw0) in previous_configs().into_iter().enumerate() {
+        // The widest mantissa of the held loop, with the reciprocal truncating.
+        let mut widest = HwConfig::texram16();
+        widest.reciprocal.recip_mantissa_bits = 28;
+        widest.reciprocal.recip_lut_bits = 4;
+        widest.reciprocal.recip_iterations = 3;
+        widest.reciprocal.recip_rounding = Rounding::Truncate;
+        widest.interp.bary_bits = 20;
+        let mut cfgs = previous_configs();
+        cfgs.push(widest);
+        for (c, hw0) in cfgs.into_iter().enumerate() {
             for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
                 let mut hw = hw0.clone();
                 hw.interp.interp_rounding = mode;
@@ -1807,7 +1848,7 @@ mod tests {
                         let d = q[0] + q[1] + q[2];
                         [1, 2].map(|k| b[k - 1] * d - q[k] * b[2])
                     };
-                    let held = steady && {
+                    let held = steady && recip.config().recip_mantissa_bits <= 28 && {
                         let (f, l) = (y_numerators(0), y_numerators(n - 1));
                         (0..2).all(|k| {
                             (f[k] < 0) == (l[k] < 0)
@@ -1827,6 +1868,10 @@ mod tests {
                         {
                             if held {
                                 held_lanes += 1;
+                                // The lanes whose barycentrics take `apply_i64_small_in`.
+                                let r = recip.eval(d as u64, &mut SatCounter::default());
+                                let sh = r.shift - cfg.bary_bits as i32;
+                                held_small += u64::from((1..64).contains(&sh));
                             } else if steady {
                                 steady_lanes += 1;
                             } else if ends_fit {
@@ -1840,10 +1885,13 @@ mod tests {
                 }
             }
         }
-        println!("held {held_lanes} steady {steady_lanes} stepped {stepped} tested {tested}");
+        println!(
+            "held {held_lanes} (small apply {held_small}) steady {steady_lanes} stepped {stepped} \
+             tested {tested}"
+        );
         assert!(
-            held_lanes > 500_000 && steady_lanes > 100_000,
-            "{held_lanes} {steady_lanes}"
+            held_lanes > 500_000 && steady_lanes > 100_000 && held_small > 200_000,
+            "{held_lanes} {held_small} {steady_lanes}"
         );
         assert!(stepped > 100_000 && tested > 40_000, "{stepped} {tested}");
     }

@@ -28,7 +28,8 @@ use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::{
-    round_shift_right_mid, round_shift_right_wide, ConstRounding, Rounding, SatCounter,
+    round_shift_right_mid, round_shift_right_small, round_shift_right_wide,
+    round_shift_right_wide_small, ConstRounding, Rounding, SatCounter,
 };
 use std::marker::PhantomData;
 
@@ -170,6 +171,9 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         // m with P fraction bits, in [2^P, 2^(P+1)).
         let mut m: i64 = if n <= p {
             (x << (p - n)) as i64
+        } else if n < 62 {
+            // `x` below 2^62, `n - p` in 1..=60.
+            round_shift_right_small::<R>(x as i64, n - p)
         } else if n < 63 {
             // `n - p` in 1..=62.
             round_shift_right_mid::<R>(x as i64, n - p)
@@ -186,10 +190,12 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         let mut y = self.lut[idx] as i64;
         let two = 2i64 << p;
         if (1..=29).contains(&p) {
-            // `nr_step`'s 64-bit products, the tests on `p` out of the loop.
+            // `nr_step`'s 64-bit products, the tests on `p` out of the loop. With `m` in
+            // [1, 2) and the seed in (1/2, 1], `y` stays at most 1/m + 2^(1-p) (`y (2 - m y)
+            // <= 1/m`), so `t` is in [0, 2] and both products are below 2^(2p+2) <= 2^60.
             for _ in 0..self.iterations {
-                let t = round_shift_right_mid::<R>(m * y, p);
-                y = round_shift_right_mid::<R>(y * (two - t), p);
+                let t = round_shift_right_small::<R>(m * y, p);
+                y = round_shift_right_small::<R>(y * (two - t), p);
             }
         } else {
             for _ in 0..self.iterations {
@@ -200,7 +206,8 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         let b = 64 - (y as u64).leading_zeros();
         let drop = b - (m_bits + 1);
         let mut mant = if (1..64).contains(&drop) {
-            round_shift_right_mid::<R>(y, drop)
+            // `y` is below 2^(P+2) <= 2^35.
+            round_shift_right_small::<R>(y, drop)
         } else {
             crate::fixed::round_shift_right(y, drop, rnd)
         } as u64;
@@ -235,7 +242,13 @@ pub fn square(r: Recip, m_bits: u32, mode: Rounding) -> Recip {
         // A mantissa of at most 31 bits (every `Reciprocal` result): the square fits `i64`.
         let sq = (r.mant * r.mant) as i64;
         let drop = (64 - sq.leading_zeros()).saturating_sub(m_bits + 1);
-        (drop, crate::fixed::round_shift_right(sq, drop, mode) as u64)
+        // `sq` is below 2^62.
+        let v = if drop == 0 {
+            sq
+        } else {
+            crate::with_rounding!(mode, M => round_shift_right_small::<M>(sq, drop))
+        };
+        (drop, v as u64)
     } else {
         let sq = i128::from(r.mant) * i128::from(r.mant);
         let drop = (128 - sq.leading_zeros()).saturating_sub(m_bits + 1);
@@ -281,6 +294,21 @@ pub fn apply_i64_in<M: ConstRounding>(r: Recip, x: i64, frac_bits: u32) -> i64 {
         return round_shift_right_wide(prod, sh as u32, M::MODE);
     }
     apply_general::<M>(r, i128::from(x), sh)
+}
+
+/// [`apply_i64_in`] for `|x| < 2^62` and a mantissa below 2^29 (the product below 2^91)
+/// when `r.shift - frac_bits` is in 1..=63: the one rounding is
+/// [`round_shift_right_wide_small`]'s. `None` outside that shift range or when the result
+/// leaves `i64` (where [`apply_i64_in`] saturates).
+#[inline(always)]
+#[must_use]
+pub fn apply_i64_small_in<M: ConstRounding>(r: Recip, x: i64, frac_bits: u32) -> Option<i64> {
+    debug_assert!(x.unsigned_abs() >> 62 == 0 && r.mant >> 29 == 0);
+    let sh = r.shift - frac_bits as i32;
+    if !(1..64).contains(&sh) {
+        return None;
+    }
+    round_shift_right_wide_small::<M>(i128::from(x) * i128::from(r.mant as u32), sh as u32)
 }
 
 /// [`apply_in`] for any operands, `sh` = `r.shift - frac_bits`: the product saturated to

@@ -70,8 +70,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
 /// Fixed twin over a span: the edges at the span's first pixel and their constant steps
 /// (`ScreenTri::edges_fixed_span`), then the interpolator's span datapath
 /// (`perspective_bary_derivs_span`, `perspective_bary_span`), bit-identical to [`fixed`] on
-/// each fragment. A one-fragment span, `lod_per_quad`, `attr_subpixel_bits` and spans beyond the edges' `i64`
-/// bounds run [`fixed`] per fragment.
+/// each fragment; a lone fragment is a one-lane span when the plan needs derivatives. A lone
+/// fragment without them (the span's setup costs more than it saves), `lod_per_quad`,
+/// `attr_subpixel_bits` and spans beyond the edges' `i64` bounds run [`fixed`] per fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let hw = px.m.hw;
     let sub = hw.raster.subpixel_bits;
@@ -79,8 +80,7 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let regrid = grid != 0 && grid != sub;
     let quad = px.plan.derivatives && hw.lod.lod_per_quad;
     let n = frags.len();
-    // A lone fragment (tiny triangles) gains nothing from the span's setup.
-    let steps = (!regrid && !quad && n > 1)
+    let steps = (!regrid && !quad && (n > 1 || px.plan.derivatives))
         .then(|| px.tri.edges_fixed_span(px.x, px.y, n, sub))
         .flatten();
     let Some((e, dx, dy)) = steps else {
