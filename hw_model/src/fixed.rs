@@ -233,6 +233,44 @@ pub fn round_shift_right_mid<M: ConstRounding>(x: i64, shift: u32) -> i64 {
     round_shift_right_narrow(x, shift, M::MODE)
 }
 
+/// [`round_shift_right`] in the mode `M` by a `shift` in 1..=63 that is fixed for a run of
+/// values (e.g. per span), its rounding constants resolved once: [`ShiftRound::apply`] adds
+/// [`round_bias`] moved below the cut (plus the floor's lowest bit where that bias takes it)
+/// before one arithmetic shift, for inputs `|x| < 2^62` (no overflow).
+#[derive(Clone, Copy, Debug)]
+pub struct ShiftRound<M> {
+    shift: u32,
+    /// `round_bias(false, M::MODE) >> (64 - shift)`: below one half of the dropped part.
+    bias: i64,
+    /// `round_bias(true, M::MODE) - round_bias(false, M::MODE)`: 1 for HalfEven, else 0.
+    odd: i64,
+    mode: std::marker::PhantomData<M>,
+}
+
+impl<M: ConstRounding> ShiftRound<M> {
+    /// The rounding by `shift`; `None` unless `shift` is in 1..=63.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(shift: u32) -> Option<Self> {
+        (1..64).contains(&shift).then(|| Self {
+            shift,
+            bias: (round_bias(false, M::MODE) >> (64 - shift)) as i64,
+            odd: (round_bias(true, M::MODE) - round_bias(false, M::MODE)) as i64,
+            mode: std::marker::PhantomData,
+        })
+    }
+
+    /// `round_shift_right(x, shift, M::MODE)` for `|x| < 2^62`: with `q = floor(x / 2^s)` and
+    /// the dropped part `r`, `x + bias + odd(q)` carries into `q + 1` iff `r + bias + odd(q)
+    /// >= 2^s`, the carry [`round_shift_right`] takes from the left-aligned `r`.
+    #[inline(always)]
+    #[must_use]
+    pub fn apply(&self, x: i64) -> i64 {
+        debug_assert!(x.unsigned_abs() < 1 << 62, "{x}");
+        (x + self.bias + ((x >> self.shift) & self.odd)) >> self.shift
+    }
+}
+
 /// [`round_shift_right`] for a `shift` in 1..=63: the floor plus the carry out of the dropped
 /// bits, left-aligned in 64 bits (one half = 2^63), when [`round_bias`] is added to them.
 #[inline(always)]
@@ -416,6 +454,37 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// 600k seeded values below 2^62 in magnitude (with the ends of that range, exact halves
+    /// and their neighbours) at every shift 1 to 63 and every mode: `ShiftRound::apply` gives
+    /// `round_shift_right`; shifts 0 and 64 have no `ShiftRound`.
+    #[test]
+    fn shift_round_matches_round_shift_right() {
+        let mut s = 0x5eed_f1d8;
+        const TOP: i64 = (1 << 62) - 1;
+        for i in 0..600_000u32 {
+            let shift = 1 + i % 63;
+            let x = match i % 5 {
+                0 => [-TOP, TOP, -1, 0, 1][(i / 5 % 5) as usize],
+                1 | 2 => {
+                    let half = ((next(&mut s) as i64 >> 2) >> shift << shift)
+                        .wrapping_add(1i64 << (shift - 1));
+                    (half + (i % 3) as i64 - 1).clamp(-TOP, TOP)
+                }
+                _ => (next(&mut s) as i64 >> 2) >> (i % 62),
+            };
+            for mode in MODES {
+                let got = crate::with_rounding!(mode, M => ShiftRound::<M>::new(shift).map(|r| r.apply(x)));
+                assert_eq!(
+                    got,
+                    Some(round_shift_right(x, shift, mode)),
+                    "{x} {shift} {mode:?}"
+                );
+            }
+        }
+        assert!(ShiftRound::<HalfEvenMode>::new(0).is_none());
+        assert!(ShiftRound::<HalfUpMode>::new(64).is_none());
     }
 
     /// `round_shift_right` as it was before the carry formulation (the decision of
