@@ -233,42 +233,74 @@ pub fn round_shift_right_mid<M: ConstRounding>(x: i64, shift: u32) -> i64 {
     round_shift_right_narrow(x, shift, M::MODE)
 }
 
-/// [`round_shift_right_mid`] for `|x| < 2^62` and a `shift` in 1..=63: the rounding bias
-/// added before the shift (`x + h` for HalfUp, `x + h - 1 + odd` for HalfEven with
-/// `h = 2^(shift-1)` and `odd` the floor's last bit), which cannot overflow at these
-/// magnitudes; the same value with fewer operations.
-#[inline(always)]
-#[must_use]
-pub fn round_shift_right_small<M: ConstRounding>(x: i64, shift: u32) -> i64 {
-    debug_assert!((1..64).contains(&shift), "shift {shift}");
-    debug_assert!(x.unsigned_abs() >> 62 == 0, "x {x}");
-    let half = 1i64 << (shift - 1);
-    match M::MODE {
-        Rounding::Truncate => x >> shift,
-        Rounding::HalfUp => (x + half) >> shift,
-        Rounding::HalfEven => (x + (half - 1) + ((x >> shift) & 1)) >> shift,
+/// [`round_shift_right`] in the mode `M` by a `shift` in 1..=63 that is fixed for a run of
+/// values (e.g. per span), its rounding constants resolved once: [`ShiftRound::apply`] adds
+/// [`round_bias`] moved below the cut (plus the floor's lowest bit where that bias takes it)
+/// before one arithmetic shift, for inputs `|x| < 2^62` (no overflow).
+#[derive(Clone, Copy, Debug)]
+pub struct ShiftRound<M> {
+    shift: u32,
+    /// `round_bias(false, M::MODE) >> (64 - shift)`: below one half of the dropped part.
+    bias: i64,
+    /// `round_bias(true, M::MODE) - round_bias(false, M::MODE)`: 1 for HalfEven, else 0.
+    odd: i64,
+    mode: std::marker::PhantomData<M>,
+}
+
+impl<M: ConstRounding> ShiftRound<M> {
+    /// The rounding by `shift`; `None` unless `shift` is in 1..=63.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(shift: u32) -> Option<Self> {
+        (1..64).contains(&shift).then(|| Self::at(shift))
+    }
+
+    /// [`ShiftRound::new`] for a `shift` the caller has checked to lie in 1..=63.
+    #[inline(always)]
+    fn at(shift: u32) -> Self {
+        debug_assert!((1..64).contains(&shift), "shift {shift}");
+        Self {
+            shift,
+            bias: (round_bias(false, M::MODE) >> (64 - shift)) as i64,
+            odd: (round_bias(true, M::MODE) - round_bias(false, M::MODE)) as i64,
+            mode: std::marker::PhantomData,
+        }
+    }
+
+    /// `round_shift_right(x, shift, M::MODE)` for `|x| < 2^62`: with `q = floor(x / 2^s)` and
+    /// the dropped part `r`, `x + bias + odd(q)` carries into `q + 1` iff `r + bias + odd(q)
+    /// >= 2^s`, the carry [`round_shift_right`] takes from the left-aligned `r`.
+    #[inline(always)]
+    #[must_use]
+    pub fn apply(&self, x: i64) -> i64 {
+        debug_assert!(x.unsigned_abs() < 1 << 62, "{x}");
+        (x + self.bias + ((x >> self.shift) & self.odd)) >> self.shift
     }
 }
 
-/// [`round_shift_right_wide`] for `|x| < 2^126` and a `shift` in 1..=63, the bias added
-/// before the shift as in [`round_shift_right_small`] (a 128-bit add of a 64-bit bias and a
-/// 64-bit funnel shift); `None` when the result does not fit `i64` (where `round_shift_right_wide`
+/// [`round_shift_right_mid`] for `|x| < 2^62` and a `shift` in 1..=63 checked by the caller:
+/// one value through [`ShiftRound`] (the bias added before the shift; no overflow at these
+/// magnitudes), the same value with fewer operations.
+#[inline(always)]
+#[must_use]
+pub fn round_shift_right_small<M: ConstRounding>(x: i64, shift: u32) -> i64 {
+    ShiftRound::<M>::at(shift).apply(x)
+}
+
+/// [`round_shift_right_wide`] for `|x| < 2^126` and a `shift` in 1..=63, the bias of
+/// [`ShiftRound`] added before the shift (a 128-bit add of a 64-bit bias and a 64-bit funnel
+/// shift); `None` when the result does not fit `i64` (where `round_shift_right_wide`
 /// saturates).
 #[inline(always)]
 #[must_use]
 pub fn round_shift_right_wide_small<M: ConstRounding>(x: i128, shift: u32) -> Option<i64> {
-    debug_assert!((1..64).contains(&shift), "shift {shift}");
     debug_assert!(x.unsigned_abs() >> 126 == 0, "x {x}");
     // `shift` < 64: the floor's last bit and the bias are in the low word, and the result
     // is the low word of a 64-bit funnel shift, which fits when the high word's rest is its
     // sign.
-    let s = shift & 63;
-    let half = 1u64 << (s - 1);
-    let bias = match M::MODE {
-        Rounding::Truncate => 0,
-        Rounding::HalfUp => half,
-        Rounding::HalfEven => half - 1 + ((x as u64) >> s & 1),
-    };
+    let r = ShiftRound::<M>::at(shift & 63);
+    let s = r.shift;
+    let bias = r.bias as u64 + ((x as u64) >> s & r.odd as u64);
     let v = x + i128::from(bias);
     let (hi, lo) = ((v >> 64) as i64, v as u64);
     let q = (lo >> s | (hi as u64) << (64 - s)) as i64;
@@ -460,32 +492,39 @@ mod tests {
         }
     }
 
-    /// 300k seeded values below 2^62 in magnitude (with the ends of that range and exact
-    /// halves) at every shift 1 to 63 and every mode: `round_shift_right_small` gives
-    /// `round_shift_right`.
+    /// 600k seeded values below 2^62 in magnitude (with the ends of that range, exact halves
+    /// and their neighbours) at every shift 1 to 63 and every mode: `ShiftRound::apply` gives
+    /// `round_shift_right`, and so does `round_shift_right_small`; shifts 0 and 64 have no
+    /// `ShiftRound`.
     #[test]
-    fn small_shift_matches_round_shift_right() {
-        let mut s = 0x5eed_5a11;
-        let end = (1i64 << 62) - 1;
-        for i in 0..300_000u32 {
+    fn shift_round_matches_round_shift_right() {
+        let mut s = 0x5eed_f1d8;
+        const TOP: i64 = (1 << 62) - 1;
+        for i in 0..600_000u32 {
             let shift = 1 + i % 63;
             let x = match i % 5 {
-                0 => [-end, end, -1, 0, 1][(i / 5 % 5) as usize],
-                1 => (next(&mut s) as i64 >> 2 >> shift << shift).wrapping_add(1i64 << (shift - 1)),
-                _ => next(&mut s) as i64 >> (2 + i % 62),
+                0 => [-TOP, TOP, -1, 0, 1][(i / 5 % 5) as usize],
+                1 | 2 => {
+                    let half = ((next(&mut s) as i64 >> 2) >> shift << shift)
+                        .wrapping_add(1i64 << (shift - 1));
+                    (half + (i % 3) as i64 - 1).clamp(-TOP, TOP)
+                }
+                _ => (next(&mut s) as i64 >> 2) >> (i % 62),
             };
-            if x.unsigned_abs() >> 62 != 0 {
-                continue;
-            }
             for mode in MODES {
-                let got = crate::with_rounding!(mode, M => round_shift_right_small::<M>(x, shift));
+                let got = crate::with_rounding!(mode, M => ShiftRound::<M>::new(shift).map(|r| r.apply(x)));
+                let small =
+                    crate::with_rounding!(mode, M => round_shift_right_small::<M>(x, shift));
+                assert_eq!(Some(small), got, "{x} {shift} {mode:?}");
                 assert_eq!(
                     got,
-                    round_shift_right(x, shift, mode),
+                    Some(round_shift_right(x, shift, mode)),
                     "{x} {shift} {mode:?}"
                 );
             }
         }
+        assert!(ShiftRound::<HalfEvenMode>::new(0).is_none());
+        assert!(ShiftRound::<HalfUpMode>::new(64).is_none());
     }
 
     /// 400k seeded values below 2^126 in magnitude (with the ends of that range, exact halves

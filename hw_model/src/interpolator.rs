@@ -974,10 +974,16 @@ fn interpolate_pairs_in<'a, M: ConstRounding>(
     };
     let range = (out.min_raw(), out.max_raw());
     let lim = narrow_limit([t0u, t0v], [d1u, d2u, d1v, d2v]);
-    if (1..64).contains(&bary_bits) {
+    if let Some(round) = crate::fixed::ShiftRound::<M>::new(bary_bits) {
+        // `-lim <= p < lim` for both barycentrics: one unsigned compare of their offsets.
+        let window = lim.wrapping_mul(2);
         for (bary, result) in lanes {
             for (b, r) in bary.iter().zip(result.iter_mut()) {
-                if (b[1].unsigned_abs() | b[2].unsigned_abs()) < lim {
+                let (o1, o2) = (
+                    (b[1] as u64).wrapping_add(lim),
+                    (b[2] as u64).wrapping_add(lim),
+                );
+                if (o1 | o2) < window {
                     let acc = |(t0, d1, d2): (i64, i64, i64)| t0 + b[1] * d1 + b[2] * d2;
                     let fit = |v: i64, sat: &mut SatCounter| {
                         if v >= range.0 && v <= range.1 {
@@ -986,10 +992,8 @@ fn interpolate_pairs_in<'a, M: ConstRounding>(
                             out.fit(v, sat)
                         }
                     };
-                    let u = round_shift_right_mid::<M>(acc((t0u, d1u, d2u)), bary_bits);
-                    r[0] = fit(u, sat);
-                    let v = round_shift_right_mid::<M>(acc((t0v, d1v, d2v)), bary_bits);
-                    r[1] = fit(v, sat);
+                    r[0] = fit(round.apply(acc((t0u, d1u, d2u))), sat);
+                    r[1] = fit(round.apply(acc((t0v, d1v, d2v))), sat);
                     continue;
                 }
                 r[0] = interpolate_terms::<M>(
@@ -1024,19 +1028,20 @@ fn interpolate_pairs_in<'a, M: ConstRounding>(
     }
 }
 
-/// The bound on the barycentrics `|p1|, |p2|` below which the accumulators `t0 + p1 d1 + p2
-/// d2` of both attributes fit `i64` (0 when none does): with every `|t0| < 2^61` and every
-/// `|d| < 2^D`, `|p| < 2^(61 - D)` gives `|p d| < 2^61` and the sum below `3 2^61 < 2^63`.
-/// Checked against the 128-bit accumulator by `interpolate_pairs_matches_interpolate`.
+/// The bound `lim` on the barycentrics, `-lim <= p1, p2 < lim`, within which the accumulators
+/// `t0 + p1 d1 + p2 d2` of both attributes stay below 2^62 in magnitude, the input range of
+/// [`crate::fixed::ShiftRound::apply`] (0 when none does): with every `|t0| < 2^61` and every `|d| <
+/// 2^D`, `|p| <= 2^(60 - D)` gives `|p d| < 2^60` and the sum below `2^61 + 2^61`. Checked
+/// against the 128-bit accumulator by `interpolate_pairs_matches_interpolate`.
 #[inline(always)]
 fn narrow_limit(t0: [i64; 2], d: [i64; 4]) -> u64 {
     let top = t0[0].unsigned_abs().max(t0[1].unsigned_abs());
     let dmax = d.iter().map(|x| x.unsigned_abs()).fold(0, u64::max);
     let bits = 64 - dmax.leading_zeros();
-    if top >= 1 << 61 || bits > 61 {
+    if top >= 1 << 61 || bits > 60 {
         0
     } else {
-        1 << (61 - bits)
+        1 << (60 - bits)
     }
 }
 
@@ -1544,9 +1549,9 @@ mod tests {
     /// 2M seeded cases, every mode and both overflow rules, attributes and barycentrics from
     /// small to near the `i64` boundaries of the accumulator (the sample-independent terms
     /// overflowing, the per-sample sum overflowing, both fitting): `interpolate_pairs` gives
-    /// one `interpolate` call per sample and attribute, bits and counts; the 64-bit
-    /// accumulators under [`narrow_limit`] are taken by over 500k samples, the 128-bit ones
-    /// by over 500k.
+    /// one `interpolate` call per sample and attribute, bits and counts, also with the
+    /// barycentrics at and next to the ends of [`narrow_limit`]'s window; the 64-bit
+    /// accumulators within it are taken by over 500k samples, the others by over 500k.
     #[test]
     fn interpolate_pairs_matches_interpolate() {
         let mut s = 0x5eed_0b44;
@@ -1564,16 +1569,25 @@ mod tests {
             let ab = [20, 33, 40, 62][(i / 27 % 4) as usize];
             let attr = [0; 3].map(|_| [signed(&mut s, ab), signed(&mut s, ab)]);
             let n = 1 + (i % 3) as usize;
+            let t0 = attr[0].map(|a| a.checked_mul(1 << bb).unwrap_or(i64::MAX));
+            let d = [0, 1].map(|ax| [1, 2].map(|v| attr[v][ax].wrapping_sub(attr[0][ax])));
+            let lim = narrow_limit(t0, [d[0][0], d[0][1], d[1][0], d[1][1]]) as i64;
             let pb = [bb + 1, 30, 45, 60][(i / 108 % 4) as usize];
-            let bary = [0; 3].map(|_| [signed(&mut s, pb), signed(&mut s, pb), signed(&mut s, pb)]);
+            let mut bary =
+                [0; 3].map(|_| [signed(&mut s, pb), signed(&mut s, pb), signed(&mut s, pb)]);
+            if i % 5 == 0 {
+                // Barycentrics at the ends of the window `-lim <= p < lim` and just outside.
+                let edge = [-lim - 1, -lim, -lim + 1, lim - 1, lim, 0];
+                for b in &mut bary {
+                    b[1] = edge[(next(&mut s) % 6) as usize];
+                    b[2] = edge[(next(&mut s) % 6) as usize];
+                }
+            }
             let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
             let mut got = [[0i64; 2]; 3];
             interpolate_pairs(&bary[..n], bb, attr, &out, &mut sa, &mut got[..n]);
-            let t0 = attr[0].map(|a| a.checked_mul(1 << bb).unwrap_or(i64::MAX));
-            let d = [0, 1].map(|ax| [1, 2].map(|v| attr[v][ax].wrapping_sub(attr[0][ax])));
-            let lim = narrow_limit(t0, [d[0][0], d[0][1], d[1][0], d[1][1]]);
             for b in &bary[..n] {
-                if (b[1].unsigned_abs() | b[2].unsigned_abs()) < lim {
+                if (-lim..lim).contains(&b[1]) && (-lim..lim).contains(&b[2]) {
                     narrow += 1;
                 } else {
                     wide += 1;

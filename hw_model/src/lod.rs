@@ -54,13 +54,57 @@ pub const fn lod_zero(lod_frac_bits: u32) -> i64 {
 #[inline(always)]
 #[must_use]
 pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64 {
-    let f = cfg.lod_frac_bits.min(16);
-    let floor_val = lod_zero(f);
-    // The squared lengths in u64 when every |d| < 2^31 (each sum < 2^63), else in u128.
-    let a = d.map(i64::unsigned_abs);
-    let small = (a[0] | a[1] | a[2] | a[3]) < 1 << 31;
+    lod_with(&LodSetup::new(frac, cfg), d, sat)
+}
+
+/// The constants of [`lod`] for one configuration and coordinate format, resolved once for a
+/// run of LODs (e.g. a span) by [`lod_with`].
+#[derive(Clone, Copy, Debug)]
+pub struct LodSetup {
+    /// Coordinate fraction bits.
+    frac: u32,
+    /// `lod_frac_bits`, at most 16.
+    f: u32,
+    /// [`lod_zero`] of `f`: the result for a zero footprint and the lower clamp.
+    floor_val: i64,
+    /// `cfg.lod_log2` is PiecewiseLinear.
+    piecewise: bool,
+    /// Fraction bits of log2(L) the Exact mode takes from the table: `f - 1` (0 for `f` = 0).
+    steps: u32,
+    /// The floor halving of the Exact mode for `f` = 0: 1, else 0.
+    halve: u32,
+}
+
+impl LodSetup {
+    /// The constants for `cfg` and coordinates with `frac` fraction bits.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(frac: u32, cfg: &LodConfig) -> Self {
+        let f = cfg.lod_frac_bits.min(16);
+        Self {
+            frac,
+            f,
+            floor_val: lod_zero(f),
+            piecewise: cfg.lod_log2 == LodLog2::PiecewiseLinear,
+            steps: f.saturating_sub(1),
+            halve: u32::from(f == 0),
+        }
+    }
+}
+
+/// [`lod`] with its constants resolved in `k`: the same value and count.
+#[inline(always)]
+#[must_use]
+pub fn lod_with(k: &LodSetup, d: [i64; 4], sat: &mut SatCounter) -> i64 {
+    let (frac, f, floor_val) = (k.frac, k.f, k.floor_val);
+    // The squared lengths in u64 when every d is in [-2^31, 2^31) (each sum <= 2^63), else in
+    // u128: one test of the four offsets `d + 2^31`.
+    let offsets = d.map(|x| (x as u64).wrapping_add(1 << 31));
+    let small = (offsets[0] | offsets[1] | offsets[2] | offsets[3]) < 1 << 32;
     let (e, mant, l) = if small {
-        let l = (a[0] * a[0] + a[1] * a[1]).max(a[2] * a[2] + a[3] * a[3]);
+        // Each square at most 2^62 in `i64`.
+        let sq = d.map(|x| (x * x) as u64);
+        let l = (sq[0] + sq[1]).max(sq[2] + sq[3]);
         if l == 0 {
             return floor_val;
         }
@@ -74,7 +118,7 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
     } else {
         wide_squares(d)
     };
-    if cfg.lod_log2 == LodLog2::PiecewiseLinear {
+    if k.piecewise {
         // floor((e - 2 frac + (L - 2^e) / 2^e) 2^16), then floor(/ 2^(17 - F)) = floor(* 2^(F-1)).
         let mf = l - (1u128 << e);
         let t16 = if e >= 16 {
@@ -91,12 +135,12 @@ pub fn lod(d: [i64; 4], frac: u32, cfg: &LodConfig, sat: &mut SatCounter) -> i64
         return v;
     }
     // lambda * 2^F = log2(L) * 2^(F-1): F - 1 fraction bits of log2(L) give the floor exactly.
-    let steps = f.saturating_sub(1);
+    let steps = k.steps;
     let bits = i64::from(table_log2_bits(mant) >> (SERIAL_STEPS - steps));
     // floor(log2(L) * 2^steps); L has 2*frac fraction bits.
     let int_part = i64::from(e) - 2 * i64::from(frac);
     let t = (int_part << steps) + bits;
-    let v = if f == 0 { t >> 1 } else { t };
+    let v = t >> k.halve;
     if v < floor_val {
         sat.saturated += 1;
         return floor_val;
@@ -454,14 +498,26 @@ mod tests {
             let sh = [1, 20, 33, 40, 50, 63][(i / 68 % 6) as usize];
             let mut d = [0; 4].map(|_| (next(&mut s) as i64) >> sh);
             if i % 97 == 0 {
-                d[(i / 97 % 4) as usize] = [i64::MIN, i64::MAX, 0][(i / 388 % 3) as usize];
+                let ends = [i64::MIN, i64::MAX, 0, 1 << 31, -(1 << 31), (1 << 31) - 1];
+                d[(i / 97 % 4) as usize] = ends[(i / 388 % 6) as usize];
+                if i % 3 == 0 {
+                    // Every derivative at or just beyond the ends of the `u64` squares.
+                    let ends = [
+                        -(1 << 31),
+                        (1 << 31) - 1,
+                        1 << 31,
+                        -(1 << 31) - 1,
+                        u32::MAX.into(),
+                    ];
+                    d = [0; 4].map(|_| ends[(next(&mut s) % 5) as usize]);
+                }
             }
             if i % 89 == 0 {
                 d = [0; 4];
             }
             match d.iter().map(|x| x.unsigned_abs()).max() {
                 Some(0) => zero += 1,
-                Some(x) if x < 1 << 31 => narrow += 1,
+                Some(x) if x <= 1 << 31 => narrow += 1,
                 _ => wide += 1,
             }
             assert_eq!(

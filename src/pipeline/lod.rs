@@ -7,7 +7,7 @@ use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
 use crate::reference::lod_mode_f64;
 use hw_model::config::CoordArith;
-use hw_model::lod::lod_cost;
+use hw_model::lod::{lod_cost, lod_with, LodSetup};
 use hw_model::UnitCost;
 
 /// Fixed twin: squared lengths, bit-serial log2.
@@ -31,8 +31,8 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     }
 }
 
-/// Fixed twin over a span: the texture's level-0 size, the formats and the configuration
-/// resolved once, then the squared lengths and log2 per fragment. The float32 coordinate
+/// Fixed twin over a span: the texture's level-0 size and the LOD unit's constants
+/// ([`LodSetup`]) resolved once, then the squared lengths and log2 per fragment. The float32 coordinate
 /// path and a Float `texcoord` producer take [`fixed`] on each fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let m = px.m;
@@ -44,10 +44,11 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     };
     let sat = &mut c.sat[StageKind::Lod.index()];
     let (w, h) = (l0.width, l0.height);
-    let (fb, cfg) = (m.uv_fmt.frac_bits, &m.hw.lod);
+    let cfg = &m.hw.lod;
+    let k = LodSetup::new(m.uv_fmt.frac_bits, cfg);
     for frag in frags.iter_mut() {
         let d = texel_derivs(&frag.uv_x, w, h);
-        frag.lod_x = hw_model::lod::lod(d, fb, cfg, sat);
+        frag.lod_x = lod_with(&k, d, sat);
     }
     if px.carriers {
         let lfb = cfg.lod_frac_bits;
