@@ -924,6 +924,64 @@ mod tests {
         })
     }
 
+    /// MIP chains of the given level sizes cut one after another from `texels`, starting at
+    /// `start` and back to 0 where a level reaches the end (that level is short: its missing
+    /// texels read zero).
+    fn chains_of<'a>(
+        texels: &'a [[u16; 4]],
+        sizes: &[&[(u32, u32)]],
+        start: usize,
+    ) -> Vec<Vec<Level<'a>>> {
+        sizes
+            .iter()
+            .map(|c| {
+                let mut at = start;
+                c.iter()
+                    .map(|&(width, height)| {
+                        let end = (at + (width * height) as usize).min(texels.len());
+                        let l = Level {
+                            width,
+                            height,
+                            texels: &texels[at..end],
+                        };
+                        at = if end == texels.len() { 0 } else { end };
+                        l
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The whole trace of [`trilinear_before`]'s sample.
+    #[allow(clippy::too_many_arguments)]
+    fn trace_before(
+        levels: &[Level],
+        u: i64,
+        v: i64,
+        frac: u32,
+        lod: i64,
+        lfb: u32,
+        wm: [WrapMode; 2],
+        cfg: &TrilinearConfig,
+    ) -> TrilinearTrace {
+        let mut t = TrilinearTrace::default();
+        let _ = trilinear_before(levels, u, v, frac, lod, lfb, wm, cfg, Some(&mut t));
+        t
+    }
+
+    /// A reused trace holding a stale second level (from a two-level sample): a sample
+    /// must overwrite all of it.
+    fn stale_trace() -> TrilinearTrace {
+        TrilinearTrace {
+            levels_used: 2,
+            level: [BilinearTrace {
+                level: 9,
+                ..BilinearTrace::default()
+            }; 2],
+            ..TrilinearTrace::default()
+        }
+    }
+
     /// 3M seeded samples against the scalar filter it replaced: the nine (filter, weight)
     /// rounding pairs, the nine wrap-mode pairs, weight widths 0 to 16, LOD fractions 0 to 16
     /// (lanes) and 17 to 30 (the scalar level blend), chains of square, non-square, 1x1 and
@@ -943,26 +1001,8 @@ mod tests {
             &[(1, 40), (1, 20), (1, 10)],
             &[(64, 64), (32, 32)],
         ];
-        let chains: Vec<Vec<Level>> = sizes
-            .iter()
-            .map(|c| {
-                let mut at = 1024usize;
-                c.iter()
-                    .map(|&(width, height)| {
-                        let n = (width * height) as usize;
-                        // The 64x64 level is short: its last 16 rows read zeros.
-                        let end = (at + n).min(texels.len());
-                        let l = Level {
-                            width,
-                            height,
-                            texels: &texels[at..end],
-                        };
-                        at = end % 1024;
-                        l
-                    })
-                    .collect()
-            })
-            .collect();
+        // The 64x64 level is short: its last 16 rows read zeros.
+        let chains = chains_of(&texels, &sizes, 1024);
         let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
         let (mut lanes_blend, mut scalar_blend, mut one_level) = (0u32, 0u32, 0u32);
         let (mut inside, mut wrapped, mut missing) = (0u32, 0u32, 0u32);
@@ -995,27 +1035,8 @@ mod tests {
                 want,
                 "{u} {v} {frac} {lod} {lfb} {wm:?} {cfg:?}"
             );
-            let mut want_trace = TrilinearTrace::default();
-            let _ = trilinear_before(
-                levels,
-                u,
-                v,
-                frac,
-                lod,
-                lfb,
-                wm,
-                &cfg,
-                Some(&mut want_trace),
-            );
-            // A reused trace (a stale second level from a two-level sample) is overwritten.
-            let mut got_trace = TrilinearTrace {
-                levels_used: 2,
-                level: [BilinearTrace {
-                    level: 9,
-                    ..BilinearTrace::default()
-                }; 2],
-                ..TrilinearTrace::default()
-            };
+            let want_trace = trace_before(levels, u, v, frac, lod, lfb, wm, &cfg);
+            let mut got_trace = stale_trace();
             let got = trilinear(levels, u, v, frac, lod, lfb, wm, &cfg, Some(&mut got_trace));
             assert_eq!(got, want);
             assert_eq!(got_trace, want_trace, "{u} {v} {lod} {lfb} {cfg:?}");
@@ -1074,25 +1095,7 @@ mod tests {
             // Not powers of two: refused.
             &[(12, 8), (6, 4), (3, 2), (1, 1)],
         ];
-        let chains: Vec<Vec<Level>> = sizes
-            .iter()
-            .map(|c| {
-                let mut at = 0usize;
-                c.iter()
-                    .map(|&(width, height)| {
-                        let n = (width * height) as usize;
-                        let end = (at + n).min(texels.len());
-                        let l = Level {
-                            width,
-                            height,
-                            texels: &texels[at..end],
-                        };
-                        at = end % 4096;
-                        l
-                    })
-                    .collect()
-            })
-            .collect();
+        let chains = chains_of(&texels, &sizes, 2000);
         let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
         let (mut fast, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
         for i in 0..2_000_000u32 {
@@ -1131,18 +1134,7 @@ mod tests {
             let lod = (next(&mut s) % ((levels.len() as u64 + 1) << lfb)) as i64 - (1 << lfb >> 1);
             let setup = UnitSetup::new(&cfg, frac, lfb);
             let want = trilinear_before(levels, u, v, frac, lod, lfb, wm, &cfg, None);
-            let mut want_trace = TrilinearTrace::default();
-            let _ = trilinear_before(
-                levels,
-                u,
-                v,
-                frac,
-                lod,
-                lfb,
-                wm,
-                &cfg,
-                Some(&mut want_trace),
-            );
+            let want_trace = trace_before(levels, u, v, frac, lod, lfb, wm, &cfg);
             crate::with_rounding!(cfg.filter_rounding, F => {
                 crate::with_rounding!(cfg.weight_rounding, W => {
                     let unit = TrilinearUnit::<F, W>::new(&cfg, &setup, wm);
@@ -1152,14 +1144,7 @@ mod tests {
                         fast += 1;
                         let got = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
                         assert_eq!(got, want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
-                        let mut got_trace = TrilinearTrace {
-                            levels_used: 2,
-                            level: [BilinearTrace {
-                                level: 9,
-                                ..BilinearTrace::default()
-                            }; 2],
-                            ..TrilinearTrace::default()
-                        };
+                        let mut got_trace = stale_trace();
                         let got = unit.sample_pow2_repeat(levels, u, v, lod, &mut got_trace);
                         assert_eq!(got, want);
                         assert_eq!(got_trace, want_trace, "{u} {v} {frac} {lod} {lfb} {cfg:?}");

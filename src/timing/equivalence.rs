@@ -22,6 +22,29 @@ fn pick<T: Copy>(r: &mut Rng, xs: &[T]) -> T {
     xs[r.below(xs.len() as u64) as usize]
 }
 
+/// A footprint of stage `kind`'s lookup on level `level` (of `size`) of texture `tex`: a
+/// random texel and, now and then not, its right and lower neighbours (wrapping).
+fn random_footprint(
+    r: &mut Rng,
+    kind: StageKind,
+    lookup: u8,
+    tex: usize,
+    level: usize,
+    (w, h): (u32, u32),
+) -> TexelFootprint {
+    let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
+    let x1 = if r.below(8) == 0 { x0 } else { (x0 + 1) % w };
+    let y1 = if r.below(8) == 0 { y0 } else { (y0 + 1) % h };
+    TexelFootprint {
+        stage: kind.index() as u8,
+        lookup,
+        level: level as u8,
+        tex: tex as u16,
+        x: [x0, x1],
+        y: [y0, y1],
+    }
+}
+
 fn machine(r: &mut Rng) -> HwConfig {
     let mut hw = HwConfig::texram16();
     let t = &mut hw.timing;
@@ -117,18 +140,8 @@ fn frame(r: &mut Rng, pixels: usize, fetching: Option<&HwConfig>) -> FrameEvents
                 let lv = &ev.textures[tex].levels;
                 for _ in 0..1 + r.below(2) {
                     let level = r.below(lv.len() as u64) as usize;
-                    let (w, h) = lv[level];
-                    let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
-                    let x1 = if r.below(8) == 0 { x0 } else { (x0 + 1) % w };
-                    let y1 = if r.below(8) == 0 { y0 } else { (y0 + 1) % h };
-                    ev.footprints.push(TexelFootprint {
-                        stage: kind.index() as u8,
-                        lookup,
-                        level: level as u8,
-                        tex: tex as u16,
-                        x: [x0, x1],
-                        y: [y0, y1],
-                    });
+                    let fp = random_footprint(r, kind, lookup, tex, level, lv[level]);
+                    ev.footprints.push(fp);
                 }
             }
         }
@@ -224,18 +237,9 @@ fn model_matches_previous_on_one_lookup_streams() {
                 let lv = &ev.textures[tex].levels;
                 let level = r.below(lv.len() as u64) as usize;
                 let levels = 1 + r.below(2) as usize;
-                for (l, &(w, h)) in lv.iter().enumerate().skip(level).take(levels) {
-                    let (x0, y0) = (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32);
-                    let x1 = if r.below(8) == 0 { x0 } else { (x0 + 1) % w };
-                    let y1 = if r.below(8) == 0 { y0 } else { (y0 + 1) % h };
-                    ev.footprints.push(TexelFootprint {
-                        stage: stage.index() as u8,
-                        lookup,
-                        level: l as u8,
-                        tex: tex as u16,
-                        x: [x0, x1],
-                        y: [y0, y1],
-                    });
+                for (l, &size) in lv.iter().enumerate().skip(level).take(levels) {
+                    let fp = random_footprint(&mut r, stage, lookup, tex, l, size);
+                    ev.footprints.push(fp);
                 }
             }
             ev.pixels.push(PixelEvent {
