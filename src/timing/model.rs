@@ -1361,7 +1361,8 @@ impl Texturing {
     /// unit) reached at `t` with its footprints `mine` (not empty): its address/footprint
     /// unit, then each lookup through the memory and a filter unit; returns its completion
     /// and updates the pixel's worst wait (cycles, cause). One or two footprints of one
-    /// lookup (a bilinear or trilinear lookup) skip the search for the lookups' runs.
+    /// lookup (a bilinear or trilinear lookup) skip the search for the lookups' runs; each
+    /// run is [`Texturing::lookup_from`].
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn stage_in<const CACHED: bool, const TILED: bool>(
@@ -1374,70 +1375,42 @@ impl Texturing {
         worst: &mut (u64, usize),
         quads: &mut QuadCounts,
     ) -> u64 {
-        const C_MEM: usize = StageKind::COUNT;
         let (Some(first), Some(last)) = (mine.first(), mine.last()) else {
             return t;
         };
-        let setup = self.setup(cycles, u64::from(last.lookup) + 1);
-        if mine.len() <= 2 && first.lookup == last.lookup {
-            return self.lookup_in::<CACHED, TILED>(alu, k, setup, t, mine, worst, quads);
-        }
-        let (setup, setup_occ) = setup;
+        let (setup, setup_occ) = self.setup(cycles, u64::from(last.lookup) + 1);
         let s = alu.take(t, setup_occ);
         if s - t > worst.0 {
             *worst = (s - t, k);
         }
         let ready = s + setup;
-        let mut done = ready;
-        let mut bytes = 0u64;
-        // The footprints of one lookup are consecutive: each run of one lookup number goes
-        // through the memory, then to a filter unit.
-        let mut i = 0;
-        while let Some(first) = mine.get(i) {
-            let (lookup, from) = (first.lookup, i);
-            let mut data = ready;
-            while let Some(f) = mine.get(i).filter(|f| f.lookup == lookup) {
-                let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
-                let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
-                bytes += b;
-                let ms = self.mem_unit.take(ready, occ);
-                if ms - ready > worst.0 {
-                    *worst = (ms - ready, C_MEM);
-                }
-                data = data.max(ms + lat);
-                i += 1;
-            }
-            done = done.max(self.filter(data, i - from, worst));
+        if mine.len() <= 2 && first.lookup == last.lookup {
+            return self.lookup_from::<CACHED, TILED>(k, ready, mine, worst, quads);
         }
-        self.stage_bytes[k & (KINDS - 1)] += bytes;
-        done
+        self.runs_from::<CACHED, TILED>(k, ready, mine, worst, quads)
     }
 
-    /// [`Texturing::stage_in`] of a stage whose footprints `mine` (one or two) are all of one
-    /// lookup, `setup` its address/footprint unit's (cycles, occupancy): the unit, then
-    /// [`Texturing::lookup_from`].
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn lookup_in<const CACHED: bool, const TILED: bool>(
+    /// [`Texturing::lookup_from`] for each lookup of stage kind `k` whose footprints `mine`
+    /// (consecutive per lookup) hold several lookups; returns the last completion. Out of
+    /// line: the one-lookup path of [`Texturing::stage_in`] stays small.
+    #[inline(never)]
+    fn runs_from<const CACHED: bool, const TILED: bool>(
         &mut self,
-        alu: &mut Unit,
         k: usize,
-        (setup, setup_occ): (u64, u64),
-        t: u64,
+        ready: u64,
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
         quads: &mut QuadCounts,
     ) -> u64 {
-        let s = alu.take(t, setup_occ);
-        if s - t > worst.0 {
-            *worst = (s - t, k);
-        }
-        self.lookup_from::<CACHED, TILED>(k, s + setup, mine, worst, quads)
+        mine.chunk_by(|a, b| a.lookup == b.lookup)
+            .fold(ready, |done, run| {
+                done.max(self.lookup_from::<CACHED, TILED>(k, ready, run, worst, quads))
+            })
     }
 
-    /// The memory and filter part of [`Texturing::lookup_in`] for stage kind `k` from `ready`
-    /// (its address/footprint unit done): the footprints `mine` through the memory, then the
-    /// lookup on a filter unit; returns the stage's completion.
+    /// One lookup of stage kind `k` from `ready` (its address/footprint unit done): its
+    /// footprints `mine` through the memory, then the lookup on a filter unit; returns the
+    /// lookup's completion (at least `ready`).
     #[inline(always)]
     fn lookup_from<const CACHED: bool, const TILED: bool>(
         &mut self,
