@@ -196,60 +196,88 @@ fn model_matches_previous_on_fetching_streams() {
 #[test]
 fn model_matches_previous_on_one_lookup_streams() {
     let mut r = Rng(0x1100_4b7e);
-    let trilinear = StageKind::Trilinear;
     for case in 0..300 {
-        let mut hw = machine(&mut r);
-        hw.timing.shade_pixels_per_cycle = pick(&mut r, &[1, 1, 1, 2]);
-        hw.timing.alu_pipelined = r.below(8) != 0;
-        let mut ev = frame(&mut r, 0, None);
-        let plain = [0, 1, 2, 3, 5, 6];
-        for p in &mut ev.plans {
-            // Distinct kinds in pipeline order around the trilinear stage.
-            let mut kinds: Vec<StageKind> = plain
-                .iter()
-                .filter(|_| r.below(2) == 0)
-                .map(|&i| StageKind::ALL[i])
-                .collect();
-            kinds.push(trilinear);
-            kinds.sort_by_key(|k| k.index());
-            p.stages = kinds
-                .into_iter()
-                .map(|k| {
-                    let cost = UnitCost {
-                        cycles: pick(&mut r, &[0, 1, 1, 2, 5, 12]),
-                        ..UnitCost::default()
-                    };
-                    (k, cost)
-                })
-                .collect();
-        }
-        let n = 1 + r.below(3000) as usize;
-        for _ in 0..n {
-            let plan = r.below(ev.plans.len() as u64) as u32;
-            let (lookups, stage) = match r.below(40) {
-                0 => (0, trilinear),
-                1 => (2, trilinear),
-                2 => (1, StageKind::BumpFetch),
-                _ => (1, trilinear),
-            };
-            for lookup in 0..lookups {
-                let tex = r.below(ev.textures.len() as u64) as usize;
-                let lv = &ev.textures[tex].levels;
-                let level = r.below(lv.len() as u64) as usize;
-                let levels = 1 + r.below(2) as usize;
-                for (l, &size) in lv.iter().enumerate().skip(level).take(levels) {
-                    let fp = random_footprint(&mut r, stage, lookup, tex, l, size);
-                    ev.footprints.push(fp);
-                }
-            }
-            ev.pixels.push(PixelEvent {
-                plan,
-                tri: 0,
-                fp_end: ev.footprints.len() as u32,
-            });
-        }
+        let (hw, ev) = one_lookup_frame(&mut r, 0, 40);
         check(&mut r, case, &hw, &ev);
     }
+}
+
+/// As [`model_matches_previous_on_one_lookup_streams`] with short runs of one plan (a mesh's
+/// spans), often of a plan the frame does not have and with more pixels of the general walk,
+/// fed in spans of 1 to 12 pixels: the units skipped for a plan's pixels stay so across its
+/// spans and are settled when another plan's pixel, a pixel of the general walk or the report
+/// comes.
+#[test]
+fn model_matches_previous_on_short_mixed_spans() {
+    let mut r = Rng(0x5a0e_7d12);
+    for case in 0..300 {
+        let (hw, ev) = one_lookup_frame(&mut r, 4, 12);
+        check(&mut r, case, &hw, &ev);
+    }
+}
+
+/// A machine and frame for [`model_matches_previous_on_one_lookup_streams`]: a pixel keeps
+/// the previous pixel's plan with probability `stay / (stay + 1)` (a random plan, now and then
+/// one the frame does not have, when `stay` > 0; else always a random plan of the frame), and
+/// one pixel in `odd` / 4 (about) makes no lookup, two or one of another stage.
+fn one_lookup_frame(r: &mut Rng, stay: u64, odd: u64) -> (HwConfig, FrameEvents) {
+    let trilinear = StageKind::Trilinear;
+    let mut hw = machine(r);
+    hw.timing.shade_pixels_per_cycle = pick(r, &[1, 1, 1, 2]);
+    hw.timing.alu_pipelined = r.below(8) != 0;
+    let mut ev = frame(r, 0, None);
+    let plain = [0, 1, 2, 3, 5, 6];
+    for p in &mut ev.plans {
+        // Distinct kinds in pipeline order around the trilinear stage.
+        let mut kinds: Vec<StageKind> = plain
+            .iter()
+            .filter(|_| r.below(2) == 0)
+            .map(|&i| StageKind::ALL[i])
+            .collect();
+        kinds.push(trilinear);
+        kinds.sort_by_key(|k| k.index());
+        p.stages = kinds
+            .into_iter()
+            .map(|k| {
+                let cost = UnitCost {
+                    cycles: pick(r, &[0, 1, 1, 2, 5, 12]),
+                    ..UnitCost::default()
+                };
+                (k, cost)
+            })
+            .collect();
+    }
+    let n = 1 + r.below(3000) as usize;
+    let plans = ev.plans.len() as u64;
+    let mut plan = 0;
+    for i in 0..n {
+        if i == 0 || stay == 0 || r.below(stay + 1) == 0 {
+            let extra = u64::from(stay > 0 && r.below(8) == 0);
+            plan = r.below(plans + extra) as u32;
+        }
+        let (lookups, stage) = match r.below(odd) {
+            0 => (0, trilinear),
+            1 => (2, trilinear),
+            2 => (1, StageKind::BumpFetch),
+            _ => (1, trilinear),
+        };
+        for lookup in 0..lookups {
+            let tex = r.below(ev.textures.len() as u64) as usize;
+            let lv = &ev.textures[tex].levels;
+            let level = r.below(lv.len() as u64) as usize;
+            let levels = 1 + r.below(2) as usize;
+            for (l, &size) in lv.iter().enumerate().skip(level).take(levels) {
+                let fp = random_footprint(r, stage, lookup, tex, l, size);
+                ev.footprints.push(fp);
+            }
+        }
+        ev.pixels.push(PixelEvent {
+            plan,
+            tri: 0,
+            fp_end: ev.footprints.len() as u32,
+        });
+    }
+    (hw, ev)
 }
 
 /// The model's reports on `ev` (as a frame, rows, pixels and spans cut at random) against

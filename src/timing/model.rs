@@ -839,6 +839,8 @@ pub struct Simulator<'a> {
     at: IssueState,
     /// Footprints fed so far.
     footprints: u64,
+    /// The pixels that skipped units, not settled yet ([`Lazy`]).
+    lazy: Option<Lazy>,
     /// The machine's memory compiled into the walk: a texel cache, a tiled interleave.
     cached: bool,
     tiled: bool,
@@ -929,13 +931,49 @@ struct Step {
 /// Where a plan's stages are in [`Simulator::steps`] (`start..end`), and whether its stage
 /// kinds are distinct: then a pixel's footprints (recorded in the plan's order) are matched
 /// to its stages by one cursor ([`stage_footprints`]). `mono`: with distinct kinds of which
-/// exactly one makes texture lookups on the machine, that stage's place in the plan.
+/// exactly one makes texture lookups on the machine, that stage ([`Mono`]).
 #[derive(Clone, Copy, Debug)]
 struct PlanSteps {
     start: usize,
     end: usize,
     distinct: bool,
-    mono: Option<usize>,
+    mono: Option<Mono>,
+}
+
+/// A plan's one fetching stage: its place in the plan, its address/footprint unit's (cycles,
+/// occupancy) for one lookup ([`Texturing::setup`]), the cycles of the steps before it and
+/// whether a pixel may skip those steps and that unit ([`settle`]: one pixel issued per cycle,
+/// and those steps and that unit occupying their units at most 1 cycle).
+#[derive(Clone, Copy, Debug)]
+struct Mono {
+    at: usize,
+    setup: (u64, u64),
+    pre_cycles: u64,
+    lazy_ok: bool,
+}
+
+impl PlanSteps {
+    /// The plan's one fetching stage ([`PlanSteps::mono`]) in `steps` (every plan's), with its
+    /// [`Mono`].
+    #[inline(always)]
+    fn one<'s>(&self, steps: &'s [Step]) -> Option<(OneStage<'s>, Mono)> {
+        let m = self.mono?;
+        let steps = steps.get(self.start..self.end)?;
+        let (pre, rest) = steps.split_at(m.at.min(steps.len()));
+        let (&step, post) = rest.split_first()?;
+        Some((OneStage { pre, step, post }, m))
+    }
+}
+
+/// Pixels of plan `plan` that skipped the steps before its fetching stage and its
+/// address/footprint unit ([`settle`]): the issue `t` of the last pixel of the run that
+/// started waiting for none of them, and the number `n` that skipped them. Kept across [`Simulator::run_in`]'s calls for the plan and settled
+/// before anything else reads or uses those units.
+#[derive(Clone, Copy, Debug)]
+struct Lazy {
+    plan: u32,
+    t: u64,
+    n: u64,
 }
 
 impl<'a> Simulator<'a> {
@@ -945,6 +983,8 @@ impl<'a> Simulator<'a> {
         let tc = &hw.timing;
         let glpc = tc.gate_levels_per_cycle;
         let tri_cost = trilinear_cost(&hw.trilinear, 2, glpc);
+        let (tri_cycles, pipelined) = (u64::from(tri_cost.cycles), tc.alu_pipelined);
+        let ppc = u64::from(tc.shade_pixels_per_cycle.max(1));
         let (bilinear_lat, blend_lat) = hw_model::trilinear::filter_latencies(&hw.trilinear, glpc);
         let alu_occ = |cycles: u64| {
             if tc.alu_pipelined {
@@ -974,7 +1014,18 @@ impl<'a> Simulator<'a> {
                     .enumerate()
                     .filter(|&(_, &(k, _))| super::events::lookups(k, hw) > 0);
                 let mono = match (fetching.next(), fetching.next()) {
-                    (Some((at, _)), None) if distinct => Some(at),
+                    (Some((at, _)), None) if distinct => {
+                        let (pre, step) = (&p.stages[..at], p.stages[at].1);
+                        let setup = setup_cost(u64::from(step.cycles), 1, tri_cycles, pipelined);
+                        Some(Mono {
+                            at,
+                            setup,
+                            pre_cycles: pre.iter().map(|s| u64::from(s.1.cycles)).sum(),
+                            lazy_ok: ppc == 1
+                                && setup.1 <= 1
+                                && pre.iter().all(|s| alu_occ(u64::from(s.1.cycles)) <= 1),
+                        })
+                    }
                     _ => None,
                 };
                 PlanSteps {
@@ -1000,14 +1051,14 @@ impl<'a> Simulator<'a> {
                 mem_unit: Unit::default(),
                 filters: vec![Unit::default(); tc.trilinear_units.max(1) as usize],
                 stage_bytes: [0; KINDS],
-                tri_cycles: u64::from(tri_cost.cycles),
+                tri_cycles,
                 bilinear_lat,
                 blend_lat,
                 bpc,
                 filter_cost: [0, 1, 2, 3].map(|n| filter_cost(n, bpc, bilinear_lat, blend_lat)),
                 alu_pipelined: tc.alu_pipelined,
             },
-            ppc: u64::from(tc.shade_pixels_per_cycle.max(1)),
+            ppc,
             stall_by: [0; CAUSES],
             ring: vec![(0, StageKind::COUNT + 2); win],
             // The first pixel is in the first group, which it does not open.
@@ -1016,6 +1067,7 @@ impl<'a> Simulator<'a> {
                 ..IssueState::default()
             },
             footprints: 0,
+            lazy: None,
             cached: tc.cache_bytes > 0,
             tiled: tc.bank_interleave == BankInterleave::Tiled,
         }
@@ -1083,7 +1135,8 @@ impl<'a> Simulator<'a> {
     /// and the four-bank footprint counts live in locals for the batch. A plan with one
     /// fetching stage ([`PlanSteps::mono`]) walks a pixel whose footprints are all that
     /// stage's without matching footprints to stages ([`walk_mono`]); any other pixel takes
-    /// the general walk ([`walk`]).
+    /// the general walk ([`walk`]). Units skipped for the plan's pixels ([`settle`]) stay so
+    /// for its next call ([`Lazy`]); another plan's call settles them first.
     #[inline(always)]
     fn run_in<'f, const CACHED: bool, const TILED: bool>(
         &mut self,
@@ -1101,8 +1154,18 @@ impl<'a> Simulator<'a> {
             ring,
             at,
             footprints,
+            lazy: kept,
             ..
         } = self;
+        // Skipped units of another plan are settled before this plan's pixels run.
+        let mut lazy = match *kept {
+            Some(Lazy { plan: p, t, n }) if p == plan => Some((t, n)),
+            Some(_) => {
+                settle_plan(alu, all_steps, plans, kept);
+                None
+            }
+            None => None,
+        };
         let ppc = *ppc;
         let ring = &mut ring[..];
         let mut st = *at;
@@ -1118,33 +1181,17 @@ impl<'a> Simulator<'a> {
                     ring[slot] = (t, C_LAT);
                 }
             }
-            Some(&PlanSteps {
-                start,
-                end,
-                distinct,
-                mono,
-            }) => {
-                let steps = &all_steps[start..end];
+            Some(p) => {
+                let (distinct, steps) = (p.distinct, &all_steps[p.start..p.end]);
                 // The one fetching stage, with the steps before and after it.
-                let one = mono.and_then(|at| {
-                    let (pre, rest) = steps.split_at(at.min(steps.len()));
-                    rest.split_first()
-                        .map(|(&step, post)| OneStage { pre, step, post })
-                });
-                // Its address/footprint unit's (cycles, occupancy) for one lookup.
-                let one = one.map(|one| (one, tex.setup(one.step.cycles, 1)));
-                // One pixel issued per cycle, the steps before the fetching stage and its
-                // address/footprint unit occupying their units at most 1 cycle: see [`settle`].
-                let (lazy_ok, pre_cycles) = one.map_or((false, 0), |(one, (_, setup_occ))| {
-                    let fits = ppc == 1 && setup_occ <= 1 && one.pre.iter().all(|s| s.occ <= 1);
-                    (fits, one.pre.iter().map(|s| s.cycles).sum::<u64>())
-                });
-                let mut lazy = None;
+                let one = p.one(all_steps);
+                let (lazy_ok, pre_cycles) =
+                    one.map_or((false, 0), |(_, m)| (m.lazy_ok, m.pre_cycles));
                 for fps in pixels {
                     fed += fps.len() as u64;
                     let (slot, t) = st.issue(ring, stall_by, ppc);
                     let (t, cause) = match one {
-                        Some((ref one, setup)) if one_lookup(fps, one.step.k) => {
+                        Some((ref one, Mono { setup, .. })) if one_lookup(fps, one.step.k) => {
                             let mut worst = (0u64, C_LAT);
                             let arrive = t + pre_cycles;
                             let (s, skipped) = match lazy {
@@ -1173,14 +1220,14 @@ impl<'a> Simulator<'a> {
                             );
                             (arith(alu, one.post, done, &mut worst), worst.1)
                         }
-                        Some((ref one, setup))
+                        Some((ref one, Mono { setup, .. }))
                             if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
                         {
                             settle(alu, one, setup.1, &mut lazy);
                             walk_mono::<CACHED, TILED>(alu, tex, one, fps, t, &mut quads)
                         }
                         _ => {
-                            if let Some((ref one, setup)) = one {
+                            if let Some((ref one, Mono { setup, .. })) = one {
                                 settle(alu, one, setup.1, &mut lazy);
                             }
                             walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads)
@@ -1189,17 +1236,21 @@ impl<'a> Simulator<'a> {
                     ring[slot] = (t, cause);
                     st.end = st.end.max(t);
                 }
-                if let Some((ref one, setup)) = one {
-                    settle(alu, one, setup.1, &mut lazy);
-                }
             }
         }
+        // Skipped units stay so for the plan's next call.
+        *kept = lazy.map(|(t, n)| Lazy { plan, t, n });
         if let Some(p) = plan_pixels.get_mut(plan as usize) {
             *p += st.pixels - first;
         }
         tex.mem.quads.add(&quads);
         *at = st;
         *footprints += fed;
+    }
+
+    /// Settles the skipped units, if any ([`Lazy`]): before a report reads them.
+    fn settle_all(&mut self) {
+        settle_plan(&mut self.alu, &self.steps, &self.plans, &mut self.lazy);
     }
 }
 
@@ -1326,6 +1377,30 @@ fn settle(alu: &mut [Unit; KINDS], one: &OneStage, setup_occ: u64, lazy: &mut Op
     }
 }
 
+/// [`Texturing::setup`] with trilinear samples of `tri_cycles` and the arithmetic units
+/// `pipelined` or not.
+#[inline(always)]
+fn setup_cost(cycles: u64, lookups: u64, tri_cycles: u64, pipelined: bool) -> (u64, u64) {
+    let setup = cycles.saturating_sub(lookups * tri_cycles).max(1);
+    let setup_occ = if pipelined { setup.min(1) } else { setup };
+    (setup, setup_occ)
+}
+
+/// [`settle`] of `lazy`'s plan (of `plans`, whose stages are in `steps`), if any.
+#[inline(never)]
+fn settle_plan(
+    alu: &mut [Unit; KINDS],
+    steps: &[Step],
+    plans: &[PlanSteps],
+    lazy: &mut Option<Lazy>,
+) {
+    if let Some(Lazy { plan, t, n }) = lazy.take() {
+        if let Some((one, m)) = plans.get(plan as usize).and_then(|p| p.one(steps)) {
+            settle(alu, &one, m.setup.1, &mut Some((t, n)));
+        }
+    }
+}
+
 impl Texturing {
     /// [`Texturing::stage_in`], not inlined (the general walk's texture stage).
     #[inline(never)]
@@ -1348,13 +1423,7 @@ impl Texturing {
     /// at least 1.
     #[inline(always)]
     fn setup(&self, cycles: u64, lookups: u64) -> (u64, u64) {
-        let setup = cycles.saturating_sub(lookups * self.tri_cycles).max(1);
-        let setup_occ = if self.alu_pipelined {
-            setup.min(1)
-        } else {
-            setup
-        };
-        (setup, setup_occ)
+        setup_cost(cycles, lookups, self.tri_cycles, self.alu_pipelined)
     }
 
     /// A texture stage of kind `k` (`cycles` per invocation, `alu` its address/footprint
@@ -1465,7 +1534,8 @@ impl Texturing {
 impl Simulator<'_> {
     /// Adds the visibility pass of the frame (`f`) and reports.
     #[must_use]
-    pub fn finish(self, f: &FrameCounts, scene: &str) -> TimingReport {
+    pub fn finish(mut self, f: &FrameCounts, scene: &str) -> TimingReport {
+        self.settle_all();
         let hw = self.hw;
         let tc = &hw.timing;
         let rc = &hw.raster;
