@@ -967,8 +967,9 @@ impl PlanSteps {
 
 /// Pixels of plan `plan` that skipped the steps before its fetching stage and its
 /// address/footprint unit ([`settle`]): the issue `t` of the last pixel of the run that
-/// started waiting for none of them, and the number `n` that skipped them. Kept across [`Simulator::run_in`]'s calls for the plan and settled
-/// before anything else reads or uses those units.
+/// started waiting for none of them, and the number `n` that skipped them. Kept across
+/// [`Simulator::run_in`]'s calls for the plan and settled before anything else reads or uses
+/// those units.
 #[derive(Clone, Copy, Debug)]
 struct Lazy {
     plan: u32,
