@@ -1909,4 +1909,64 @@ mod tests {
         );
         assert!(stepped > 100_000 && tested > 40_000, "{stepped} {tested}");
     }
+
+    /// 270k seeded spans of 1 to 8 lanes (the short spans of a mesh) over 5 configurations x
+    /// 3 interpolator roundings, edge values from 4 to 62 bits with zero edges and steps from
+    /// 4 bits to the edges' size: every lane of the span datapaths gives
+    /// the bits and saturation counts of one [`perspective_bary_derivs`] call per lane.
+    #[test]
+    fn short_spans_match_per_lane_calls() {
+        let mut s = 0x5407_5fa2;
+        let (mut short, mut spans) = (0u64, 0u64);
+        let mut got = [[[0i64; 3]; 3]; 8];
+        for (c, hw0) in previous_configs().into_iter().enumerate() {
+            for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
+                let mut hw = hw0.clone();
+                hw.interp.interp_rounding = mode;
+                let (cfg, recip) = (&hw.interp, Reciprocal::new(&hw.reciprocal));
+                let wb = cfg.inv_w_bits;
+                for i in 0..18_000u64 {
+                    let n = 1 + (next(&mut s) % 8) as usize;
+                    let eb = [4, 20, 40, 62 - wb - 1, 62 - wb, 63 - wb, 62][(i % 7) as usize];
+                    let db = [4, 20, eb.saturating_sub(3).max(1), eb][(i / 7 % 4) as usize];
+                    let mut edge = [0; 3].map(|_| signed(&mut s, eb));
+                    if i % 3 != 0 {
+                        edge = edge.map(i64::abs);
+                    }
+                    if i % 5 == 0 {
+                        edge[(i / 5 % 3) as usize] = 0;
+                    }
+                    let dx = [0; 3].map(|_| signed(&mut s, db) >> (i % 2 * 5));
+                    let dy = [0; 3].map(|_| signed(&mut s, db));
+                    let mut inv_w = [0; 3].map(|_| (next(&mut s) >> (64 - wb)) as i64 + 1);
+                    inv_w[(i as usize + c) % 3] = 1 << wb;
+                    let at = |j: usize| {
+                        [0, 1, 2].map(|k| i128::from(edge[k]) + j as i128 * i128::from(dx[k]))
+                    };
+                    if at(n - 1).iter().any(|e| i64::try_from(*e).is_err()) {
+                        continue;
+                    }
+                    let span = EdgeSpan {
+                        edge,
+                        dx,
+                        dy,
+                        lanes: n,
+                    };
+                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
+                    perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
+                        got[j] = b;
+                    });
+                    for (j, lane) in got[..n].iter().enumerate() {
+                        let e = at(j).map(|v| v as i64);
+                        let want = perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);
+                        assert_eq!(*lane, want, "{:?}", (e, dx, dy, inv_w, mode, c, j, n));
+                    }
+                    assert_eq!(sa, sb, "{edge:?} {dx:?} {dy:?} {inv_w:?} {mode:?} {c} {n}");
+                    spans += 1;
+                    short += u64::from(n == 1);
+                }
+            }
+        }
+        assert!(spans > 200_000 && short > 20_000, "{spans} {short}");
+    }
 }
