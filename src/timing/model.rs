@@ -334,9 +334,10 @@ struct Memory {
     /// DRAM page hit and miss cycles.
     page_hit: u64,
     page_miss: u64,
-    /// Tiled interleave with a power-of-two bank count: a texel's bank is its tile bits (no
-    /// clamp), so a footprint whose columns and rows differ in those bits reads 4 banks.
-    quad_banks: bool,
+    /// Tiled interleave with a power-of-two bank count (at most 64): `tile_mask`, else
+    /// (0, 0). A texel's bank is then its tile bits (no clamp), so a footprint whose columns
+    /// and rows differ in these bits reads 4 banks (never with (0, 0)).
+    quad_mask: (u32, u32),
     /// Latency a cache adds to a footprint (`cache_hit_cycles`).
     hit_latency: u64,
     /// [`Memory::quad_dram`]'s occupancy by the number of its page hits (0..=4; 8 slots so a
@@ -458,9 +459,14 @@ impl Memory {
             page_miss: u64::from(tc.dram_page_miss_cycles),
             hit_latency: u64::from(tc.cache_hit_cycles),
             quad_occ,
-            quad_banks: tc.bank_interleave == BankInterleave::Tiled
+            quad_mask: if tc.bank_interleave == BankInterleave::Tiled
                 && banks.is_power_of_two()
-                && banks <= 64,
+                && banks <= 64
+            {
+                (bank_tile.0 - 1, bank_tile.1 - 1)
+            } else {
+                (0, 0)
+            },
             counts: MemoryCounts::default(),
             quads: QuadCounts::default(),
         }
@@ -479,12 +485,8 @@ impl Memory {
         fp: &TexelFootprint,
         quads: &mut QuadCounts,
     ) -> (u64, u64) {
-        let (m0, m1) = self.tile_mask;
-        if !(TILED
-            && self.quad_banks
-            && (fp.x[0] ^ fp.x[1]) & m0 != 0
-            && (fp.y[0] ^ fp.y[1]) & m1 != 0)
-        {
+        let (m0, m1) = self.quad_mask;
+        if !(TILED && (fp.x[0] ^ fp.x[1]) & m0 != 0 && (fp.y[0] ^ fp.y[1]) & m1 != 0) {
             return self.footprint_any::<CACHED, TILED>(fp);
         }
         if !CACHED {
@@ -549,7 +551,7 @@ impl Memory {
     /// footprint as long as its slowest access; counted in `quads`.
     #[inline(always)]
     fn quad_dram(&mut self, fp: &TexelFootprint, quads: &mut QuadCounts) -> (u64, u64) {
-        let (m0, m1) = self.tile_mask;
+        let (m0, m1) = self.quad_mask;
         let sh = self.tile_shift;
         let lv = self.map.level(fp.tex, fp.level);
         let (px, py) = lv.page_shift;
