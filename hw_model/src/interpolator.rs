@@ -1258,6 +1258,44 @@ mod tests {
     use crate::test_rng::splitmix64 as next;
 
     /// A value of up to `bits` magnitude bits, either sign.
+    /// A seeded span for the span tests: `n` lanes, edges of `eb` bits (made positive unless
+    /// `i % 3 == 0`; edge `zero` then cleared), steps of `db` bits (x steps shifted right by
+    /// `dsh`), `1/w` of `wb` bits with vertex `(i + c) % 3` at 1; `None` when the last lane's
+    /// edges leave `i64`.
+    fn random_span(
+        s: &mut u64,
+        (n, eb, db, dsh): (usize, u32, u32, u32),
+        (i, c, wb): (usize, usize, u32),
+        zero: Option<usize>,
+    ) -> Option<(EdgeSpan, [i64; 3])> {
+        let mut edge = [0; 3].map(|_| signed(s, eb));
+        if i % 3 != 0 {
+            edge = edge.map(i64::abs);
+        }
+        if let Some(k) = zero {
+            edge[k] = 0;
+        }
+        let dx = [0; 3].map(|_| signed(s, db) >> dsh);
+        let dy = [0; 3].map(|_| signed(s, db));
+        let mut inv_w = [0; 3].map(|_| (next(s) >> (64 - wb)) as i64 + 1);
+        inv_w[(i + c) % 3] = 1 << wb;
+        let span = EdgeSpan {
+            edge,
+            dx,
+            dy,
+            lanes: n,
+        };
+        lane_at(&span, n - 1)
+            .iter()
+            .all(|e| i64::try_from(*e).is_ok())
+            .then_some((span, inv_w))
+    }
+
+    /// Lane `j`'s edges `edge + j dx` of `span`, exactly.
+    fn lane_at(span: &EdgeSpan, j: usize) -> [i128; 3] {
+        [0, 1, 2].map(|k| i128::from(span.edge[k]) + j as i128 * i128::from(span.dx[k]))
+    }
+
     fn signed(s: &mut u64, bits: u32) -> i64 {
         let v = (next(s) >> (64 - bits.clamp(1, 63))) as i64;
         if next(s) & 1 == 1 {
@@ -1806,26 +1844,13 @@ mod tests {
                         .chain([(60 - wb, 0)])
                         .nth((i / 6 % 5) as usize)
                         .unwrap_or((4, 5));
-                    let mut edge = [0; 3].map(|_| signed(&mut s, eb));
-                    if i % 3 != 0 {
-                        edge = edge.map(i64::abs);
-                    }
-                    let dx = [0; 3].map(|_| signed(&mut s, db) >> dsh);
-                    let dy = [0; 3].map(|_| signed(&mut s, db));
-                    let mut inv_w = [0; 3].map(|_| (next(&mut s) >> (64 - wb)) as i64 + 1);
-                    inv_w[(i as usize + c) % 3] = 1 << wb;
-                    let at = |j: usize| {
-                        [0, 1, 2].map(|k| i128::from(edge[k]) + j as i128 * i128::from(dx[k]))
-                    };
-                    if at(n - 1).iter().any(|e| i64::try_from(*e).is_err()) {
+                    let Some((span, inv_w)) =
+                        random_span(&mut s, (n, eb, db, dsh), (i as usize, c, wb), None)
+                    else {
                         continue;
-                    }
-                    let span = EdgeSpan {
-                        edge,
-                        dx,
-                        dy,
-                        lanes: n,
                     };
+                    let EdgeSpan { edge, dx, dy, .. } = span;
+                    let at = |j: usize| lane_at(&span, j);
                     let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
                     perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
                         got[j] = b;
@@ -1929,29 +1954,15 @@ mod tests {
                     let n = 1 + (next(&mut s) % 8) as usize;
                     let eb = [4, 20, 40, 62 - wb - 1, 62 - wb, 63 - wb, 62][(i % 7) as usize];
                     let db = [4, 20, eb.saturating_sub(3).max(1), eb][(i / 7 % 4) as usize];
-                    let mut edge = [0; 3].map(|_| signed(&mut s, eb));
-                    if i % 3 != 0 {
-                        edge = edge.map(i64::abs);
-                    }
-                    if i % 5 == 0 {
-                        edge[(i / 5 % 3) as usize] = 0;
-                    }
-                    let dx = [0; 3].map(|_| signed(&mut s, db) >> (i % 2 * 5));
-                    let dy = [0; 3].map(|_| signed(&mut s, db));
-                    let mut inv_w = [0; 3].map(|_| (next(&mut s) >> (64 - wb)) as i64 + 1);
-                    inv_w[(i as usize + c) % 3] = 1 << wb;
-                    let at = |j: usize| {
-                        [0, 1, 2].map(|k| i128::from(edge[k]) + j as i128 * i128::from(dx[k]))
-                    };
-                    if at(n - 1).iter().any(|e| i64::try_from(*e).is_err()) {
+                    let zero = (i % 5 == 0).then_some((i / 5 % 3) as usize);
+                    let dsh = (i % 2 * 5) as u32;
+                    let Some((span, inv_w)) =
+                        random_span(&mut s, (n, eb, db, dsh), (i as usize, c, wb), zero)
+                    else {
                         continue;
-                    }
-                    let span = EdgeSpan {
-                        edge,
-                        dx,
-                        dy,
-                        lanes: n,
                     };
+                    let EdgeSpan { edge, dx, dy, .. } = span;
+                    let at = |j: usize| lane_at(&span, j);
                     let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
                     perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
                         got[j] = b;
