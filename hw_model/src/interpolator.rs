@@ -566,7 +566,14 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
     };
     if let Some(ns_y) = held {
         let tops = Tops { nx, ny, ns_y };
-        return derivs_span_held::<M, R>(span, st, &tops, inv_w, cfg, recip, sat, out);
+        // The reciprocal's iteration count as a constant for the common widths.
+        return match recip.lane::<R>().narrow_iterations() {
+            Some(1) => derivs_span_held::<M, R, 1>(span, st, &tops, inv_w, cfg, recip, sat, out),
+            Some(2) => derivs_span_held::<M, R, 2>(span, st, &tops, inv_w, cfg, recip, sat, out),
+            _ => derivs_span_held::<M, R, ANY_ITERATIONS>(
+                span, st, &tops, inv_w, cfg, recip, sat, out,
+            ),
+        };
     }
     let limit = BARY_LIMIT as u64;
     for j in 0..span.lanes {
@@ -623,15 +630,21 @@ struct Tops {
     ns_y: (u32, u32),
 }
 
+/// The `N` of [`derivs_span_held`] that evaluates each `1/D` with
+/// [`crate::reciprocal::RecipLane::eval`] (any width and iteration count); another `N` takes
+/// [`crate::reciprocal::RecipLane::eval_narrow`] with `N` iterations.
+const ANY_ITERATIONS: u32 = u32::MAX;
+
 /// [`derivs_span_steady`] when every mantissa is below 2^29 and the y numerators keep one
-/// drop along the span ([`held_drop`]): per lane the barycentrics take
+/// drop along the span ([`held_drop`]): per lane `1/D` takes `eval_narrow::<N>` (`N` the
+/// iteration count, else [`ANY_ITERATIONS`]: `eval`), the barycentrics
 /// [`apply_i64_small_in`] (else [`apply_i64_in`]), the y tops are a shift of the stepped
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
 /// [`derivative_held`]'s 64-bit rounding (else each takes [`derivative_of_top`]). Checked
 /// against one call per lane in `derivs_span_stepping_matches_per_lane_calls`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn derivs_span_held<M: ConstRounding, R: ConstRounding>(
+fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     span: &EdgeSpan,
     st: &Steady,
     tops: &Tops,
@@ -656,7 +669,11 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding>(
     let limit = BARY_LIMIT as u64;
     for j in 0..span.lanes {
         // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
-        let r = lane_recip.eval(d as u64, &mut SatCounter::default());
+        let r = if N == ANY_ITERATIONS {
+            lane_recip.eval(d as u64, &mut SatCounter::default())
+        } else {
+            lane_recip.eval_narrow::<N>(d as u64)
+        };
         // `q_1`, `q_2` below 2^62 and the mantissa below 2^29.
         let (p1, p2) = match (
             apply_i64_small_in::<M>(r, q1, bb),

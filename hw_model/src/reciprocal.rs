@@ -203,15 +203,64 @@ impl<R: ConstRounding> RecipLane<'_, R> {
             }
         }
         // Normalize y (positive, about 2^P / m) to M + 1 significant bits.
+        self.normalized(y, p + n)
+    }
+}
+
+impl<R: ConstRounding> RecipLane<'_, R> {
+    /// The `recip_iterations` N when the working width P is in 1..=29 (where
+    /// [`RecipLane::eval_narrow`] applies), else `None`.
+    #[inline(always)]
+    #[must_use]
+    pub fn narrow_iterations(&self) -> Option<u32> {
+        (1..=29).contains(&self.p).then_some(self.iterations)
+    }
+
+    /// [`RecipLane::eval`] of an `x` in 1..2^62 when P is in 1..=29 and `recip_iterations`
+    /// is `N` ([`RecipLane::narrow_iterations`]): the same steps without the tests those bounds
+    /// settle (checked against `eval` in `eval_narrow_matches_eval`).
+    #[inline(always)]
+    #[must_use]
+    pub fn eval_narrow<const N: u32>(&self, x: u64) -> Recip {
+        debug_assert!(x != 0 && x >> 62 == 0 && (1..=29).contains(&self.p));
+        debug_assert_eq!(N, self.iterations);
+        let p = self.p;
+        let mut n = 63 - x.leading_zeros();
+        // m with P fraction bits, in [2^P, 2^(P+1)); `x` below 2^62, `n - p` in 1..=60.
+        let mut m: i64 = if n <= p {
+            (x << (p - n)) as i64
+        } else {
+            round_shift_right_small::<R>(x as i64, n - p)
+        };
+        if m >> (p + 1) != 0 {
+            m >>= 1;
+            n += 1;
+        }
+        let idx = (((m << self.idx_up) >> self.idx_down) & self.idx_mask) as usize;
+        let mut y = self.lut[idx] as i64;
+        let two = 2i64 << p;
+        // `eval`'s 64-bit steps (products below 2^(2p+2) <= 2^60).
+        for _ in 0..N {
+            let t = round_shift_right_small::<R>(m * y, p);
+            y = round_shift_right_small::<R>(y * (two - t), p);
+        }
+        self.normalized(y, p + n)
+    }
+
+    /// The last step of [`RecipLane::eval`]: `y` (positive, below 2^(P+2)) rounded to M + 1
+    /// significant bits, the result `y * 2^-(p + n)`.
+    #[inline(always)]
+    fn normalized(&self, y: i64, pn: u32) -> Recip {
+        let m_bits = self.m_bits;
         let b = 64 - (y as u64).leading_zeros();
         let drop = b - (m_bits + 1);
         let mut mant = if (1..64).contains(&drop) {
             // `y` is below 2^(P+2) <= 2^35.
             round_shift_right_small::<R>(y, drop)
         } else {
-            crate::fixed::round_shift_right(y, drop, rnd)
+            crate::fixed::round_shift_right(y, drop, R::MODE)
         } as u64;
-        let mut shift = (p + n) as i32 - drop as i32;
+        let mut shift = pn as i32 - drop as i32;
         if mant >> (m_bits + 1) != 0 {
             mant >>= 1;
             shift -= 1;
@@ -566,5 +615,58 @@ mod tests {
             }
         }
         assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
+    }
+
+    /// 4.6M seeded arguments in 1..2^62 (every bit length, 1 and 2^62 - 1 included) over every
+    /// rounding mode, LUT width 1..=16, iteration count 0..=4 and the mantissa widths 8..=26
+    /// (working width P <= 29, where `narrow_iterations` is `Some`): `eval_narrow::<N>` gives
+    /// `eval`'s bits; wider mantissas have no narrow form.
+    #[test]
+    fn eval_narrow_matches_eval() {
+        let mut s = 0x5eed_0008;
+        let base = HwConfig::texram16().reciprocal;
+        let mut cases = 0u64;
+        for mode in MODES {
+            for l in 1..=16 {
+                for n in 0..=4 {
+                    for mb in [8, 12, 16, 20, 23, 24, 25, 26, 27, 30] {
+                        let cfg = ReciprocalConfig {
+                            recip_lut_bits: l,
+                            recip_iterations: n,
+                            recip_mantissa_bits: mb,
+                            recip_rounding: mode,
+                            ..base.clone()
+                        };
+                        let u = Reciprocal::new(&cfg);
+                        crate::with_rounding!(mode, R => {
+                            let lane = u.lane::<R>();
+                            let Some(it) = lane.narrow_iterations() else {
+                                assert!(mb + GUARD_BITS > 29, "{cfg:?}");
+                                continue;
+                            };
+                            assert_eq!(it, n);
+                            for i in 0..2_400u32 {
+                                let x = match i {
+                                    0 => 1,
+                                    1 => (1 << 62) - 1,
+                                    _ => (next(&mut s) >> 2 >> (i % 62)).max(1),
+                                };
+                                let want = u.eval(x, &mut SatCounter::default());
+                                let got = match n {
+                                    0 => lane.eval_narrow::<0>(x),
+                                    1 => lane.eval_narrow::<1>(x),
+                                    2 => lane.eval_narrow::<2>(x),
+                                    3 => lane.eval_narrow::<3>(x),
+                                    _ => lane.eval_narrow::<4>(x),
+                                };
+                                assert_eq!(got, want, "1/{x} {cfg:?}");
+                                cases += 1;
+                            }
+                        });
+                    }
+                }
+            }
+        }
+        assert!(cases > 4_000_000, "{cases}");
     }
 }
