@@ -682,7 +682,9 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
             (Some(p1), Some(p2)) => (p1, p2),
             _ => (apply_i64_in::<M>(r, q1, bb), apply_i64_in::<M>(r, q2, bb)),
         };
-        if p1.unsigned_abs() <= limit && p2.unsigned_abs() <= limit {
+        // |p_1|, |p_2| <= 2^60 as one unsigned compare of the larger of `p_i + 2^60`.
+        let off = |p: i64| p.wrapping_add(BARY_LIMIT) as u64;
+        if off(p1).max(off(p2)) <= 2 * limit {
             let r2 = square(r, m_bits, M::MODE);
             let ty = [(ny[0] >> (ny1 & 63), ny1), (ny[1] >> (ny2 & 63), ny2)];
             let (x1, x2, y1, y2) = if (lo..hi).contains(&r2.shift) {
@@ -1830,12 +1832,14 @@ mod tests {
     /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
     /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
     /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
-    /// whose lanes test their own.
+    /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
+    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`.
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
         let (mut held_lanes, mut steady_lanes) = (0u64, 0u64);
         let (mut stepped, mut tested, mut held_small) = (0u64, 0u64, 0u64);
+        let mut held_clamped = 0u64;
         let mut got = [[[0i64; 3]; 3]; 24];
         // The widest mantissa of the held loop, with the reciprocal truncating.
         let mut widest = HwConfig::texram16();
@@ -1861,11 +1865,34 @@ mod tests {
                         .chain([(60 - wb, 0)])
                         .nth((i / 6 % 5) as usize)
                         .unwrap_or((4, 5));
-                    let Some((span, inv_w)) =
+                    let Some((mut span, inv_w)) =
                         random_span(&mut s, (n, eb, db, dsh), (i as usize, c, wb), None)
                     else {
                         continue;
                     };
+                    if i % 4 == 3 {
+                        // Near the horizon: `E_0` and its x step moved so that `D` is small
+                        // and positive along the span while `q_1`, `q_2` stay large (the
+                        // barycentrics beyond the clamp).
+                        let w = inv_w.map(i128::from);
+                        let d0 = (0..3)
+                            .map(|k| i128::from(span.edge[k]) * w[k])
+                            .sum::<i128>();
+                        let sx = (0..3).map(|k| i128::from(span.dx[k]) * w[k]).sum::<i128>();
+                        let t = i128::from(next(&mut s) % (1 << 20)) + 1;
+                        let e0 = i128::from(span.edge[0]) - (d0 - t).div_euclid(w[0]);
+                        let dx0 = i128::from(span.dx[0]) - sx.div_euclid(w[0]);
+                        let (Ok(e0), Ok(dx0)) = (i64::try_from(e0), i64::try_from(dx0)) else {
+                            continue;
+                        };
+                        (span.edge[0], span.dx[0]) = (e0, dx0);
+                        if lane_at(&span, n - 1)
+                            .iter()
+                            .any(|e| i64::try_from(*e).is_err())
+                        {
+                            continue;
+                        }
+                    }
                     let EdgeSpan { edge, dx, dy, .. } = span;
                     let at = |j: usize| lane_at(&span, j);
                     let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
@@ -1924,6 +1951,8 @@ mod tests {
                         {
                             if held {
                                 held_lanes += 1;
+                                held_clamped +=
+                                    u64::from(want[0][1..].iter().any(|v| v.abs() == BARY_LIMIT));
                                 // The lanes whose barycentrics take `apply_i64_small_in`.
                                 let r = recip.eval(d as u64, &mut SatCounter::default());
                                 let sh = r.shift - cfg.bary_bits as i32;
@@ -1942,9 +1971,10 @@ mod tests {
             }
         }
         println!(
-            "held {held_lanes} (small apply {held_small}) steady {steady_lanes} stepped {stepped} \
-             tested {tested}"
+            "held {held_lanes} (small apply {held_small}, clamped {held_clamped}) steady \
+             {steady_lanes} stepped {stepped} tested {tested}"
         );
+        assert!(held_clamped > 50_000, "{held_clamped}");
         assert!(
             held_lanes > 500_000 && steady_lanes > 100_000 && held_small > 200_000,
             "{held_lanes} {held_small} {steady_lanes}"
