@@ -1228,17 +1228,9 @@ impl<'a> Simulator<'a> {
                             );
                             (arith(alu, one.post, done, &mut worst), worst.1)
                         }
-                        Some((ref one, Mono { setup, .. }))
-                            if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
-                        {
-                            settle(alu, one, setup.1, &mut lazy);
-                            walk_mono::<CACHED, TILED>(alu, tex, one, fps, t)
-                        }
                         _ => {
-                            if let Some((ref one, Mono { setup, .. })) = one {
-                                settle(alu, one, setup.1, &mut lazy);
-                            }
-                            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t)
+                            let plan = (&one, steps, distinct);
+                            other_pixel::<CACHED, TILED>(alu, tex, plan, fps, t, &mut lazy)
                         }
                     };
                     ring[slot] = (t, cause);
@@ -1309,6 +1301,35 @@ fn walk<const CACHED: bool, const TILED: bool>(
         t = arith(alu, std::slice::from_ref(step), t, &mut worst);
     }
     (t, worst.1)
+}
+
+/// A pixel of a plan (its one fetching stage if any, its steps and whether their kinds are
+/// distinct) issued at `t` that is not one lookup of its one fetching stage: the skipped units
+/// settled ([`settle`]), [`walk_mono`] if its footprints `fps` are all that stage's, else
+/// [`walk`]. Out of line, so [`Simulator::run_in`]'s one-lookup loop stays small.
+#[inline(never)]
+fn other_pixel<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    (one, steps, distinct): (&Option<(OneStage, Mono)>, &[Step], bool),
+    fps: &[TexelFootprint],
+    t: u64,
+    lazy: &mut Option<(u64, u64)>,
+) -> (u64, usize) {
+    match one {
+        Some((one, Mono { setup, .. }))
+            if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
+        {
+            settle(alu, one, setup.1, lazy);
+            walk_mono::<CACHED, TILED>(alu, tex, one, fps, t)
+        }
+        _ => {
+            if let Some((one, Mono { setup, .. })) = one {
+                settle(alu, one, setup.1, lazy);
+            }
+            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t)
+        }
+    }
 }
 
 /// A plan's one fetching stage as [`walk_mono`] walks it: the steps before it, its step and
@@ -1481,7 +1502,10 @@ impl Texturing {
 
     /// One lookup of stage kind `k` from `ready` (its address/footprint unit done): its
     /// footprints `mine` through the memory, then the lookup on a filter unit; returns the
-    /// lookup's completion (at least `ready`).
+    /// lookup's completion (at least `ready`). The footprints all arrive at `ready`, so the
+    /// memory unit serves them back to back from the first one's start: they take it as one
+    /// request of their summed occupancy, and the last one starts latest (the longest wait)
+    /// and is ready last.
     #[inline(always)]
     fn lookup_from<const CACHED: bool, const TILED: bool>(
         &mut self,
@@ -1491,17 +1515,20 @@ impl Texturing {
         worst: &mut (u64, usize),
     ) -> u64 {
         const C_MEM: usize = StageKind::COUNT;
-        let mut bytes = 0u64;
-        let mut data = ready;
+        let (mut occ, mut bytes, mut last) = (0u64, 0u64, 0u64);
         for f in mine {
-            let (occ, b) = self.mem.footprint::<CACHED, TILED>(f);
-            let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
+            let (o, b) = self.mem.footprint::<CACHED, TILED>(f);
+            occ += o;
             bytes += b;
-            let ms = self.mem_unit.take(ready, occ);
+            last = o;
+        }
+        let mut data = ready;
+        if !mine.is_empty() {
+            let ms = self.mem_unit.take(ready, occ) + occ - last;
             if ms - ready > worst.0 {
                 *worst = (ms - ready, C_MEM);
             }
-            data = data.max(ms + lat);
+            data = ms + last + if CACHED { self.mem.hit_latency } else { 0 };
         }
         let done = ready.max(self.filter(data, mine.len(), worst));
         self.stage_bytes[k & (KINDS - 1)] += bytes;
