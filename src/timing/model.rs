@@ -206,12 +206,16 @@ const DUMMY_LEVEL: LevelAddr = LevelAddr {
 /// powers of two, so indices are shifts). The levels of every texture are in one table of
 /// `2^shift` entries per texture: texture `t`'s level `l` is entry `t << shift | l`, the
 /// entries beyond a texture's levels being the dummy level; `first` (texture `t`'s levels are
-/// `first[t]..first[t + 1]` in order) checks a lookup in debug builds.
+/// `first[t]..first[t + 1]` in order) checks a lookup in debug builds. `recent` keeps the
+/// last level resolved by [`AddressMap::level_recent`] per level parity (a trilinear lookup's
+/// two footprints are on neighbouring levels) with its key `tex << 8 | level` (`u32::MAX`:
+/// none).
 #[derive(Clone)]
 struct AddressMap {
     table: Vec<LevelAddr>,
     shift: u32,
     first: Vec<usize>,
+    recent: [(u32, LevelAddr); 2],
 }
 
 impl AddressMap {
@@ -247,7 +251,20 @@ impl AddressMap {
             table,
             shift,
             first,
+            recent: [(u32::MAX, DUMMY_LEVEL); 2],
         }
+    }
+
+    /// [`AddressMap::level`] through `recent`: a level resolved by the previous call of its
+    /// parity is not looked up again.
+    #[inline(always)]
+    fn level_recent(&mut self, tex: u16, level: u8) -> &LevelAddr {
+        let key = u32::from(tex) << 8 | u32::from(level);
+        let i = usize::from(level & 1);
+        if self.recent[i].0 != key {
+            self.recent[i] = (key, *self.level(tex, level));
+        }
+        &self.recent[i].1
     }
 
     /// The address record of a level (a dummy 1-texel level if out of range, which a
@@ -354,14 +371,6 @@ struct Memory {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct QuadCounts {
     by_hits: [u64; 8],
-}
-
-impl QuadCounts {
-    fn add(&mut self, q: &QuadCounts) {
-        for (a, b) in self.by_hits.iter_mut().zip(q.by_hits) {
-            *a += b;
-        }
-    }
 }
 
 /// The memory's running sums; [`MemoryCounts::report`] derives the rest of the report.
@@ -483,16 +492,15 @@ impl Memory {
     fn footprint<const CACHED: bool, const TILED: bool>(
         &mut self,
         fp: &TexelFootprint,
-        quads: &mut QuadCounts,
     ) -> (u64, u64) {
         let (m0, m1) = self.quad_mask;
         if !(TILED && (fp.x[0] ^ fp.x[1]) & m0 != 0 && (fp.y[0] ^ fp.y[1]) & m1 != 0) {
             return self.footprint_any::<CACHED, TILED>(fp);
         }
         if !CACHED {
-            return self.quad_dram(fp, quads);
+            return self.quad_dram(fp);
         }
-        let lv = self.map.level(fp.tex, fp.level);
+        let lv = self.map.level_recent(fp.tex, fp.level);
         let sh = self.tile_shift;
         let bank_col = fp.x.map(|x| (x & m0) as usize);
         let bank_row = fp.y.map(|y| ((y & m1) << sh) as usize);
@@ -548,12 +556,12 @@ impl Memory {
 
     /// [`Memory::footprint`]'s four-bank footprint without a cache: each texel a DRAM access
     /// to its own bank (hit if the bank's open page is the texel's, which it opens), the
-    /// footprint as long as its slowest access; counted in `quads`.
+    /// footprint as long as its slowest access; counted in [`Memory::quads`].
     #[inline(always)]
-    fn quad_dram(&mut self, fp: &TexelFootprint, quads: &mut QuadCounts) -> (u64, u64) {
+    fn quad_dram(&mut self, fp: &TexelFootprint) -> (u64, u64) {
         let (m0, m1) = self.quad_mask;
         let sh = self.tile_shift;
-        let lv = self.map.level(fp.tex, fp.level);
+        let lv = self.map.level_recent(fp.tex, fp.level);
         let (px, py) = lv.page_shift;
         let [x0, x1] = fp.x;
         let [y0, y1] = fp.y;
@@ -579,7 +587,7 @@ impl Memory {
             *o = page;
         }
         let occ = self.quad_occ[(hits & 7) as usize];
-        quads.by_hits[(hits & 7) as usize] += 1;
+        self.quads.by_hits[(hits & 7) as usize] += 1;
         (occ, bytes)
     }
 
@@ -1135,7 +1143,7 @@ impl<'a> Simulator<'a> {
     /// Issues each pixel of plan `plan` (the footprints its stages fetched) in turn, with the
     /// memory's [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache, for
     /// the tiled (`TILED`) or linear interleave. The plan is resolved once; the issue state
-    /// and the four-bank footprint counts live in locals for the batch. A plan with one
+    /// lives in locals for the batch. A plan with one
     /// fetching stage ([`PlanSteps::mono`]) walks a pixel whose footprints are all that
     /// stage's without matching footprints to stages ([`walk_mono`]); any other pixel takes
     /// the general walk ([`walk`]). Units skipped for the plan's pixels ([`settle`]) stay so
@@ -1173,7 +1181,6 @@ impl<'a> Simulator<'a> {
         let ring = &mut ring[..];
         let mut st = *at;
         let mut fed = 0u64;
-        let mut quads = QuadCounts::default();
         let first = st.pixels;
         match plans.get(plan as usize) {
             // A plan the frame does not have: the pixel issues and completes at once.
@@ -1213,27 +1220,17 @@ impl<'a> Simulator<'a> {
                                 }
                             };
                             lazy = (lazy_ok && s == arrive).then_some((t, skipped));
-                            let q = &mut quads;
                             let done = tex.lookup_from::<CACHED, TILED>(
                                 one.step.k,
                                 s + setup.0,
                                 fps,
                                 &mut worst,
-                                q,
                             );
                             (arith(alu, one.post, done, &mut worst), worst.1)
                         }
-                        Some((ref one, Mono { setup, .. }))
-                            if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
-                        {
-                            settle(alu, one, setup.1, &mut lazy);
-                            walk_mono::<CACHED, TILED>(alu, tex, one, fps, t, &mut quads)
-                        }
                         _ => {
-                            if let Some((ref one, Mono { setup, .. })) = one {
-                                settle(alu, one, setup.1, &mut lazy);
-                            }
-                            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t, &mut quads)
+                            let plan = (&one, steps, distinct);
+                            other_pixel::<CACHED, TILED>(alu, tex, plan, fps, t, &mut lazy)
                         }
                     };
                     ring[slot] = (t, cause);
@@ -1246,7 +1243,6 @@ impl<'a> Simulator<'a> {
         if let Some(p) = plan_pixels.get_mut(plan as usize) {
             *p += st.pixels - first;
         }
-        tex.mem.quads.add(&quads);
         *at = st;
         *footprints += fed;
     }
@@ -1285,7 +1281,6 @@ fn walk<const CACHED: bool, const TILED: bool>(
     distinct: bool,
     fps: &[TexelFootprint],
     mut t: u64,
-    quads: &mut QuadCounts,
 ) -> (u64, usize) {
     let mut worst = (0u64, C_LAT);
     // The stage kinds that fetched (stage kinds number fewer than 64).
@@ -1299,13 +1294,42 @@ fn walk<const CACHED: bool, const TILED: bool>(
                 let unit = &mut alu[k & (KINDS - 1)];
                 // The plan's count charges this step's arithmetic occupancy.
                 unit.busy = unit.busy.wrapping_sub(step.occ);
-                t = tex.stage::<CACHED, TILED>(unit, k, step.cycles, t, mine, &mut worst, quads);
+                t = tex.stage::<CACHED, TILED>(unit, k, step.cycles, t, mine, &mut worst);
                 continue;
             }
         }
         t = arith(alu, std::slice::from_ref(step), t, &mut worst);
     }
     (t, worst.1)
+}
+
+/// A pixel of a plan (its one fetching stage if any, its steps and whether their kinds are
+/// distinct) issued at `t` that is not one lookup of its one fetching stage: the skipped units
+/// settled ([`settle`]), [`walk_mono`] if its footprints `fps` are all that stage's, else
+/// [`walk`]. Out of line, so [`Simulator::run_in`]'s one-lookup loop stays small.
+#[inline(never)]
+fn other_pixel<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    (one, steps, distinct): (&Option<(OneStage, Mono)>, &[Step], bool),
+    fps: &[TexelFootprint],
+    t: u64,
+    lazy: &mut Option<(u64, u64)>,
+) -> (u64, usize) {
+    match one {
+        Some((one, Mono { setup, .. }))
+            if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
+        {
+            settle(alu, one, setup.1, lazy);
+            walk_mono::<CACHED, TILED>(alu, tex, one, fps, t)
+        }
+        _ => {
+            if let Some((one, Mono { setup, .. })) = one {
+                settle(alu, one, setup.1, lazy);
+            }
+            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t)
+        }
+    }
 }
 
 /// A plan's one fetching stage as [`walk_mono`] walks it: the steps before it, its step and
@@ -1327,7 +1351,6 @@ fn walk_mono<const CACHED: bool, const TILED: bool>(
     one: &OneStage,
     fps: &[TexelFootprint],
     t: u64,
-    quads: &mut QuadCounts,
 ) -> (u64, usize) {
     let mut worst = (0u64, C_LAT);
     let step = one.step;
@@ -1338,7 +1361,7 @@ fn walk_mono<const CACHED: bool, const TILED: bool>(
         let unit = &mut alu[step.k & (KINDS - 1)];
         unit.busy = unit.busy.wrapping_sub(step.occ);
         let w = &mut worst;
-        t = tex.stage_in::<CACHED, TILED>(unit, step.k, step.cycles, t, fps, w, quads);
+        t = tex.stage_in::<CACHED, TILED>(unit, step.k, step.cycles, t, fps, w);
     }
     (arith(alu, one.post, t, &mut worst), worst.1)
 }
@@ -1416,9 +1439,8 @@ impl Texturing {
         t: u64,
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
-        quads: &mut QuadCounts,
     ) -> u64 {
-        self.stage_in::<CACHED, TILED>(alu, k, cycles, t, mine, worst, quads)
+        self.stage_in::<CACHED, TILED>(alu, k, cycles, t, mine, worst)
     }
 
     /// The address/footprint unit's (cycles, occupancy) in a texture stage of `cycles` per
@@ -1445,7 +1467,6 @@ impl Texturing {
         t: u64,
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
-        quads: &mut QuadCounts,
     ) -> u64 {
         let (Some(first), Some(last)) = (mine.first(), mine.last()) else {
             return t;
@@ -1457,9 +1478,9 @@ impl Texturing {
         }
         let ready = s + setup;
         if mine.len() <= 2 && first.lookup == last.lookup {
-            return self.lookup_from::<CACHED, TILED>(k, ready, mine, worst, quads);
+            return self.lookup_from::<CACHED, TILED>(k, ready, mine, worst);
         }
-        self.runs_from::<CACHED, TILED>(k, ready, mine, worst, quads)
+        self.runs_from::<CACHED, TILED>(k, ready, mine, worst)
     }
 
     /// [`Texturing::lookup_from`] for each lookup of stage kind `k` whose footprints `mine`
@@ -1472,17 +1493,19 @@ impl Texturing {
         ready: u64,
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
-        quads: &mut QuadCounts,
     ) -> u64 {
         mine.chunk_by(|a, b| a.lookup == b.lookup)
             .fold(ready, |done, run| {
-                done.max(self.lookup_from::<CACHED, TILED>(k, ready, run, worst, quads))
+                done.max(self.lookup_from::<CACHED, TILED>(k, ready, run, worst))
             })
     }
 
     /// One lookup of stage kind `k` from `ready` (its address/footprint unit done): its
     /// footprints `mine` through the memory, then the lookup on a filter unit; returns the
-    /// lookup's completion (at least `ready`).
+    /// lookup's completion (at least `ready`). The footprints all arrive at `ready`, so the
+    /// memory unit serves them back to back from the first one's start: they take it as one
+    /// request of their summed occupancy, and the last one starts latest (the longest wait)
+    /// and is ready last.
     #[inline(always)]
     fn lookup_from<const CACHED: bool, const TILED: bool>(
         &mut self,
@@ -1490,20 +1513,22 @@ impl Texturing {
         ready: u64,
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
-        quads: &mut QuadCounts,
     ) -> u64 {
         const C_MEM: usize = StageKind::COUNT;
-        let mut bytes = 0u64;
-        let mut data = ready;
+        let (mut occ, mut bytes, mut last) = (0u64, 0u64, 0u64);
         for f in mine {
-            let (occ, b) = self.mem.footprint::<CACHED, TILED>(f, quads);
-            let lat = occ + if CACHED { self.mem.hit_latency } else { 0 };
+            let (o, b) = self.mem.footprint::<CACHED, TILED>(f);
+            occ += o;
             bytes += b;
-            let ms = self.mem_unit.take(ready, occ);
+            last = o;
+        }
+        let mut data = ready;
+        if !mine.is_empty() {
+            let ms = self.mem_unit.take(ready, occ) + occ - last;
             if ms - ready > worst.0 {
                 *worst = (ms - ready, C_MEM);
             }
-            data = data.max(ms + lat);
+            data = ms + last + if CACHED { self.mem.hit_latency } else { 0 };
         }
         let done = ready.max(self.filter(data, mine.len(), worst));
         self.stage_bytes[k & (KINDS - 1)] += bytes;
@@ -1686,7 +1711,7 @@ pub fn simulate(ev: &FrameEvents, hw: &HwConfig, scene: &str) -> TimingReport {
 
 #[cfg(test)]
 mod tests {
-    use super::{Memory, QuadCounts, TexelFootprint, TextureLayout};
+    use super::{Memory, TexelFootprint, TextureLayout};
     use crate::rng_common::Rng;
     use hw_model::timing_config::BankInterleave;
     use hw_model::HwConfig;
@@ -1725,7 +1750,6 @@ mod tests {
                 .collect();
             let mut fast = Memory::new(&textures, &tc);
             let mut general = fast.clone();
-            let mut fast_quads = QuadCounts::default();
             for i in 0..400 {
                 let tex = r.below(textures.len() as u64) as usize;
                 let level = r.below(2) as usize;
@@ -1741,29 +1765,28 @@ mod tests {
                     x: [x0, x1],
                     y: [y0, y1],
                 };
-                let q = &mut fast_quads;
                 let (want, got) = match (tc.cache_bytes > 0, tc.bank_interleave) {
                     (true, BankInterleave::Tiled) => (
                         general.footprint_any::<true, true>(&fp),
-                        fast.footprint::<true, true>(&fp, q),
+                        fast.footprint::<true, true>(&fp),
                     ),
                     (false, BankInterleave::Tiled) => (
                         general.footprint_any::<false, true>(&fp),
-                        fast.footprint::<false, true>(&fp, q),
+                        fast.footprint::<false, true>(&fp),
                     ),
                     (true, BankInterleave::Linear) => (
                         general.footprint_any::<true, false>(&fp),
-                        fast.footprint::<true, false>(&fp, q),
+                        fast.footprint::<true, false>(&fp),
                     ),
                     (false, BankInterleave::Linear) => (
                         general.footprint_any::<false, false>(&fp),
-                        fast.footprint::<false, false>(&fp, q),
+                        fast.footprint::<false, false>(&fp),
                     ),
                 };
                 assert_eq!(got, want, "case {case} footprint {i}: {fp:?}");
                 let (hit, miss) = (general.page_hit, general.page_miss);
                 assert_eq!(
-                    fast.counts.total(&fast_quads, hit, miss),
+                    fast.counts.total(&fast.quads, hit, miss),
                     general.counts.total(&general.quads, hit, miss),
                     "case {case} footprint {i}"
                 );
