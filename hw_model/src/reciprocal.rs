@@ -510,6 +510,22 @@ mod tests {
         }
     }
 
+    /// `base` with the seed table's index bits `l`, `n` Newton-Raphson steps, `mb` mantissa
+    /// bits and the rounding `mode`.
+    fn config(
+        base: &ReciprocalConfig,
+        (l, n, mb): (u32, u32, u32),
+        mode: Rounding,
+    ) -> ReciprocalConfig {
+        ReciprocalConfig {
+            recip_lut_bits: l,
+            recip_iterations: n,
+            recip_mantissa_bits: mb,
+            recip_rounding: mode,
+            ..base.clone()
+        }
+    }
+
     /// 3M seeded arguments over 15 configurations (every mode; LUT, iteration and mantissa
     /// widths varied; arguments of 1 to 64 bits and 0): `eval` and `apply` give the old bits, `apply`
     /// across the 64-bit path, the unchecked 128-bit product (|x| < 2^96) and the saturating
@@ -520,13 +536,7 @@ mod tests {
         let base = HwConfig::texram16().reciprocal;
         for mode in MODES {
             for (l, n, mb) in [(8, 2, 24), (8, 1, 24), (4, 3, 30), (12, 1, 16), (16, 0, 8)] {
-                let cfg = ReciprocalConfig {
-                    recip_lut_bits: l,
-                    recip_iterations: n,
-                    recip_mantissa_bits: mb,
-                    recip_rounding: mode,
-                    ..base.clone()
-                };
+                let cfg = config(&base, (l, n, mb), mode);
                 let u = Reciprocal::new(&cfg);
                 for i in 0..200_000u32 {
                     let x = if i == 0 { 0 } else { next(&mut s) >> (i % 64) };
@@ -566,13 +576,7 @@ mod tests {
                 (16, 0, 8),
                 (10, 1, 20),
             ] {
-                let cfg = ReciprocalConfig {
-                    recip_lut_bits: l,
-                    recip_iterations: n,
-                    recip_mantissa_bits: mb,
-                    recip_rounding: mode,
-                    ..base.clone()
-                };
+                let cfg = config(&base, (l, n, mb), mode);
                 let u = Reciprocal::new(&cfg);
                 for i in 0..200_000u32 {
                     let x = match [0, 1, 1 << 63, u64::MAX].get(i as usize) {
@@ -630,13 +634,7 @@ mod tests {
             for l in 1..=16 {
                 for n in 0..=4 {
                     for mb in [8, 12, 16, 20, 23, 24, 25, 26, 27, 30] {
-                        let cfg = ReciprocalConfig {
-                            recip_lut_bits: l,
-                            recip_iterations: n,
-                            recip_mantissa_bits: mb,
-                            recip_rounding: mode,
-                            ..base.clone()
-                        };
+                        let cfg = config(&base, (l, n, mb), mode);
                         let u = Reciprocal::new(&cfg);
                         crate::with_rounding!(mode, R => {
                             let lane = u.lane::<R>();
