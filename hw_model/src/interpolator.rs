@@ -1304,15 +1304,33 @@ mod tests {
             dy,
             lanes: n,
         };
-        lane_at(&span, n - 1)
-            .iter()
-            .all(|e| i64::try_from(*e).is_ok())
-            .then_some((span, inv_w))
+        last_lane_fits(&span).then_some((span, inv_w))
     }
 
     /// Lane `j`'s edges `edge + j dx` of `span`, exactly.
     fn lane_at(span: &EdgeSpan, j: usize) -> [i128; 3] {
         [0, 1, 2].map(|k| i128::from(span.edge[k]) + j as i128 * i128::from(span.dx[k]))
+    }
+
+    /// Whether the last lane's edges of `span` fit `i64` (the first lane's do).
+    fn last_lane_fits(span: &EdgeSpan) -> bool {
+        lane_at(span, span.lanes.max(1) - 1)
+            .iter()
+            .all(|e| i64::try_from(*e).is_ok())
+    }
+
+    /// [`perspective_bary_derivs_span`] of `span` into `got` (lane `j` at `got[j]`); returns
+    /// its saturation counts.
+    fn span_derivs(
+        span: &EdgeSpan,
+        inv_w: [i64; 3],
+        cfg: &InterpConfig,
+        recip: &Reciprocal,
+        got: &mut [[[i64; 3]; 3]],
+    ) -> SatCounter {
+        let mut sat = SatCounter::default();
+        perspective_bary_derivs_span(span, inv_w, cfg, recip, &mut sat, |j, b| got[j] = b);
+        sat
     }
 
     fn signed(s: &mut u64, bits: u32) -> i64 {
@@ -1886,19 +1904,14 @@ mod tests {
                             continue;
                         };
                         (span.edge[0], span.dx[0]) = (e0, dx0);
-                        if lane_at(&span, n - 1)
-                            .iter()
-                            .any(|e| i64::try_from(*e).is_err())
-                        {
+                        if !last_lane_fits(&span) {
                             continue;
                         }
                     }
                     let EdgeSpan { edge, dx, dy, .. } = span;
                     let at = |j: usize| lane_at(&span, j);
-                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
-                    perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
-                        got[j] = b;
-                    });
+                    let sa = span_derivs(&span, inv_w, cfg, &recip, &mut got);
+                    let mut sb = SatCounter::default();
                     // Whether the ends' products and sums fit `i64` (the span steps them).
                     let fits = |j: usize| {
                         let q = [0, 1, 2].map(|k| at(j)[k] * i128::from(inv_w[k]));
@@ -2010,10 +2023,8 @@ mod tests {
                     };
                     let EdgeSpan { edge, dx, dy, .. } = span;
                     let at = |j: usize| lane_at(&span, j);
-                    let (mut sa, mut sb) = (SatCounter::default(), SatCounter::default());
-                    perspective_bary_derivs_span(&span, inv_w, cfg, &recip, &mut sa, |j, b| {
-                        got[j] = b;
-                    });
+                    let sa = span_derivs(&span, inv_w, cfg, &recip, &mut got);
+                    let mut sb = SatCounter::default();
                     for (j, lane) in got[..n].iter().enumerate() {
                         let e = at(j).map(|v| v as i64);
                         let want = perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);

@@ -167,9 +167,9 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         }
         let p = self.p;
         let rnd = R::MODE;
-        let mut n = 63 - x.leading_zeros();
-        // m with P fraction bits, in [2^P, 2^(P+1)).
-        let mut m: i64 = if n <= p {
+        let n = 63 - x.leading_zeros();
+        // m with P fraction bits, in [2^P, 2^(P+1)] (a rounding up reaches 2^(P+1)).
+        let m: i64 = if n <= p {
             (x << (p - n)) as i64
         } else if n < 62 {
             // `x` below 2^62, `n - p` in 1..=60.
@@ -180,24 +180,11 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         } else {
             round_shift_right_wide(i128::from(x), n - p, rnd)
         };
-        if m >> (p + 1) != 0 {
-            m >>= 1;
-            n += 1;
-        }
-        // Top L fraction bits of m (m has only P; a wider index sees zeros below them); m is
-        // below 2^34 and L - P at most 5, so the left shift is exact.
-        let idx = (((m << self.idx_up) >> self.idx_down) & self.idx_mask) as usize;
-        let mut y = self.lut[idx] as i64;
-        let two = 2i64 << p;
+        let (m, n, mut y) = self.seed(m, n);
         if (1..=29).contains(&p) {
-            // `nr_step`'s 64-bit products, the tests on `p` out of the loop. With `m` in
-            // [1, 2) and the seed in (1/2, 1], `y` stays at most 1/m + 2^(1-p) (`y (2 - m y)
-            // <= 1/m`), so `t` is in [0, 2] and both products are below 2^(2p+2) <= 2^60.
-            for _ in 0..self.iterations {
-                let t = round_shift_right_small::<R>(m * y, p);
-                y = round_shift_right_small::<R>(y * (two - t), p);
-            }
+            y = self.steps_narrow(m, y, self.iterations);
         } else {
+            let two = 2i64 << p;
             for _ in 0..self.iterations {
                 y = nr_step(m, y, two, p, rnd);
             }
@@ -225,26 +212,44 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         debug_assert!(x != 0 && x >> 62 == 0 && (1..=29).contains(&self.p));
         debug_assert_eq!(N, self.iterations);
         let p = self.p;
-        let mut n = 63 - x.leading_zeros();
-        // m with P fraction bits, in [2^P, 2^(P+1)); `x` below 2^62, `n - p` in 1..=60.
-        let mut m: i64 = if n <= p {
+        let n = 63 - x.leading_zeros();
+        // m with P fraction bits, in [2^P, 2^(P+1)]; `x` below 2^62, `n - p` in 1..=60.
+        let m: i64 = if n <= p {
             (x << (p - n)) as i64
         } else {
             round_shift_right_small::<R>(x as i64, n - p)
         };
-        if m >> (p + 1) != 0 {
+        let (m, n, y) = self.seed(m, n);
+        self.normalized(self.steps_narrow(m, y, N), p + n)
+    }
+
+    /// `m` (P fraction bits, below 2^(P+2)) brought into [2^P, 2^(P+1)) with its exponent `n`,
+    /// and its seed from the table: `(m, n, y)`.
+    #[inline(always)]
+    fn seed(&self, mut m: i64, mut n: u32) -> (i64, u32, i64) {
+        if m >> (self.p + 1) != 0 {
             m >>= 1;
             n += 1;
         }
+        // Top L fraction bits of m (m has only P; a wider index sees zeros below them); m is
+        // below 2^34 and L - P at most 5, so the left shift is exact.
         let idx = (((m << self.idx_up) >> self.idx_down) & self.idx_mask) as usize;
-        let mut y = self.lut[idx] as i64;
+        (m, n, self.lut[idx] as i64)
+    }
+
+    /// `iterations` Newton-Raphson steps from the seed `y` when P is in 1..=29: `nr_step`'s
+    /// 64-bit products without its tests on P. With `m` in [1, 2) and the seed in (1/2, 1],
+    /// `y` stays at most 1/m + 2^(1-p) (`y (2 - m y) <= 1/m`), so `t` is in [0, 2] and both
+    /// products are below 2^(2p+2) <= 2^60.
+    #[inline(always)]
+    fn steps_narrow(&self, m: i64, mut y: i64, iterations: u32) -> i64 {
+        let p = self.p;
         let two = 2i64 << p;
-        // `eval`'s 64-bit steps (products below 2^(2p+2) <= 2^60).
-        for _ in 0..N {
+        for _ in 0..iterations {
             let t = round_shift_right_small::<R>(m * y, p);
             y = round_shift_right_small::<R>(y * (two - t), p);
         }
-        self.normalized(y, p + n)
+        y
     }
 
     /// The last step of [`RecipLane::eval`]: `y` (positive, below 2^(P+2)) rounded to M + 1
