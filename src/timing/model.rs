@@ -1203,8 +1203,14 @@ impl<'a> Simulator<'a> {
                         Some((ref one, Mono { setup, .. })) if one_lookup(fps, one.step.k) => {
                             let mut worst = (0u64, C_LAT);
                             let arrive = t + pre_cycles;
-                            let (s, skipped) = match lazy {
-                                Some((_, n)) => (arrive, n + 1),
+                            // Only a plan whose pixels may skip (`lazy_ok`) starts skipping, and
+                            // a skipping pixel reaches the stage at `arrive`: the next one skips.
+                            let s = match lazy {
+                                Some((_, n)) => {
+                                    debug_assert!(lazy_ok);
+                                    lazy = Some((t, n + 1));
+                                    arrive
+                                }
                                 None => {
                                     let pre_end = arith(alu, one.pre, t, &mut worst);
                                     let (k, occ) = (one.step.k, one.step.occ);
@@ -1215,10 +1221,10 @@ impl<'a> Simulator<'a> {
                                     if s - pre_end > worst.0 {
                                         worst = (s - pre_end, k);
                                     }
-                                    (s, 0)
+                                    lazy = (lazy_ok && s == arrive).then_some((t, 0));
+                                    s
                                 }
                             };
-                            lazy = (lazy_ok && s == arrive).then_some((t, skipped));
                             let done = tex.lookup_from::<CACHED, TILED>(
                                 one.step.k,
                                 s + setup.0,
