@@ -187,8 +187,15 @@ fn level_from_u16(width: u32, height: u32, texels: &[[u16; 4]]) -> MipLevel {
 /// they run out) the remaining levels are box-filtered.
 #[must_use]
 pub fn build_mip_chain(tex: &TextureImage) -> MipChain {
+    build_levels(tex).0
+}
+
+/// [`build_mip_chain`] and, per level, the 16-bit texels it was made from (`None` for the
+/// box-filtered levels).
+fn build_levels(tex: &TextureImage) -> (MipChain, Vec<Option<&[[u16; 4]]>>) {
     let sizes = chain_sizes(tex.width, tex.height);
     let mut levels = Vec::with_capacity(sizes.len());
+    let mut sources = Vec::with_capacity(sizes.len());
     let expected0 = tex.width as usize * tex.height as usize;
     if tex.width == 0 || tex.height == 0 || tex.texels.len() != expected0 {
         // Not a valid image (`scene::validate` rejects these); give a defined 1x1 black chain.
@@ -197,25 +204,82 @@ pub fn build_mip_chain(tex: &TextureImage) -> MipChain {
             height: 1,
             texels: vec![[0.0; 4]],
         });
-        return MipChain { levels };
+        return (MipChain { levels }, vec![None]);
     }
     levels.push(level_from_u16(tex.width, tex.height, &tex.texels));
+    sources.push(Some(&tex.texels[..]));
     let prebuilt = tex.prebuilt_levels.as_deref().unwrap_or(&[]);
     let mut use_prebuilt = true;
     for (li, &(w, h)) in sizes.iter().enumerate().skip(1) {
         let pre = prebuilt
             .get(li - 1)
             .filter(|(pw, ph, t)| *pw == w && *ph == h && t.len() == w as usize * h as usize);
-        let level = match pre {
-            Some((pw, ph, t)) if use_prebuilt => level_from_u16(*pw, *ph, t),
+        let (level, source) = match pre {
+            Some((pw, ph, t)) if use_prebuilt => (level_from_u16(*pw, *ph, t), Some(&t[..])),
             _ => {
                 use_prebuilt = false;
-                downsample(&levels[li - 1])
+                (downsample(&levels[li - 1]), None)
             }
         };
         levels.push(level);
+        sources.push(source);
     }
-    MipChain { levels }
+    (MipChain { levels }, sources)
+}
+
+/// `quantize_unorm(v / 65535, bits)` for every 16-bit `v`, `bits` in 1..=16 (built once).
+fn u16_table(bits: u32) -> &'static [u16; 65536] {
+    static TABLES: [std::sync::OnceLock<Box<[u16; 65536]>>; 16] =
+        [const { std::sync::OnceLock::new() }; 16];
+    TABLES[bits as usize - 1].get_or_init(|| {
+        let mut t = Box::new([0u16; 65536]);
+        for (v, q) in (0..=u16::MAX).zip(t.iter_mut()) {
+            *q = quantize_unorm(f32::from(v) / 65535.0, bits);
+        }
+        t
+    })
+}
+
+/// Quantizes 16-bit texels `v` as their float level `v / 65535` quantizes to `bits` (1..=16):
+/// a copy at 16 bits, else a table of [`quantize_unorm`].
+#[must_use]
+pub fn quantize_u16_texels(texels: &[[u16; 4]], bits: u32) -> Vec<[u16; 4]> {
+    let bits = bits.clamp(1, 16);
+    if bits == 16 {
+        return texels.to_vec();
+    }
+    let t = u16_table(bits);
+    texels
+        .par_iter()
+        .map(|p| p.map(|c| t[usize::from(c)]))
+        .collect()
+}
+
+/// `(build_mip_chain(tex), quantize_chain(&build_mip_chain(tex), texel_bits))` in one pass:
+/// the levels made from 16-bit texels quantize from those ([`quantize_u16_texels`]).
+#[must_use]
+pub fn build_chains(tex: &TextureImage, texel_bits: u32) -> (MipChain, FixedMipChain) {
+    let bits = texel_bits.clamp(1, 16);
+    let (chain, sources) = build_levels(tex);
+    let levels = chain
+        .levels
+        .iter()
+        .zip(&sources)
+        .map(|(l, src)| FixedLevel {
+            width: l.width,
+            height: l.height,
+            texels: match src {
+                Some(t) => quantize_u16_texels(t, bits),
+                None => quantize_texels(&l.texels, bits),
+            },
+        })
+        .collect();
+    let fixed = FixedMipChain {
+        texel_bits: bits,
+        format: TexelFormat { channels: 4, bits },
+        levels,
+    };
+    (chain, fixed)
 }
 
 /// Quantizes one value in 0..1 to `bits` bits (module doc rule).
@@ -245,12 +309,15 @@ pub fn quantize_chain(chain: &MipChain, texel_bits: u32) -> FixedMipChain {
             .map(|l| FixedLevel {
                 width: l.width,
                 height: l.height,
-                texels: l
-                    .texels
-                    .par_iter()
-                    .map(|t| t.map(|c| quantize_unorm(c, bits)))
-                    .collect(),
+                texels: quantize_texels(&l.texels, bits),
             })
             .collect(),
     }
+}
+
+fn quantize_texels(texels: &[[f32; 4]], bits: u32) -> Vec<[u16; 4]> {
+    texels
+        .par_iter()
+        .map(|t| t.map(|c| quantize_unorm(c, bits)))
+        .collect()
 }

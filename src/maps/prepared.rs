@@ -3,7 +3,7 @@
 //! width. Map `i` of [`Maps`] is the same map in `float[i]` and `fixed[i]`.
 
 use super::{
-    build_mip_chain, quantize_chain, quantize_unorm, FixedMipChain, MipChain, OFFSET_CHANNELS,
+    build_chains, quantize_chain, quantize_unorm, FixedMipChain, MipChain, OFFSET_CHANNELS,
 };
 use crate::scene::{Scene, TextureImage};
 use crate::shading::bump::{
@@ -123,9 +123,17 @@ fn quantize_host_maps(
 }
 
 /// Encodes offsets (range `2^offset_int_bits`) and builds the offset map's MIP chain with the
-/// ordinary texture path (16-bit unorm level 0, box-filtered levels). Returns the chain and
-/// the number of clamped offsets.
-fn offset_chain(w: u32, h: u32, name: &str, offs: &[[f32; 2]], bits: u32) -> (MipChain, u64) {
+/// ordinary texture path (16-bit unorm level 0, box-filtered levels). Returns the chain, its
+/// quantization to `texel_bits` (stored as the two offset channels) and the number of clamped
+/// offsets.
+fn offset_chain(
+    w: u32,
+    h: u32,
+    name: &str,
+    offs: &[[f32; 2]],
+    bits: u32,
+    texel_bits: u32,
+) -> (MipChain, FixedMipChain, u64) {
     let enc = OffsetEncoding::for_offset_int_bits(bits);
     let img = offsets_to_image(offs, w, h, &enc);
     let tex = TextureImage {
@@ -139,7 +147,9 @@ fn offset_chain(w: u32, h: u32, name: &str, offs: &[[f32; 2]], bits: u32) -> (Mi
             .collect(),
         prebuilt_levels: None,
     };
-    (build_mip_chain(&tex), img.clamped)
+    let (c, q) = build_chains(&tex, texel_bits);
+    let tb = q.texel_bits;
+    (c, q.stored_as(OFFSET_CHANNELS, tb), img.clamped)
 }
 
 impl Maps {
@@ -158,7 +168,11 @@ impl Maps {
     /// cannot be converted (bad size) gives a flat offset map.
     #[must_use]
     pub fn with_offset_bits(scene: &Scene, texel_bits: u32, offset_int_bits: u32) -> Self {
-        let mut float: Vec<MipChain> = scene.textures.par_iter().map(build_mip_chain).collect();
+        let (mut float, mut fixed): (Vec<MipChain>, Vec<FixedMipChain>) = scene
+            .textures
+            .par_iter()
+            .map(|t| build_chains(t, texel_bits))
+            .unzip();
         let mut bump_offsets = Vec::new();
         let mut normal_nz_clamped = 0;
         for b in bump_sources(scene) {
@@ -183,11 +197,11 @@ impl Maps {
         }
         let mut bump_clamped = normal_nz_clamped;
         for (w, h, name, offs) in &bump_offsets {
-            let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
+            let (c, q, cl) = offset_chain(*w, *h, name, offs, offset_int_bits, texel_bits);
             float.push(c);
+            fixed.push(q);
             bump_clamped += cl;
         }
-        let fixed = quantize_host_maps(&float, float.len() - bump_offsets.len(), texel_bits);
         let mut maps = Self {
             float,
             fixed,
@@ -275,9 +289,8 @@ impl Maps {
         let texel_bits = self.fixed.first().map_or(16, |f| f.texel_bits);
         self.bump_clamped = self.normal_nz_clamped;
         for (k, (w, h, name, offs)) in self.bump_offsets.iter().enumerate() {
-            let (c, cl) = offset_chain(*w, *h, name, offs, offset_int_bits);
-            self.fixed[first + k] =
-                quantize_chain(&c, texel_bits).stored_as(OFFSET_CHANNELS, texel_bits);
+            let (c, q, cl) = offset_chain(*w, *h, name, offs, offset_int_bits, texel_bits);
+            self.fixed[first + k] = q;
             self.float[first + k] = c;
             self.bump_clamped += cl;
         }

@@ -87,21 +87,23 @@ pub fn hash2(x: u32, y: u32) -> u32 {
 #[must_use]
 pub fn noise_checker_rgba8(size: u32, light: [i32; 3], dark: [i32; 3]) -> Vec<[u8; 4]> {
     let n = size as usize;
-    (0..n * n)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = ((i % n) as u32, (i / n) as u32);
-            let check = ((x >> 3) ^ (y >> 3)) & 1;
-            let c = if check == 1 { light } else { dark };
-            let h = hash2(x, y);
-            let mut p = [0u8, 0, 0, 255];
-            for k in 0..3 {
-                let n = ((h >> (8 * k)) & 63) as i32 - 32;
-                p[k] = (c[k] + n).clamp(0, 255) as u8;
+    let mut out = vec![[0u8; 4]; n * n];
+    out.par_chunks_mut(n.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            let y = y as u32;
+            for (p, x) in row.iter_mut().zip(0u32..) {
+                let check = ((x >> 3) ^ (y >> 3)) & 1;
+                let c = if check == 1 { light } else { dark };
+                let h = hash2(x, y);
+                *p = [0, 0, 0, 255];
+                for k in 0..3 {
+                    let n = ((h >> (8 * k)) & 63) as i32 - 32;
+                    p[k] = (c[k] + n).clamp(0, 255) as u8;
+                }
             }
-            p
-        })
-        .collect()
+        });
+    out
 }
 
 /// The Mesa anchor's next level: `(a+b+c+d+2) >> 2` per channel (`downsample` in the anchor).
@@ -109,22 +111,34 @@ pub fn noise_checker_rgba8(size: u32, light: [i32; 3], dark: [i32; 3]) -> Vec<[u
 pub fn downsample_rgba8(src: &[[u8; 4]], w: u32, h: u32) -> (u32, u32, Vec<[u8; 4]>) {
     let nw = if w > 1 { w / 2 } else { 1 };
     let nh = if h > 1 { h / 2 } else { 1 };
-    let at = |x: u32, y: u32| src[y as usize * w as usize + x as usize];
-    let d = (0..nw as usize * nh as usize)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = ((i % nw as usize) as u32, (i / nw as usize) as u32);
-            let (x0, x1) = (2 * x, if w > 1 { 2 * x + 1 } else { 2 * x });
-            let (y0, y1) = (2 * y, if h > 1 { 2 * y + 1 } else { 2 * y });
-            let (a, b, c, e) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
-            let mut p = [0u8; 4];
-            for k in 0..4 {
-                let s = u32::from(a[k]) + u32::from(b[k]) + u32::from(c[k]) + u32::from(e[k]);
-                p[k] = ((s + 2) >> 2) as u8;
+    let avg = |a: [u8; 4], b: [u8; 4], c: [u8; 4], e: [u8; 4]| {
+        let mut p = [0u8; 4];
+        for k in 0..4 {
+            let s = u32::from(a[k]) + u32::from(b[k]) + u32::from(c[k]) + u32::from(e[k]);
+            p[k] = ((s + 2) >> 2) as u8;
+        }
+        p
+    };
+    let wu = w as usize;
+    let mut d = vec![[0u8; 4]; nw as usize * nh as usize];
+    d.par_chunks_mut(nw as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let y0 = 2 * y;
+            let y1 = if h > 1 { y0 + 1 } else { y0 };
+            let (r0, r1) = (&src[y0 * wu..][..wu], &src[y1 * wu..][..wu]);
+            if w > 1 {
+                for ((p, a), c) in row
+                    .iter_mut()
+                    .zip(r0.chunks_exact(2))
+                    .zip(r1.chunks_exact(2))
+                {
+                    *p = avg(a[0], a[1], c[0], c[1]);
+                }
+            } else {
+                row[0] = avg(r0[0], r0[0], r1[0], r1[0]);
             }
-            p
-        })
-        .collect();
+        });
     (nw, nh, d)
 }
 

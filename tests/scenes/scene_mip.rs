@@ -3,8 +3,12 @@
 //! hashes (FNV-1a-64 of the 8-bit bytes, as `mesa_anchor.c` prints them).
 
 use crate::rng_common::Rng;
-use texsim::maps::{build_mip_chain, chain_sizes, quantize_chain, quantize_unorm};
-use texsim::scene::texture::mesa_levels_rgba8;
+use texsim::maps::{
+    build_chains, build_mip_chain, chain_sizes, quantize_chain, quantize_u16_texels, quantize_unorm,
+};
+use texsim::scene::texture::{
+    downsample_rgba8, mesa_levels_rgba8, mesa_texture, noise_checker_rgba8, MESA_DARK, MESA_LIGHT,
+};
 use texsim::scene::{builtin, TextureImage};
 
 fn random_texture(rng: &mut Rng, w: u32, h: u32) -> TextureImage {
@@ -254,4 +258,129 @@ fn prebuilt_levels_are_used_only_when_consistent() {
     let q = quantize_chain(&build_mip_chain(&tex), 16);
     assert_eq!(q.levels[1].texels, l1);
     assert_eq!(q.levels[2].texels, vec![[1000, 2000, 3000, 4000]]);
+}
+
+#[test]
+fn u16_quantization_matches_the_float_path_exhaustively() {
+    let all: Vec<[u16; 4]> = (0..=65535u32)
+        .map(|v| {
+            [
+                v as u16,
+                (65535 - v) as u16,
+                (v * 7 % 65536) as u16,
+                v as u16,
+            ]
+        })
+        .collect();
+    for bits in 0..=17u32 {
+        let q = quantize_u16_texels(&all, bits);
+        for (p, t) in all.iter().zip(&q) {
+            let f = p.map(|c| quantize_unorm(f32::from(c) / 65535.0, bits));
+            assert_eq!(*t, f, "bits {bits} texel {p:?}");
+        }
+    }
+}
+
+fn assert_chains_match(tex: &TextureImage, what: &str) {
+    let float = build_mip_chain(tex);
+    for bits in 0..=17u32 {
+        let (c, q) = build_chains(tex, bits);
+        assert_eq!(c, float, "{what}");
+        assert_eq!(q, quantize_chain(&float, bits), "{what} bits {bits}");
+    }
+}
+
+#[test]
+fn build_chains_matches_build_then_quantize() {
+    let mut rng = Rng(31);
+    for &(w, h) in &[
+        (1, 1),
+        (2, 2),
+        (5, 3),
+        (7, 1),
+        (1, 6),
+        (16, 16),
+        (33, 17),
+        (64, 9),
+    ] {
+        let tex = random_texture(&mut rng, w, h);
+        assert_chains_match(&tex, &format!("random {w}x{h}"));
+    }
+    // Prebuilt levels: all consistent (Mesa), and a wrong size part way down.
+    assert_chains_match(&mesa_texture(64), "mesa-64");
+    let mut tex = random_texture(&mut rng, 8, 8);
+    tex.prebuilt_levels = Some(vec![
+        (4, 4, vec![[1000, 2000, 3000, 4000]; 16]),
+        (2, 1, vec![[0; 4]; 2]),
+    ]);
+    assert_chains_match(&tex, "bad prebuilt");
+    // Invalid image: the 1x1 black chain.
+    tex.texels.pop();
+    assert_chains_match(&tex, "invalid");
+    // Random 8-bit data (x 257), the decoder's and generators' usual input, on many sizes.
+    for _ in 0..40 {
+        let (w, h) = (1 + rng.below(40) as u32, 1 + rng.below(40) as u32);
+        let mut tex = random_texture(&mut rng, w, h);
+        for p in &mut tex.texels {
+            *p = p.map(|c| (c >> 8) * 257);
+        }
+        assert_chains_match(&tex, &format!("8-bit {w}x{h}"));
+    }
+}
+
+/// `downsample_rgba8` as the anchor writes it, texel by texel.
+fn downsample_model(src: &[[u8; 4]], w: u32, h: u32) -> (u32, u32, Vec<[u8; 4]>) {
+    let nw = if w > 1 { w / 2 } else { 1 };
+    let nh = if h > 1 { h / 2 } else { 1 };
+    let at = |x: u32, y: u32| src[(y * w + x) as usize];
+    let mut d = Vec::new();
+    for y in 0..nh {
+        for x in 0..nw {
+            let (x0, x1) = (2 * x, if w > 1 { 2 * x + 1 } else { 2 * x });
+            let (y0, y1) = (2 * y, if h > 1 { 2 * y + 1 } else { 2 * y });
+            let t = [at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)];
+            d.push(std::array::from_fn(|k| {
+                let s: u32 = t.iter().map(|p| u32::from(p[k])).sum();
+                ((s + 2) >> 2) as u8
+            }));
+        }
+    }
+    (nw, nh, d)
+}
+
+#[test]
+fn rgba8_generators_match_texel_models() {
+    let mut rng = Rng(77);
+    for _ in 0..200 {
+        let (w, h) = (1 + rng.below(37) as u32, 1 + rng.below(37) as u32);
+        let src: Vec<[u8; 4]> = (0..w * h)
+            .map(|_| std::array::from_fn(|_| rng.below(256) as u8))
+            .collect();
+        assert_eq!(
+            downsample_rgba8(&src, w, h),
+            downsample_model(&src, w, h),
+            "{w}x{h}"
+        );
+    }
+    for size in [0u32, 1, 3, 8, 17, 100] {
+        let t = noise_checker_rgba8(size, MESA_LIGHT, MESA_DARK);
+        assert_eq!(t.len(), (size * size) as usize);
+        for (i, p) in t.iter().enumerate() {
+            let (x, y) = (i as u32 % size, i as u32 / size);
+            let c = if ((x >> 3) ^ (y >> 3)) & 1 == 1 {
+                MESA_LIGHT
+            } else {
+                MESA_DARK
+            };
+            let hh = texsim::scene::texture::hash2(x, y);
+            let want: [u8; 4] = std::array::from_fn(|k| {
+                if k == 3 {
+                    255
+                } else {
+                    (c[k] + ((hh >> (8 * k)) & 63) as i32 - 32).clamp(0, 255) as u8
+                }
+            });
+            assert_eq!(*p, want, "size {size} texel {i}");
+        }
+    }
 }
