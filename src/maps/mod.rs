@@ -170,14 +170,16 @@ pub fn downsample(src: &MipLevel) -> MipLevel {
     }
 }
 
+/// A 16-bit unorm channel as a float level holds it: `v / 65535`.
+fn unorm16(v: u16) -> f32 {
+    f32::from(v) / 65535.0
+}
+
 fn level_from_u16(width: u32, height: u32, texels: &[[u16; 4]]) -> MipLevel {
     MipLevel {
         width,
         height,
-        texels: texels
-            .iter()
-            .map(|t| t.map(|c| f32::from(c) / 65535.0))
-            .collect(),
+        texels: texels.iter().map(|t| t.map(unorm16)).collect(),
     }
 }
 
@@ -227,14 +229,15 @@ fn build_levels(tex: &TextureImage) -> (MipChain, Vec<Option<&[[u16; 4]]>>) {
     (MipChain { levels }, sources)
 }
 
-/// `quantize_unorm(v / 65535, bits)` for every 16-bit `v`, `bits` in 1..=16 (built once).
+/// `quantize_unorm(unorm16(v), bits)` for every 16-bit `v`, `bits` in 1..=16 (built once):
+/// the float path's value for a level made from 16-bit texels, by construction.
 fn u16_table(bits: u32) -> &'static [u16; 65536] {
     static TABLES: [std::sync::OnceLock<Box<[u16; 65536]>>; 16] =
         [const { std::sync::OnceLock::new() }; 16];
     TABLES[bits as usize - 1].get_or_init(|| {
         let mut t = Box::new([0u16; 65536]);
         for (v, q) in (0..=u16::MAX).zip(t.iter_mut()) {
-            *q = quantize_unorm(f32::from(v) / 65535.0, bits);
+            *q = quantize_unorm(unorm16(v), bits);
         }
         t
     })
@@ -315,6 +318,7 @@ pub fn quantize_chain(chain: &MipChain, texel_bits: u32) -> FixedMipChain {
     }
 }
 
+/// [`quantize_unorm`] on every channel of float texels (`bits` already clamped).
 fn quantize_texels(texels: &[[f32; 4]], bits: u32) -> Vec<[u16; 4]> {
     texels
         .par_iter()
