@@ -58,10 +58,13 @@ impl Image {
     /// `(x * 255 + 32767) / 65535`.
     #[must_use]
     pub fn to_rgba8(&self) -> Vec<u8> {
-        self.px
-            .iter()
-            .flat_map(|p| p.map(|c| quantize(c, 8) as u8))
-            .collect()
+        let mut bytes = vec![0u8; self.px.len() * 4];
+        for (out, p) in bytes.chunks_exact_mut(4).zip(&self.px) {
+            for (o, &c) in out.iter_mut().zip(p) {
+                *o = unorm16_to_unorm8(c);
+            }
+        }
+        bytes
     }
 
     /// Whether `px` holds exactly `width * height` pixels.
@@ -69,4 +72,11 @@ impl Image {
     pub fn is_consistent(&self) -> bool {
         u64::from(self.width) * u64::from(self.height) == self.px.len() as u64
     }
+}
+
+/// [`quantize`]`(c, 8)` in 32-bit arithmetic, without its clamp:
+/// `(c * 255 + 32767) / 65535` stays below 2^24.
+#[inline]
+fn unorm16_to_unorm8(c: u16) -> u8 {
+    ((u32::from(c) * 255 + 32767) / 65535) as u8
 }

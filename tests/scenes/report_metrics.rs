@@ -110,19 +110,28 @@ fn quantize_first_then_difference() {
     assert_eq!(compare(&a, &b, 99, None).bits, 16);
 }
 
+/// Four different channel values made from `v`; each channel covers all 65,536 values over `v`.
+fn channels(v: u16) -> [u16; 4] {
+    [v, !v, v.rotate_left(5), v ^ 0x5a5a]
+}
+
 #[test]
 fn quantize_8_matches_to_rgba8_exhaustively() {
     let img = Image {
         width: 65536,
         height: 1,
-        px: (0..=u16::MAX).map(|v| [v, v, v, v]).collect(),
+        px: (0..=u16::MAX).map(channels).collect(),
     };
     let b = img.to_rgba8();
     assert_eq!(b.len(), 65536 * 4);
+    let rule = |v: u16| ((f64::from(v) * 255.0 / 65535.0) + 0.5).floor() as u8;
     for v in 0..=u16::MAX {
-        let expect = ((f64::from(v) * 255.0 / 65535.0) + 0.5).floor() as u8;
-        assert_eq!(b[usize::from(v) * 4], expect, "v={v}");
-        assert_eq!(b[usize::from(v) * 4 + 3], expect, "v={v}");
+        let expect = rule(v);
+        // Every channel of every pixel: each holds a different value, so a mixed-up channel
+        // or pixel order fails too.
+        for (c, x) in channels(v).into_iter().enumerate() {
+            assert_eq!(b[usize::from(v) * 4 + c], rule(x), "v={v} channel {c}");
+        }
         assert_eq!(quantize(v, 8), u32::from(expect));
         assert_eq!(quantize(v, 16), u32::from(v));
     }
