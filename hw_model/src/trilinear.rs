@@ -223,6 +223,27 @@ fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
     ]
 }
 
+/// [`fetch_quad`] of indices masked to a level with power-of-two sides (Repeat): the second
+/// index of an axis is the first's successor unless the first is the last (`size - 1`), so
+/// that test replaces the comparison of both indices.
+#[inline(always)]
+fn fetch_quad_pow2(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
+    debug_assert!(level.width.is_power_of_two() && level.height.is_power_of_two());
+    let w = level.width as usize;
+    let i00 = wy.i0 as usize * w + wx.i0 as usize;
+    if wx.i0 != level.width - 1 && wy.i0 != level.height - 1 {
+        if let Some(q) = level.texels.get(i00..i00 + w + 2) {
+            return [q[0], q[1], q[w], q[w + 1]];
+        }
+    }
+    [
+        fetch(level, wx.i0, wy.i0),
+        fetch(level, wx.i1, wy.i0),
+        fetch(level, wx.i0, wy.i1),
+        fetch(level, wx.i1, wy.i1),
+    ]
+}
+
 /// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
 /// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: both
 /// coordinates [`fits_i64`] (the caller's test, once for every level of a sample), wrapped
@@ -259,7 +280,11 @@ fn bilinear_lanes<W: ConstRounding, S: SampleSink, const POW2_REPEAT: bool>(
             wrap_in::<W>(v, frac, level.height, wrap_mode[1], cfg),
         )
     };
-    let [t00, t10, t01, t11] = fetch_quad(level, &wx, &wy);
+    let [t00, t10, t01, t11] = if POW2_REPEAT && narrow.is_some() {
+        fetch_quad_pow2(level, &wx, &wy)
+    } else {
+        fetch_quad(level, &wx, &wy)
+    };
     let top = Lanes::of(t00).lerp(Lanes::of(t10), wx.weight, filter);
     let bot = Lanes::of(t01).lerp(Lanes::of(t11), wx.weight, filter);
     let out = top.lerp(bot, wy.weight, filter);

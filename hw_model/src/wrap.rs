@@ -170,8 +170,11 @@ fn address<W: crate::fixed::ConstRounding>(coord: i64, size: u32, k: &WrapShifts
     let i0 = s >> k.sf;
     // `s - i0 2^sf`, in [0, 2^sf).
     let fr = s & k.fmask;
-    // Reduced to `wb` fraction bits when `sf > wb`, else widened (exact).
-    let w = if k.down == 0 {
+    // Reduced to `wb` fraction bits when `sf > wb`, else widened (exact). Truncate is the
+    // floor either way (one of `down`, `up` is 0): two shifts, no branch.
+    let w = if W::MODE == crate::fixed::Rounding::Truncate {
+        (fr >> k.down) << k.up
+    } else if k.down == 0 {
         fr << k.up
     } else {
         crate::fixed::round_shift_right_mid::<W>(fr, k.down)
