@@ -337,7 +337,8 @@ fn texels(fp: &TexelFootprint) -> [(u32, u32); 4] {
 struct Memory {
     map: AddressMap,
     cache: Option<Cache>,
-    open_page: Vec<u64>,
+    /// Per bank its open DRAM page (banks number at most 64: `TimingConfig::validate`).
+    open_page: [u64; 64],
     /// Banks (at least 1) and the last bank's index.
     banks: u32,
     last_bank: usize,
@@ -464,8 +465,7 @@ impl Memory {
         Self {
             map: AddressMap::new(textures, tc),
             cache,
-            // At least 64 entries, so the four-bank path indexes a fixed-size array.
-            open_page: vec![EMPTY; (banks as usize).max(64)],
+            open_page: [EMPTY; 64],
             banks,
             last_bank: banks as usize - 1,
             tile_mask: (bank_tile.0 - 1, bank_tile.1 - 1),
@@ -519,7 +519,7 @@ impl Memory {
             fp.y.map(|y| lv.line_base + u64::from(y >> ly) * lv.line_row);
         let texel_bytes = u64::from(lv.texel_bytes);
         let (page_hit, page_miss) = (self.page_hit, self.page_miss);
-        let open_page = &mut self.open_page[..];
+        let open_page = &mut self.open_page;
         let mut cache = self.cache.as_mut();
         let mut last_line = None;
         let (mut hits, mut page_hits, mut slowest) = (0u64, 0u64, 0u64);
@@ -536,7 +536,7 @@ impl Memory {
                 1
             } else {
                 let page = page_row[r] + page_col[c];
-                let open = &mut open_page[bank_col[c] | bank_row[r]];
+                let open = &mut open_page[(bank_col[c] | bank_row[r]) & 63];
                 if *open == page {
                     page_hits += 1;
                     page_hit
@@ -574,7 +574,8 @@ impl Memory {
         let r1 = lv.page_base + u64::from(y1 >> py) * lv.page_row;
         let bytes = 4 * u64::from(lv.texel_bytes);
         let mut hits = 0u64;
-        if let (true, Some(open)) = (self.quad4, self.open_page.first_chunk_mut::<4>()) {
+        let open = &mut self.open_page;
+        if self.quad4 {
             // Bank `x & 1 | (y & 1) << 1`: the footprint's two columns and two rows differ in
             // parity, so its texels' banks are texel (x0, y0)'s with bits flipped.
             let b = ((x0 & 1) | (y0 & 1) << 1) as usize;
@@ -593,10 +594,6 @@ impl Memory {
             let sh = self.tile_shift;
             let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
             let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
-            // Quad banks are fewer than 64 and `open_page` has at least 64 entries.
-            let Some(open) = self.open_page.first_chunk_mut::<64>() else {
-                return self.footprint_any::<false, true>(fp);
-            };
             for (bank, page) in [
                 (b0 | s0, r0 + c0),
                 (b1 | s0, r0 + c1),
@@ -650,7 +647,7 @@ impl Memory {
         let page_col = fp.x.map(|x| u64::from(x >> px));
         let line_col = fp.x.map(|x| u64::from(x >> lx));
         let mut cache = self.cache.as_mut();
-        let open_page = &mut self.open_page[..];
+        let open_page = &mut self.open_page;
         let mut acc = Accesses::default();
         // One texel access: column `c` of row `y` (whose page and line rows are given).
         let mut access = |c: usize, y: u32, page_row: u64, line_row: u64| {
@@ -664,7 +661,7 @@ impl Memory {
                 1
             } else {
                 let page = page_row + page_col[c];
-                let open = &mut open_page[b];
+                let open = &mut open_page[b & 63];
                 if *open == page {
                     acc.page_hits += 1;
                     page_hit
