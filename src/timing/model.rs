@@ -337,7 +337,8 @@ fn texels(fp: &TexelFootprint) -> [(u32, u32); 4] {
 struct Memory {
     map: AddressMap,
     cache: Option<Cache>,
-    open_page: Vec<u64>,
+    /// Per bank its open DRAM page (banks number at most 64: `TimingConfig::validate`).
+    open_page: [u64; 64],
     /// Banks (at least 1) and the last bank's index.
     banks: u32,
     last_bank: usize,
@@ -355,6 +356,9 @@ struct Memory {
     /// (0, 0). A texel's bank is then its tile bits (no clamp), so a footprint whose columns
     /// and rows differ in these bits reads 4 banks (never with (0, 0)).
     quad_mask: (u32, u32),
+    /// `quad_mask` is (1, 1) with a bank tile 2 wide: the four banks of a four-bank
+    /// footprint are banks 0..4, one per (column, row) parity ([`Memory::quad_dram`]).
+    quad4: bool,
     /// Latency a cache adds to a footprint (`cache_hit_cycles`).
     hit_latency: u64,
     /// [`Memory::quad_dram`]'s occupancy by the number of its page hits (0..=4; 8 slots so a
@@ -450,11 +454,18 @@ impl Memory {
             some,
             u64::from(hit.max(1)),
         ]);
+        let quad_mask = if tc.bank_interleave == BankInterleave::Tiled
+            && banks.is_power_of_two()
+            && banks <= 64
+        {
+            (bank_tile.0 - 1, bank_tile.1 - 1)
+        } else {
+            (0, 0)
+        };
         Self {
             map: AddressMap::new(textures, tc),
             cache,
-            // At least 64 entries, so the four-bank path indexes a fixed-size array.
-            open_page: vec![EMPTY; (banks as usize).max(64)],
+            open_page: [EMPTY; 64],
             banks,
             last_bank: banks as usize - 1,
             tile_mask: (bank_tile.0 - 1, bank_tile.1 - 1),
@@ -468,14 +479,8 @@ impl Memory {
             page_miss: u64::from(tc.dram_page_miss_cycles),
             hit_latency: u64::from(tc.cache_hit_cycles),
             quad_occ,
-            quad_mask: if tc.bank_interleave == BankInterleave::Tiled
-                && banks.is_power_of_two()
-                && banks <= 64
-            {
-                (bank_tile.0 - 1, bank_tile.1 - 1)
-            } else {
-                (0, 0)
-            },
+            quad4: quad_mask == (1, 1) && bank_tile.0 == 2,
+            quad_mask,
             counts: MemoryCounts::default(),
             quads: QuadCounts::default(),
         }
@@ -514,7 +519,7 @@ impl Memory {
             fp.y.map(|y| lv.line_base + u64::from(y >> ly) * lv.line_row);
         let texel_bytes = u64::from(lv.texel_bytes);
         let (page_hit, page_miss) = (self.page_hit, self.page_miss);
-        let open_page = &mut self.open_page[..];
+        let open_page = &mut self.open_page;
         let mut cache = self.cache.as_mut();
         let mut last_line = None;
         let (mut hits, mut page_hits, mut slowest) = (0u64, 0u64, 0u64);
@@ -531,7 +536,7 @@ impl Memory {
                 1
             } else {
                 let page = page_row[r] + page_col[c];
-                let open = &mut open_page[bank_col[c] | bank_row[r]];
+                let open = &mut open_page[(bank_col[c] | bank_row[r]) & 63];
                 if *open == page {
                     page_hits += 1;
                     page_hit
@@ -556,11 +561,10 @@ impl Memory {
 
     /// [`Memory::footprint`]'s four-bank footprint without a cache: each texel a DRAM access
     /// to its own bank (hit if the bank's open page is the texel's, which it opens), the
-    /// footprint as long as its slowest access; counted in [`Memory::quads`].
+    /// footprint as long as its slowest access; counted in [`Memory::quads`]. With four banks
+    /// ([`Memory::quad4`]) the texels' banks are the first texel's with its parity bits flipped.
     #[inline(always)]
     fn quad_dram(&mut self, fp: &TexelFootprint) -> (u64, u64) {
-        let (m0, m1) = self.quad_mask;
-        let sh = self.tile_shift;
         let lv = self.map.level_recent(fp.tex, fp.level);
         let (px, py) = lv.page_shift;
         let [x0, x1] = fp.x;
@@ -568,23 +572,38 @@ impl Memory {
         let (c0, c1) = (u64::from(x0 >> px), u64::from(x1 >> px));
         let r0 = lv.page_base + u64::from(y0 >> py) * lv.page_row;
         let r1 = lv.page_base + u64::from(y1 >> py) * lv.page_row;
-        let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
-        let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
         let bytes = 4 * u64::from(lv.texel_bytes);
-        // Quad banks are fewer than 64 and `open_page` has at least 64 entries.
-        let Some(open) = self.open_page.first_chunk_mut::<64>() else {
-            return self.footprint_any::<false, true>(fp);
-        };
         let mut hits = 0u64;
-        for (bank, page) in [
-            (b0 | s0, r0 + c0),
-            (b1 | s0, r0 + c1),
-            (b0 | s1, r1 + c0),
-            (b1 | s1, r1 + c1),
-        ] {
-            let o = &mut open[bank & 63];
-            hits += u64::from(*o == page);
-            *o = page;
+        let open = &mut self.open_page;
+        if self.quad4 {
+            // Bank `x & 1 | (y & 1) << 1`: the footprint's two columns and two rows differ in
+            // parity, so its texels' banks are texel (x0, y0)'s with bits flipped.
+            let b = ((x0 & 1) | (y0 & 1) << 1) as usize;
+            for (bank, page) in [
+                (b, r0 + c0),
+                (b ^ 1, r0 + c1),
+                (b ^ 2, r1 + c0),
+                (b ^ 3, r1 + c1),
+            ] {
+                let o = &mut open[bank & 3];
+                hits += u64::from(*o == page);
+                *o = page;
+            }
+        } else {
+            let (m0, m1) = self.quad_mask;
+            let sh = self.tile_shift;
+            let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
+            let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
+            for (bank, page) in [
+                (b0 | s0, r0 + c0),
+                (b1 | s0, r0 + c1),
+                (b0 | s1, r1 + c0),
+                (b1 | s1, r1 + c1),
+            ] {
+                let o = &mut open[bank & 63];
+                hits += u64::from(*o == page);
+                *o = page;
+            }
         }
         let occ = self.quad_occ[(hits & 7) as usize];
         self.quads.by_hits[(hits & 7) as usize] += 1;
@@ -628,7 +647,7 @@ impl Memory {
         let page_col = fp.x.map(|x| u64::from(x >> px));
         let line_col = fp.x.map(|x| u64::from(x >> lx));
         let mut cache = self.cache.as_mut();
-        let open_page = &mut self.open_page[..];
+        let open_page = &mut self.open_page;
         let mut acc = Accesses::default();
         // One texel access: column `c` of row `y` (whose page and line rows are given).
         let mut access = |c: usize, y: u32, page_row: u64, line_row: u64| {
@@ -642,7 +661,7 @@ impl Memory {
                 1
             } else {
                 let page = page_row + page_col[c];
-                let open = &mut open_page[b];
+                let open = &mut open_page[b & 63];
                 if *open == page {
                     acc.page_hits += 1;
                     page_hit
@@ -1720,6 +1739,73 @@ mod tests {
     use crate::rng_common::Rng;
     use hw_model::timing_config::BankInterleave;
     use hw_model::HwConfig;
+
+    /// [`Memory::quad_dram`]'s four-bank slots ([`Memory::quad4`]) against
+    /// [`Memory::footprint_any`] on 1.2M seeded random footprints of four tiled banks without a
+    /// cache: neighbouring texels (wrapping around odd and even levels), any two columns and
+    /// rows, repeated ones (the fallback), small and large pages; the same cycles and bytes,
+    /// counters and open pages after every footprint.
+    #[test]
+    fn four_bank_slots_match_the_general_path() {
+        let mut r = Rng(0x4b_a9c5);
+        let pick = |r: &mut Rng, xs: &[u32]| xs[r.below(xs.len() as u64) as usize];
+        for case in 0..300 {
+            let mut tc = HwConfig::texram16().timing;
+            tc.banks = 4;
+            tc.bank_interleave = BankInterleave::Tiled;
+            tc.cache_bytes = 0;
+            tc.dram_page_bytes = pick(&mut r, &[8, 64, 512, 2048]);
+            tc.dram_page_hit_cycles = pick(&mut r, &[1, 2, 8]);
+            tc.dram_page_miss_cycles = pick(&mut r, &[1, 6, 40]);
+            let textures: Vec<TextureLayout> = (0..1 + r.below(3))
+                .map(|_| {
+                    let (w, h) = (1 + r.below(90) as u32, 1 + r.below(90) as u32);
+                    TextureLayout {
+                        levels: vec![(w, h), ((w / 2).max(1), (h / 2).max(1))],
+                        texel_bytes: pick(&mut r, &[1, 2, 4, 8]),
+                    }
+                })
+                .collect();
+            let mut fast = Memory::new(&textures, &tc);
+            assert!(fast.quad4);
+            let mut general = fast.clone();
+            for i in 0..4000 {
+                let tex = r.below(textures.len() as u64) as usize;
+                let level = r.below(2) as usize;
+                let (w, h) = textures[tex].levels[level];
+                let near = |r: &mut Rng, n: u32| {
+                    let a = r.below(u64::from(n)) as u32;
+                    let b = match r.below(8) {
+                        0 => a,
+                        1 => r.below(u64::from(n)) as u32,
+                        _ => (a + 1) % n,
+                    };
+                    [a, b]
+                };
+                let fp = TexelFootprint {
+                    stage: 0,
+                    lookup: 0,
+                    level: level as u8,
+                    tex: tex as u16,
+                    x: near(&mut r, w),
+                    y: near(&mut r, h),
+                };
+                let want = general.footprint_any::<false, true>(&fp);
+                let got = fast.footprint::<false, true>(&fp);
+                assert_eq!(got, want, "case {case} footprint {i}: {fp:?}");
+                let (hit, miss) = (general.page_hit, general.page_miss);
+                assert_eq!(
+                    fast.counts.total(&fast.quads, hit, miss),
+                    general.counts.total(&general.quads, hit, miss),
+                    "case {case} footprint {i}"
+                );
+                assert_eq!(
+                    fast.open_page, general.open_page,
+                    "case {case} footprint {i}"
+                );
+            }
+        }
+    }
 
     /// [`Memory::footprint`] (with its four-bank fast path) against [`Memory::footprint_any`]
     /// (the general path) on seeded random machines and footprints, most of them 2x2 on
