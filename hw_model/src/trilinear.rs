@@ -225,7 +225,8 @@ fn fetch_quad(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
 
 /// [`fetch_quad`] of indices masked to a level with power-of-two sides (Repeat): the second
 /// index of an axis is the first's successor unless the first is the last (`size - 1`), so
-/// that test replaces the comparison of both indices.
+/// that test replaces the comparison of both indices. Written out beside [`fetch_quad`]: a
+/// shared helper taking the test as an argument cost W1 1.7M more instructions (callgrind).
 #[inline(always)]
 fn fetch_quad_pow2(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
     debug_assert!(level.width.is_power_of_two() && level.height.is_power_of_two());
