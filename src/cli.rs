@@ -952,13 +952,7 @@ pub fn parse_axis(s: &str) -> Result<Axis> {
 /// identical), a second `hw` axis, or two axes on the same field.
 pub fn check_axes(base: &HwConfig, axes: &[Axis]) -> Result<()> {
     let fields = hwconfig::fields(base);
-    let path = |name: &str| -> String {
-        let name = if name == "frame" { "frame_kind" } else { name };
-        fields
-            .iter()
-            .find(|(p, _)| p == name || p.rsplit('.').next() == Some(name))
-            .map_or_else(|| name.to_string(), |(p, _)| p.clone())
-    };
+    let path = |name: &str| hwconfig::dotted_path(&fields, name);
     for (i, ax) in axes.iter().enumerate() {
         if ax.field == "hw" && i > 0 {
             return Err(Error::field(
@@ -1081,6 +1075,17 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let mut maps = Maps::new(&sc, base.trilinear.texel_bits);
+    // Rows that agree on every axis reaching the float passes share them: their key is the
+    // values of those axes (a `hw` axis among them).
+    let base_fields = hwconfig::fields(&base);
+    let reaches: Vec<bool> = axes
+        .iter()
+        .map(|ax| {
+            ax.field == "hw"
+                || !crate::render::float_blind(&hwconfig::dotted_path(&base_fields, &ax.field))
+        })
+        .collect();
+    let mut float_passes = crate::render::FloatPassCache::default();
     let mut rows = Vec::with_capacity(configs.len());
     let mut worst_pixels = Vec::with_capacity(configs.len());
     let mut strips: Vec<Vec<(String, Vec<u8>)>> = Vec::with_capacity(configs.len());
@@ -1099,13 +1104,21 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         eprintln!("[{}/{}] {}{eta}", i + 1, configs.len(), label.join(" "));
         maps.ensure_texel_bits(cfg.trilinear.texel_bits);
         maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
+        let key: Vec<&String> = set
+            .iter()
+            .zip(&reaches)
+            .filter(|(_, &r)| r)
+            .map(|((_, v), _)| v)
+            .collect();
         let opts = RenderOptions {
             timing,
             truth,
             hw_impls: impls,
+            float_passes: float_passes.get(&key),
             ..RenderOptions::default()
         };
         let r = render(&sc, &maps, cfg, &opts)?;
+        float_passes.keep(key, &sc, &r, &opts);
         for w in &r.stats.warnings {
             eprintln!("  warning: {w}");
         }

@@ -287,6 +287,29 @@ pub fn fields(c: &HwConfig) -> Vec<(String, String)> {
         .collect()
 }
 
+/// True for the dotted paths of the widths and iteration counts of a unit (`*_bits` except
+/// the timing model's `*_bits_per_cycle`, and `*_iterations`).
+#[must_use]
+pub fn is_width(path: &str) -> bool {
+    let leaf = path.rsplit('.').next().unwrap_or(path);
+    (leaf.ends_with("_bits") || leaf.ends_with("_iterations")) && !path.starts_with("timing.")
+}
+
+/// The dotted path of the field `name` (a leaf name, a dotted path or the alias `frame` /
+/// `roughness`) among `fields` ([`fields`]); `name` itself when no field has it.
+#[must_use]
+pub fn dotted_path(fields: &[(String, String)], name: &str) -> String {
+    let name = match name {
+        "frame" => "frame_kind",
+        "roughness" => "rough_variant",
+        other => other,
+    };
+    fields
+        .iter()
+        .find(|(p, _)| p == name || p.rsplit('.').next() == Some(name))
+        .map_or_else(|| name.to_string(), |(p, _)| p.clone())
+}
+
 /// Returns `c` with the field `name` (a unique leaf name like `weight_bits`, or a dotted path
 /// like `trilinear.weight_bits`) set to `value`, validated.
 /// `frame` is an alias of `frame_kind` (`--vary frame=natural,unit,main`).

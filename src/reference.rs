@@ -81,7 +81,7 @@ pub fn lod_mode_f64(d: [f64; 4], mode: hw_model::config::LodLog2) -> f64 {
     if l.is_nan() || l <= 0.0 || !l.is_finite() {
         return -32.0;
     }
-    let mut e = l.log2().floor();
+    let mut e = crate::fixedpoint::floor_exact(l.log2());
     // log2 may round across a power of two: fix e so that 2^e <= l < 2^(e+1).
     if e.exp2() > l {
         e -= 1.0;
@@ -92,9 +92,37 @@ pub fn lod_mode_f64(d: [f64; 4], mode: hw_model::config::LodLog2) -> f64 {
 }
 
 /// Wraps a texel index by `mode` into `[0, size-1]`.
+///
+/// An integral `i` below 2^53 in magnitude (every index [`wrap_f64`] makes for a texture
+/// coordinate of that range) wraps in `i64`: the f64 remainder of two integers is exact, so
+/// the result is the same, without the software `fmod` that `rem_euclid` calls. Any other
+/// `i` (fractions, NaN, infinities, huge values) takes the f64 formula.
 #[inline]
 #[must_use]
 pub fn wrap_index_f64(i: f64, size: u32, mode: WrapMode) -> u32 {
+    const TWO_53: f64 = 9_007_199_254_740_992.0;
+    if i.abs() < TWO_53 && i as i64 as f64 == i {
+        let (k, n) = (i as i64, i64::from(size.max(1)));
+        let r = match mode {
+            WrapMode::Repeat => k.rem_euclid(n),
+            WrapMode::ClampToEdge => k.clamp(0, n - 1),
+            WrapMode::Mirror => {
+                let m = k.rem_euclid(2 * n);
+                if m >= n {
+                    2 * n - 1 - m
+                } else {
+                    m
+                }
+            }
+        };
+        return r as u32;
+    }
+    wrap_index_f64_any(i, size, mode)
+}
+
+/// [`wrap_index_f64`] in f64 arithmetic, for any `i`.
+#[inline(never)]
+fn wrap_index_f64_any(i: f64, size: u32, mode: WrapMode) -> u32 {
     let n = f64::from(size.max(1));
     let r = match mode {
         WrapMode::Repeat => i.rem_euclid(n),
@@ -121,7 +149,7 @@ pub fn wrap_index_f64(i: f64, size: u32, mode: WrapMode) -> u32 {
 #[must_use]
 pub fn wrap_f64(coord: f64, size: u32, mode: WrapMode) -> (u32, u32, f64) {
     let s = coord * f64::from(size.max(1)) - 0.5;
-    let i0 = s.floor();
+    let i0 = crate::fixedpoint::floor_exact(s);
     (
         wrap_index_f64(i0, size, mode),
         wrap_index_f64(i0 + 1.0, size, mode),
@@ -184,7 +212,7 @@ pub fn trilinear_f64(levels: &[LevelF], u: f64, v: f64, lod: f64, wrap: [WrapMod
     if lod >= last {
         return bilinear_f64(&levels[n - 1], u, v, wrap);
     }
-    let l0 = lod.floor();
+    let l0 = crate::fixedpoint::floor_exact(lod);
     let f = lod - l0;
     let l0 = l0 as usize;
     let c0 = bilinear_f64(&levels[l0], u, v, wrap);

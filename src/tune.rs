@@ -20,7 +20,7 @@
 //! (`progress`).
 
 use crate::hwconfig;
-use crate::render::{render, Maps, RenderOptions};
+use crate::render::{render, FloatPassCache, Maps, RenderOptions};
 use crate::report::{compare, ErrorMetrics};
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -299,20 +299,12 @@ impl TuneResult {
     }
 }
 
-/// True for the leaf names that are widths or iteration counts of a unit (`*_bits` except
-/// the timing model's `*_bits_per_cycle`, and `*_iterations`).
-#[must_use]
-pub fn is_width(path: &str) -> bool {
-    let leaf = path.rsplit('.').next().unwrap_or(path);
-    (leaf.ends_with("_bits") || leaf.ends_with("_iterations")) && !path.starts_with("timing.")
-}
-
 /// The dotted paths of every integer width of `base` with room to search (its least valid
 /// value below its value), in the config's order.
 pub fn default_knobs(base: &HwConfig) -> Result<Vec<Knob>> {
     let mut out = Vec::new();
     for (path, v) in hwconfig::fields(base) {
-        if !is_width(&path) {
+        if !hwconfig::is_width(&path) {
             continue;
         }
         if let Ok(hi) = v.parse::<u32>() {
@@ -400,6 +392,10 @@ struct Search<'a> {
     knobs: Vec<Knob>,
     maps: Vec<Maps>,
     cache: HashMap<Vec<u32>, Option<usize>>,
+    /// Per knob: it reaches the float passes (not [`crate::render::float_blind`]).
+    reaches: Vec<bool>,
+    /// Per scene: its float passes, by the values of the knobs that reach them.
+    float_passes: Vec<FloatPassCache<Vec<u32>>>,
     trials: Vec<Trial>,
     renders: u64,
     progress: &'a mut dyn FnMut(&Trial),
@@ -437,16 +433,29 @@ impl Search<'_> {
     ) -> Result<usize> {
         let spec = self.spec;
         let mut scenes = Vec::with_capacity(spec.scenes.len());
-        for (sc, maps) in spec.scenes.iter().zip(&mut self.maps) {
+        let key: Vec<u32> = values
+            .iter()
+            .zip(&self.reaches)
+            .filter(|(_, &r)| r)
+            .map(|(&v, _)| v)
+            .collect();
+        for ((sc, maps), kept) in spec
+            .scenes
+            .iter()
+            .zip(&mut self.maps)
+            .zip(&mut self.float_passes)
+        {
             maps.ensure_texel_bits(cfg.trilinear.texel_bits);
             maps.ensure_offset_bits(cfg.shading.vector.offset_int_bits);
             let opts = RenderOptions {
                 truth: spec.truth,
                 timing,
                 keep_events: false,
+                float_passes: kept.get(&key),
                 ..RenderOptions::default()
             };
             let r = render(sc, maps, cfg, &opts)?;
+            kept.keep(key.clone(), sc, &r, &opts);
             self.renders += 1;
             let e = if spec.truth > 0 {
                 match &r.truth_image {
@@ -575,6 +584,15 @@ pub fn tune(spec: &TuneSpec, progress: &mut dyn FnMut(&Trial)) -> Result<TuneRes
             .collect(),
         knobs: knobs.clone(),
         cache: HashMap::new(),
+        reaches: knobs
+            .iter()
+            .map(|k| !crate::render::float_blind(&k.field))
+            .collect(),
+        float_passes: spec
+            .scenes
+            .iter()
+            .map(|_| FloatPassCache::default())
+            .collect(),
         trials: Vec::new(),
         renders: 0,
         progress,

@@ -11,7 +11,8 @@ use super::bump::{
 use super::rough::{rough_config, rough_of};
 use super::stages::{Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
-use crate::fixedpoint::{to_raw, to_unorm};
+use crate::fixedpoint::{floor_exact, to_raw, to_unorm};
+use crate::reference::wrap_index_f64;
 use crate::shading::reference as fref;
 use crate::shading::roughness::{
     normalize_factor, rough_blinn_phong_f, scale_d_f, RoughnessEncoding,
@@ -23,6 +24,7 @@ use hw_model::roughness::{
 };
 use hw_model::rsqrt::rsqrt_cost;
 use hw_model::vector::normalize_cost;
+use hw_model::wrap::WrapMode;
 use hw_model::UnitCost;
 
 /// Fixed twin: the eye and light vectors normalized, the D texel decoded and scaled by the
@@ -228,9 +230,9 @@ pub(super) fn sample_offsets(
     let (w, h) = (f64::from(l0.width), f64::from(l0.height));
     let fix = |x: f64| if x.is_finite() { x } else { 0.0 };
     let (x, y) = (fix(u) * w - 0.5, fix(v) * h - 0.5);
-    let (x0, y0) = (x.floor(), y.floor());
+    let (x0, y0) = (floor_exact(x), floor_exact(y));
     let (fx, fy) = (x - x0, y - y0);
-    let wrap = |i: f64, n: u32| (i.rem_euclid(f64::from(n)) as u32).min(n - 1) as usize;
+    let wrap = |i: f64, n: u32| wrap_index_f64(i, n, WrapMode::Repeat).min(n - 1) as usize;
     let (xa, xb) = (wrap(x0, l0.width), wrap(x0 + 1.0, l0.width));
     let (ya, yb) = (wrap(y0, l0.height), wrap(y0 + 1.0, l0.height));
     let at = |xi: usize, yi: usize, c: usize| {

@@ -10,13 +10,17 @@
 //! The phases, one file each, dependencies one way (the stages never import this module):
 //! [`geometry`] (host transforms, lighting, plans), [`shading`] (per-triangle attributes,
 //! the compiled programs over every covered pixel, timing events), [`stats`] (what the render
-//! measured); maps come prepared from [`crate::maps`], visibility from [`crate::raster`].
+//! measured), [`float_passes`] (the reference and truth kept for the next render on a machine
+//! they do not see: sweeps and `texsim tune`); maps come prepared from [`crate::maps`],
+//! visibility from [`crate::raster`].
 
+mod float_passes;
 mod geometry;
 pub mod ranges;
 mod shading;
 mod stats;
 
+pub use float_passes::{float_blind, FloatPassCache, FloatPasses};
 pub use geometry::Geometry;
 use shading::{bump_attrs, f32_tris, shade, tri_attrs, ShadeInput};
 use stats::bump_frames;
@@ -35,6 +39,7 @@ use crate::scene::Scene;
 use crate::timing::events::{PlanTiming, TextureLayout};
 use hw_model::HwConfig;
 use serde::Serialize;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// How the reference pass chooses its fragments.
@@ -76,6 +81,9 @@ pub struct RenderOptions {
     /// Shade one fragment at a time through every stage (the reference of the default, which
     /// runs each stage over spans of consecutive pixels of one triangle): the same frame.
     pub per_fragment: bool,
+    /// The float passes of an earlier render of the same scene ([`FloatPasses`]): used
+    /// instead of running them again when they match this render's options.
+    pub float_passes: Option<Arc<FloatPasses>>,
 }
 
 impl Default for RenderOptions {
@@ -90,6 +98,7 @@ impl Default for RenderOptions {
             progress: None,
             ranges: false,
             per_fragment: false,
+            float_passes: None,
         }
     }
 }
@@ -273,7 +282,16 @@ pub fn render(
     let mut ref_image = None;
     let mut ref_nonfinite = 0;
     let (mut e8, mut e16) = (None, None);
-    if opts.reference {
+    let kept = opts
+        .float_passes
+        .as_deref()
+        .filter(|fp| fp.fits(scene, opts));
+    if let Some((img, nonfinite)) = kept.and_then(|fp| fp.reference.as_ref()) {
+        ref_nonfinite = *nonfinite;
+        e8 = Some(compare(&hw_image, img, 8, Some(&mask)));
+        e16 = Some(compare(&hw_image, img, 16, Some(&mask)));
+        ref_image = Some(img.clone());
+    } else if opts.reference {
         let t_ref = Instant::now();
         let ref_vis;
         let rv = match opts.coverage {
@@ -306,7 +324,9 @@ pub fn render(
     let mut truth_image = None;
     let has_ndf = geo.plans.iter().any(|p| p.ndf.is_some());
     let has_env = geo.plans.iter().any(|p| p.env.is_some());
-    if opts.truth > 0
+    if let Some(fp) = kept {
+        truth_image.clone_from(&fp.truth);
+    } else if opts.truth > 0
         && (has_rough || has_ndf || has_env || has_toksvig || has_lean || has_fitted_lobes)
     {
         let t_truth = Instant::now();

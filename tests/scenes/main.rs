@@ -11,6 +11,7 @@ mod bad_input_files;
 mod bad_input_validate;
 mod bump_scene;
 mod env_scene;
+mod float_passes;
 mod report_flip;
 mod report_images;
 mod report_metrics;

@@ -202,3 +202,98 @@ fn exhaustive_8_bit() {
     }
     assert_eq!(n, 9 << 24);
 }
+
+/// The f64 twin's addressing as first written: `floor` and `rem_euclid` in f64 (the
+/// independent checker of `wrap_index_f64`'s integer path and `wrap_f64`'s `floor_exact`).
+fn wrap_index_f64_formula(i: f64, size: u32, mode: WrapMode) -> u32 {
+    let n = f64::from(size.max(1));
+    let r = match mode {
+        WrapMode::Repeat => i.rem_euclid(n),
+        WrapMode::ClampToEdge => i.clamp(0.0, n - 1.0),
+        WrapMode::Mirror => {
+            let m = i.rem_euclid(2.0 * n);
+            if m >= n {
+                2.0 * n - 1.0 - m
+            } else {
+                m
+            }
+        }
+    };
+    if r.is_nan() {
+        0
+    } else {
+        r as u32
+    }
+}
+
+/// A double of every kind the twin meets or could: integers of every bit length, fractions,
+/// signed zeros, the ends of the exact `i64` path (2^53 and its neighbours), huge values,
+/// infinities and NaN.
+fn any_double(rng: &mut Rng) -> f64 {
+    let special = [
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        9_007_199_254_740_992.0,
+        -9_007_199_254_740_992.0,
+        9_007_199_254_740_991.0,
+        -9_007_199_254_740_991.0,
+        9_007_199_254_740_994.0,
+        9.3e18,
+        -9.3e18,
+        1e300,
+        f64::MIN_POSITIVE,
+    ];
+    let sign = if rng.next() & 1 == 0 { 1.0 } else { -1.0 };
+    match rng.below(4) {
+        0 => special[rng.below(special.len() as u64) as usize],
+        1 => sign * (rng.next() >> rng.below(64)) as f64,
+        2 => sign * (rng.next() >> rng.below(64)) as f64 / f64::from(1u32 << rng.below(31)),
+        _ => f64::from_bits(rng.next()),
+    }
+}
+
+/// `wrap_index_f64` (an `i64` path for integral indices below 2^53) and `wrap_f64`
+/// (`floor_exact`) equal the f64 formulas bit for bit: 3M seeded indices and coordinates of
+/// every kind, on every mode and sizes from 0 to `u32::MAX`.
+#[test]
+fn f64_twin_addressing_equals_the_f64_formulas() {
+    use texsim::reference::wrap_index_f64;
+    let mut rng = Rng(0x3a_0003);
+    for k in 0..3_000_000u32 {
+        let mode = MODES[(k % 3) as usize];
+        let size = match rng.below(4) {
+            0 => rng.below(5) as u32,
+            1 => u32::MAX - rng.below(3) as u32,
+            _ => (rng.next() >> rng.below(64)) as u32,
+        };
+        let i = if k % 2 == 0 {
+            any_double(&mut rng).floor()
+        } else {
+            any_double(&mut rng)
+        };
+        assert_eq!(
+            wrap_index_f64(i, size, mode),
+            wrap_index_f64_formula(i, size, mode),
+            "i={i:e} size={size} {mode:?}"
+        );
+        let coord = any_double(&mut rng);
+        let s = coord * f64::from(size.max(1)) - 0.5;
+        let i0 = s.floor();
+        let want = (
+            wrap_index_f64_formula(i0, size, mode),
+            wrap_index_f64_formula(i0 + 1.0, size, mode),
+            (s - i0).to_bits(),
+        );
+        let (a, b, w) = wrap_f64(coord, size, mode);
+        assert_eq!(
+            (a, b, w.to_bits()),
+            want,
+            "coord={coord:e} size={size} {mode:?}"
+        );
+    }
+}
