@@ -100,14 +100,12 @@ pub struct WorstPixel {
 #[must_use]
 pub fn worst_pixel(hw: &Image, reference: &Image, mask: &[bool]) -> Option<WorstPixel> {
     let mut best: Option<(usize, u32)> = None;
-    for (i, (a, b)) in hw.px.iter().zip(&reference.px).enumerate() {
+    let errors = crate::report::ChannelErrors::new(8);
+    for (i, (&a, &b)) in hw.px.iter().zip(&reference.px).enumerate() {
         if !mask.get(i).copied().unwrap_or(false) {
             continue;
         }
-        let e = (0..3)
-            .map(|c| quantize(a[c], 8).abs_diff(quantize(b[c], 8)))
-            .max()
-            .unwrap_or(0);
+        let e = errors.max_of(a, b);
         if best.is_none_or(|(_, b)| e > b) {
             best = Some((i, e));
         }

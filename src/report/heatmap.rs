@@ -10,7 +10,7 @@ use tiny_skia::Pixmap;
 
 use super::draw::{draw_text, fill_rect, new_pixmap, opaque};
 use super::font;
-use super::metrics::{channel_errors, selected};
+use super::metrics::{row, selected, ChannelErrors};
 use super::Image;
 
 /// Colour of pixels outside the mask (or outside the second image).
@@ -135,20 +135,26 @@ pub fn heatmap_layout(width: u32, height: u32, bits: u32, max_err: u32) -> Heatm
 #[must_use]
 pub fn heatmap(a: &Image, b: &Image, bits: u32, mask: Option<&[bool]>) -> Pixmap {
     let bits = bits.clamp(1, 16);
-    let err_at = |x: u32, y: u32| -> Option<u32> {
-        let i = y as usize * a.width as usize + x as usize;
-        if !selected(mask, i) {
-            return None;
-        }
-        let (pa, pb) = (a.get(x, y)?, b.get(x, y)?);
-        let e = channel_errors(pa, pb, bits);
-        Some(e[0].max(e[1]).max(e[2]))
-    };
+    let errors = ChannelErrors::new(bits);
+    // Every pixel of `a`'s area, row by row: its max-channel error, `NONE` outside the mask
+    // or outside either image.
+    const NONE: u32 = u32::MAX;
+    let mut errs = vec![NONE; a.width as usize * a.height as usize];
     let mut max_err = 0u32;
-    for y in 0..a.height {
-        for x in 0..a.width {
-            if let Some(e) = err_at(x, y) {
-                max_err = max_err.max(e);
+    if a.width > 0 {
+        for (y, out) in (0..a.height).zip(errs.chunks_exact_mut(a.width as usize)) {
+            let first = y as usize * a.width as usize;
+            let b_row = if y < b.height {
+                row(b, y, b.width.min(a.width))
+            } else {
+                &[]
+            };
+            let pairs = row(a, y, a.width).iter().zip(b_row);
+            for (x, ((&pa, &pb), e)) in pairs.zip(out.iter_mut()).enumerate() {
+                if selected(mask, first + x) {
+                    *e = errors.max_of(pa, pb);
+                    max_err = max_err.max(*e);
+                }
             }
         }
     }
@@ -171,12 +177,14 @@ pub fn heatmap(a: &Image, b: &Image, bits: u32, mask: Option<&[bool]>) -> Pixmap
     );
     let stride = lay.width as usize;
     let px = p.pixels_mut();
-    for y in 0..a.height {
-        for x in 0..a.width {
-            px[y as usize * stride + x as usize] = match err_at(x, y) {
-                Some(e) => lut[e as usize],
-                None => masked,
-            };
+    if a.width > 0 {
+        for (out, e_row) in px
+            .chunks_mut(stride)
+            .zip(errs.chunks_exact(a.width as usize))
+        {
+            for (o, &e) in out.iter_mut().zip(e_row) {
+                *o = if e == NONE { masked } else { lut[e as usize] };
+            }
         }
     }
     draw_legend(&mut p, &lay, bits, max_err, &lut);

@@ -54,17 +54,57 @@ pub fn quantize(x: u16, bits: u32) -> u32 {
 
 /// Index into [`HISTOGRAM_BUCKETS`] of a max channel error.
 #[must_use]
+#[inline]
 pub(crate) fn bucket_of(err: u32) -> usize {
-    HISTOGRAM_BUCKETS
-        .iter()
-        .rposition(|&(_, lo)| err >= lo)
-        .unwrap_or(0)
+    // 0..=3 are their own buckets; from 4 on a bucket per power of two up to 32+.
+    if err < 4 {
+        err as usize
+    } else {
+        (2 + (31 - err.leading_zeros()) as usize).min(HISTOGRAM_BUCKETS.len() - 1)
+    }
 }
 
-/// Per-pixel errors of the RGB channels (alpha ignored) after reducing both to `bits` bits.
+/// The RGB channel errors (alpha ignored) of two pixels after reducing both to one width:
+/// [`quantize`] with `2^bits - 1` resolved once, in `u32` (`x (2^bits - 1) + 32767 < 2^32`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ChannelErrors {
+    maxv: u32,
+}
+
+impl ChannelErrors {
+    /// For `bits` (clamped to 1..=16).
+    pub(crate) fn new(bits: u32) -> Self {
+        Self {
+            maxv: (1u32 << bits.clamp(1, 16)) - 1,
+        }
+    }
+
+    /// The three channel errors of `pa` against `pb`.
+    #[inline]
+    pub(crate) fn of(self, pa: [u16; 4], pb: [u16; 4]) -> [u32; 3] {
+        let q = |x: u16| (u32::from(x) * self.maxv + 32767) / 65535;
+        [
+            q(pa[0]).abs_diff(q(pb[0])),
+            q(pa[1]).abs_diff(q(pb[1])),
+            q(pa[2]).abs_diff(q(pb[2])),
+        ]
+    }
+
+    /// The largest of the three.
+    #[inline]
+    pub(crate) fn max_of(self, pa: [u16; 4], pb: [u16; 4]) -> u32 {
+        let e = self.of(pa, pb);
+        e[0].max(e[1]).max(e[2])
+    }
+}
+
+/// The pixels of row `y` of `img` from column 0 to `w - 1` that its pixel vector holds (all
+/// of them unless the vector is shorter than `width * height`).
 #[inline]
-pub(crate) fn channel_errors(pa: [u16; 4], pb: [u16; 4], bits: u32) -> [u32; 3] {
-    [0, 1, 2].map(|c| quantize(pa[c], bits).abs_diff(quantize(pb[c], bits)))
+pub(crate) fn row(img: &Image, y: u32, w: u32) -> &[[u16; 4]] {
+    let n = img.px.len();
+    let start = (y as usize * img.width as usize).min(n);
+    &img.px[start..(start + w as usize).min(n)]
 }
 
 /// Whether pixel `i` (row-major in `a`'s layout) is selected by `mask` (missing entries are
@@ -91,23 +131,21 @@ pub fn compare(a: &Image, b: &Image, bits: u32, mask: Option<&[bool]>) -> ErrorM
     let mut sum_abs = 0u64;
     let mut sum_sq = 0u128;
     let mut hist = [0u64; HISTOGRAM_BUCKETS.len()];
+    let errors = ChannelErrors::new(bits);
     for y in 0..h {
-        for x in 0..w {
-            let i = y as usize * a.width as usize + x as usize;
-            if !selected(mask, i) {
+        let first = y as usize * a.width as usize;
+        for (x, (&pa, &pb)) in row(a, y, w).iter().zip(row(b, y, w)).enumerate() {
+            if !selected(mask, first + x) {
                 continue;
             }
-            let (Some(pa), Some(pb)) = (a.get(x, y), b.get(x, y)) else {
-                continue;
-            };
-            let e = channel_errors(pa, pb, bits);
+            let e = errors.of(pa, pb);
             let m = e[0].max(e[1]).max(e[2]);
             pixels += 1;
             max_abs = max_abs.max(m);
-            for v in e {
-                sum_abs += u64::from(v);
-                sum_sq += u128::from(v) * u128::from(v);
-            }
+            sum_abs += u64::from(e[0]) + u64::from(e[1]) + u64::from(e[2]);
+            // Three squares below 2^32: their sum fits `u64`.
+            let sq = |v: u32| u64::from(v) * u64::from(v);
+            sum_sq += u128::from(sq(e[0]) + sq(e[1]) + sq(e[2]));
             hist[bucket_of(m)] += 1;
         }
     }

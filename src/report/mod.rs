@@ -17,6 +17,7 @@ mod png;
 mod sheet;
 
 pub use heatmap::{heatmap, heatmap_colour, heatmap_layout, HeatmapLayout, MASKED_RGB};
+pub(crate) use metrics::ChannelErrors;
 pub use metrics::{compare, format_metrics_table, quantize, ErrorMetrics, HISTOGRAM_BUCKETS};
 pub use output::OutputSet;
 pub use png::{encode_pixmap, encode_png16, encode_png8, image_to_pixmap};

@@ -275,3 +275,67 @@ fn font_covers_labels_and_glyphs_are_distinct() {
     assert_eq!(text_width("8", 1), 5);
     assert_eq!(text_width("16-BIT", 2), (6 * 6 - 1) * 2);
 }
+
+/// The heatmap's image area against a per-pixel model (`Image::get`, `metrics::quantize`,
+/// `heatmap_colour`): random sizes of both images, every width, random masks (some short),
+/// pixel vectors shorter or longer than their size, 300 seeded cases.
+#[test]
+fn heatmap_random_against_model() {
+    use texsim::report::quantize;
+    let mut rng = Rng(0x4EA7_0001);
+    for case in 0..300 {
+        let bits = 1 + rng.below(16) as u32;
+        let size = |rng: &mut Rng| (rng.below(20) as u32, rng.below(20) as u32);
+        let ((aw, ah), (bw, bh)) = (size(&mut rng), size(&mut rng));
+        let mut a = random_image(&mut rng, aw, ah);
+        let mut b = random_image(&mut rng, bw, bh);
+        // Near pairs too, so small errors and exact pixels occur.
+        if rng.below(2) == 0 {
+            for (pb, pa) in b.px.iter_mut().zip(&a.px) {
+                *pb = pa.map(|c| c.saturating_add(rng.below(600) as u16));
+            }
+        }
+        for img in [&mut a, &mut b] {
+            match rng.below(4) {
+                0 => img.px.truncate(rng.below(img.px.len() as u64 + 1) as usize),
+                1 => img.px.extend((0..rng.below(30)).map(|_| [7u16; 4])),
+                _ => {}
+            }
+        }
+        let mask: Option<Vec<bool>> = (rng.below(3) != 0).then(|| {
+            (0..rng.below(u64::from(aw * ah) + 10))
+                .map(|_| rng.below(3) != 0)
+                .collect()
+        });
+        let err = |x: u32, y: u32| -> Option<u32> {
+            let i = (y * aw + x) as usize;
+            if let Some(m) = &mask {
+                if !m.get(i).copied().unwrap_or(false) {
+                    return None;
+                }
+            }
+            let (pa, pb) = (a.get(x, y)?, b.get(x, y)?);
+            (0..3)
+                .map(|c| quantize(pa[c], bits).abs_diff(quantize(pb[c], bits)))
+                .max()
+        };
+        let max = (0..ah)
+            .flat_map(|y| (0..aw).map(move |x| (x, y)))
+            .filter_map(|(x, y)| err(x, y))
+            .max()
+            .unwrap_or(0);
+        let p = heatmap(&a, &b, bits, mask.as_deref());
+        let lay = heatmap_layout(aw, ah, bits, max);
+        assert_eq!(
+            (p.width(), p.height()),
+            (lay.width, lay.height),
+            "case {case}"
+        );
+        for y in 0..ah {
+            for x in 0..aw {
+                let want = err(x, y).map_or(MASKED_RGB, |e| heatmap_colour(e, max));
+                assert_eq!(rgba(&p, x, y), opaque(want), "case {case} ({x},{y})");
+            }
+        }
+    }
+}
