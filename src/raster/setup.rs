@@ -247,6 +247,28 @@ impl ScreenTri {
         }
         e
     }
+
+    /// [`Self::edges_float`] at `(px, py)`, `(px + 1, py)` and `(px, py + 1)`, bit for bit,
+    /// each edge's canonical order found once for the three.
+    #[must_use]
+    pub fn edges_float_and_steps(&self, px: f64, py: f64) -> [[f64; 3]; 3] {
+        let (x, y) = (px + 0.5, py + 0.5);
+        let (x1, y1) = ((px + 1.0) + 0.5, (py + 1.0) + 0.5);
+        let mut out = [[0.0; 3]; 3];
+        // Indexed: the iterator forms measured 1-2% more instructions on W1's float frame.
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..3 {
+            let (a, b) = (self.xy_f[(i + 1) % 3], self.xy_f[(i + 2) % 3]);
+            let swap = (b[0], b[1]) < (a[0], a[1]);
+            let (p, q) = if swap { (b, a) } else { (a, b) };
+            let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+            let sign = |e: f64| if swap { -e } else { e };
+            out[0][i] = sign(dx * (y - p[1]) - dy * (x - p[0]));
+            out[1][i] = sign(dx * (y - p[1]) - dy * (x1 - p[0]));
+            out[2][i] = sign(dx * (y1 - p[1]) - dy * (x - p[0]));
+        }
+        out
+    }
 }
 
 /// Vertex coordinates below this bound (in magnitude, on the evaluation grid) and sample

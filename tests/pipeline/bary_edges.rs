@@ -93,3 +93,47 @@ fn screen_tri_edges_match_the_exact_values() {
     }
     assert!(small > 500_000 && large > 500_000, "{small} {large}");
 }
+
+/// `edges_float_and_steps` is `edges_float` at the pixel and its two neighbours, bit for bit
+/// (signed zeros included; a NaN is any NaN, as Rust leaves a NaN result's sign open): 1M
+/// seeded triangles, shared and equal vertices, pixels near and far, coordinates of every
+/// magnitude and non-finite ones.
+#[test]
+fn float_edges_and_steps_equal_three_evaluations() {
+    let mut rng = Rng(0xED6E_0003);
+    let mut t = tri();
+    let coord = |rng: &mut Rng| match rng.below(5) {
+        0 => rng.below(8) as f64 - 4.0,
+        1 => rng.range(-2048.0, 2048.0),
+        2 => rng.range(-1.0, 1.0) * 2f64.powi(rng.below(60) as i32),
+        3 => [0.0, -0.0, 0.5, f64::NAN, f64::INFINITY][rng.below(5) as usize],
+        _ => (rng.below(4096) as f64) / 256.0,
+    };
+    for k in 0..1_000_000u32 {
+        for v in &mut t.xy_f {
+            *v = [coord(&mut rng), coord(&mut rng)];
+        }
+        if k % 7 == 0 {
+            t.xy_f[2] = t.xy_f[k as usize % 2];
+        }
+        let (px, py) = (coord(&mut rng), coord(&mut rng));
+        let got = t.edges_float_and_steps(px, py);
+        let want = [
+            t.edges_float(px, py),
+            t.edges_float(px + 1.0, py),
+            t.edges_float(px, py + 1.0),
+        ];
+        let bits = |e: [[f64; 3]; 3]| {
+            e.map(|r| {
+                r.map(|v| {
+                    if v.is_nan() {
+                        f64::NAN.to_bits()
+                    } else {
+                        v.to_bits()
+                    }
+                })
+            })
+        };
+        assert_eq!(bits(got), bits(want), "{:?} at ({px}, {py})", t.xy_f);
+    }
+}
