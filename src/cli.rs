@@ -1085,7 +1085,13 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
                 || !crate::render::float_blind(&hwconfig::dotted_path(&base_fields, &ax.field))
         })
         .collect();
-    let mut float_passes = crate::render::FloatPassCache::default();
+    // Keys are worth keeping only when some axis does not reach the passes (else every row
+    // has its own key).
+    let mut float_passes = crate::render::FloatPassCache::new(if reaches.contains(&false) {
+        crate::render::FloatPassCache::<Vec<&String>>::command_budget()
+    } else {
+        0
+    });
     let mut rows = Vec::with_capacity(configs.len());
     let mut worst_pixels = Vec::with_capacity(configs.len());
     let mut strips: Vec<Vec<(String, Vec<u8>)>> = Vec::with_capacity(configs.len());

@@ -575,6 +575,17 @@ pub fn tune(spec: &TuneSpec, progress: &mut dyn FnMut(&Trial)) -> Result<TuneRes
         .map(|k| f64::from(k.hi - k.lo + 1))
         .product::<f64>();
     let grid_renders = grid_points * spec.scenes.len() as f64;
+    let reaches: Vec<bool> = knobs
+        .iter()
+        .map(|k| !crate::render::float_blind(&k.field))
+        .collect();
+    // The scenes share the command's budget for kept float passes; none are kept when every
+    // knob reaches them (every trial would have its own key).
+    let scene_budget = if reaches.contains(&false) {
+        FloatPassCache::<Vec<u32>>::command_budget() / spec.scenes.len().max(1) as u64
+    } else {
+        0
+    };
     let mut s = Search {
         spec,
         maps: spec
@@ -584,14 +595,11 @@ pub fn tune(spec: &TuneSpec, progress: &mut dyn FnMut(&Trial)) -> Result<TuneRes
             .collect(),
         knobs: knobs.clone(),
         cache: HashMap::new(),
-        reaches: knobs
-            .iter()
-            .map(|k| !crate::render::float_blind(&k.field))
-            .collect(),
+        reaches,
         float_passes: spec
             .scenes
             .iter()
-            .map(|_| FloatPassCache::default())
+            .map(|_| FloatPassCache::new(scene_budget))
             .collect(),
         trials: Vec::new(),
         renders: 0,

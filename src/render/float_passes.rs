@@ -69,12 +69,6 @@ impl FloatPasses {
         })
     }
 
-    /// The bytes of the kept images.
-    fn bytes(&self) -> u64 {
-        let px = |img: &Image| (img.px.len() * std::mem::size_of::<[u16; 4]>()) as u64;
-        self.reference.as_ref().map_or(0, |(img, _)| px(img)) + self.truth.as_ref().map_or(0, px)
-    }
-
     /// True when these passes are what a render of `scene` with `opts` would make (the caller
     /// vouches for the machine: it differs only in [`float_blind`] fields).
     pub(super) fn fits(&self, scene: &Scene, opts: &RenderOptions) -> bool {
@@ -87,8 +81,8 @@ impl FloatPasses {
 
 /// [`FloatPasses`] kept per key (the values of the varied fields that reach the float
 /// passes: renders with the same key differ only in [`float_blind`] fields), within a budget
-/// of image bytes: a quarter of the memory budget ([`crate::budget::max_memory`]). Past it
-/// the cache keeps what it has and a new key's renders run their own passes.
+/// of image bytes. Past it the cache keeps what it has and a new key's renders run their own
+/// passes; a budget of 0 keeps nothing.
 #[derive(Debug)]
 pub struct FloatPassCache<K> {
     kept: HashMap<K, Arc<FloatPasses>>,
@@ -96,17 +90,24 @@ pub struct FloatPassCache<K> {
     budget: u64,
 }
 
-impl<K: Hash + Eq> Default for FloatPassCache<K> {
-    fn default() -> Self {
+impl<K: Hash + Eq> FloatPassCache<K> {
+    /// The bytes all the caches of one command may keep together: a quarter of the memory
+    /// budget ([`crate::budget::max_memory`]).
+    #[must_use]
+    pub fn command_budget() -> u64 {
+        crate::budget::max_memory() / 4
+    }
+
+    /// An empty cache that keeps at most `budget` bytes of images.
+    #[must_use]
+    pub fn new(budget: u64) -> Self {
         Self {
             kept: HashMap::new(),
             bytes: 0,
-            budget: crate::budget::max_memory() / 4,
+            budget,
         }
     }
-}
 
-impl<K: Hash + Eq> FloatPassCache<K> {
     /// The passes kept for `key`.
     #[must_use]
     pub fn get(&self, key: &K) -> Option<Arc<FloatPasses>> {
@@ -116,14 +117,12 @@ impl<K: Hash + Eq> FloatPassCache<K> {
     /// Keeps the passes `r` (a render of `scene` with `opts`) made, for `key`, unless the
     /// key has some or they do not fit the budget.
     pub fn keep(&mut self, key: K, scene: &Scene, r: &Rendered, opts: &RenderOptions) {
-        if self.kept.contains_key(&key) {
+        let px = |img: &Image| (img.px.len() * std::mem::size_of::<[u16; 4]>()) as u64;
+        let bytes = r.ref_image.as_ref().map_or(0, px) + r.truth_image.as_ref().map_or(0, px);
+        if self.kept.contains_key(&key) || self.bytes + bytes > self.budget {
             return;
         }
-        let Some(fp) = FloatPasses::of(scene, r, opts) else {
-            return;
-        };
-        let bytes = fp.bytes();
-        if self.bytes + bytes <= self.budget {
+        if let Some(fp) = FloatPasses::of(scene, r, opts) {
             self.bytes += bytes;
             self.kept.insert(key, Arc::new(fp));
         }

@@ -224,3 +224,29 @@ fn a_sweep_plan_file_runs_and_the_command_line_adds_to_it() {
     assert_eq!(o.status.code(), Some(1));
     assert!(text(&o).contains("--vary"), "{}", text(&o));
 }
+
+/// Rows that share the float passes (a blind axis, `weight_bits`, beside one that reaches
+/// them, `subpixel_bits`, alternating keys) measure what each row measures alone.
+#[test]
+fn rows_sharing_float_passes_equal_rows_rendered_alone() {
+    let d = tmp("float-passes");
+    let axes = ["--vary", "weight_bits=2,8", "--vary", "subpixel_bits=1,8"];
+    let mut extra = axes.to_vec();
+    extra.extend(["--out", "all"]);
+    let o = sweep(&d, &extra);
+    assert!(o.status.success(), "{}", text(&o));
+    let rows = json(&d.join("all/sweep.json"));
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    for (i, r) in rows.iter().enumerate() {
+        let (w, s) = (["2", "8"][i / 2], ["1", "8"][i % 2]);
+        let (wv, sv) = (format!("weight_bits={w}"), format!("subpixel_bits={s}"));
+        let out = format!("one{i}");
+        let o = sweep(&d, &["--vary", &wv, "--vary", &sv, "--out", &out]);
+        assert!(o.status.success(), "{}", text(&o));
+        let alone = &json(&d.join(format!("{out}/sweep.json")))[0];
+        for k in ["error_8bit", "error_16bit", "worst_pixel"] {
+            assert_eq!(r[k], alone[k], "row {i} {k}");
+        }
+    }
+}

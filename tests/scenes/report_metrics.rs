@@ -325,3 +325,66 @@ fn table_and_json() {
     let json = serde_json::to_value(&diff).expect("json");
     assert_eq!(json["max_abs_lsb"], 40);
 }
+
+/// `compare` against a per-pixel model (`Image::get`, `quantize`) on images of different
+/// sizes whose pixel vectors may be shorter or longer than their size, with short masks.
+#[test]
+fn random_sizes_and_broken_images_against_model() {
+    use texsim::report::quantize;
+    let mut rng = Rng(0x5EED_0002);
+    for case in 0..300 {
+        let bits = 1 + rng.below(16) as u32;
+        let img = |rng: &mut Rng| {
+            let (w, h) = (rng.below(12) as u32, rng.below(12) as u32);
+            let mut px: Vec<[u16; 4]> = (0..w * h)
+                .map(|_| [0; 4].map(|_: u16| rng.below(65536) as u16))
+                .collect();
+            match rng.below(4) {
+                0 => px.truncate(rng.below(px.len() as u64 + 1) as usize),
+                1 => px.extend((0..rng.below(20)).map(|_| [9u16; 4])),
+                _ => {}
+            }
+            Image {
+                width: w,
+                height: h,
+                px,
+            }
+        };
+        let (a, b) = (img(&mut rng), img(&mut rng));
+        let n = u64::from(a.width * a.height);
+        let mask: Option<Vec<bool>> =
+            (rng.below(2) == 0).then(|| (0..rng.below(n + 5)).map(|_| rng.below(3) != 0).collect());
+        let (mut pixels, mut max, mut sum) = (0u64, 0u32, 0u64);
+        for y in 0..a.height.min(b.height) {
+            for x in 0..a.width.min(b.width) {
+                let i = (y * a.width + x) as usize;
+                if mask
+                    .as_ref()
+                    .is_some_and(|m| !m.get(i).copied().unwrap_or(false))
+                {
+                    continue;
+                }
+                let (Some(pa), Some(pb)) = (a.get(x, y), b.get(x, y)) else {
+                    continue;
+                };
+                pixels += 1;
+                for c in 0..3 {
+                    let e = quantize(pa[c], bits).abs_diff(quantize(pb[c], bits));
+                    max = max.max(e);
+                    sum += u64::from(e);
+                }
+            }
+        }
+        let m = compare(&a, &b, bits, mask.as_deref());
+        assert_eq!((m.pixels, m.max_abs_lsb), (pixels, max), "case {case}");
+        let mean = if pixels == 0 {
+            0.0
+        } else {
+            sum as f64 / (3 * pixels) as f64
+        };
+        assert!(
+            (m.mean_abs_lsb - mean).abs() <= 1e-12 * (1.0 + mean),
+            "case {case}"
+        );
+    }
+}
