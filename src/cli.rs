@@ -1088,7 +1088,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
     // Keys are worth keeping only when some axis does not reach the passes (else every row
     // has its own key).
     let mut float_passes = crate::render::FloatPassCache::new(if reaches.contains(&false) {
-        crate::render::FloatPassCache::<Vec<&String>>::command_budget()
+        crate::render::float_pass_budget()
     } else {
         0
     });

@@ -295,15 +295,21 @@ pub fn is_width(path: &str) -> bool {
     (leaf.ends_with("_bits") || leaf.ends_with("_iterations")) && !path.starts_with("timing.")
 }
 
-/// The dotted path of the field `name` (a leaf name, a dotted path or the alias `frame` /
-/// `roughness`) among `fields` ([`fields`]); `name` itself when no field has it.
-#[must_use]
-pub fn dotted_path(fields: &[(String, String)], name: &str) -> String {
-    let name = match name {
+/// The field an alias names (`frame` is `frame_kind`, `roughness` is `rough_variant`), or
+/// `name` itself.
+fn unalias(name: &str) -> &str {
+    match name {
         "frame" => "frame_kind",
         "roughness" => "rough_variant",
         other => other,
-    };
+    }
+}
+
+/// The dotted path of the field `name` (a leaf name, a dotted path or an alias, [`unalias`])
+/// among `fields` ([`fields`]); `name` itself when no field has it.
+#[must_use]
+pub fn dotted_path(fields: &[(String, String)], name: &str) -> String {
+    let name = unalias(name);
     fields
         .iter()
         .find(|(p, _)| p == name || p.rsplit('.').next() == Some(name))
@@ -323,11 +329,7 @@ pub fn dotted_path(fields: &[(String, String)], name: &str) -> String {
 /// # Ok::<(), texsim::Error>(())
 /// ```
 pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
-    let name = match name {
-        "frame" => "frame_kind",
-        "roughness" => "rough_variant",
-        other => other,
-    };
+    let name = unalias(name);
     if let Some(why) = removed_field(name) {
         return Err(Error::field(name, why));
     }

@@ -582,7 +582,7 @@ pub fn tune(spec: &TuneSpec, progress: &mut dyn FnMut(&Trial)) -> Result<TuneRes
     // The scenes share the command's budget for kept float passes; none are kept when every
     // knob reaches them (every trial would have its own key).
     let scene_budget = if reaches.contains(&false) {
-        FloatPassCache::<Vec<u32>>::command_budget() / spec.scenes.len().max(1) as u64
+        crate::render::float_pass_budget() / spec.scenes.len().max(1) as u64
     } else {
         0
     };

@@ -72,7 +72,8 @@ impl FloatPasses {
     /// True when these passes are what a render of `scene` with `opts` would make (the caller
     /// vouches for the machine: it differs only in [`float_blind`] fields).
     pub(super) fn fits(&self, scene: &Scene, opts: &RenderOptions) -> bool {
-        self.scene == (scene.name.clone(), scene.width, scene.height)
+        let (name, width, height) = &self.scene;
+        (name.as_str(), *width, *height) == (scene.name.as_str(), scene.width, scene.height)
             && opts.coverage == CoverageMode::Shared
             && self.truth_samples == opts.truth
             && self.reference.is_some() == opts.reference
@@ -90,14 +91,14 @@ pub struct FloatPassCache<K> {
     budget: u64,
 }
 
-impl<K: Hash + Eq> FloatPassCache<K> {
-    /// The bytes all the caches of one command may keep together: a quarter of the memory
-    /// budget ([`crate::budget::max_memory`]).
-    #[must_use]
-    pub fn command_budget() -> u64 {
-        crate::budget::max_memory() / 4
-    }
+/// The bytes of images all the [`FloatPassCache`]s of one command may keep together: a
+/// quarter of the memory budget ([`crate::budget::max_memory`]).
+#[must_use]
+pub fn float_pass_budget() -> u64 {
+    crate::budget::max_memory() / 4
+}
 
+impl<K: Hash + Eq> FloatPassCache<K> {
     /// An empty cache that keeps at most `budget` bytes of images.
     #[must_use]
     pub fn new(budget: u64) -> Self {

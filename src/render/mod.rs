@@ -20,7 +20,7 @@ pub mod ranges;
 mod shading;
 mod stats;
 
-pub use float_passes::{float_blind, FloatPassCache, FloatPasses};
+pub use float_passes::{float_blind, float_pass_budget, FloatPassCache, FloatPasses};
 pub use geometry::Geometry;
 use shading::{bump_attrs, f32_tris, shade, tri_attrs, ShadeInput};
 use stats::bump_frames;
