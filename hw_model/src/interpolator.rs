@@ -943,7 +943,7 @@ pub fn interpolate_pairs(
     result: &mut [[i64; 2]],
 ) {
     crate::with_rounding!(out.rounding, M => {
-        interpolate_pairs_in::<M>(std::iter::once((bary, result)), bary_bits, attr, out, sat)
+        interpolate_span_in::<M, 2>(std::iter::once((bary, result)), bary_bits, attr, out, sat)
     })
 }
 
@@ -959,17 +959,33 @@ pub fn interpolate_pairs_span<'a>(
     out: &Format,
     sat: &mut SatCounter,
 ) {
+    interpolate_span(lanes, bary_bits, attr, out, sat);
+}
+
+/// [`interpolate`] of the `N` attributes `attr` (per vertex, e.g. a colour's channels) at each
+/// sample of each lane of a span into the same index of its results: the per-triangle terms,
+/// the format's range and the rounding mode resolved once for the span; the same bits and
+/// counts as one [`interpolate`] call per sample and attribute (checked by
+/// `interpolate_span_matches_interpolate` and `interpolate_pairs_span_matches_per_fragment_calls`).
+#[inline]
+pub fn interpolate_span<'a, const N: usize>(
+    lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; N]])>,
+    bary_bits: u32,
+    attr: [[i64; N]; 3],
+    out: &Format,
+    sat: &mut SatCounter,
+) {
     crate::with_rounding!(out.rounding, M => {
-        interpolate_pairs_in::<M>(lanes, bary_bits, attr, out, sat)
+        interpolate_span_in::<M, N>(lanes, bary_bits, attr, out, sat)
     })
 }
 
-/// [`interpolate_pairs_span`] compiled for the rounding mode `M` (`out.rounding`).
+/// [`interpolate_span`] compiled for the rounding mode `M` (`out.rounding`).
 #[inline(always)]
-fn interpolate_pairs_in<'a, M: ConstRounding>(
-    lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; 2]])>,
+fn interpolate_span_in<'a, M: ConstRounding, const N: usize>(
+    lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; N]])>,
     bary_bits: u32,
-    attr: [[i64; 2]; 3],
+    attr: [[i64; N]; 3],
     out: &Format,
     sat: &mut SatCounter,
 ) {
@@ -983,16 +999,20 @@ fn interpolate_pairs_in<'a, M: ConstRounding>(
             attr[2][ax].checked_sub(a0)?,
         ))
     };
-    let (Some((t0u, d1u, d2u)), Some((t0v, d1v, d2v))) = (terms(0), terms(1)) else {
+    let all: [Option<(i64, i64, i64)>; N] = std::array::from_fn(terms);
+    if all.iter().any(Option::is_none) {
         for (bary, result) in lanes {
             for (b, r) in bary.iter().zip(result.iter_mut()) {
-                *r = [0, 1].map(|ax| interpolate_cold::<M>(b, bary_bits, &attr, ax, out, sat));
+                *r = std::array::from_fn(|ax| {
+                    interpolate_cold::<M, N>(b, bary_bits, &attr, ax, out, sat)
+                });
             }
         }
         return;
-    };
+    }
+    let terms = all.map(|t| t.unwrap_or_default());
     let range = (out.min_raw(), out.max_raw());
-    let lim = narrow_limit([t0u, t0v], [d1u, d2u, d1v, d2v]);
+    let lim = narrow_limit(&terms);
     if let Some(round) = crate::fixed::ShiftRound::<M>::new(bary_bits) {
         // `-lim <= p < lim` for both barycentrics: one unsigned compare of their offsets.
         let window = lim.wrapping_mul(2);
@@ -1011,51 +1031,40 @@ fn interpolate_pairs_in<'a, M: ConstRounding>(
                             out.fit(v, sat)
                         }
                     };
-                    r[0] = fit(round.apply(acc((t0u, d1u, d2u))), sat);
-                    r[1] = fit(round.apply(acc((t0v, d1v, d2v))), sat);
+                    for ax in 0..N {
+                        r[ax] = fit(round.apply(acc(terms[ax])), sat);
+                    }
                     continue;
                 }
-                r[0] = interpolate_terms::<M>(
-                    b,
-                    (t0u, d1u, d2u),
-                    bary_bits,
-                    range,
-                    (&attr, 0),
-                    out,
-                    sat,
-                );
-                r[1] = interpolate_terms::<M>(
-                    b,
-                    (t0v, d1v, d2v),
-                    bary_bits,
-                    range,
-                    (&attr, 1),
-                    out,
-                    sat,
-                );
+                for (ax, (r, &t)) in r.iter_mut().zip(&terms).enumerate() {
+                    *r = interpolate_terms::<M, N>(b, t, bary_bits, range, (&attr, ax), out, sat);
+                }
             }
         }
         return;
     }
     for (bary, result) in lanes {
         for (b, r) in bary.iter().zip(result.iter_mut()) {
-            r[0] =
-                interpolate_terms::<M>(b, (t0u, d1u, d2u), bary_bits, range, (&attr, 0), out, sat);
-            r[1] =
-                interpolate_terms::<M>(b, (t0v, d1v, d2v), bary_bits, range, (&attr, 1), out, sat);
+            for (ax, (r, &t)) in r.iter_mut().zip(&terms).enumerate() {
+                *r = interpolate_terms::<M, N>(b, t, bary_bits, range, (&attr, ax), out, sat);
+            }
         }
     }
 }
 
 /// The bound `lim` on the barycentrics, `-lim <= p1, p2 < lim`, within which the accumulators
-/// `t0 + p1 d1 + p2 d2` of both attributes stay below 2^62 in magnitude, the input range of
-/// [`crate::fixed::ShiftRound::apply`] (0 when none does): with every `|t0| < 2^61` and every `|d| <
-/// 2^D`, `|p| <= 2^(60 - D)` gives `|p d| < 2^60` and the sum below `2^61 + 2^61`. Checked
-/// against the 128-bit accumulator by `interpolate_pairs_matches_interpolate`.
+/// `t0 + p1 d1 + p2 d2` of every attribute's `terms` `(t0, d1, d2)` stay below 2^62 in
+/// magnitude, the input range of [`crate::fixed::ShiftRound::apply`] (0 when none does): with
+/// every `|t0| < 2^61` and every `|d| < 2^D`, `|p| <= 2^(60 - D)` gives `|p d| < 2^60` and the
+/// sum below `2^61 + 2^61`. Checked against the 128-bit accumulator by
+/// `interpolate_pairs_matches_interpolate`.
 #[inline(always)]
-fn narrow_limit(t0: [i64; 2], d: [i64; 4]) -> u64 {
-    let top = t0[0].unsigned_abs().max(t0[1].unsigned_abs());
-    let dmax = d.iter().map(|x| x.unsigned_abs()).fold(0, u64::max);
+fn narrow_limit(terms: &[(i64, i64, i64)]) -> u64 {
+    let top = terms.iter().map(|t| t.0.unsigned_abs()).fold(0, u64::max);
+    let dmax = terms
+        .iter()
+        .map(|t| t.1.unsigned_abs().max(t.2.unsigned_abs()))
+        .fold(0, u64::max);
     let bits = 64 - dmax.leading_zeros();
     if top >= 1 << 61 || bits > 60 {
         0
@@ -1069,19 +1078,19 @@ fn narrow_limit(t0: [i64; 2], d: [i64; 4]) -> u64 {
 /// (else [`interpolate_in`]), then `Format::requantize` from `frac_bits + bary_bits` with the
 /// range `(min_raw, max_raw)` of `out` tested inline.
 #[inline(always)]
-fn interpolate_terms<M: ConstRounding>(
+fn interpolate_terms<M: ConstRounding, const N: usize>(
     b: &[i64; 3],
     (t0, d1, d2): (i64, i64, i64),
     bary_bits: u32,
     (lo, hi): (i64, i64),
-    (attr, ax): (&[[i64; 2]; 3], usize),
+    (attr, ax): (&[[i64; N]; 3], usize),
     out: &Format,
     sat: &mut SatCounter,
 ) -> i64 {
     let wide =
         i128::from(t0) + i128::from(b[1]) * i128::from(d1) + i128::from(b[2]) * i128::from(d2);
     let Ok(acc) = i64::try_from(wide) else {
-        return interpolate_cold::<M>(b, bary_bits, attr, ax, out, sat);
+        return interpolate_cold::<M, N>(b, bary_bits, attr, ax, out, sat);
     };
     let v = round_shift_right(acc, bary_bits, M::MODE);
     if v >= lo && v <= hi {
@@ -1095,10 +1104,10 @@ fn interpolate_terms<M: ConstRounding>(
 /// beyond `i64`.
 #[cold]
 #[inline(never)]
-fn interpolate_cold<M: ConstRounding>(
+fn interpolate_cold<M: ConstRounding, const N: usize>(
     bary: &[i64; 3],
     bary_bits: u32,
-    attr: &[[i64; 2]; 3],
+    attr: &[[i64; N]; 3],
     ax: usize,
     out: &Format,
     sat: &mut SatCounter,
@@ -1646,7 +1655,7 @@ mod tests {
             let n = 1 + (i % 3) as usize;
             let t0 = attr[0].map(|a| a.checked_mul(1 << bb).unwrap_or(i64::MAX));
             let d = [0, 1].map(|ax| [1, 2].map(|v| attr[v][ax].wrapping_sub(attr[0][ax])));
-            let lim = narrow_limit(t0, [d[0][0], d[0][1], d[1][0], d[1][1]]) as i64;
+            let lim = narrow_limit(&[0, 1].map(|ax| (t0[ax], d[ax][0], d[ax][1]))) as i64;
             let pb = [bb + 1, 30, 45, 60][(i / 108 % 4) as usize];
             let mut bary =
                 [0; 3].map(|_| [signed(&mut s, pb), signed(&mut s, pb), signed(&mut s, pb)]);

@@ -3,7 +3,7 @@
 use super::stages::{unorm, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::to_unorm;
-use hw_model::modulate::{modulate, modulate_cost};
+use hw_model::modulate::{modulate, modulate_cost, modulate_span};
 use hw_model::UnitCost;
 
 /// Fixed twin: four unorm products.
@@ -29,6 +29,35 @@ pub fn fixed(px: &Px, frag: &mut Frag, _: &mut Counters) {
         }
     }
     frag.out_bits = cb;
+}
+
+/// Fixed twin over a span: [`fixed`] on each fragment, with the widths and the rounding
+/// resolved once for the span (`modulate_span`, bit-identical to `modulate`).
+pub fn fixed_span(px: &Px, frags: &mut [Frag], _: &mut Counters) {
+    let hw = px.m.hw;
+    let cb = hw.color.color_bits;
+    let tb = hw.trilinear.texel_bits;
+    let (color_raw, texel_raw) = (px.color_raw, px.fixed(StageKind::Trilinear));
+    let lanes = frags.iter_mut().map(|f| {
+        let col = if color_raw {
+            f.color_x
+        } else {
+            f.color.map(|x| to_unorm(x, cb))
+        };
+        let tex = if texel_raw {
+            f.texel_x
+        } else {
+            f.texel.map(|x| to_unorm(x, tb))
+        };
+        (col, tex, &mut f.out_x)
+    });
+    modulate_span(lanes, cb, tb, cb, hw.color.color_rounding);
+    for f in frags.iter_mut() {
+        if px.carriers {
+            f.out = f.out_x.map(|x| unorm(x, cb));
+        }
+        f.out_bits = cb;
+    }
 }
 
 /// Float twin.

@@ -149,7 +149,8 @@ stage_table! {
     }
     /// Vertex colour interpolation (Gouraud lighting result).
     Color "color" {
-        fixed: color::fixed, float: color::float, cost: color::cost, lookups: no_lookups
+        fixed: color::fixed, fixed_span: color::fixed_span, float: color::float,
+        cost: color::cost, lookups: no_lookups,
     }
     /// Texture-coordinate interpolation, with the helper samples for derivatives.
     Texcoord "texcoord" {
@@ -168,8 +169,8 @@ stage_table! {
     }
     /// Colour x texel.
     Modulate "modulate" {
-        fixed: modulate::fixed, float: modulate::float, cost: modulate::cost,
-        lookups: no_lookups,
+        fixed: modulate::fixed, fixed_span: modulate::fixed_span, float: modulate::float,
+        cost: modulate::cost, lookups: no_lookups,
     }
     /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
     Normal "normal" {

@@ -1,5 +1,5 @@
-//! Stages over spans of fragments: the span twins of `bary` and `texcoord`, and of `lod` and
-//! `trilinear`, against their per-fragment twins on seeded spans (values, carriers, traced
+//! Stages over spans of fragments: the span twins of `bary` and `texcoord`, of `lod` and
+//! `trilinear`, and of `color` and `modulate`, against their per-fragment twins on seeded spans (values, carriers, traced
 //! footprints, saturation counts and costs), and whole
 //! frames shaded in spans against the same frames shaded one fragment at a time (images,
 //! statistics, counters and cycle counts).
@@ -11,7 +11,7 @@ use hw_model::wrap::WrapMode;
 use texsim::maps::{build_mip_chain, quantize_chain};
 use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
 use texsim::pipeline::{
-    bary, lod, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls, StageKind,
+    bary, color, lod, modulate, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls, StageKind,
 };
 use texsim::raster::{ScreenTri, VertexSource};
 use texsim::render::{render, Maps, RenderOptions, Rendered};
@@ -354,6 +354,140 @@ fn lookup_span_twins_match_the_per_fragment_twins() {
         }
     }
     assert!(fast > 30_000, "{fast} spans on the span twins' own paths");
+}
+
+/// The fields `color` and `modulate` write (raw values, carriers' bits, output width).
+fn written_color(f: &Frag) -> String {
+    format!(
+        "{:?} {:?} {:?} {:?} {}",
+        f.color_x,
+        f.color.map(f64::to_bits),
+        f.out_x,
+        f.out.map(f64::to_bits),
+        f.out_bits,
+    )
+}
+
+/// 120k seeded spans of 1..=16 fragments of a lit, textured plan: `bary`, `color` and
+/// `modulate` over the span give, at every fragment, the raw values, carriers and output of
+/// their per-fragment twins and the same saturation counts; over colour and texel widths 1
+/// to 16, the colour rounding modes, vertex colours at 0, at their maximum and between,
+/// raw texels up to beyond their maximum (the unit clamps) and texel carriers unrelated to
+/// them, a Float `bary`, `color` or `trilinear` producer (the per-fragment fallback and the
+/// carriers' rounding), carriers on and off.
+#[test]
+fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
+    let mut rng = Rng(0x5a4e_1003);
+    let lit = Material {
+        texture: Some(0),
+        lit: true,
+        ..Material::default()
+    };
+    let pl = plan(&lit, true);
+    assert!(pl.has(StageKind::Color) && pl.has(StageKind::Modulate));
+    let mut fast = 0u32;
+    for group in 0..60u32 {
+        let mut hw = config(&mut rng);
+        let (cb, tb) = (rng.int_in(1, 16) as u32, rng.int_in(1, 16) as u32);
+        hw.color.color_bits = cb;
+        hw.color.color_rounding = MODES[rng.below(3) as usize];
+        hw.trilinear.texel_bits = tb;
+        let m = Machine::new(&hw, &[], &[]);
+        let sub = hw.raster.subpixel_bits;
+        let (cmax, tmax) = ((1i64 << cb) - 1, (1i64 << tb) - 1);
+        for case in 0..2000u32 {
+            let tri = triangle(&mut rng, sub);
+            let mut a = attrs(&mut rng, &hw);
+            a.color_x = [[0u16; 3]; 3].map(|_| {
+                [0; 3].map(|_| match rng.below(4) {
+                    0 => 0,
+                    1 => cmax as u16,
+                    _ => rng.int_in(0, cmax) as u16,
+                })
+            });
+            a.color_f = a.color_x.map(|v| v.map(|c| f64::from(c) / cmax as f64));
+            let mut impls = StageImpls::FIXED;
+            for k in [StageKind::Bary, StageKind::Color, StageKind::Trilinear] {
+                if rng.below(8) == 0 {
+                    impls = impls.with(k, Impl::Float);
+                }
+            }
+            let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
+            let n = rng.int_in(1, 16) as usize;
+            let px = Px {
+                plan: &pl,
+                impls: &impls,
+                m: &m,
+                tri: &tri,
+                a: &a,
+                x: vx + rng.int_in(-12, 4),
+                y: vy + rng.int_in(-3, 3),
+                color_raw: impls.of(StageKind::Color) == Impl::Fixed,
+                carriers: rng.below(2) == 0,
+            };
+            let input: Vec<Frag> = (0..n)
+                .map(|_| Frag {
+                    texel_x: [0; 4].map(|_| rng.int_in(0, tmax + tmax / 2) as u32),
+                    // A carrier unrelated to the raw texel: a Float `trilinear` is read from it.
+                    texel: [0.0; 4].map(|_| rng.unit()),
+                    ..Frag::default()
+                })
+                .collect();
+            let fixed = |k: StageKind| impls.of(k) == Impl::Fixed;
+            let bary_twin = if fixed(StageKind::Bary) {
+                bary::fixed
+            } else {
+                bary::float
+            };
+            let color_twin = if fixed(StageKind::Color) {
+                color::fixed
+            } else {
+                color::float
+            };
+            let mut span = input.clone();
+            let mut c_span = Counters::default();
+            let each = texsim::pipeline::stages::each_fragment;
+            if fixed(StageKind::Bary) {
+                bary::fixed_span(&px, &mut span, &mut c_span);
+            } else {
+                each(bary::float, &px, &mut span, &mut c_span);
+            }
+            if fixed(StageKind::Color) {
+                color::fixed_span(&px, &mut span, &mut c_span);
+            } else {
+                each(color::float, &px, &mut span, &mut c_span);
+            }
+            modulate::fixed_span(&px, &mut span, &mut c_span);
+            let mut c_one = Counters::default();
+            for (j, (got, f)) in span.iter().zip(input).enumerate() {
+                let at = Px {
+                    x: px.x + j as i64,
+                    ..px
+                };
+                let mut f = f;
+                bary_twin(&at, &mut f, &mut c_one);
+                color_twin(&at, &mut f, &mut c_one);
+                modulate::fixed(&at, &mut f, &mut c_one);
+                assert_eq!(
+                    written_color(got),
+                    written_color(&f),
+                    "group {group} case {case} fragment {j}"
+                );
+            }
+            for k in [StageKind::Bary, StageKind::Color, StageKind::Modulate] {
+                assert_eq!(
+                    c_span.sat[k.index()],
+                    c_one.sat[k.index()],
+                    "group {group} case {case}: {k} counts"
+                );
+            }
+            fast += u32::from(fixed(StageKind::Bary) && fixed(StageKind::Color));
+        }
+    }
+    assert!(
+        fast > 60_000,
+        "{fast} spans on the colour span twin's own path"
+    );
 }
 
 fn render_with(s: &scene::Scene, hw: &HwConfig, per_fragment: bool) -> Rendered {

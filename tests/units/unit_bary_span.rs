@@ -1,5 +1,5 @@
 //! The interpolator's span datapaths (`perspective_bary_derivs_span`, `perspective_bary_span`,
-//! `interpolate_pairs_span`) against one call of the per-sample routine per lane: the same
+//! `interpolate_pairs_span`, `interpolate_span`) against one call of the per-sample routine per lane: the same
 //! values and the same saturation counts, on seeded spans over random widths and rounding
 //! modes, from screen-sized to near-degenerate and huge triangles, tiny and large 1/w, lanes
 //! inside and outside the triangle, spans longer than `SPAN_LANES`.
@@ -8,8 +8,9 @@ use crate::rng_common::Rng;
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Overflow, Rounding, SatCounter};
 use hw_model::interpolator::{
-    interpolate_pairs, interpolate_pairs_span, perspective_bary, perspective_bary_derivs,
-    perspective_bary_derivs_span, perspective_bary_span, EdgeSpan, SPAN_LANES,
+    interpolate, interpolate_pairs, interpolate_pairs_span, interpolate_span, perspective_bary,
+    perspective_bary_derivs, perspective_bary_derivs_span, perspective_bary_span, EdgeSpan,
+    SPAN_LANES,
 };
 use hw_model::reciprocal::Reciprocal;
 
@@ -240,6 +241,52 @@ fn interpolate_pairs_span_matches_per_fragment_calls() {
                 &mut want[..samples],
             );
             assert_eq!(g, &want, "case {case}");
+        }
+        assert_eq!(sat, sat_ref, "case {case}: overflow counts");
+    }
+}
+
+/// 1M spans of 1 to 16 one-sample fragments: `interpolate_span` of three attributes (a
+/// colour's channels) equals one `interpolate` per fragment and channel (values and overflow
+/// counts), over unsigned and signed formats, rounding and overflow modes, attributes from
+/// unorm colours to beyond the `i64` accumulator and barycentrics inside and far outside
+/// the triangle.
+#[test]
+fn interpolate_span_matches_interpolate() {
+    let mut rng = Rng(0x5a4e_0004);
+    for case in 0..1_000_000u32 {
+        let bb = rng.int_in(4, 30) as u32;
+        let frac = rng.int_in(1, 24) as u32;
+        let mode = MODES[rng.below(3) as usize];
+        let mut out = if rng.below(2) == 0 {
+            Format::unsigned(0, frac, mode)
+        } else {
+            Format::signed(rng.int_in(1, 16) as u32, frac, mode)
+        };
+        if rng.below(4) == 0 {
+            out = out.with_overflow(Overflow::Wrap);
+        }
+        let abits = [frac, frac + 2, 40, 62][rng.below(4) as usize];
+        let attr = [[0i64; 3]; 3].map(|_| [0; 3].map(|_| signed(&mut rng, abits)));
+        let n = rng.int_in(1, 16) as usize;
+        let bbits = [bb, bb + 1, bb + 3, 40][rng.below(4) as usize];
+        let bary: Vec<[i64; 3]> = (0..n)
+            .map(|_| [0; 3].map(|_| signed(&mut rng, bbits)))
+            .collect();
+        let mut got = vec![[[0i64; 3]; 1]; n];
+        let mut sat = SatCounter::default();
+        let lanes = bary
+            .iter()
+            .zip(got.iter_mut())
+            .map(|(b, r)| (std::slice::from_ref(b), &mut r[..]));
+        interpolate_span(lanes, bb, attr, &out, &mut sat);
+        let mut sat_ref = SatCounter::default();
+        for (b, g) in bary.iter().zip(&got) {
+            let want = [0, 1, 2].map(|ch| {
+                let column = [attr[0][ch], attr[1][ch], attr[2][ch]];
+                interpolate(*b, bb, column, &out, &mut sat_ref)
+            });
+            assert_eq!(g[0], want, "case {case}");
         }
         assert_eq!(sat, sat_ref, "case {case}: overflow counts");
     }

@@ -3,7 +3,7 @@
 
 use crate::rng_common::Rng;
 use hw_model::fixed::Rounding;
-use hw_model::modulate::{modulate, modulate_cost, unorm_convert};
+use hw_model::modulate::{modulate, modulate_cost, modulate_span, unorm_convert};
 use texsim::fixedpoint::{from_unorm, to_unorm};
 use texsim::reference::modulate_f64;
 
@@ -88,6 +88,59 @@ fn modulate_random_mixed_widths() {
         )
         .ops > 0
     );
+}
+
+/// `modulate_span` equals `modulate` per channel: every input pair at every width pair up to
+/// 6 bits (the output width and mode cycling), then 4M seeded lanes in spans of 1 to 16 with
+/// widths 0 to 20 (beyond 16 clamps), inputs up to 2^20 (above their maximum clamps) and a
+/// fifth of them at the maxima.
+#[test]
+fn modulate_span_matches_modulate() {
+    fn check(lanes: &[([u32; 4], [u32; 4])], (ab, bb, ob): (u32, u32, u32), mode: Rounding) {
+        let mut got = vec![[u32::MAX; 4]; lanes.len()];
+        let it = lanes
+            .iter()
+            .zip(got.iter_mut())
+            .map(|(&(a, b), o)| (a, b, o));
+        modulate_span(it, ab, bb, ob, mode);
+        for (&(a, b), g) in lanes.iter().zip(&got) {
+            let want = [0, 1, 2, 3].map(|ch| modulate(a[ch], ab, b[ch], bb, ob, mode));
+            assert_eq!(*g, want, "{a:?}/{ab} x {b:?}/{bb} -> {ob} {mode:?}");
+        }
+    }
+    for ab in 1u32..=6 {
+        for bb in 1u32..=6 {
+            let ob = (ab + bb) % 16 + 1;
+            let mode = ROUNDINGS[((ab + bb) % 3) as usize];
+            let lanes: Vec<_> = (0..1u32 << ab)
+                .flat_map(|a| (0..1u32 << bb).map(move |b| ([a; 4], [b, b, b, 0])))
+                .collect();
+            check(&lanes, (ab, bb, ob), mode);
+        }
+    }
+    let mut rng = Rng(0x30d_0002);
+    let mut lanes = Vec::with_capacity(16);
+    let mut done = 0u32;
+    while done < 4_000_000 {
+        let w = [0u32; 3].map(|_| rng.below(21) as u32);
+        let mode = ROUNDINGS[rng.below(3) as usize];
+        let n = rng.int_in(1, 16) as usize;
+        let value = |bits: u32, rng: &mut Rng| {
+            if rng.below(5) == 0 {
+                ((1u64 << bits.min(16)) - 1) as u32
+            } else {
+                (rng.next() % (1u64 << (bits + 1).min(20))) as u32
+            }
+        };
+        lanes.clear();
+        for _ in 0..n {
+            let a = [0; 4].map(|_| value(w[0], &mut rng));
+            let b = [0; 4].map(|_| value(w[1], &mut rng));
+            lanes.push((a, b));
+        }
+        check(&lanes, (w[0], w[1], w[2]), mode);
+        done += n as u32;
+    }
 }
 
 #[test]
