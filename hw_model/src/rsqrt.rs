@@ -21,7 +21,7 @@ use crate::config::ConfigError;
 use crate::cost::UnitCost;
 use crate::datapath::Cycles;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, Rounding};
+use crate::fixed::{round_shift_right_wide, ConstRounding, Rounding, ShiftRound};
 use serde::{Deserialize, Serialize};
 
 /// Guard fraction bits carried inside the Newton-Raphson datapath beyond the mantissa.
@@ -162,11 +162,17 @@ impl Rsqrt {
         if x == 0 {
             return None;
         }
+        crate::with_rounding!(self.rounding, M => Some(self.eval_in::<M>(x)))
+    }
+
+    /// [`Rsqrt::eval`] of `x > 0` compiled for the rounding mode `M` (`rsqrt_rounding`).
+    #[inline(always)]
+    fn eval_in<M: ConstRounding>(&self, x: u64) -> RsqrtOut {
         let b = self.bits;
         let mut e = 63 - x.leading_zeros() as i32;
         let mut m = if e + 1 > b as i32 {
             let s = (e + 1 - b as i32) as u32;
-            round_shift_right_wide(i128::from(x), s, self.rounding) as u64
+            round_shift_right_wide(i128::from(x), s, M::MODE) as u64
         } else {
             x << (b as i32 - 1 - e)
         };
@@ -174,12 +180,23 @@ impl Rsqrt {
             m >>= 1;
             e += 1;
         }
-        Some(self.eval_mantissa(m, e))
+        self.eval_mantissa_in::<M>(m, e)
     }
 
     /// Core: mantissa `m` in `[2^(B-1), 2^B)` (value `m / 2^(B-1)` in `[1, 2)`) times `2^e`.
     #[must_use]
     pub fn eval_mantissa(&self, m: u64, e: i32) -> RsqrtOut {
+        crate::with_rounding!(self.rounding, M => self.eval_mantissa_in::<M>(m, e))
+    }
+
+    /// [`Rsqrt::eval_mantissa`] compiled for the rounding mode `M`. The iterate `y`, `y^2` and
+    /// `M y^2` are reductions (saturated to `i64`), so only the products need more: each
+    /// Newton-Raphson step runs in `i64` with the rounding resolved ([`ShiftRound`]) when its
+    /// three products stay below 2^62 in magnitude (texram16's 28-bit datapath always does),
+    /// else in `i128` ([`newton_step_wide`]); the same bits either way (checked against the
+    /// all-`i128` step by `narrow_steps_match_the_wide_step`).
+    #[inline(always)]
+    fn eval_mantissa_in<M: ConstRounding>(&self, m: u64, e: i32) -> RsqrtOut {
         let b = self.bits;
         let w = b + RSQRT_GUARD_BITS;
         let k = e.div_euclid(2);
@@ -191,24 +208,51 @@ impl Rsqrt {
             0
         };
         let idx = ((p as usize) << (l - 1)) | frac_idx as usize;
-        let mut y = i128::from(self.lut[idx]);
-        let mw = i128::from(m) << (RSQRT_GUARD_BITS + 1 + p);
-        let three = 3i128 << w;
+        // Seeds are below 2^(w + 1), mantissas below 2^30 shifted by at most 6, and w <= 34.
+        let mut y = self.lut[idx] as i64;
+        let mw = (m as i64) << (RSQRT_GUARD_BITS + 1 + p);
+        let three = 3i64 << w;
+        let rounds = ShiftRound::<M>::new(w).zip(ShiftRound::<M>::new(w + 1));
         for _ in 0..self.iterations {
-            let y2 = i128::from(round_shift_right_wide(y * y, w, self.rounding));
-            let t = i128::from(round_shift_right_wide(mw * y2, w, self.rounding));
-            y = i128::from(round_shift_right_wide(
-                y * (three - t),
-                w + 1,
-                self.rounding,
-            ));
+            y = rounds
+                .as_ref()
+                .and_then(|r| newton_step_narrow(y, mw, three, r))
+                .unwrap_or_else(|| newton_step_wide(y, mw, three, w, M::MODE));
         }
-        let out = round_shift_right_wide(y, RSQRT_GUARD_BITS, self.rounding).clamp(1, 1i64 << b);
+        let out =
+            round_shift_right_wide(i128::from(y), RSQRT_GUARD_BITS, M::MODE).clamp(1, 1i64 << b);
         RsqrtOut {
             mant: out as u64,
             shift: b as i32 + k,
         }
     }
+}
+
+/// One Newton-Raphson step `y (3 - M y^2) / 2` of the unit's datapath (`w` fraction bits, each
+/// product rounded by `mode`), with exact 128-bit products.
+fn newton_step_wide(y: i64, mw: i64, three: i64, w: u32, mode: Rounding) -> i64 {
+    let y2 = i128::from(round_shift_right_wide(
+        i128::from(y) * i128::from(y),
+        w,
+        mode,
+    ));
+    let t = i128::from(round_shift_right_wide(i128::from(mw) * y2, w, mode));
+    round_shift_right_wide(i128::from(y) * (i128::from(three) - t), w + 1, mode)
+}
+
+/// [`newton_step_wide`] in `i64` with the roundings by `w` and `w + 1` resolved, when every
+/// product is below 2^62 in magnitude ([`ShiftRound::apply`]'s range); `None` otherwise.
+#[inline(always)]
+fn newton_step_narrow<M: ConstRounding>(
+    y: i64,
+    mw: i64,
+    three: i64,
+    (r_w, r_w1): &(ShiftRound<M>, ShiftRound<M>),
+) -> Option<i64> {
+    let small = |v: i64| (v.unsigned_abs() >> 62 == 0).then_some(v);
+    let y2 = r_w.apply(small(y.checked_mul(y)?)?);
+    let t = r_w.apply(small(mw.checked_mul(y2)?)?);
+    Some(r_w1.apply(small(y.checked_mul(three.checked_sub(t)?)?)?))
 }
 
 /// Cost of one `1/sqrt`: one LUT read, then three multiplies and a subtract per iteration;
@@ -261,4 +305,156 @@ pub fn datapath(cfg: &RsqrtConfig) -> Datapath {
                 .then(Component::Adder { width: b + 1 })
                 .then(Component::Register { bits: b + 1 + 8 }),
         )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixed::{HalfEvenMode, HalfUpMode, TruncateMode};
+    use crate::test_rng::splitmix64 as next;
+
+    const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+    /// [`Rsqrt::eval_mantissa`] as first written, every product in `i128` and the mode
+    /// branched at each rounding: the oracle.
+    fn eval_mantissa_before(u: &Rsqrt, m: u64, e: i32) -> RsqrtOut {
+        let b = u.bits;
+        let w = b + RSQRT_GUARD_BITS;
+        let k = e.div_euclid(2);
+        let p = (e - 2 * k) as u32;
+        let l = u.lut_bits;
+        let frac_idx = if l > 1 {
+            (m >> (b - l)) & ((1u64 << (l - 1)) - 1)
+        } else {
+            0
+        };
+        let idx = ((p as usize) << (l - 1)) | frac_idx as usize;
+        let mut y = i128::from(u.lut[idx]);
+        let mw = i128::from(m) << (RSQRT_GUARD_BITS + 1 + p);
+        let three = 3i128 << w;
+        for _ in 0..u.iterations {
+            let y2 = i128::from(round_shift_right_wide(y * y, w, u.rounding));
+            let t = i128::from(round_shift_right_wide(mw * y2, w, u.rounding));
+            y = i128::from(round_shift_right_wide(y * (three - t), w + 1, u.rounding));
+        }
+        let out = round_shift_right_wide(y, RSQRT_GUARD_BITS, u.rounding).clamp(1, 1i64 << b);
+        RsqrtOut {
+            mant: out as u64,
+            shift: b as i32 + k,
+        }
+    }
+
+    fn unit(bits: u32, lut_bits: u32, iterations: u32, rounding: Rounding) -> Rsqrt {
+        Rsqrt::new(&RsqrtConfig {
+            rsqrt_lut_bits: lut_bits.min(bits),
+            rsqrt_iterations: iterations,
+            rsqrt_mantissa_bits: bits,
+            rsqrt_rounding: rounding,
+            ..RsqrtConfig::texram16()
+        })
+    }
+
+    /// The unit with its steps in `i64` where they fit against [`eval_mantissa_before`]:
+    /// every mantissa and parity of texram16 (2^24 cases) and of every mantissa width up to 12
+    /// bits with seed widths 1, 4 and 8 and 0 to 4 iterations in every mode; 2M seeded
+    /// mantissas of widths 13 to 30 (beyond 25 bits the products leave `i64` and the steps
+    /// take the 128-bit path) over seed widths, iterations and modes.
+    #[test]
+    fn narrow_steps_match_the_wide_step() {
+        let check = |u: &Rsqrt, m: u64, e: i32| {
+            assert_eq!(
+                u.eval_mantissa(m, e),
+                eval_mantissa_before(u, m, e),
+                "m {m} e {e} B {} L {} it {} {:?}",
+                u.bits,
+                u.lut_bits,
+                u.iterations,
+                u.rounding
+            );
+        };
+        let texram = Rsqrt::new(&RsqrtConfig::texram16());
+        for e in [0, 1] {
+            for m in 1u64 << 23..1 << 24 {
+                check(&texram, m, e);
+            }
+        }
+        for bits in 8..=12 {
+            for lut_bits in [1, 4, 8] {
+                for iterations in 0..=4 {
+                    for mode in MODES {
+                        let u = unit(bits, lut_bits, iterations, mode);
+                        for e in [-3, 0, 1, 6] {
+                            for m in 1u64 << (bits - 1)..1 << bits {
+                                check(&u, m, e);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut s = 0x5eed_0a51;
+        for i in 0..1000u32 {
+            let bits = 13 + (next(&mut s) % 18) as u32;
+            let lut_bits = 1 + (next(&mut s) % 16) as u32;
+            let u = unit(bits, lut_bits, i % 5, MODES[(i / 5 % 3) as usize]);
+            for _ in 0..2000 {
+                let m = (1u64 << (bits - 1)) | (next(&mut s) & ((1u64 << (bits - 1)) - 1));
+                check(&u, m, (next(&mut s) % 64) as i32 - 32);
+            }
+        }
+    }
+
+    /// [`newton_step_narrow`] against [`newton_step_wide`] on 3M seeded iterates, mantissas
+    /// and widths, from small to beyond `i64` (where it answers `None`): the same step
+    /// whenever it answers, and an answer whenever the products are below 2^62.
+    #[test]
+    fn newton_step_narrow_matches_newton_step_wide() {
+        fn case<M: ConstRounding>(y: i64, mw: i64, w: u32) -> bool {
+            let three = 3i64 << w;
+            let r = (
+                ShiftRound::<M>::new(w).expect("w"),
+                ShiftRound::<M>::new(w + 1).expect("w + 1"),
+            );
+            let wide = newton_step_wide(y, mw, three, w, M::MODE);
+            match newton_step_narrow(y, mw, three, &r) {
+                Some(v) => {
+                    assert_eq!(v, wide, "y {y} mw {mw} w {w} {:?}", M::MODE);
+                    true
+                }
+                None => {
+                    let y = i128::from(y);
+                    let y2 = i128::from(round_shift_right_wide(y * y, w, M::MODE));
+                    let t = i128::from(round_shift_right_wide(i128::from(mw) * y2, w, M::MODE));
+                    let widest = [y * y, i128::from(mw) * y2, y * (i128::from(three) - t)]
+                        .map(i128::unsigned_abs)
+                        .into_iter()
+                        .max();
+                    assert!(
+                        widest >= Some(1 << 62),
+                        "y {y} mw {mw} w {w}: refused with products below 2^62"
+                    );
+                    false
+                }
+            }
+        }
+        let mut s = 0x5eed_0a52;
+        let (mut narrow, mut wide) = (0u32, 0u32);
+        for i in 0..3_000_000u32 {
+            let w = 12 + (next(&mut s) % 23) as u32;
+            let y = (next(&mut s) >> (next(&mut s) % 64)) as i64 * if i % 2 == 0 { 1 } else { -1 };
+            let y = y >> (i % 40);
+            let mw = (next(&mut s) >> (28 + next(&mut s) % 36)) as i64;
+            let took = match i % 3 {
+                0 => case::<TruncateMode>(y, mw, w),
+                1 => case::<HalfUpMode>(y, mw, w),
+                _ => case::<HalfEvenMode>(y, mw, w),
+            };
+            if took {
+                narrow += 1;
+            } else {
+                wide += 1;
+            }
+        }
+        assert!(narrow > 500_000 && wide > 500_000, "{narrow} {wide}");
+    }
 }
