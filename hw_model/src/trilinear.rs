@@ -28,9 +28,7 @@ use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, ConstRounding, Rounding};
-use crate::wrap::{
-    fits_i64, wrap_i64_with, wrap_in, wrap_pow2_repeat, WrapMode, WrapOut, WrapShifts,
-};
+use crate::wrap::{wrap_i64_with, wrap_in, wrap_pow2_repeat, WrapMode, WrapOut, WrapShifts};
 
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
@@ -246,10 +244,11 @@ fn fetch_quad_pow2(level: &Level, wx: &WrapOut, wy: &WrapOut) -> [[u16; 4]; 4] {
 }
 
 /// One bilinear footprint in lanes, its wrapped addresses and texels reported to `sink`
-/// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: both
-/// coordinates [`fits_i64`] (the caller's test, once for every level of a sample), wrapped
-/// with the shifts `k` of `frac` and `weight_bits`; `POW2_REPEAT`: both axes Repeat and both
-/// sides of the level powers of two (the caller's test, once per span), wrapped by masks.
+/// (as footprint `index` of level `level_index`) when the sink keeps them. `narrow`: `frac
+/// <= 30` and both coordinates fit the level's sides ([`crate::wrap::fits_i64_on`]; the
+/// caller's test, once for every level of a sample), wrapped with the shifts `k` of `frac`
+/// and `weight_bits`; `POW2_REPEAT`: both axes Repeat and both sides of the level powers of
+/// two (the caller's test, once per span), wrapped by masks.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn bilinear_lanes<W: ConstRounding, S: SampleSink, const POW2_REPEAT: bool>(
@@ -328,19 +327,22 @@ pub fn bilinear(
         }
         fn sample(&mut self, _: u32, _: u32, _: [u16; 4]) {}
     }
+    let fits = |u, v| {
+        crate::wrap::fits_i64(u, frac, level.width) && crate::wrap::fits_i64(v, frac, level.height)
+    };
     crate::with_rounding!(cfg.filter_rounding, F => {
         crate::with_rounding!(cfg.weight_rounding, W => match trace {
             None => {
                 let f = LaneLerp::new(cfg.weight_bits.min(16), F::MODE);
                 let k = WrapShifts::new(frac, cfg.weight_bits.min(16));
-                let narrow = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&k);
+                let narrow = fits(u, v).then_some(&k);
                 bilinear_lanes::<W, (), false>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut ())
             }
             Some(t) => {
                 let mut one = One(t);
                 let f = LaneLerp::new(cfg.weight_bits.min(16), F::MODE);
                 let k = WrapShifts::new(frac, cfg.weight_bits.min(16));
-                let narrow = (fits_i64(u, frac) && fits_i64(v, frac)).then_some(&k);
+                let narrow = fits(u, v).then_some(&k);
                 bilinear_lanes::<W, One, false>(level, 0, u, v, frac, wrap_mode, cfg, &f, 0, narrow, &mut one)
             }
         }
@@ -436,9 +438,9 @@ pub struct UnitSetup {
     filter: LaneLerp,
     /// The level blend in lanes (`lf <= 16`).
     blend: LaneLerp,
-    /// The wrap's shifts (`frac`, `weight_bits`) for coordinates that [`fits_i64`].
+    /// The wrap's shifts (`frac`, `weight_bits`) for coordinates that fit `i64`.
     shifts: WrapShifts,
-    /// `frac <= 30`: coordinates in [-2^29, 2^29) [`fits_i64`].
+    /// `frac <= 30`: coordinates that [`crate::wrap::fits_i64_on`] a level wrap in `i64`.
     narrow_frac: bool,
     /// The filter and weight roundings it was built for.
     modes: (Rounding, Rounding),
@@ -458,7 +460,7 @@ impl UnitSetup {
             filter: LaneLerp::new(wb, cfg.filter_rounding),
             blend: LaneLerp::new(lf.min(16), cfg.filter_rounding),
             shifts: WrapShifts::new(frac, wb),
-            narrow_frac: fits_i64(0, frac),
+            narrow_frac: frac <= 30,
             modes: (cfg.filter_rounding, cfg.weight_rounding),
         }
     }
@@ -563,9 +565,16 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
             ((lod >> lf) as usize, (lod & k.lod_mask) as u32)
         };
         let (frac, wm, cfg, f) = (k.frac, self.wrap_mode, self.cfg, &k.filter);
-        // `fits_i64(u, frac) && fits_i64(v, frac)`: both in [-2^29, 2^29).
+        // Both coordinates `fits_i64_on` every side of both levels: at once when both are in
+        // [-2^29, 2^29) (which fits any `u32` side), else tested against the sides' bitwise or
+        // (at least each side).
         let both = (u as u64).wrapping_add(1 << 29) | (v as u64).wrapping_add(1 << 29);
-        let nw = (k.narrow_frac && both < 1 << 30).then_some(&k.shifts);
+        let fits = both < 1 << 30 || {
+            let l1 = (l0 + 1).min(n - 1);
+            let sides = levels[l0].width | levels[l0].height | levels[l1].width | levels[l1].height;
+            crate::wrap::fits_i64_on(u.unsigned_abs().max(v.unsigned_abs()) as i64, sides)
+        };
+        let nw = (k.narrow_frac && fits).then_some(&k.shifts);
         let c0 = bilinear_lanes::<W, S, POW2_REPEAT>(
             &levels[l0],
             l0 as u32,
@@ -719,7 +728,7 @@ mod tests {
     use super::*;
     use crate::config::HwConfig;
     use crate::wrap::tests::wrap_before;
-    use crate::wrap::wrap;
+    use crate::wrap::{fits_i64, wrap};
 
     const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
 
@@ -1103,8 +1112,8 @@ mod tests {
     /// its general `sample` and of the scalar filter it replaced; the nine rounding pairs,
     /// weight widths 0 to 16, LOD fractions 0 to 30, coordinate formats with 4 to 30 fraction
     /// bits and wider ones (the 128-bit wrap), coordinates inside and far outside [0, 1] and at
-    /// the ends of the 64-bit path; square, non-square, 1xN and short power-of-two chains, and
-    /// non-power-of-two chains and other wrap modes (refused, counted).
+    /// the ends of the 64-bit path on a level's sides; square, non-square, 1xN and short
+    /// power-of-two chains, and non-power-of-two chains and other wrap modes (refused, counted).
     #[test]
     fn pow2_repeat_matches_the_general_sample() {
         let mut s = 0x5eed_0016;
@@ -1148,9 +1157,13 @@ mod tests {
                     ((next(&mut s) as i64) >> sh, (next(&mut s) as i64) >> sh)
                 }
                 1 => {
-                    let edge = [-(1i64 << 29) - 1, -(1 << 29), 1 << 29, (1 << 29) - 1];
-                    let e = |x: u64| edge[(x % 4) as usize] + (x % 3) as i64 - 1;
-                    (e(next(&mut s)), e(next(&mut s)))
+                    // The ends of the 64-bit path on a level's sides (`fits_i64_on`).
+                    let l = &levels[(next(&mut s) % levels.len() as u64) as usize];
+                    let e = |x: u64, side: u32| {
+                        let end = ((1u64 << 61).div_ceil(u64::from(side.max(1)))) as i64;
+                        [-end - 1, -end, end, end - 1][(x % 4) as usize] + (x / 4 % 3) as i64 - 1
+                    };
+                    (e(next(&mut s), l.width), e(next(&mut s), l.height))
                 }
                 _ => {
                     let r = |x: u64| (x % (4 * one as u64)) as i64 - 3 * one / 2;
@@ -1174,7 +1187,9 @@ mod tests {
                         let got = unit.sample_pow2_repeat(levels, u, v, lod, &mut got_trace);
                         assert_eq!(got, want);
                         assert_eq!(got_trace, want_trace, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
-                        if !(fits_i64(u, frac) && fits_i64(v, frac)) {
+                        if !(fits_i64(u, frac, levels[0].width)
+                            && fits_i64(v, frac, levels[0].height))
+                        {
                             wide += 1;
                         }
                         if want_trace.levels_used == 2 {

@@ -63,19 +63,28 @@ pub fn wrap_in<W: crate::fixed::ConstRounding>(
     mode: WrapMode,
     cfg: &crate::config::TrilinearConfig,
 ) -> WrapOut {
-    if fits_i64(coord, frac) {
+    if fits_i64(coord, frac, size) {
         wrap_i64_in::<W>(coord, frac, size, mode, cfg.weight_bits.min(16))
     } else {
         wrap_wide_in::<W>(coord, frac, size, mode, cfg)
     }
 }
 
-/// Whether [`wrap`] of `coord` takes its 64-bit path: `frac <= 30` and `coord` in
-/// `[-2^29, 2^29)` (then `|s| < 2^63` for any `u32` size).
+/// Whether [`wrap`] of `coord` on an axis of `size` texels takes its 64-bit path: `frac <= 30`
+/// and [`fits_i64_on`] `size`.
 #[inline(always)]
 #[must_use]
-pub fn fits_i64(coord: i64, frac: u32) -> bool {
-    frac <= 30 && (coord as u64).wrapping_add(1 << 29) < 1 << 30
+pub fn fits_i64(coord: i64, frac: u32, size: u32) -> bool {
+    frac <= 30 && fits_i64_on(coord, size)
+}
+
+/// Whether `|coord| size.max(1) < 2^61`: then `|2 coord size| < 2^62`, so with `frac <= 30`
+/// the address `s` of [`wrap`] and its index stay below 2^63 (any `coord` in `[-2^29, 2^29]`
+/// for the widest `u32` size, `|coord| < 2^53` for 256 texels).
+#[inline(always)]
+#[must_use]
+pub fn fits_i64_on(coord: i64, size: u32) -> bool {
+    coord.unsigned_abs().saturating_mul(u64::from(size.max(1))) < 1 << 61
 }
 
 /// [`wrap_in`] of a coordinate that [`fits_i64`], `wb` = `weight_bits.min(16)`.

@@ -120,6 +120,45 @@ fn random_wide() {
     }
 }
 
+/// 1M seeded coordinates within 3 of either end of the 64-bit path (`fits_i64_on`:
+/// `|coord| size < 2^61`) on sizes of every bit length up to `u32::MAX`, both sides of each
+/// end taken, and at twice the end on the widest sizes of each bit length (where `2 coord
+/// size` leaves `i64`), against the exact model.
+#[test]
+fn ends_of_the_64_bit_path() {
+    let mut rng = Rng(0x3a_0002);
+    let (mut narrow, mut wide) = (0u32, 0u32);
+    for k in 0..1_000_000u32 {
+        let wb = (rng.next() % 17) as u32;
+        let rnd = ROUNDINGS[(k % 3) as usize];
+        let mode = MODES[(k / 3 % 3) as usize];
+        let frac = 4 + (rng.next() % 27) as u32;
+        let len = 1 + (rng.next() % 32) as u32;
+        let top = ((1u64 << len) - 1) as u32;
+        let (size, reach) = if k % 4 < 2 {
+            (
+                ((top >> 1) + 1) | (rng.next() as u32 & (top >> 1)),
+                1u64 << 61,
+            )
+        } else {
+            (top - ((rng.next() % 3) as u32).min(top >> 1), 1u64 << 62)
+        };
+        let end = reach.div_ceil(u64::from(size)) as i64;
+        let coord = if k % 2 == 0 { end } else { -end } + (rng.next() % 7) as i64 - 3;
+        if hw_model::wrap::fits_i64(coord, frac, size) {
+            narrow += 1;
+        } else {
+            wide += 1;
+        }
+        assert_eq!(
+            wrap(coord, frac, size, mode, &tcfg(wb, rnd)),
+            model(coord, frac, size, mode, wb, rnd),
+            "coord={coord} frac={frac} size={size} {mode:?} wb={wb} {rnd:?}"
+        );
+    }
+    assert!(narrow > 200_000 && wide > 600_000, "{narrow} {wide}");
+}
+
 #[test]
 fn nearest_like_with_zero_weight_bits() {
     let c = tcfg(0, Rounding::HalfUp);
