@@ -947,26 +947,14 @@ pub fn interpolate_pairs(
     })
 }
 
-/// [`interpolate_pairs`] over the fragments of a span: each item of `lanes` is one fragment's
-/// samples' barycentrics and the slots of their results. The per-triangle terms `a0 2^B`,
-/// `a1 - a0`, `a2 - a0`, the format's range and the rounding mode are resolved once for the
-/// span; the same bits and counts as one [`interpolate_pairs`] call per fragment.
-#[inline]
-pub fn interpolate_pairs_span<'a>(
-    lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; 2]])>,
-    bary_bits: u32,
-    attr: [[i64; 2]; 3],
-    out: &Format,
-    sat: &mut SatCounter,
-) {
-    interpolate_span(lanes, bary_bits, attr, out, sat);
-}
-
-/// [`interpolate`] of the `N` attributes `attr` (per vertex, e.g. a colour's channels) at each
-/// sample of each lane of a span into the same index of its results: the per-triangle terms,
-/// the format's range and the rounding mode resolved once for the span; the same bits and
-/// counts as one [`interpolate`] call per sample and attribute (checked by
-/// `interpolate_span_matches_interpolate` and `interpolate_pairs_span_matches_per_fragment_calls`).
+/// [`interpolate`] of the `N` attributes `attr` (per vertex: a colour's channels, a texture
+/// coordinate's pair) at each sample of each lane of a span (one fragment's samples'
+/// barycentrics and the slots of their results) into the same index of its results: the
+/// per-triangle terms `a0 2^B`, `a1 - a0`, `a2 - a0`, the format's range and the rounding
+/// mode resolved once for the span; the same bits and counts as one [`interpolate`] call per
+/// sample and attribute, and for pairs as one [`interpolate_pairs`] call per fragment
+/// (checked by `interpolate_span_matches_interpolate` and
+/// `interpolate_span_of_pairs_matches_per_fragment_calls`).
 #[inline]
 pub fn interpolate_span<'a, const N: usize>(
     lanes: impl Iterator<Item = (&'a [[i64; 3]], &'a mut [[i64; N]])>,

@@ -572,7 +572,7 @@ impl<'a, F: ConstRounding, W: ConstRounding> TrilinearUnit<'a, F, W> {
         let fits = both < 1 << 30 || {
             let l1 = (l0 + 1).min(n - 1);
             let sides = levels[l0].width | levels[l0].height | levels[l1].width | levels[l1].height;
-            crate::wrap::fits_i64_on(u.unsigned_abs().max(v.unsigned_abs()) as i64, sides)
+            crate::wrap::fits_i64_on(u, sides) && crate::wrap::fits_i64_on(v, sides)
         };
         let nw = (k.narrow_frac && fits).then_some(&k.shifts);
         let c0 = bilinear_lanes::<W, S, POW2_REPEAT>(

@@ -7,7 +7,7 @@ use crate::fixedpoint::{from_raw, to_raw};
 use crate::reference::interpolate_f64;
 use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
-use hw_model::interpolator::{interpolate_cost, interpolate_pairs, interpolate_pairs_span};
+use hw_model::interpolator::{interpolate_cost, interpolate_pairs, interpolate_span};
 use hw_model::UnitCost;
 
 /// Fixed twin: two interpolations per sample.
@@ -39,7 +39,7 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
 }
 
 /// Fixed twin over a span: after a Fixed `bary`, the triangle's terms resolved once for the
-/// span (`interpolate_pairs_span`), bit-identical to [`fixed`] on each fragment; otherwise
+/// span (`interpolate_span`), bit-identical to [`fixed`] on each fragment; otherwise
 /// [`fixed`] per fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let m = px.m;
@@ -53,7 +53,7 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     });
     let sat = &mut c.sat[StageKind::Texcoord.index()];
     let bb = m.hw.interp.bary_bits;
-    interpolate_pairs_span(lanes, bb, px.a.uv_x, &m.uv_fmt, sat);
+    interpolate_span(lanes, bb, px.a.uv_x, &m.uv_fmt, sat);
     if px.carriers {
         let fb = m.uv_fmt.frac_bits;
         for frag in frags.iter_mut() {

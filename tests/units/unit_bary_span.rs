@@ -1,6 +1,6 @@
 //! The interpolator's span datapaths (`perspective_bary_derivs_span`, `perspective_bary_span`,
-//! `interpolate_pairs_span`, `interpolate_span`) against one call of the per-sample routine per lane: the same
-//! values and the same saturation counts, on seeded spans over random widths and rounding
+//! `interpolate_span`) against one call of the per-sample routine per lane: the same values
+//! and the same saturation counts, on seeded spans over random widths and rounding
 //! modes, from screen-sized to near-degenerate and huge triangles, tiny and large 1/w, lanes
 //! inside and outside the triangle, spans longer than `SPAN_LANES`.
 
@@ -8,9 +8,8 @@ use crate::rng_common::Rng;
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Overflow, Rounding, SatCounter};
 use hw_model::interpolator::{
-    interpolate, interpolate_pairs, interpolate_pairs_span, interpolate_span, perspective_bary,
-    perspective_bary_derivs, perspective_bary_derivs_span, perspective_bary_span, EdgeSpan,
-    SPAN_LANES,
+    interpolate, interpolate_pairs, interpolate_span, perspective_bary, perspective_bary_derivs,
+    perspective_bary_derivs_span, perspective_bary_span, EdgeSpan, SPAN_LANES,
 };
 use hw_model::reciprocal::Reciprocal;
 
@@ -200,11 +199,11 @@ fn bary_span_matches_the_per_sample_routine() {
     }
 }
 
-/// 1M spans of fragments with 1 or 3 samples: `interpolate_pairs_span` equals one
+/// 1M spans of fragments with 1 or 3 samples: `interpolate_span` of pairs equals one
 /// `interpolate_pairs` per fragment (values and overflow counts), over formats, rounding
 /// and overflow modes, attributes from small to beyond the `i64` accumulator.
 #[test]
-fn interpolate_pairs_span_matches_per_fragment_calls() {
+fn interpolate_span_of_pairs_matches_per_fragment_calls() {
     let mut rng = Rng(0x5a4e_0003);
     for case in 0..1_000_000u32 {
         let bb = rng.int_in(4, 30) as u32;
@@ -228,7 +227,7 @@ fn interpolate_pairs_span_matches_per_fragment_calls() {
             .iter()
             .zip(got.iter_mut())
             .map(|(b, r)| (&b[..samples], &mut r[..samples]));
-        interpolate_pairs_span(lanes, bb, attr, &out, &mut sat);
+        interpolate_span(lanes, bb, attr, &out, &mut sat);
         let mut sat_ref = SatCounter::default();
         for (b, g) in bary.iter().zip(&got) {
             let mut want = [[0i64; 2]; 3];
