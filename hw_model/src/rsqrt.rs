@@ -21,7 +21,9 @@ use crate::config::ConfigError;
 use crate::cost::UnitCost;
 use crate::datapath::Cycles;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, ConstRounding, Rounding, ShiftRound};
+use crate::fixed::{
+    round_shift_right_mid, round_shift_right_wide, ConstRounding, Rounding, ShiftRound,
+};
 use serde::{Deserialize, Serialize};
 
 /// Guard fraction bits carried inside the Newton-Raphson datapath beyond the mantissa.
@@ -172,7 +174,11 @@ impl Rsqrt {
         let mut e = 63 - x.leading_zeros() as i32;
         let mut m = if e + 1 > b as i32 {
             let s = (e + 1 - b as i32) as u32;
-            round_shift_right_wide(i128::from(x), s, M::MODE) as u64
+            // Below 2^63 the 64-bit rounding is the 128-bit one of the same value.
+            match i64::try_from(x) {
+                Ok(x) => round_shift_right_mid::<M>(x, s) as u64,
+                Err(_) => round_shift_right_wide(i128::from(x), s, M::MODE) as u64,
+            }
         } else {
             x << (b as i32 - 1 - e)
         };
@@ -219,8 +225,7 @@ impl Rsqrt {
                 .and_then(|r| newton_step_narrow(y, mw, three, r))
                 .unwrap_or_else(|| newton_step_wide(y, mw, three, w, M::MODE));
         }
-        let out =
-            round_shift_right_wide(i128::from(y), RSQRT_GUARD_BITS, M::MODE).clamp(1, 1i64 << b);
+        let out = round_shift_right_mid::<M>(y, RSQRT_GUARD_BITS).clamp(1, 1i64 << b);
         RsqrtOut {
             mant: out as u64,
             shift: b as i32 + k,
@@ -400,6 +405,52 @@ mod tests {
             for _ in 0..2000 {
                 let m = (1u64 << (bits - 1)) | (next(&mut s) & ((1u64 << (bits - 1)) - 1));
                 check(&u, m, (next(&mut s) % 64) as i32 - 32);
+            }
+        }
+    }
+
+    /// [`Rsqrt::eval`] (its mantissa rounded in 64 bits below 2^63) against the reduction as
+    /// first written (in `i128`) followed by [`Rsqrt::eval_mantissa`]: 2M seeded inputs of
+    /// every bit length 1 to 64 over mantissa widths, seed widths and modes, and the ends.
+    #[test]
+    fn eval_reduces_as_the_wide_rounding() {
+        let before = |u: &Rsqrt, x: u64| {
+            let b = u.bits;
+            let mut e = 63 - x.leading_zeros() as i32;
+            let mut m = if e + 1 > b as i32 {
+                let s = (e + 1 - b as i32) as u32;
+                round_shift_right_wide(i128::from(x), s, u.rounding) as u64
+            } else {
+                x << (b as i32 - 1 - e)
+            };
+            if m >= 1u64 << b {
+                m >>= 1;
+                e += 1;
+            }
+            u.eval_mantissa(m, e)
+        };
+        let mut s = 0x5eed_e7a1;
+        for i in 0..400u32 {
+            let bits = 8 + (next(&mut s) % 23) as u32;
+            let lut_bits = 1 + (next(&mut s) % 8) as u32;
+            let u = unit(bits, lut_bits, i % 5, MODES[(i / 5 % 3) as usize]);
+            let ends = [
+                1,
+                2,
+                3,
+                (1 << 62) - 1,
+                1 << 62,
+                (1 << 63) - 1,
+                1 << 63,
+                u64::MAX,
+            ];
+            for x in ends {
+                assert_eq!(u.eval(x), Some(before(&u, x)), "x {x} B {bits}");
+            }
+            for _ in 0..5000 {
+                let len = 1 + next(&mut s) % 64;
+                let x = (next(&mut s) >> (64 - len)) | 1 << (len - 1);
+                assert_eq!(u.eval(x), Some(before(&u, x)), "x {x} B {bits}");
             }
         }
     }

@@ -14,7 +14,10 @@
 use crate::config::ConfigError;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Cycles, Datapath, Stage};
-use crate::fixed::{round_shift_right_wide, Format, Rounding, SatCounter};
+use crate::fixed::{
+    round_shift_right, round_shift_right_wide, ConstRounding, Format, Rounding, SatCounter,
+    ShiftRound,
+};
 use crate::rsqrt::{range, Rsqrt};
 use serde::{Deserialize, Serialize};
 
@@ -105,8 +108,28 @@ pub fn dot3_exact(a: &Vec3x, b: &Vec3x) -> i128 {
 #[must_use]
 pub fn dot3(a: &Vec3x, b: &Vec3x, cfg: &VectorConfig, sat: &mut SatCounter) -> i64 {
     let f = cfg.vector_frac_bits;
-    let r = round_shift_right_wide(dot3_exact(a, b), f, cfg.vector_rounding);
+    let r = match dot3_narrow(a, b) {
+        Some(d) => round_shift_right(d, f, cfg.vector_rounding),
+        None => round_shift_right_wide(dot3_exact(a, b), f, cfg.vector_rounding),
+    };
     vector_format(cfg).fit(r, sat)
+}
+
+/// [`dot3_exact`] when its products and sums fit `i64` (always for vector- and wide-format
+/// inputs, below 2^26), else `None`. `round_shift_right` of an `i64` is
+/// `round_shift_right_wide` of the same value, so the units reduce it in 64 bits with the
+/// same result (checked against the 128-bit forms in `tests/units/frames_vector.rs`).
+#[inline(always)]
+fn dot3_narrow(a: &Vec3x, b: &Vec3x) -> Option<i64> {
+    a[0].checked_mul(b[0])?
+        .checked_add(a[1].checked_mul(b[1])?)?
+        .checked_add(a[2].checked_mul(b[2])?)
+}
+
+/// `x y - z w` when it fits `i64` with its products, else `None`.
+#[inline(always)]
+fn cross_term(x: i64, y: i64, z: i64, w: i64) -> Option<i64> {
+    x.checked_mul(y)?.checked_sub(z.checked_mul(w)?)
 }
 
 /// Exact cross product of raw vectors (fraction bits add); inputs must be below 2^31 in
@@ -125,14 +148,20 @@ pub fn cross3_exact(a: &Vec3x, b: &Vec3x) -> [i128; 3] {
 /// ERROR: at most 1/2 ulp per component from the exact cross product, unless saturated.
 #[must_use]
 pub fn cross3(a: &Vec3x, b: &Vec3x, cfg: &VectorConfig, sat: &mut SatCounter) -> Vec3x {
-    let f = cfg.vector_frac_bits;
+    let (f, mode) = (cfg.vector_frac_bits, cfg.vector_rounding);
     let fmt = vector_format(cfg);
-    let c = cross3_exact(a, b);
-    let mut out = [0i64; 3];
-    for i in 0..3 {
-        out[i] = fmt.fit(round_shift_right_wide(c[i], f, cfg.vector_rounding), sat);
-    }
-    out
+    let narrow = (|| {
+        Some([
+            cross_term(a[1], b[2], a[2], b[1])?,
+            cross_term(a[2], b[0], a[0], b[2])?,
+            cross_term(a[0], b[1], a[1], b[0])?,
+        ])
+    })();
+    let r = match narrow {
+        Some(c) => c.map(|c| round_shift_right(c, f, mode)),
+        None => cross3_exact(a, b).map(|c| round_shift_right_wide(c, f, mode)),
+    };
+    r.map(|r| fmt.fit(r, sat))
 }
 
 /// Result of a normalization.
@@ -162,10 +191,31 @@ pub fn normalize3(
     cfg: &VectorConfig,
     sat: &mut SatCounter,
 ) -> Normalized {
-    let s: u128 = v
-        .iter()
-        .map(|&c| (i128::from(c) * i128::from(c)) as u128)
-        .sum();
+    crate::with_rounding!(cfg.vector_rounding, M => normalize3_in::<M>(v, fallback, rsqrt, cfg, sat))
+}
+
+/// [`normalize3`] compiled for the rounding mode `M` (`vector_rounding`). Components below
+/// 2^31 (vector and wide formats always) take 64-bit arithmetic: their squares' sum fits
+/// `u64` (3 * 2^62 < 2^64) and their products with the rsqrt mantissa (at most 2^30) stay
+/// below 2^62, reduced by one [`ShiftRound`] resolved per call; larger ones the 128-bit forms.
+/// The same bits either way (`narrow_normalize_matches_the_wide_form`).
+#[inline(always)]
+fn normalize3_in<M: ConstRounding>(
+    v: &[i64; 3],
+    fallback: Vec3x,
+    rsqrt: &Rsqrt,
+    cfg: &VectorConfig,
+    sat: &mut SatCounter,
+) -> Normalized {
+    let small = (v[0].unsigned_abs() | v[1].unsigned_abs() | v[2].unsigned_abs()) >> 31 == 0;
+    let s: u128 = if small {
+        let sq = |c: i64| c.unsigned_abs() * c.unsigned_abs();
+        u128::from(sq(v[0]) + sq(v[1]) + sq(v[2]))
+    } else {
+        v.iter()
+            .map(|&c| (i128::from(c) * i128::from(c)) as u128)
+            .sum()
+    };
     if s == 0 {
         sat.saturated += 1;
         return Normalized {
@@ -191,16 +241,22 @@ pub fn normalize3(
     let f = cfg.vector_frac_bits as i32;
     let rshift = j as i32 + r.shift - f;
     let fmt = vector_format(cfg);
-    let mut out = [0i64; 3];
-    for i in 0..3 {
-        let p = i128::from(v[i]) * i128::from(r.mant);
-        let q = if rshift >= 0 {
-            round_shift_right_wide(p, rshift as u32, cfg.vector_rounding)
-        } else {
-            i64::try_from(p << (-rshift).min(64) as u32).unwrap_or(i64::MAX)
-        };
-        out[i] = fmt.fit(q, sat);
-    }
+    let scale = u32::try_from(rshift)
+        .ok()
+        .and_then(ShiftRound::<M>::new)
+        .filter(|_| small && r.mant >> 31 == 0);
+    let out = match scale {
+        Some(round) => v.map(|c| fmt.fit(round.apply(c * r.mant as i64), sat)),
+        None => v.map(|c| {
+            let p = i128::from(c) * i128::from(r.mant);
+            let q = if rshift >= 0 {
+                round_shift_right_wide(p, rshift as u32, M::MODE)
+            } else {
+                i64::try_from(p << (-rshift).min(64) as u32).unwrap_or(i64::MAX)
+            };
+            fmt.fit(q, sat)
+        }),
+    };
     Normalized {
         v: out,
         zero: false,
@@ -224,10 +280,21 @@ pub fn madd(
     let fmt = wide_format(cfg);
     let mut out = [0i64; 3];
     for i in 0..3 {
-        let acc = (i128::from(n[i]) << o)
-            + i128::from(g_u) * i128::from(t_u[i])
-            + i128::from(g_v) * i128::from(t_v[i]);
-        out[i] = fmt.fit(round_shift_right_wide(acc, o, cfg.vector_rounding), sat);
+        let narrow = (|| {
+            let n = n[i].checked_mul((o < 62).then(|| 1i64 << o)?)?;
+            n.checked_add(g_u.checked_mul(t_u[i])?)?
+                .checked_add(g_v.checked_mul(t_v[i])?)
+        })();
+        let r = match narrow {
+            Some(acc) => round_shift_right(acc, o, cfg.vector_rounding),
+            None => {
+                let acc = (i128::from(n[i]) << o)
+                    + i128::from(g_u) * i128::from(t_u[i])
+                    + i128::from(g_v) * i128::from(t_v[i]);
+                round_shift_right_wide(acc, o, cfg.vector_rounding)
+            }
+        };
+        out[i] = fmt.fit(r, sat);
     }
     out
 }
@@ -364,4 +431,220 @@ pub fn offset_from_texel(t: u64, texel_bits: u32, cfg: &VectorConfig, sat: &mut 
         round_shift_right_wide(i128::from(centered), (-sh) as u32, cfg.vector_rounding)
     };
     offset_format(cfg).fit(raw, sat)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rsqrt::RsqrtConfig;
+    use crate::test_rng::splitmix64 as next;
+
+    const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
+
+    /// [`dot3`] as first written (the exact dot in `i128`): the oracle.
+    fn dot3_before(a: &Vec3x, b: &Vec3x, cfg: &VectorConfig, sat: &mut SatCounter) -> i64 {
+        let r = round_shift_right_wide(dot3_exact(a, b), cfg.vector_frac_bits, cfg.vector_rounding);
+        vector_format(cfg).fit(r, sat)
+    }
+
+    /// [`cross3`] as first written.
+    fn cross3_before(a: &Vec3x, b: &Vec3x, cfg: &VectorConfig, sat: &mut SatCounter) -> Vec3x {
+        let fmt = vector_format(cfg);
+        cross3_exact(a, b).map(|c| {
+            fmt.fit(
+                round_shift_right_wide(c, cfg.vector_frac_bits, cfg.vector_rounding),
+                sat,
+            )
+        })
+    }
+
+    /// [`madd`] as first written.
+    fn madd_before(
+        n: &Vec3x,
+        t_u: &Vec3x,
+        t_v: &Vec3x,
+        (g_u, g_v): (i64, i64),
+        cfg: &VectorConfig,
+        sat: &mut SatCounter,
+    ) -> [i64; 3] {
+        let o = cfg.offset_frac_bits;
+        let fmt = wide_format(cfg);
+        [0, 1, 2].map(|i| {
+            let acc = (i128::from(n[i]) << o)
+                + i128::from(g_u) * i128::from(t_u[i])
+                + i128::from(g_v) * i128::from(t_v[i]);
+            fmt.fit(round_shift_right_wide(acc, o, cfg.vector_rounding), sat)
+        })
+    }
+
+    /// [`normalize3`] as first written (`|v|^2` and the scaling products in `i128`).
+    fn normalize3_before(
+        v: &[i64; 3],
+        fallback: Vec3x,
+        rsqrt: &Rsqrt,
+        cfg: &VectorConfig,
+        sat: &mut SatCounter,
+    ) -> Normalized {
+        let s: u128 = v
+            .iter()
+            .map(|&c| (i128::from(c) * i128::from(c)) as u128)
+            .sum();
+        let zero = Normalized {
+            v: fallback,
+            zero: true,
+        };
+        if s == 0 {
+            sat.saturated += 1;
+            return zero;
+        }
+        let bits = 128 - s.leading_zeros();
+        let j = if bits > 62 {
+            (bits - 62).div_ceil(2)
+        } else {
+            0
+        };
+        let Some(r) = rsqrt.eval((s >> (2 * j)) as u64) else {
+            sat.saturated += 1;
+            return zero;
+        };
+        let rshift = j as i32 + r.shift - cfg.vector_frac_bits as i32;
+        let fmt = vector_format(cfg);
+        let out = v.map(|c| {
+            let p = i128::from(c) * i128::from(r.mant);
+            let q = if rshift >= 0 {
+                round_shift_right_wide(p, rshift as u32, cfg.vector_rounding)
+            } else {
+                i64::try_from(p << (-rshift).min(64) as u32).unwrap_or(i64::MAX)
+            };
+            fmt.fit(q, sat)
+        });
+        Normalized {
+            v: out,
+            zero: false,
+        }
+    }
+
+    /// A seeded component of a random bit length 0 to 62 and sign (the ends of that range,
+    /// 2^31 and its neighbours among them), so the inputs cross the units' 64-bit bounds
+    /// (the units take components below 2^62, where their 128-bit sums cannot overflow).
+    fn component(s: &mut u64) -> i64 {
+        const ENDS: [i64; 8] = [
+            (1 << 62) - 1,
+            1 - (1 << 62),
+            1 << 31,
+            (1 << 31) - 1,
+            -(1 << 31),
+            -(1 << 31) - 1,
+            0,
+            -1,
+        ];
+        let r = next(s);
+        if r & 15 == 0 {
+            return ENDS[(r >> 4) as usize % ENDS.len()];
+        }
+        let len = (r >> 8) % 63;
+        let mag = if len == 0 { 0 } else { next(s) >> (64 - len) };
+        let v = mag as i64;
+        if r & 32 == 0 {
+            v.wrapping_neg()
+        } else {
+            v
+        }
+    }
+
+    /// A vector of components of one random bit length, up to `max_bits` (so normalize sees
+    /// vectors near its bounds, not only one huge component).
+    fn vector(s: &mut u64, max_bits: u64) -> Vec3x {
+        let len = next(s) % (max_bits + 1);
+        [0; 3].map(|_: i64| {
+            if next(s) & 7 == 0 {
+                component(s)
+            } else if len == 0 {
+                0
+            } else {
+                let m = (next(s) >> (64 - len)) as i64;
+                if next(s) & 1 == 0 {
+                    -m
+                } else {
+                    m
+                }
+            }
+        })
+    }
+
+    /// A configuration of random widths and rounding (within `VectorConfig::validate`).
+    fn config(s: &mut u64) -> VectorConfig {
+        VectorConfig {
+            vector_frac_bits: 4 + (next(s) % 12) as u32,
+            offset_frac_bits: 4 + (next(s) % 13) as u32,
+            offset_int_bits: (next(s) % 9) as u32,
+            vector_rounding: MODES[(next(s) % 3) as usize],
+            ..VectorConfig::texram16()
+        }
+    }
+
+    /// dot, cross and the bump multiply-add (their sums in `i64` where they fit) against the
+    /// units as first written, in `i128`: 3M seeded cases over random widths and modes with
+    /// components of every bit length and the ends of `i64`; the same outputs and counts.
+    #[test]
+    fn narrow_dot_cross_madd_match_the_wide_forms() {
+        let mut s = 0x0dd_c0de;
+        let (mut sat, mut sat_before) = (SatCounter::default(), SatCounter::default());
+        for i in 0..1_000_000u32 {
+            let cfg = config(&mut s);
+            let max_bits = if i % 2 == 0 { 62 } else { 34 };
+            let (a, b) = (vector(&mut s, max_bits), vector(&mut s, max_bits));
+            let c = vector(&mut s, max_bits);
+            let g = (component(&mut s), component(&mut s));
+            assert_eq!(
+                dot3(&a, &b, &cfg, &mut sat),
+                dot3_before(&a, &b, &cfg, &mut sat_before),
+                "dot {a:?} {b:?} {cfg:?}"
+            );
+            assert_eq!(
+                cross3(&a, &b, &cfg, &mut sat),
+                cross3_before(&a, &b, &cfg, &mut sat_before),
+                "cross {a:?} {b:?} {cfg:?}"
+            );
+            assert_eq!(
+                madd(&a, &b, &c, g.0, g.1, &cfg, &mut sat),
+                madd_before(&a, &b, &c, g, &cfg, &mut sat_before),
+                "madd {a:?} {b:?} {c:?} {g:?} {cfg:?}"
+            );
+        }
+        assert_eq!(sat, sat_before);
+        assert!(sat.saturated > 0, "the saturation path was exercised");
+    }
+
+    /// [`normalize3`] (`|v|^2` in `u64` and the scaling in `i64` where they fit) against the
+    /// unit as first written: 2M seeded vectors over random vector widths, rsqrt widths and
+    /// modes, components of every bit length to 62, zero vectors among them.
+    #[test]
+    fn narrow_normalize_matches_the_wide_form() {
+        let mut s = 0x0a11_5ca1;
+        let (mut sat, mut sat_before) = (SatCounter::default(), SatCounter::default());
+        let units: Vec<Rsqrt> = (0..24u32)
+            .map(|i| {
+                Rsqrt::new(&RsqrtConfig {
+                    rsqrt_mantissa_bits: 8 + (next(&mut s) % 23) as u32,
+                    rsqrt_lut_bits: 1 + (next(&mut s) % 8) as u32,
+                    rsqrt_iterations: i % 5,
+                    rsqrt_rounding: MODES[(i / 5 % 3) as usize],
+                    ..RsqrtConfig::texram16()
+                })
+            })
+            .collect();
+        for i in 0..2_000_000u32 {
+            let cfg = config(&mut s);
+            let u = &units[(next(&mut s) % 24) as usize];
+            let v = vector(&mut s, if i % 2 == 0 { 62 } else { 33 });
+            let fallback = [1, 2, 3];
+            assert_eq!(
+                normalize3(&v, fallback, u, &cfg, &mut sat),
+                normalize3_before(&v, fallback, u, &cfg, &mut sat_before),
+                "{v:?} {cfg:?}"
+            );
+        }
+        assert_eq!(sat, sat_before);
+    }
 }

@@ -3,13 +3,13 @@
 //! `hw_model::interpolator`). The per-triangle data is [`super::bump::BumpAttrs`].
 
 use super::bump::{bump_of, constant_m, point_lights, raw3, val3};
-use super::stages::{column, column_f, Counters, Machine};
-use super::{BumpPlan, Frag, Plan, Px, StageKind};
+use super::stages::{column, column_f, each_fragment, Counters, Machine};
+use super::{BumpFrag, BumpPlan, Frag, Plan, Px, StageKind};
 use crate::fixedpoint::{from_raw, to_raw};
 use crate::reference::interpolate_f64;
 use crate::scene::{FrameKind, MainDirection};
-use hw_model::fixed::Format;
-use hw_model::interpolator::{interpolate, interpolate_cost};
+use hw_model::fixed::{Format, SatCounter};
+use hw_model::interpolator::{interpolate, interpolate_cost, interpolate_span};
 use hw_model::vector::Vec3x;
 use hw_model::UnitCost;
 
@@ -57,6 +57,79 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         bf.len_x = [1i64 << lfb; 2];
         bf.len = [1.0; 2];
     }
+    carriers(bf, f, np);
+}
+
+/// Fixed twin over a span: after a Fixed `bary`, each attribute of every fragment through
+/// `interpolate_span` (the triangle's terms and the rounding resolved once per attribute and
+/// span) and the constant main direction quantized once, bit-identical to [`fixed`] on each
+/// fragment (`tests/pipeline`'s span tests); otherwise [`fixed`] per fragment.
+pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    let Some((bp, ba)) = bump_of(px) else { return };
+    if !px.fixed(StageKind::Bary) {
+        return each_fragment(fixed, px, frags, c);
+    }
+    let m = px.m;
+    let f = m.units.cfg.vector.vector_frac_bits;
+    let lfb = m.units.cfg.frame.frame_len_frac_bits;
+    let fk = m.frame_of(bp);
+    let np = point_lights(m);
+    let sat = &mut c.sat[StageKind::Normal.index()];
+    let bb = m.hw.interp.bary_bits;
+    let vec_fmt = &m.vec_fmt;
+    // One attribute of every fragment into the slot `at` picks in its bump signals.
+    let mut ip = |attr: [[i64; 3]; 3], at: &dyn Fn(&mut BumpFrag) -> &mut Vec3x| {
+        let lanes = frags.iter_mut().map(|fr| {
+            let Frag { bary_x, bump, .. } = fr;
+            (&bary_x[..1], std::slice::from_mut(at(bump)))
+        });
+        interpolate_span(lanes, bb, attr, vec_fmt, sat);
+    };
+    ip(ba.n_x, &|b| &mut b.n_i_x);
+    ip(ba.eye_x, &|b| &mut b.to_eye_x);
+    for l in 0..np {
+        ip(ba.light_x[l], &|b| &mut b.to_light_x[l]);
+    }
+    if fk != FrameKind::Main {
+        ip(ba.du_x, &|b| &mut b.d_u_x);
+        ip(ba.dv_x, &|b| &mut b.d_v_x);
+    }
+    if fk == FrameKind::Main {
+        match bp.main {
+            MainDirection::Constant(_) => {
+                // Quantized once: every fragment's quantization counts its saturations.
+                let mut once = SatCounter::default();
+                let m_x = raw3(&constant_m(bp), vec_fmt, &mut once);
+                sat.saturated += once.saturated * frags.len() as u64;
+                sat.wrapped += once.wrapped * frags.len() as u64;
+                for fr in frags.iter_mut() {
+                    fr.bump.m_x = m_x;
+                }
+            }
+            _ => ip(ba.m_x, &|b| &mut b.m_x),
+        }
+    }
+    if fk == FrameKind::Natural {
+        let lanes = frags.iter_mut().map(|fr| {
+            let Frag { bary_x, bump, .. } = fr;
+            (&bary_x[..1], std::slice::from_mut(&mut bump.len_x))
+        });
+        interpolate_span(lanes, bb, ba.len_x, &m.len_fmt, sat);
+    }
+    for fr in frags.iter_mut() {
+        let bf = &mut fr.bump;
+        if fk == FrameKind::Natural {
+            bf.len = bf.len_x.map(|x| from_raw(x, lfb));
+        } else {
+            bf.len_x = [1i64 << lfb; 2];
+            bf.len = [1.0; 2];
+        }
+        carriers(bf, f, np);
+    }
+}
+
+/// The float carriers of the fixed twins' raw vectors (`f` fraction bits, `np` point lights).
+fn carriers(bf: &mut BumpFrag, f: u32, np: usize) {
     bf.n_i = val3(&bf.n_i_x, f);
     bf.to_eye = val3(&bf.to_eye_x, f);
     for l in 0..np {

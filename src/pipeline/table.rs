@@ -174,7 +174,8 @@ stage_table! {
     }
     /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
     Normal "normal" {
-        fixed: normal::fixed, float: normal::float, cost: normal::cost,
+        fixed: normal::fixed, fixed_span: normal::fixed_span, float: normal::float,
+        cost: normal::cost,
         lookups: no_lookups,
     }
     /// Bump materials: LOD + trilinear fetch of the offset map `(f_u, f_v)`.

@@ -1,5 +1,5 @@
 //! Stages over spans of fragments: the span twins of `bary` and `texcoord`, of `lod` and
-//! `trilinear`, and of `color` and `modulate`, against their per-fragment twins on seeded spans (values, carriers, traced
+//! `trilinear`, of `color` and `modulate`, and of `normal`, against their per-fragment twins on seeded spans (values, carriers, traced
 //! footprints, saturation counts and costs), and whole
 //! frames shaded in spans against the same frames shaded one fragment at a time (images,
 //! statistics, counters and cycle counts).
@@ -9,13 +9,15 @@ use hw_model::config::{CoordArith, HwConfig, LodLog2};
 use hw_model::fixed::Rounding;
 use hw_model::wrap::WrapMode;
 use texsim::maps::{build_mip_chain, quantize_chain};
+use texsim::pipeline::bump::BumpAttrs;
 use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
 use texsim::pipeline::{
-    bary, color, lod, modulate, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls, StageKind,
+    bary, color, lod, modulate, normal, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls,
+    StageKind, MAX_POINT_LIGHTS,
 };
 use texsim::raster::{ScreenTri, VertexSource};
 use texsim::render::{render, Maps, RenderOptions, Rendered};
-use texsim::scene::{self, Material, TextureImage};
+use texsim::scene::{self, FrameKind, MainDirection, Material, TextureImage};
 use texsim::timing::simulate;
 
 const MODES: [Rounding; 3] = [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven];
@@ -488,6 +490,126 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
         fast > 60_000,
         "{fast} spans on the colour span twin's own path"
     );
+}
+
+/// 60k seeded spans of 1..=16 fragments of a bump plan: `bary` then `normal` over the span
+/// give, at every fragment, the bump signals (raw and carriers) and saturation counts of the
+/// per-fragment twins; over the natural, unit and main frames (main directions constant,
+/// `p_u` and `p_v`), 0 to 5 point lights (4 are shaded), vector, length and interpolator
+/// widths and rounding modes, vertex vectors within their format and beyond it (the
+/// interpolator saturates), and a Float `bary` (the per-fragment fallback).
+#[test]
+fn normal_span_twin_matches_the_per_fragment_twin() {
+    let mut rng = Rng(0x5a4e_1004);
+    let bumpy = Material {
+        texture: Some(0),
+        bump: Some(0),
+        ..Material::default()
+    };
+    let (mut fast, mut saturated) = (0u32, 0u64);
+    for group in 0..60u32 {
+        let mut hw = config(&mut rng);
+        let v = &mut hw.shading.vector;
+        v.vector_frac_bits = rng.int_in(4, 15) as u32;
+        v.vector_rounding = MODES[rng.below(3) as usize];
+        hw.shading.frame.frame_len_frac_bits = rng.int_in(2, 12) as u32;
+        let f = hw.shading.vector.vector_frac_bits;
+        let lights: Vec<scene::Light> = (0..rng.int_in(0, 5))
+            .map(|_| scene::Light::Point {
+                position: [1.0, 2.0, 3.0],
+                color: [1.0; 3],
+            })
+            .collect();
+        let frame = [FrameKind::Natural, FrameKind::Unit, FrameKind::Main][group as usize % 3];
+        let main = match rng.below(3) {
+            0 => MainDirection::Constant([0.0, 0.0, if group % 2 == 0 { 1.0 } else { -1.0 }]),
+            1 => MainDirection::Pu,
+            _ => MainDirection::Pv,
+        };
+        let mut pl = texsim::pipeline::plan_with_bump(&bumpy, true, Some(1));
+        let bp = pl.bump.as_mut().expect("bump plan");
+        bp.frame = Some(frame);
+        bp.main = main;
+        assert!(pl.has(StageKind::Normal));
+        let big = 1i64 << (f + 2);
+        let vec3 = |rng: &mut Rng| [[0i64; 3]; 3].map(|_| [0; 3].map(|_| rng.int_in(-big, big)));
+        let battrs: Vec<BumpAttrs> = (0..40)
+            .map(|_| BumpAttrs {
+                n_x: vec3(&mut rng),
+                du_x: vec3(&mut rng),
+                dv_x: vec3(&mut rng),
+                m_x: vec3(&mut rng),
+                eye_x: vec3(&mut rng),
+                light_x: [0; MAX_POINT_LIGHTS].map(|_| vec3(&mut rng)),
+                len_x: [[0i64; 2]; 3].map(|_| [0; 2].map(|_| rng.int_in(-big, big))),
+                ..BumpAttrs::default()
+            })
+            .collect();
+        let m = Machine::new(&hw, &[], &[])
+            .with_lights(&lights, [0.1; 3])
+            .with_bump_attrs(&battrs);
+        let sub = hw.raster.subpixel_bits;
+        for case in 0..1000u32 {
+            let tri = triangle(&mut rng, sub);
+            let mut a = attrs(&mut rng, &hw);
+            a.bump = rng.below(battrs.len() as u64) as u32;
+            let impls = if rng.below(8) == 0 {
+                StageImpls::FIXED.with(StageKind::Bary, Impl::Float)
+            } else {
+                StageImpls::FIXED
+            };
+            let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
+            let n = rng.int_in(1, 16) as usize;
+            let px = Px {
+                plan: &pl,
+                impls: &impls,
+                m: &m,
+                tri: &tri,
+                a: &a,
+                x: vx + rng.int_in(-12, 4),
+                y: vy + rng.int_in(-3, 3),
+                color_raw: false,
+                carriers: rng.below(2) == 0,
+            };
+            let bary_fixed = impls.of(StageKind::Bary) == Impl::Fixed;
+            let input = vec![Frag::default(); n];
+            let mut span = input.clone();
+            let mut c_span = Counters::default();
+            if bary_fixed {
+                bary::fixed_span(&px, &mut span, &mut c_span);
+            } else {
+                texsim::pipeline::stages::each_fragment(bary::float, &px, &mut span, &mut c_span);
+            }
+            normal::fixed_span(&px, &mut span, &mut c_span);
+            let mut c_one = Counters::default();
+            for (j, (got, mut f)) in span.iter().zip(input).enumerate() {
+                let at = Px {
+                    x: px.x + j as i64,
+                    ..px
+                };
+                if bary_fixed {
+                    bary::fixed(&at, &mut f, &mut c_one);
+                } else {
+                    bary::float(&at, &mut f, &mut c_one);
+                }
+                normal::fixed(&at, &mut f, &mut c_one);
+                assert_eq!(
+                    format!("{:?}", got.bump),
+                    format!("{:?}", f.bump),
+                    "group {group} case {case} fragment {j}"
+                );
+            }
+            let k = StageKind::Normal.index();
+            assert_eq!(c_span.sat[k], c_one.sat[k], "group {group} case {case}");
+            fast += u32::from(bary_fixed);
+            saturated += c_span.sat[k].saturated;
+        }
+    }
+    assert!(
+        fast > 45_000,
+        "{fast} spans on the normal span twin's own path"
+    );
+    assert!(saturated > 0, "the interpolator's saturation was exercised");
 }
 
 fn render_with(s: &scene::Scene, hw: &HwConfig, per_fragment: bool) -> Rendered {
