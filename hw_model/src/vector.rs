@@ -118,7 +118,8 @@ pub fn dot3(a: &Vec3x, b: &Vec3x, cfg: &VectorConfig, sat: &mut SatCounter) -> i
 /// [`dot3_exact`] when its products and sums fit `i64` (always for vector- and wide-format
 /// inputs, below 2^26), else `None`. `round_shift_right` of an `i64` is
 /// `round_shift_right_wide` of the same value, so the units reduce it in 64 bits with the
-/// same result (checked against the 128-bit forms in `tests/units/frames_vector.rs`).
+/// same result (checked against the 128-bit forms by
+/// `narrow_dot_cross_madd_match_the_wide_forms`).
 #[inline(always)]
 fn dot3_narrow(a: &Vec3x, b: &Vec3x) -> Option<i64> {
     a[0].checked_mul(b[0])?
@@ -191,7 +192,9 @@ pub fn normalize3(
     cfg: &VectorConfig,
     sat: &mut SatCounter,
 ) -> Normalized {
-    crate::with_rounding!(cfg.vector_rounding, M => normalize3_in::<M>(v, fallback, rsqrt, cfg, sat))
+    crate::with_rounding!(cfg.vector_rounding, M => {
+        normalize3_in::<M>(v, fallback, rsqrt, cfg, sat)
+    })
 }
 
 /// [`normalize3`] compiled for the rounding mode `M` (`vector_rounding`). Components below

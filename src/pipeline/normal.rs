@@ -63,7 +63,8 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
 /// Fixed twin over a span: after a Fixed `bary`, each attribute of every fragment through
 /// `interpolate_span` (the triangle's terms and the rounding resolved once per attribute and
 /// span) and the constant main direction quantized once, bit-identical to [`fixed`] on each
-/// fragment (`tests/pipeline`'s span tests); otherwise [`fixed`] per fragment.
+/// fragment (`normal_span_twin_matches_the_per_fragment_twin`); otherwise [`fixed`] per
+/// fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let Some((bp, ba)) = bump_of(px) else { return };
     if !px.fixed(StageKind::Bary) {

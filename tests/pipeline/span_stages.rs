@@ -1,8 +1,8 @@
 //! Stages over spans of fragments: the span twins of `bary` and `texcoord`, of `lod` and
-//! `trilinear`, of `color` and `modulate`, and of `normal`, against their per-fragment twins on seeded spans (values, carriers, traced
-//! footprints, saturation counts and costs), and whole
-//! frames shaded in spans against the same frames shaded one fragment at a time (images,
-//! statistics, counters and cycle counts).
+//! `trilinear`, of `color` and `modulate`, and of `normal`, against their per-fragment twins
+//! on seeded spans (values, carriers, traced footprints, saturation counts and costs), and
+//! whole frames shaded in spans against the same frames shaded one fragment at a time
+//! (images, statistics, counters and cycle counts).
 
 use crate::rng_common::Rng;
 use hw_model::config::{CoordArith, HwConfig, LodLog2};
