@@ -78,22 +78,12 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let sat = &mut c.sat[StageKind::Normal.index()];
     let bb = m.hw.interp.bary_bits;
     let vec_fmt = &m.vec_fmt;
-    // One attribute of every fragment into the slot `at` picks in its bump signals.
-    let mut ip = |attr: [[i64; 3]; 3], at: &dyn Fn(&mut BumpFrag) -> &mut Vec3x| {
-        let lanes = frags.iter_mut().map(|fr| {
-            let Frag { bary_x, bump, .. } = fr;
-            (&bary_x[..1], std::slice::from_mut(at(bump)))
-        });
-        interpolate_span(lanes, bb, attr, vec_fmt, sat);
-    };
-    ip(ba.n_x, &|b| &mut b.n_i_x);
-    ip(ba.eye_x, &|b| &mut b.to_eye_x);
+    interpolate_into(frags, bb, ba.n_x, vec_fmt, sat, |b| &mut b.n_i_x);
+    interpolate_into(frags, bb, ba.eye_x, vec_fmt, sat, |b| &mut b.to_eye_x);
     for l in 0..np {
-        ip(ba.light_x[l], &|b| &mut b.to_light_x[l]);
-    }
-    if fk != FrameKind::Main {
-        ip(ba.du_x, &|b| &mut b.d_u_x);
-        ip(ba.dv_x, &|b| &mut b.d_v_x);
+        interpolate_into(frags, bb, ba.light_x[l], vec_fmt, sat, |b| {
+            &mut b.to_light_x[l]
+        });
     }
     if fk == FrameKind::Main {
         match bp.main {
@@ -107,15 +97,14 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
                     fr.bump.m_x = m_x;
                 }
             }
-            _ => ip(ba.m_x, &|b| &mut b.m_x),
+            _ => interpolate_into(frags, bb, ba.m_x, vec_fmt, sat, |b| &mut b.m_x),
         }
+    } else {
+        interpolate_into(frags, bb, ba.du_x, vec_fmt, sat, |b| &mut b.d_u_x);
+        interpolate_into(frags, bb, ba.dv_x, vec_fmt, sat, |b| &mut b.d_v_x);
     }
     if fk == FrameKind::Natural {
-        let lanes = frags.iter_mut().map(|fr| {
-            let Frag { bary_x, bump, .. } = fr;
-            (&bary_x[..1], std::slice::from_mut(&mut bump.len_x))
-        });
-        interpolate_span(lanes, bb, ba.len_x, &m.len_fmt, sat);
+        interpolate_into(frags, bb, ba.len_x, &m.len_fmt, sat, |b| &mut b.len_x);
     }
     for fr in frags.iter_mut() {
         let bf = &mut fr.bump;
@@ -127,6 +116,23 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
         }
         carriers(bf, f, np);
     }
+}
+
+/// `interpolate_span` of one per-vertex attribute (`N` channels) at every fragment's first
+/// sample into the slot `at` picks in its bump signals.
+fn interpolate_into<const N: usize>(
+    frags: &mut [Frag],
+    bary_bits: u32,
+    attr: [[i64; N]; 3],
+    fmt: &Format,
+    sat: &mut SatCounter,
+    at: impl Fn(&mut BumpFrag) -> &mut [i64; N],
+) {
+    let lanes = frags.iter_mut().map(|fr| {
+        let Frag { bary_x, bump, .. } = fr;
+        (&bary_x[..1], std::slice::from_mut(at(bump)))
+    });
+    interpolate_span(lanes, bary_bits, attr, fmt, sat);
 }
 
 /// The float carriers of the fixed twins' raw vectors (`f` fraction bits, `np` point lights).
