@@ -59,13 +59,11 @@ impl Image {
     /// `(x * 255 + 32767) / 65535`.
     #[must_use]
     pub fn to_rgba8(&self) -> Vec<u8> {
-        let mut bytes = vec![0u8; self.px.len() * 4];
-        for (out, p) in bytes.chunks_exact_mut(4).zip(&self.px) {
-            for (o, &c) in out.iter_mut().zip(p) {
-                *o = unorm16_to_unorm8(c);
-            }
-        }
-        bytes
+        self.px
+            .as_flattened()
+            .iter()
+            .map(|&c| unorm16_to_unorm8(c))
+            .collect()
     }
 
     /// Whether `px` holds exactly `width * height` pixels.
@@ -75,9 +73,23 @@ impl Image {
     }
 }
 
-/// [`quantize`]`(c, 8)` in 32-bit arithmetic, without its clamp:
-/// `(c * 255 + 32767) / 65535` stays below 2^24.
+/// [`quantize`]`(c, 8)`, `(c * 255 + 32767) / 65535`, as a multiply, an add and a shift,
+/// `(c * 255 + 32895) >> 16`: equal for every 16-bit `c` (checked exhaustively by
+/// `unorm8_matches_quantize`), and with no division the loop of [`Image::to_rgba8`]
+/// vectorizes wherever the compiler places it.
 #[inline]
 fn unorm16_to_unorm8(c: u16) -> u8 {
-    ((u32::from(c) * 255 + 32767) / 65535) as u8
+    ((u32::from(c) * 255 + 32895) >> 16) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unorm8_matches_quantize() {
+        for c in 0..=u16::MAX {
+            assert_eq!(u32::from(unorm16_to_unorm8(c)), quantize(c, 8), "c = {c}");
+        }
+    }
 }
