@@ -216,6 +216,47 @@ fn model_matches_previous_on_short_mixed_spans() {
     }
 }
 
+/// As [`model_matches_previous_on_one_lookup_streams`] on the default machine's memory and
+/// units (no texel cache, four banks tiled 2x2, one filter unit, one pixel per cycle,
+/// pipelined arithmetic: `Simulator::run_in`'s quad lane) with coherent footprints, as a
+/// textured surface makes them: each lookup's footprints walk their level a texel or two
+/// from the previous ones, now and then jumping, so runs of footprints stay in one DRAM page
+/// (all four banks holding it) and cross into the next; now and then a thin footprint (one
+/// column or row, so two texels share a bank), none, two lookups or another stage's, and a
+/// plan the frame does not have, mid-run.
+#[test]
+fn quad_lane_matches_previous() {
+    let mut r = Rng(0x9aad_1a4e);
+    for case in 0..300 {
+        let (stay, odd) = pick(&mut r, &[(0, 40), (4, 12), (50, 200)]);
+        let (mut hw, mut ev) = one_lookup_frame(&mut r, stay, odd);
+        let t = &mut hw.timing;
+        t.cache_bytes = 0;
+        t.banks = 4;
+        t.bank_interleave = BankInterleave::Tiled;
+        t.trilinear_units = 1;
+        t.shade_pixels_per_cycle = 1;
+        t.alu_pipelined = r.below(16) != 0;
+        t.dram_page_bytes = pick(&mut r, &[64, 256, 2048]);
+        let mut at = [(0u32, 0u32); 16];
+        for f in &mut ev.footprints {
+            let (w, h) = ev.textures[usize::from(f.tex)].levels[usize::from(f.level)];
+            let cursor = &mut at[usize::from(f.level) & 15];
+            *cursor = if r.below(64) == 0 {
+                (r.below(u64::from(w)) as u32, r.below(u64::from(h)) as u32)
+            } else {
+                let step = (r.below(3) as u32, u32::from(r.below(16) == 0));
+                ((cursor.0 + step.0) % w, (cursor.1 + step.1) % h)
+            };
+            let (x0, y0) = *cursor;
+            let thin = r.below(32) == 0;
+            f.x = [x0, if thin { x0 } else { (x0 + 1) % w }];
+            f.y = [y0, (y0 + 1) % h];
+        }
+        check(&mut r, case, &hw, &ev);
+    }
+}
+
 /// A machine and frame for [`model_matches_previous_on_one_lookup_streams`]: a pixel keeps
 /// the previous pixel's plan with probability `stay / (stay + 1)` (a random plan, now and then
 /// one the frame does not have, when `stay` > 0; else always a random plan of the frame), and

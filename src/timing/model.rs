@@ -566,47 +566,29 @@ impl Memory {
     #[inline(always)]
     fn quad_dram(&mut self, fp: &TexelFootprint) -> (u64, u64) {
         let lv = self.map.level_recent(fp.tex, fp.level);
-        let (px, py) = lv.page_shift;
+        let pages = quad_pages(lv, fp);
+        let bytes = 4 * u64::from(lv.texel_bytes);
         let [x0, x1] = fp.x;
         let [y0, y1] = fp.y;
-        let (c0, c1) = (u64::from(x0 >> px), u64::from(x1 >> px));
-        let r0 = lv.page_base + u64::from(y0 >> py) * lv.page_row;
-        let r1 = lv.page_base + u64::from(y1 >> py) * lv.page_row;
-        let bytes = 4 * u64::from(lv.texel_bytes);
-        let mut hits = 0u64;
-        let open = &mut self.open_page;
-        if self.quad4 {
-            // Bank `x & 1 | (y & 1) << 1`: the footprint's two columns and two rows differ in
-            // parity, so its texels' banks are texel (x0, y0)'s with bits flipped.
-            let b = ((x0 & 1) | (y0 & 1) << 1) as usize;
-            for (bank, page) in [
-                (b, r0 + c0),
-                (b ^ 1, r0 + c1),
-                (b ^ 2, r1 + c0),
-                (b ^ 3, r1 + c1),
-            ] {
-                let o = &mut open[bank & 3];
-                hits += u64::from(*o == page);
-                *o = page;
+        let hits = match self.open_page.first_chunk_mut::<4>() {
+            Some(open) if self.quad4 => quad4_hits(open, quad4_bank(fp), pages),
+            _ => {
+                let (m0, m1) = self.quad_mask;
+                let sh = self.tile_shift;
+                let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
+                let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
+                let banks = [b0 | s0, b1 | s0, b0 | s1, b1 | s1];
+                let mut hits = 0;
+                for (bank, page) in banks.into_iter().zip(pages) {
+                    let o = &mut self.open_page[bank & 63];
+                    hits += usize::from(*o == page);
+                    *o = page;
+                }
+                hits
             }
-        } else {
-            let (m0, m1) = self.quad_mask;
-            let sh = self.tile_shift;
-            let (b0, b1) = ((x0 & m0) as usize, (x1 & m0) as usize);
-            let (s0, s1) = (((y0 & m1) << sh) as usize, ((y1 & m1) << sh) as usize);
-            for (bank, page) in [
-                (b0 | s0, r0 + c0),
-                (b1 | s0, r0 + c1),
-                (b0 | s1, r1 + c0),
-                (b1 | s1, r1 + c1),
-            ] {
-                let o = &mut open[bank & 63];
-                hits += u64::from(*o == page);
-                *o = page;
-            }
-        }
-        let occ = self.quad_occ[(hits & 7) as usize];
-        self.quads.by_hits[(hits & 7) as usize] += 1;
+        };
+        let occ = self.quad_occ[hits & 7];
+        self.quads.by_hits[hits & 7] += 1;
         (occ, bytes)
     }
 
@@ -736,6 +718,38 @@ impl Memory {
     }
 }
 
+/// The DRAM pages of a footprint's texels (x0, y0), (x1, y0), (x0, y1), (x1, y1) on level `lv`.
+#[inline(always)]
+fn quad_pages(lv: &LevelAddr, fp: &TexelFootprint) -> [u64; 4] {
+    let (px, py) = lv.page_shift;
+    let (c0, c1) = (u64::from(fp.x[0] >> px), u64::from(fp.x[1] >> px));
+    let r0 = lv.page_base + u64::from(fp.y[0] >> py) * lv.page_row;
+    let r1 = lv.page_base + u64::from(fp.y[1] >> py) * lv.page_row;
+    [r0 + c0, r0 + c1, r1 + c0, r1 + c1]
+}
+
+/// With four banks tiled 2x2 (bank `x & 1 | (y & 1) << 1`), the bank of a four-bank
+/// footprint's first texel: its columns and rows differ in parity, so its texels' banks are
+/// this one with bits flipped ([`quad4_hits`]).
+#[inline(always)]
+fn quad4_bank(fp: &TexelFootprint) -> usize {
+    ((fp.x[0] & 1) | (fp.y[0] & 1) << 1) as usize
+}
+
+/// The page hits of a four-bank footprint's texels, pages `pages` ([`quad_pages`]), in banks
+/// `b`, `b ^ 1`, `b ^ 2` and `b ^ 3` of `open` (the four banks' open pages): each access hits
+/// if its bank's open page is its page, which it opens.
+#[inline(always)]
+fn quad4_hits(open: &mut [u64; 4], b: usize, pages: [u64; 4]) -> usize {
+    let mut hits = 0;
+    for (flip, page) in (0..4).zip(pages) {
+        let o = &mut open[(b ^ flip) & 3];
+        hits += usize::from(*o == page);
+        *o = page;
+    }
+    hits
+}
+
 /// The bank accesses of one footprint so far ([`Memory::footprint`]): each one's bank and
 /// cycles, their count, the slowest, the cache and page hits, the banks used (a bit each)
 /// and the conflicts.
@@ -749,6 +763,16 @@ struct Accesses {
     page_hits: u64,
     used: u64,
     conflicts: u64,
+}
+
+/// One lookup's footprints through the memory: their count, summed occupancy, the last one's
+/// occupancy and their texel bytes ([`Texturing::lookup_timed`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct Fetched {
+    n: usize,
+    occ: u64,
+    last: u64,
+    bytes: u64,
 }
 
 /// A unit that serves requests in arrival order.
@@ -1210,55 +1234,26 @@ impl<'a> Simulator<'a> {
                 }
             }
             Some(p) => {
-                let (distinct, steps) = (p.distinct, &all_steps[p.start..p.end]);
-                // The one fetching stage, with the steps before and after it.
-                let one = p.one(all_steps);
-                let (lazy_ok, pre_cycles) =
-                    one.map_or((false, 0), |(_, m)| (m.lazy_ok, m.pre_cycles));
-                for fps in pixels {
-                    fed += fps.len() as u64;
-                    let (slot, t) = st.issue(ring, stall_by, ppc);
-                    let (t, cause) = match one {
-                        Some((ref one, Mono { setup, .. })) if one_lookup(fps, one.step.k) => {
-                            let mut worst = (0u64, C_LAT);
-                            let arrive = t + pre_cycles;
-                            // Only a plan whose pixels may skip (`lazy_ok`) starts skipping, and
-                            // a skipping pixel reaches the stage at `arrive`: the next one skips.
-                            let s = match lazy {
-                                Some((_, n)) => {
-                                    debug_assert!(lazy_ok);
-                                    lazy = Some((t, n + 1));
-                                    arrive
-                                }
-                                None => {
-                                    let pre_end = arith(alu, one.pre, t, &mut worst);
-                                    let (k, occ) = (one.step.k, one.step.occ);
-                                    let unit = &mut alu[k & (KINDS - 1)];
-                                    // The plan's count charges the step's arithmetic occupancy.
-                                    unit.busy = unit.busy.wrapping_sub(occ);
-                                    let s = unit.take(pre_end, setup.1);
-                                    if s - pre_end > worst.0 {
-                                        worst = (s - pre_end, k);
-                                    }
-                                    lazy = (lazy_ok && s == arrive).then_some((t, 0));
-                                    s
-                                }
-                            };
-                            let done = tex.lookup_from::<CACHED, TILED>(
-                                one.step.k,
-                                s + setup.0,
-                                fps,
-                                &mut worst,
-                            );
-                            (arith(alu, one.post, done, &mut worst), worst.1)
+                let plan = Walk {
+                    one: p.one(all_steps),
+                    steps: &all_steps[p.start..p.end],
+                    distinct: p.distinct,
+                };
+                match plan.one {
+                    Some((one, m)) if !CACHED && TILED && m.lazy_ok && tex.quad_lane() => {
+                        let run = (ring, stall_by, ppc, &mut fed);
+                        quad_lane(alu, tex, &plan, (&one, &m), pixels, &mut st, run, &mut lazy);
+                    }
+                    _ => {
+                        for fps in pixels {
+                            fed += fps.len() as u64;
+                            let (slot, t) = st.issue(ring, stall_by, ppc);
+                            let (t, cause) =
+                                pixel_in::<CACHED, TILED>(alu, tex, &plan, fps, t, &mut lazy);
+                            ring[slot] = (t, cause);
+                            st.end = st.end.max(t);
                         }
-                        _ => {
-                            let plan = (&one, steps, distinct);
-                            other_pixel::<CACHED, TILED>(alu, tex, plan, fps, t, &mut lazy)
-                        }
-                    };
-                    ring[slot] = (t, cause);
-                    st.end = st.end.max(t);
+                    }
                 }
             }
         }
@@ -1353,6 +1348,231 @@ fn other_pixel<const CACHED: bool, const TILED: bool>(
             }
             walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t)
         }
+    }
+}
+
+/// A plan as [`Simulator::run_in`] walks its pixels: its one fetching stage if any (with the
+/// steps before and after it), its steps and whether their kinds are distinct.
+struct Walk<'s> {
+    one: Option<(OneStage<'s>, Mono)>,
+    steps: &'s [Step],
+    distinct: bool,
+}
+
+/// One pixel of plan `plan` issued at `t` with its footprints `fps`: a pixel that is one
+/// lookup of the plan's one fetching stage is walked here (the steps before the stage
+/// skipped while `lazy`, [`settle`]); any other takes [`other_pixel`] ([`walk_mono`] or the
+/// general walk [`walk`]). Returns its completion and worst cause.
+#[inline(always)]
+fn pixel_in<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    plan: &Walk,
+    fps: &[TexelFootprint],
+    t: u64,
+    lazy: &mut Option<(u64, u64)>,
+) -> (u64, usize) {
+    match plan.one {
+        Some((ref one, m)) if one_lookup(fps, one.step.k) => {
+            let mut worst = (0u64, C_LAT);
+            let arrive = t + m.pre_cycles;
+            // Only a plan whose pixels may skip (`lazy_ok`) starts skipping, and a skipping
+            // pixel reaches the stage at `arrive`: the next one skips.
+            let s = match *lazy {
+                Some((_, n)) => {
+                    debug_assert!(m.lazy_ok);
+                    *lazy = Some((t, n + 1));
+                    arrive
+                }
+                None => {
+                    let pre_end = arith(alu, one.pre, t, &mut worst);
+                    let (k, occ) = (one.step.k, one.step.occ);
+                    let unit = &mut alu[k & (KINDS - 1)];
+                    // The plan's count charges the step's arithmetic occupancy.
+                    unit.busy = unit.busy.wrapping_sub(occ);
+                    let s = unit.take(pre_end, m.setup.1);
+                    if s - pre_end > worst.0 {
+                        worst = (s - pre_end, k);
+                    }
+                    *lazy = (m.lazy_ok && s == arrive).then_some((t, 0));
+                    s
+                }
+            };
+            let done = tex.lookup_from::<CACHED, TILED>(one.step.k, s + m.setup.0, fps, &mut worst);
+            (arith(alu, one.post, done, &mut worst), worst.1)
+        }
+        _ => {
+            let walk = (&plan.one, plan.steps, plan.distinct);
+            other_pixel::<CACHED, TILED>(alu, tex, walk, fps, t, lazy)
+        }
+    }
+}
+
+/// [`pixel_in`] out of line: a pixel [`quad_lane`] does not take.
+#[inline(never)]
+fn general_pixel<const CACHED: bool, const TILED: bool>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    plan: &Walk,
+    fps: &[TexelFootprint],
+    t: u64,
+    lazy: &mut Option<(u64, u64)>,
+) -> (u64, usize) {
+    pixel_in::<CACHED, TILED>(alu, tex, plan, fps, t, lazy)
+}
+
+/// [`Simulator::run_in`]'s loop on the common machine and plan ([`Texturing::quad_lane`]: no
+/// texel cache, four banks tiled 2x2, one filter unit; a plan whose pixels skip the units
+/// before its one fetching stage `one`): a skipping pixel that is one lookup of the stage
+/// with one or two footprints whose columns and rows differ in parity (each texel its own
+/// bank: [`Memory::quad_dram`]) is walked here as [`pixel_in`] walks it, with the memory's
+/// open pages, its unit and the filter unit in locals; any other takes [`general_pixel`]. A
+/// footprint whose four texels share a page finds that page in all four banks when the
+/// previous footprints left it there (`QuadLocals::uniform`): four page hits, nothing to
+/// store. Checked against the previous model by `quad_lane_matches_previous`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn quad_lane<'f>(
+    alu: &mut [Unit; KINDS],
+    tex: &mut Texturing,
+    plan: &Walk,
+    (one, m): (&OneStage, &Mono),
+    pixels: impl Iterator<Item = &'f [TexelFootprint]>,
+    st: &mut IssueState,
+    (ring, stall_by, ppc, fed): (&mut [(u64, usize)], &mut [u64; CAUSES], u64, &mut u64),
+    lazy: &mut Option<(u64, u64)>,
+) {
+    const C_MEM: usize = StageKind::COUNT;
+    const C_FILT: usize = StageKind::COUNT + 1;
+    let k = one.step.k;
+    // A footprint of the stage's first lookup reading four banks.
+    let quad = |f: &TexelFootprint| {
+        usize::from(f.stage) == k
+            && f.lookup == 0
+            && (f.x[0] ^ f.x[1]) & 1 != 0
+            && (f.y[0] ^ f.y[1]) & 1 != 0
+    };
+    let ready_after = m.pre_cycles + m.setup.0;
+    let [_, cost1, cost2, _] = tex.filter_cost;
+    let quad_occ = tex.mem.quad_occ;
+    let mut q = QuadLocals::load(tex);
+    for fps in pixels {
+        *fed += fps.len() as u64;
+        let (slot, t) = st.issue(ring, stall_by, ppc);
+        let fast = match fps {
+            [a] => quad(a),
+            [a, b] => quad(a) && quad(b),
+            _ => false,
+        };
+        let n = match *lazy {
+            Some((_, n)) if fast => n,
+            _ => {
+                q.store(tex, k);
+                let (done, cause) = general_pixel::<false, true>(alu, tex, plan, fps, t, lazy);
+                q = QuadLocals::load(tex);
+                ring[slot] = (done, cause);
+                st.end = st.end.max(done);
+                continue;
+            }
+        };
+        *lazy = Some((t, n + 1));
+        let ready = t + ready_after;
+        let (mut occ, mut last) = (0u64, 0u64);
+        for fp in fps {
+            let lv = tex.mem.map.level_recent(fp.tex, fp.level);
+            let pages = quad_pages(lv, fp);
+            q.bytes += 4 * u64::from(lv.texel_bytes);
+            let page = pages[0];
+            let hits = if pages[1] == page && pages[2] == page {
+                // One page for the four texels (same columns' and rows' pages), so for the four
+                // banks: the hits do not depend on which texel is in which bank.
+                if page == q.uniform {
+                    4
+                } else {
+                    let hits = q.open.iter().filter(|&&o| o == page).count();
+                    q.open = [page; 4];
+                    q.uniform = page;
+                    hits
+                }
+            } else {
+                // Two pages or more: the banks no longer hold one page.
+                q.uniform = EMPTY;
+                quad4_hits(&mut q.open, quad4_bank(fp), pages)
+            };
+            let o = quad_occ[hits & 7];
+            q.by_hits[hits & 7] += 1;
+            occ += o;
+            last = o;
+        }
+        // The memory unit, then the filter unit ([`Texturing::lookup_timed`]).
+        let start = ready.max(q.mem.free);
+        q.mem.free = start + occ;
+        q.mem.busy = q.mem.busy.wrapping_add(occ);
+        let ms = start + occ - last;
+        let mut worst = (0u64, C_LAT);
+        if ms > ready {
+            worst = (ms - ready, C_MEM);
+        }
+        let data = ms + last;
+        let (f_occ, f_lat) = if fps.len() == 1 { cost1 } else { cost2 };
+        let fs = data.max(q.filter.free);
+        q.filter.free = fs + f_occ;
+        q.filter.busy = q.filter.busy.wrapping_add(f_occ);
+        if fs - data > worst.0 {
+            worst = (fs - data, C_FILT);
+        }
+        let mut done = ready.max(fs + f_lat);
+        if !one.post.is_empty() {
+            done = arith(alu, one.post, done, &mut worst);
+        }
+        ring[slot] = (done, worst.1);
+        st.end = st.end.max(done);
+    }
+    q.store(tex, k);
+}
+
+/// What [`quad_lane`] keeps in locals: the four banks' open pages, the memory unit, the
+/// filter unit, the four-bank footprints by page hits and the texel bytes read since the last
+/// [`QuadLocals::store`].
+struct QuadLocals {
+    open: [u64; 4],
+    /// The page all four banks hold, if one ([`EMPTY`] otherwise: no page is).
+    uniform: u64,
+    mem: Unit,
+    filter: Unit,
+    by_hits: [u64; 8],
+    bytes: u64,
+}
+
+impl QuadLocals {
+    #[inline(always)]
+    fn load(tex: &Texturing) -> Self {
+        let o = &tex.mem.open_page;
+        let open = [o[0], o[1], o[2], o[3]];
+        Self {
+            open,
+            uniform: if open.iter().all(|&p| p == open[0]) {
+                open[0]
+            } else {
+                EMPTY
+            },
+            mem: tex.mem_unit,
+            filter: tex.filters.first().copied().unwrap_or_default(),
+            by_hits: tex.mem.quads.by_hits,
+            bytes: 0,
+        }
+    }
+
+    /// Writes the locals back, the bytes to stage kind `k`'s.
+    #[inline(always)]
+    fn store(&mut self, tex: &mut Texturing, k: usize) {
+        tex.stage_bytes[k & (KINDS - 1)] += std::mem::take(&mut self.bytes);
+        tex.mem.open_page[..4].copy_from_slice(&self.open);
+        tex.mem_unit = self.mem;
+        if let Some(f) = tex.filters.first_mut() {
+            *f = self.filter;
+        }
+        tex.mem.quads.by_hits = self.by_hits;
     }
 }
 
@@ -1452,6 +1672,12 @@ fn settle_plan(
 }
 
 impl Texturing {
+    /// Whether [`quad_lane`] serves this machine: no texel cache, four banks tiled 2x2
+    /// ([`Memory::quad4`]) and one filter unit.
+    fn quad_lane(&self) -> bool {
+        self.mem.cache.is_none() && self.mem.quad4 && self.filters.len() == 1
+    }
+
     /// [`Texturing::stage_in`], not inlined (the general walk's texture stage).
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
@@ -1525,11 +1751,8 @@ impl Texturing {
     }
 
     /// One lookup of stage kind `k` from `ready` (its address/footprint unit done): its
-    /// footprints `mine` through the memory, then the lookup on a filter unit; returns the
-    /// lookup's completion (at least `ready`). The footprints all arrive at `ready`, so the
-    /// memory unit serves them back to back from the first one's start: they take it as one
-    /// request of their summed occupancy, and the last one starts latest (the longest wait)
-    /// and is ready last.
+    /// footprints `mine` through the memory, then its timing ([`Texturing::lookup_timed`]);
+    /// returns the lookup's completion (at least `ready`).
     #[inline(always)]
     fn lookup_from<const CACHED: bool, const TILED: bool>(
         &mut self,
@@ -1538,24 +1761,44 @@ impl Texturing {
         mine: &[TexelFootprint],
         worst: &mut (u64, usize),
     ) -> u64 {
-        const C_MEM: usize = StageKind::COUNT;
-        let (mut occ, mut bytes, mut last) = (0u64, 0u64, 0u64);
-        for f in mine {
-            let (o, b) = self.mem.footprint::<CACHED, TILED>(f);
-            occ += o;
-            bytes += b;
-            last = o;
+        let mut f = Fetched {
+            n: mine.len(),
+            ..Fetched::default()
+        };
+        for fp in mine {
+            let (o, b) = self.mem.footprint::<CACHED, TILED>(fp);
+            f.occ += o;
+            f.bytes += b;
+            f.last = o;
         }
+        self.lookup_timed::<CACHED>(k, ready, &f, worst)
+    }
+
+    /// The timing of one lookup of stage kind `k` from `ready` whose footprints went through
+    /// the memory as `f`: the memory unit, then the lookup on a filter unit; returns the
+    /// lookup's completion (at least `ready`). The footprints all arrive at `ready`, so the
+    /// memory unit serves them back to back from the first one's start: they take it as one
+    /// request of their summed occupancy, and the last one starts latest (the longest wait)
+    /// and is ready last.
+    #[inline(always)]
+    fn lookup_timed<const CACHED: bool>(
+        &mut self,
+        k: usize,
+        ready: u64,
+        f: &Fetched,
+        worst: &mut (u64, usize),
+    ) -> u64 {
+        const C_MEM: usize = StageKind::COUNT;
         let mut data = ready;
-        if !mine.is_empty() {
-            let ms = self.mem_unit.take(ready, occ) + occ - last;
+        if f.n != 0 {
+            let ms = self.mem_unit.take(ready, f.occ) + f.occ - f.last;
             if ms - ready > worst.0 {
                 *worst = (ms - ready, C_MEM);
             }
-            data = ms + last + if CACHED { self.mem.hit_latency } else { 0 };
+            data = ms + f.last + if CACHED { self.mem.hit_latency } else { 0 };
         }
-        let done = ready.max(self.filter(data, mine.len(), worst));
-        self.stage_bytes[k & (KINDS - 1)] += bytes;
+        let done = ready.max(self.filter(data, f.n, worst));
+        self.stage_bytes[k & (KINDS - 1)] += f.bytes;
         done
     }
 
