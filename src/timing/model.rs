@@ -1425,8 +1425,8 @@ fn general_pixel<const CACHED: bool, const TILED: bool>(
 /// texel cache, four banks tiled 2x2, one filter unit; a plan whose pixels skip the units
 /// before its one fetching stage `one`): a skipping pixel that is one lookup of the stage
 /// with one or two footprints whose columns and rows differ in parity (each texel its own
-/// bank: [`Memory::quad_dram`]) is walked here as [`pixel_in`] walks it, with the memory's
-/// open pages, its unit and the filter unit in locals; any other takes [`general_pixel`]. A
+/// bank: [`Memory::quad_dram`]) is walked here as [`pixel_in`] walks it, with the four banks'
+/// open pages in locals ([`QuadLocals`]); any other takes [`general_pixel`]. A
 /// footprint whose four texels share a page finds that page in all four banks when the
 /// previous footprints left it there (`QuadLocals::uniform`): four page hits, nothing to
 /// store. Checked against the previous model by `quad_lane_matches_previous`.
@@ -1442,8 +1442,6 @@ fn quad_lane<'f>(
     (ring, stall_by, ppc, fed): (&mut [(u64, usize)], &mut [u64; CAUSES], u64, &mut u64),
     lazy: &mut Option<(u64, u64)>,
 ) {
-    const C_MEM: usize = StageKind::COUNT;
-    const C_FILT: usize = StageKind::COUNT + 1;
     let k = one.step.k;
     // A footprint of the stage's first lookup reading four banks.
     let quad = |f: &TexelFootprint| {
@@ -1453,7 +1451,6 @@ fn quad_lane<'f>(
             && (f.y[0] ^ f.y[1]) & 1 != 0
     };
     let ready_after = m.pre_cycles + m.setup.0;
-    let [_, cost1, cost2, _] = tex.filter_cost;
     let quad_occ = tex.mem.quad_occ;
     let mut q = QuadLocals::load(tex);
     for fps in pixels {
@@ -1504,24 +1501,15 @@ fn quad_lane<'f>(
             occ += o;
             last = o;
         }
-        // The memory unit, then the filter unit ([`Texturing::lookup_timed`]).
-        let start = ready.max(q.mem.free);
-        q.mem.free = start + occ;
-        q.mem.busy = q.mem.busy.wrapping_add(occ);
-        let ms = start + occ - last;
+        let f = Fetched {
+            n: fps.len(),
+            occ,
+            last,
+            // Counted in `q.bytes`, added to the stage's on store.
+            bytes: 0,
+        };
         let mut worst = (0u64, C_LAT);
-        if ms > ready {
-            worst = (ms - ready, C_MEM);
-        }
-        let data = ms + last;
-        let (f_occ, f_lat) = if fps.len() == 1 { cost1 } else { cost2 };
-        let fs = data.max(q.filter.free);
-        q.filter.free = fs + f_occ;
-        q.filter.busy = q.filter.busy.wrapping_add(f_occ);
-        if fs - data > worst.0 {
-            worst = (fs - data, C_FILT);
-        }
-        let mut done = ready.max(fs + f_lat);
+        let mut done = tex.lookup_timed::<false>(k, ready, &f, &mut worst);
         if !one.post.is_empty() {
             done = arith(alu, one.post, done, &mut worst);
         }
@@ -1531,15 +1519,13 @@ fn quad_lane<'f>(
     q.store(tex, k);
 }
 
-/// What [`quad_lane`] keeps in locals: the four banks' open pages, the memory unit, the
-/// filter unit, the four-bank footprints by page hits and the texel bytes read since the last
+/// What [`quad_lane`] keeps in locals: the four banks' open pages, the page they all hold if
+/// one, the four-bank footprints by page hits and the texel bytes read since the last
 /// [`QuadLocals::store`].
 struct QuadLocals {
     open: [u64; 4],
     /// The page all four banks hold, if one ([`EMPTY`] otherwise: no page is).
     uniform: u64,
-    mem: Unit,
-    filter: Unit,
     by_hits: [u64; 8],
     bytes: u64,
 }
@@ -1556,8 +1542,6 @@ impl QuadLocals {
             } else {
                 EMPTY
             },
-            mem: tex.mem_unit,
-            filter: tex.filters.first().copied().unwrap_or_default(),
             by_hits: tex.mem.quads.by_hits,
             bytes: 0,
         }
@@ -1568,10 +1552,6 @@ impl QuadLocals {
     fn store(&mut self, tex: &mut Texturing, k: usize) {
         tex.stage_bytes[k & (KINDS - 1)] += std::mem::take(&mut self.bytes);
         tex.mem.open_page[..4].copy_from_slice(&self.open);
-        tex.mem_unit = self.mem;
-        if let Some(f) = tex.filters.first_mut() {
-            *f = self.filter;
-        }
         tex.mem.quads.by_hits = self.by_hits;
     }
 }
