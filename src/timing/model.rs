@@ -1322,20 +1322,20 @@ fn walk<const CACHED: bool, const TILED: bool>(
     (t, worst.1)
 }
 
-/// A pixel of a plan (its one fetching stage if any, its steps and whether their kinds are
-/// distinct) issued at `t` that is not one lookup of its one fetching stage: the skipped units
-/// settled ([`settle`]), [`walk_mono`] if its footprints `fps` are all that stage's, else
-/// [`walk`]. Out of line, so [`Simulator::run_in`]'s one-lookup loop stays small.
+/// A pixel of plan `plan` ([`Walk`]) issued at `t` that is not one lookup of its one
+/// fetching stage: the skipped units settled ([`settle`]), [`walk_mono`] if its footprints
+/// `fps` are all that stage's, else [`walk`]. Out of line, so [`Simulator::run_in`]'s
+/// one-lookup loop stays small.
 #[inline(never)]
 fn other_pixel<const CACHED: bool, const TILED: bool>(
     alu: &mut [Unit; KINDS],
     tex: &mut Texturing,
-    (one, steps, distinct): (&Option<(OneStage, Mono)>, &[Step], bool),
+    plan: &Walk,
     fps: &[TexelFootprint],
     t: u64,
     lazy: &mut Option<(u64, u64)>,
 ) -> (u64, usize) {
-    match one {
+    match &plan.one {
         Some((one, Mono { setup, .. }))
             if fps.iter().all(|f| usize::from(f.stage) == one.step.k) =>
         {
@@ -1343,10 +1343,10 @@ fn other_pixel<const CACHED: bool, const TILED: bool>(
             walk_mono::<CACHED, TILED>(alu, tex, one, fps, t)
         }
         _ => {
-            if let Some((one, Mono { setup, .. })) = one {
+            if let Some((one, Mono { setup, .. })) = &plan.one {
                 settle(alu, one, setup.1, lazy);
             }
-            walk::<CACHED, TILED>(alu, tex, steps, distinct, fps, t)
+            walk::<CACHED, TILED>(alu, tex, plan.steps, plan.distinct, fps, t)
         }
     }
 }
@@ -1401,10 +1401,7 @@ fn pixel_in<const CACHED: bool, const TILED: bool>(
             let done = tex.lookup_from::<CACHED, TILED>(one.step.k, s + m.setup.0, fps, &mut worst);
             (arith(alu, one.post, done, &mut worst), worst.1)
         }
-        _ => {
-            let walk = (&plan.one, plan.steps, plan.distinct);
-            other_pixel::<CACHED, TILED>(alu, tex, walk, fps, t, lazy)
-        }
+        _ => other_pixel::<CACHED, TILED>(alu, tex, plan, fps, t, lazy),
     }
 }
 
