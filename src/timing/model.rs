@@ -1186,10 +1186,10 @@ impl<'a> Simulator<'a> {
     /// Issues each pixel of plan `plan` (the footprints its stages fetched) in turn, with the
     /// memory's [`Memory::footprint`] compiled with (`CACHED`) or without a texel cache, for
     /// the tiled (`TILED`) or linear interleave. The plan is resolved once; the issue state
-    /// lives in locals for the batch. A pixel that is one lookup of the plan's one fetching
-    /// stage is walked here; any other pixel takes [`other_pixel`] ([`walk_mono`] or the
-    /// general walk [`walk`]). Units skipped for the plan's pixels ([`settle`]) stay so
-    /// for its next call ([`Lazy`]); another plan's call settles them first.
+    /// lives in locals for the batch. Each pixel is [`pixel_in`] (one lookup of the plan's one
+    /// fetching stage walked there, any other pixel [`other_pixel`]), or on the default
+    /// machine's memory [`quad_lane`]'s loop. Units skipped for the plan's pixels ([`settle`])
+    /// stay so for its next call ([`Lazy`]); another plan's call settles them first.
     #[inline(always)]
     fn run_in<'f, const CACHED: bool, const TILED: bool>(
         &mut self,
