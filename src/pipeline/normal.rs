@@ -38,26 +38,19 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     for l in 0..np {
         bf.to_light_x[l] = ip(&ba.light_x[l], &m.vec_fmt);
     }
-    if fk != FrameKind::Main {
-        bf.d_u_x = ip(&ba.du_x, &m.vec_fmt);
-        bf.d_v_x = ip(&ba.dv_x, &m.vec_fmt);
-    }
     if fk == FrameKind::Main {
         bf.m_x = match bp.main {
             MainDirection::Constant(_) => raw3(&constant_m(bp), &m.vec_fmt, sat),
             _ => ip(&ba.m_x, &m.vec_fmt),
         };
+    } else {
+        bf.d_u_x = ip(&ba.du_x, &m.vec_fmt);
+        bf.d_v_x = ip(&ba.dv_x, &m.vec_fmt);
     }
     if fk == FrameKind::Natural {
-        for ax in 0..2 {
-            bf.len_x[ax] = interpolate(b, bb, column(&ba.len_x, ax), &m.len_fmt, sat);
-            bf.len[ax] = from_raw(bf.len_x[ax], lfb);
-        }
-    } else {
-        bf.len_x = [1i64 << lfb; 2];
-        bf.len = [1.0; 2];
+        bf.len_x = [0, 1].map(|ax| interpolate(b, bb, column(&ba.len_x, ax), &m.len_fmt, sat));
     }
-    carriers(bf, f, np);
+    lengths_and_carriers(bf, fk, lfb, f, np);
 }
 
 /// Fixed twin over a span: after a Fixed `bary`, each attribute of every fragment through
@@ -107,15 +100,20 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
         interpolate_into(frags, bb, ba.len_x, &m.len_fmt, sat, |b| &mut b.len_x);
     }
     for fr in frags.iter_mut() {
-        let bf = &mut fr.bump;
-        if fk == FrameKind::Natural {
-            bf.len = bf.len_x.map(|x| from_raw(x, lfb));
-        } else {
-            bf.len_x = [1i64 << lfb; 2];
-            bf.len = [1.0; 2];
-        }
-        carriers(bf, f, np);
+        lengths_and_carriers(&mut fr.bump, fk, lfb, f, np);
     }
+}
+
+/// The frame's lengths (a natural frame's from its interpolated `len_x`, `lfb` fraction bits;
+/// another frame's unit lengths) and the float carriers of the stage's signals.
+fn lengths_and_carriers(bf: &mut BumpFrag, fk: FrameKind, lfb: u32, f: u32, np: usize) {
+    if fk == FrameKind::Natural {
+        bf.len = bf.len_x.map(|x| from_raw(x, lfb));
+    } else {
+        bf.len_x = [1i64 << lfb; 2];
+        bf.len = [1.0; 2];
+    }
+    carriers(bf, f, np);
 }
 
 /// `interpolate_span` of one per-vertex attribute (`N` channels) at every fragment's first

@@ -115,6 +115,35 @@ fn written(f: &Frag, samples: usize) -> String {
     )
 }
 
+/// A span of 1 to 16 fragments near `tri`'s first vertex (partly outside the triangle, or all
+/// outside): its first pixel and length.
+fn span_near(rng: &mut Rng, tri: &ScreenTri, sub: u32) -> (i64, i64, usize) {
+    let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
+    let n = rng.int_in(1, 16) as usize;
+    let x = vx + rng.int_in(-12, 4);
+    let y = vy + rng.int_in(-3, 3);
+    (x, y, n)
+}
+
+/// The `bary` stage of `impls` over a span: its span twin when fixed, else the float twin on
+/// each fragment.
+fn bary_span(px: &Px, span: &mut [Frag], c: &mut Counters) {
+    if px.impls.of(StageKind::Bary) == Impl::Fixed {
+        bary::fixed_span(px, span, c);
+    } else {
+        texsim::pipeline::stages::each_fragment(bary::float, px, span, c);
+    }
+}
+
+/// The `bary` stage of `impls` on one fragment.
+fn bary_one(px: &Px, f: &mut Frag, c: &mut Counters) {
+    if px.impls.of(StageKind::Bary) == Impl::Fixed {
+        bary::fixed(px, f, c);
+    } else {
+        bary::float(px, f, c);
+    }
+}
+
 /// 300k seeded spans of 1..=16 fragments (pixels in and out of the triangle): `bary` then
 /// `texcoord` over the span give, at every fragment, the values and carriers of their
 /// per-fragment twins, and the same counters; over raster and interpolator widths, rounding
@@ -141,32 +170,21 @@ fn span_twins_match_the_per_fragment_twins() {
             } else {
                 StageImpls::FIXED
             };
-            // A span around the triangle's first vertex (partly outside it, or all outside).
-            let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
-            let n = rng.int_in(1, 16) as usize;
+            let (x, y, n) = span_near(&mut rng, &tri, sub);
             let px = Px {
                 plan: &pl,
                 impls: &impls,
                 m: &m,
                 tri: &tri,
                 a: &a,
-                x: vx + rng.int_in(-12, 4),
-                y: vy + rng.int_in(-3, 3),
+                x,
+                y,
                 color_raw: false,
                 carriers: rng.below(2) == 0,
             };
-            let bary_twin = if impls.of(StageKind::Bary) == Impl::Fixed {
-                bary::fixed
-            } else {
-                bary::float
-            };
             let mut span = vec![Frag::default(); n];
             let mut c_span = Counters::default();
-            if impls.of(StageKind::Bary) == Impl::Fixed {
-                bary::fixed_span(&px, &mut span, &mut c_span);
-            } else {
-                texsim::pipeline::stages::each_fragment(bary::float, &px, &mut span, &mut c_span);
-            }
+            bary_span(&px, &mut span, &mut c_span);
             texcoord::fixed_span(&px, &mut span, &mut c_span);
             let mut c_one = Counters::default();
             let samples = px.samples();
@@ -176,7 +194,7 @@ fn span_twins_match_the_per_fragment_twins() {
                     ..px
                 };
                 let mut f = Frag::default();
-                bary_twin(&at, &mut f, &mut c_one);
+                bary_one(&at, &mut f, &mut c_one);
                 texcoord::fixed(&at, &mut f, &mut c_one);
                 assert_eq!(
                     written(got, samples),
@@ -414,16 +432,15 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                     impls = impls.with(k, Impl::Float);
                 }
             }
-            let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
-            let n = rng.int_in(1, 16) as usize;
+            let (x, y, n) = span_near(&mut rng, &tri, sub);
             let px = Px {
                 plan: &pl,
                 impls: &impls,
                 m: &m,
                 tri: &tri,
                 a: &a,
-                x: vx + rng.int_in(-12, 4),
-                y: vy + rng.int_in(-3, 3),
+                x,
+                y,
                 color_raw: impls.of(StageKind::Color) == Impl::Fixed,
                 carriers: rng.below(2) == 0,
             };
@@ -436,11 +453,6 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                 })
                 .collect();
             let fixed = |k: StageKind| impls.of(k) == Impl::Fixed;
-            let bary_twin = if fixed(StageKind::Bary) {
-                bary::fixed
-            } else {
-                bary::float
-            };
             let color_twin = if fixed(StageKind::Color) {
                 color::fixed
             } else {
@@ -448,15 +460,11 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
             };
             let mut span = input.clone();
             let mut c_span = Counters::default();
-            let each = texsim::pipeline::stages::each_fragment;
-            if fixed(StageKind::Bary) {
-                bary::fixed_span(&px, &mut span, &mut c_span);
-            } else {
-                each(bary::float, &px, &mut span, &mut c_span);
-            }
+            bary_span(&px, &mut span, &mut c_span);
             if fixed(StageKind::Color) {
                 color::fixed_span(&px, &mut span, &mut c_span);
             } else {
+                let each = texsim::pipeline::stages::each_fragment;
                 each(color::float, &px, &mut span, &mut c_span);
             }
             modulate::fixed_span(&px, &mut span, &mut c_span);
@@ -467,7 +475,7 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                     ..px
                 };
                 let mut f = f;
-                bary_twin(&at, &mut f, &mut c_one);
+                bary_one(&at, &mut f, &mut c_one);
                 color_twin(&at, &mut f, &mut c_one);
                 modulate::fixed(&at, &mut f, &mut c_one);
                 assert_eq!(
@@ -558,28 +566,22 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
             } else {
                 StageImpls::FIXED
             };
-            let (vx, vy) = (tri.xy[0][0] >> sub, tri.xy[0][1] >> sub);
-            let n = rng.int_in(1, 16) as usize;
+            let (x, y, n) = span_near(&mut rng, &tri, sub);
             let px = Px {
                 plan: &pl,
                 impls: &impls,
                 m: &m,
                 tri: &tri,
                 a: &a,
-                x: vx + rng.int_in(-12, 4),
-                y: vy + rng.int_in(-3, 3),
+                x,
+                y,
                 color_raw: false,
                 carriers: rng.below(2) == 0,
             };
-            let bary_fixed = impls.of(StageKind::Bary) == Impl::Fixed;
             let input = vec![Frag::default(); n];
             let mut span = input.clone();
             let mut c_span = Counters::default();
-            if bary_fixed {
-                bary::fixed_span(&px, &mut span, &mut c_span);
-            } else {
-                texsim::pipeline::stages::each_fragment(bary::float, &px, &mut span, &mut c_span);
-            }
+            bary_span(&px, &mut span, &mut c_span);
             normal::fixed_span(&px, &mut span, &mut c_span);
             let mut c_one = Counters::default();
             for (j, (got, mut f)) in span.iter().zip(input).enumerate() {
@@ -587,11 +589,7 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
                     x: px.x + j as i64,
                     ..px
                 };
-                if bary_fixed {
-                    bary::fixed(&at, &mut f, &mut c_one);
-                } else {
-                    bary::float(&at, &mut f, &mut c_one);
-                }
+                bary_one(&at, &mut f, &mut c_one);
                 normal::fixed(&at, &mut f, &mut c_one);
                 assert_eq!(
                     format!("{:?}", got.bump),
@@ -601,7 +599,7 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
             }
             let k = StageKind::Normal.index();
             assert_eq!(c_span.sat[k], c_one.sat[k], "group {group} case {case}");
-            fast += u32::from(bary_fixed);
+            fast += u32::from(impls.of(StageKind::Bary) == Impl::Fixed);
             saturated += c_span.sat[k].saturated;
         }
     }
