@@ -20,7 +20,8 @@ use hw_model::config::CoordArith;
 use hw_model::f32_convert::from_i32;
 use hw_model::fixed::SatCounter;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// Bump data of every screen triangle of a bump plan (clipped vertices blended from their
 /// source vertices), computed in parallel and stored in triangle order; sets
@@ -363,9 +364,6 @@ pub(super) fn frag_scratch() -> Vec<Frag> {
     vec![Frag::default(); SPAN_MAX]
 }
 
-/// Rows shaded per band when the timing model runs beside the shading (see [`shade`]).
-const BAND_ROWS: usize = 16;
-
 /// Shades every covered pixel with `impls`; returns the image, the counters and, when `timing`
 /// holds the frame's timing model, the event stream (rows concatenated in row order) and the
 /// model fed with every pixel (the stream's pixel and footprint lists stay empty unless
@@ -373,10 +371,9 @@ const BAND_ROWS: usize = 16;
 /// any thread count:
 /// - on one thread the rows are shaded in order and each fragment's trace goes straight to
 ///   the model (and, with `keep_events`, to the stream): no row's events are stored;
-/// - on more, the frame is shaded in bands of [`BAND_ROWS`] rows: while a band is shaded (in
-///   parallel by rows, each row recording its events) the previous band's events are fed to
-///   the model and appended to the stream, so the sequential model overlaps the shading; the
-///   two sets of row buffers alternate between the bands.
+/// - on more, [`shade_feeding`]: the workers take the rows in order, each recording its row's
+///   events, and whichever worker finds the model free feeds it the rows finished so far, in
+///   order, so the sequential model overlaps the shading with no barrier between rows.
 pub(super) fn shade<'h>(
     inp: &ShadeInput,
     impls: &StageImpls,
@@ -410,13 +407,13 @@ pub(super) fn shade<'h>(
             });
         return (img, counters, None);
     };
-    let mut counters = Counters::default();
     let mut fe = FrameEvents {
         width: vis.width,
         height: vis.height,
         ..FrameEvents::default()
     };
     if rayon::current_num_threads() == 1 {
+        let mut counters = Counters::default();
         let mut ev = RowEvents::default();
         let mut frags = frag_scratch();
         for (y, row) in img.px.chunks_mut(w.max(1)).enumerate() {
@@ -436,6 +433,54 @@ pub(super) fn shade<'h>(
         }
         return (img, counters, Some((fe, sim)));
     }
+    let fed = Fed {
+        next: 0,
+        counters: Counters::default(),
+        sim,
+        fe,
+        keep_events,
+    };
+    let (counters, fe, sim) = shade_feeding(inp, progs, &mut img, fed);
+    (img, counters, Some((fe, sim)))
+}
+
+/// The timing model's side of [`shade_feeding`]: the next row it takes and what the rows fed
+/// so far added up to.
+struct Fed<'h> {
+    next: usize,
+    counters: Counters,
+    sim: Simulator<'h>,
+    fe: FrameEvents,
+    keep_events: bool,
+}
+
+/// A mutex's value, also after a worker panicked holding it (the panic is re-raised when the
+/// workers are joined).
+fn locked<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Most rows a worker of [`shade_feeding`] finishes ahead of the model before it waits to feed
+/// the model itself: it bounds the rows' events held at once to about this many rows (plus
+/// one per worker).
+const MAX_ROWS_AHEAD: usize = 32;
+
+/// [`shade`] on several threads with the timing model: every worker of the pool takes the
+/// next row (one atomic counter, so the rows finish nearly in order), shades it recording its
+/// events into a row buffer and leaves them in the row's slot; then, when no other worker is
+/// feeding the model, it feeds it every finished row from the model's next one on, in raster
+/// order, and recycles their buffers (a worker [`MAX_ROWS_AHEAD`] rows ahead of the model
+/// waits for its turn instead). Rows a feeding worker did not see are fed by the next worker
+/// to finish a row, and whatever remains after the last row, here. The model, the stream and
+/// the counters take the rows in raster order whichever worker shaded or fed them, so the
+/// result is that of one thread.
+fn shade_feeding<'h>(
+    inp: &ShadeInput,
+    progs: &[Program],
+    img: &mut Image,
+    fed: Fed<'h>,
+) -> (Counters, FrameEvents, Simulator<'h>) {
+    let w = inp.vis.width as usize;
     // A row's events: at most the most lookups of a plan, of two levels each, per pixel.
     let lookups = inp
         .geo
@@ -453,48 +498,65 @@ pub(super) fn shade<'h>(
         pixels: Vec::with_capacity(w),
         footprints: Vec::with_capacity(w * 2 * lookups),
     };
-    let mut consume = |rows: Vec<(Counters, RowEvents)>| {
-        rows.into_iter()
-            .map(|(c, mut ev)| {
-                counters.add(&c);
-                sim.row(&ev);
-                if keep_events {
-                    fe.append_row(&ev);
-                }
-                ev.clear();
-                ev
-            })
-            .collect::<Vec<_>>()
+    let rows: Vec<Mutex<Option<&mut [[u16; 4]]>>> = img
+        .px
+        .chunks_mut(w.max(1))
+        .map(|row| Mutex::new(Some(row)))
+        .collect();
+    let slots: Vec<Mutex<Option<(Counters, RowEvents)>>> =
+        rows.iter().map(|_| Mutex::new(None)).collect();
+    let spare: Mutex<Vec<RowEvents>> = Mutex::new(Vec::new());
+    let (next_row, fed_rows) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let model = Mutex::new(fed);
+    let feed = |m: &mut Fed| {
+        while let Some(slot) = slots.get(m.next) {
+            let Some((c, mut ev)) = locked(slot).take() else {
+                break;
+            };
+            m.counters.add(&c);
+            m.sim.row(&ev);
+            if m.keep_events {
+                m.fe.append_row(&ev);
+            }
+            ev.clear();
+            locked(&spare).push(ev);
+            m.next += 1;
+        }
+        fed_rows.store(m.next, Ordering::Release);
     };
-    let mut pending = Vec::new();
-    let mut spare: Vec<RowEvents> = Vec::new();
-    for (band, px) in img.px.chunks_mut((w * BAND_ROWS).max(1)).enumerate() {
-        let previous = std::mem::take(&mut pending);
-        let rows = px.len().div_ceil(w.max(1));
-        spare.resize_with(rows, new_row);
-        let buffers = std::mem::take(&mut spare);
-        let (shaded, returned) = rayon::join(
-            || {
-                px.par_chunks_mut(w.max(1))
-                    .zip(buffers)
-                    .enumerate()
-                    .map_init(frag_scratch, |frags, (r, (row, mut ev))| {
-                        let mut c = Counters::default();
-                        let y = band * BAND_ROWS + r;
-                        shade_row(inp, progs, y, row, frags, &mut c, true, |pi, t, frag| {
-                            record_pixel(pi, t, frag, &mut ev);
-                        });
-                        (c, ev)
-                    })
-                    .collect::<Vec<_>>()
-            },
-            || consume(previous),
-        );
-        pending = shaded;
-        spare = returned;
-    }
-    consume(pending);
-    (img, counters, Some((fe, sim)))
+    rayon::broadcast(|_| {
+        let mut frags = frag_scratch();
+        loop {
+            let y = next_row.fetch_add(1, Ordering::Relaxed);
+            let Some(row) = rows.get(y).and_then(|r| locked(r).take()) else {
+                break;
+            };
+            let mut ev = locked(&spare).pop().unwrap_or_else(new_row);
+            let mut c = Counters::default();
+            shade_row(
+                inp,
+                progs,
+                y,
+                row,
+                &mut frags,
+                &mut c,
+                true,
+                |pi, t, frag| {
+                    record_pixel(pi, t, frag, &mut ev);
+                },
+            );
+            *locked(&slots[y]) = Some((c, ev));
+            if y >= fed_rows.load(Ordering::Acquire) + MAX_ROWS_AHEAD {
+                feed(&mut locked(&model));
+            } else if let Ok(mut m) = model.try_lock() {
+                feed(&mut m);
+            }
+        }
+    });
+    let mut m = model.into_inner().unwrap_or_else(PoisonError::into_inner);
+    feed(&mut m);
+    debug_assert_eq!(m.next, slots.len(), "every row fed to the model");
+    (m.counters, m.fe, m.sim)
 }
 
 #[cfg(test)]

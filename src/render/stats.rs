@@ -59,7 +59,7 @@ pub struct Timings {
     pub geometry_ms: f64,
     pub setup_ms: f64,
     pub raster_ms: f64,
-    /// Hardware shading; with cycles on it includes the timing model fed band by band beside
+    /// Hardware shading; with cycles on it includes the timing model fed row by row beside
     /// it (the part that did not overlap the shading).
     pub shade_hw_ms: f64,
     pub raster_ref_ms: f64,

@@ -33,8 +33,7 @@ pub struct RowEvents {
 }
 
 impl RowEvents {
-    /// Empties the lists, keeping their buffers (a row's buffers serve the rows of later
-    /// bands).
+    /// Empties the lists, keeping their buffers (a fed row's buffers serve later rows).
     pub fn clear(&mut self) {
         self.pixels.clear();
         self.footprints.clear();

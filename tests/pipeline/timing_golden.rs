@@ -608,9 +608,20 @@ fn timed_on(
     hw: &hw_model::HwConfig,
     keep_events: bool,
 ) -> (TimingReport, Option<texsim::timing::FrameEvents>) {
+    timed_at(threads, name, hw, keep_events, (96, 64))
+}
+
+/// [`timed_on`] at `width` x `height`.
+fn timed_at(
+    threads: usize,
+    name: &str,
+    hw: &hw_model::HwConfig,
+    keep_events: bool,
+    (width, height): (u32, u32),
+) -> (TimingReport, Option<texsim::timing::FrameEvents>) {
     let mut s = scene::builtin(name).expect("builtin scene");
-    s.width = 96;
-    s.height = 64;
+    s.width = width;
+    s.height = height;
     let maps = Maps::new(&s, hw.trilinear.texel_bits);
     let opts = RenderOptions {
         reference: false,
@@ -627,8 +638,9 @@ fn timed_on(
 }
 
 #[test]
-fn streamed_model_is_the_same_on_one_thread_and_in_bands() {
-    // One thread feeds each fragment's trace to the model; more shade in bands and feed rows.
+fn streamed_model_is_the_same_on_one_thread_and_fed_by_the_workers() {
+    // One thread feeds each fragment's trace to the model; on more, the workers take the rows
+    // in order and whichever finds the model free feeds it the finished rows.
     // With or without the kept stream, the report is that of `simulate` over the stream.
     let mut aniso = hw_model::HwConfig::d3d11();
     aniso.trilinear.aniso_probes = 4;
@@ -647,6 +659,31 @@ fn streamed_model_is_the_same_on_one_thread_and_in_bands() {
                 let (r, none) = timed_on(threads, name, &hw, false);
                 assert!(none.is_none(), "{name}: no stream unless kept");
                 assert_eq!(r, kept, "{name}: {threads} threads, not kept");
+            }
+        }
+    }
+}
+
+#[test]
+fn rows_reach_the_model_in_order_whichever_worker_feeds_them() {
+    // Tall frames of short rows: many rows finish while another worker feeds the model, so
+    // rows wait in their slots, are fed by a later worker or after the last row. Every run,
+    // on 2 to 4 threads, repeated, gives the one-thread model and stream.
+    let hw = hw_model::HwConfig::texram16();
+    for (name, size) in [("w1-plane", (24, 600)), ("demo", (40, 360))] {
+        let (one, ev) = timed_at(1, name, &hw, true, size);
+        let ev = ev.expect("kept events");
+        for threads in [2, 3, 4] {
+            for _ in 0..3 {
+                let (r, ev_n) = timed_at(threads, name, &hw, true, size);
+                assert_eq!(r, one, "{name}: {threads} threads");
+                let ev_n = ev_n.expect("kept events");
+                assert_eq!(
+                    ev_n.pixels, ev.pixels,
+                    "{name}: {threads} threads, pixel events"
+                );
+                assert_eq!(ev_n.footprints, ev.footprints, "{name}: {threads} threads");
+                assert_eq!(timed_at(threads, name, &hw, false, size).0, one, "{name}");
             }
         }
     }
