@@ -344,7 +344,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_reference: bool,
     /// Skip the timing model (no cycle count; the hardware path runs without collecting its
-    /// timing events, about a fifth less wall time).
+    /// timing events: a tenth to a fifth less wall time on the built-in scenes).
     #[arg(long)]
     pub no_cycles: bool,
     /// Also render the supersampled ground truth (roughness materials: the full-resolution
