@@ -30,14 +30,16 @@ pub const ENV_MAX_MEMORY: &str = "TEXSIM_MAX_MEMORY";
 pub const MAX_TEXT_FILE_BYTES: u64 = 64 << 20;
 
 /// Bytes per triangle of a whole run, every triangle assumed visible: its set-up screen
-/// triangle and its attributes in the units' formats (the two per-triangle arrays the shading
-/// pass reads), and [`BYTES_PER_DRAW`] for its indices, draw, plan index and setup outcome.
+/// triangle, its attributes in the units' formats and in float (the per-triangle arrays the
+/// shading passes read; the float ones only when a float pass or twin reads them, counted
+/// always), and [`BYTES_PER_DRAW`] for its indices, draw, plan index and setup outcome.
 /// The sizes are the types' own, so the estimate follows them (544 B in all today). With
 /// [`BYTES_PER_VERTEX`] a grid mesh is estimated at 640 B per triangle; measured, the peak
 /// resident memory grows by 584 B per triangle of a fully visible grid at 256x256 (3,200 to
 /// 180,000 triangles) and by 528 B at 1024x1024 (250k to 1M triangles).
 pub const BYTES_PER_TRIANGLE: u64 = (std::mem::size_of::<crate::raster::ScreenTri>()
-    + std::mem::size_of::<crate::pipeline::stages::TriAttrs>())
+    + std::mem::size_of::<crate::pipeline::stages::TriAttrs>()
+    + std::mem::size_of::<crate::pipeline::stages::TriFloat>())
     as u64
     + BYTES_PER_DRAW;
 /// ...of which the input triangle's indices (12 B), draw (16 B), plan index (4 B), the

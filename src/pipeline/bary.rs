@@ -114,11 +114,11 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
 /// Float twin: the same algorithm on float edge functions.
 pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let (x, y) = (px.x as f64, px.y as f64);
-    let (tri, a) = (px.tri, px.a);
+    let (tri, af) = (px.tri, px.af);
     if px.plan.derivatives && px.m.hw.lod.lod_per_quad {
-        let p = perspective_bary_f64(tri.edges_float(x, y), a.inv_w_f);
+        let p = perspective_bary_f64(tri.edges_float(x, y), af.inv_w);
         let (qx, qy) = ((px.x & !1) as f64, (px.y & !1) as f64);
-        let b = |x: f64, y: f64| perspective_bary_f64(tri.edges_float(x, y), a.inv_w_f);
+        let b = |x: f64, y: f64| perspective_bary_f64(tri.edges_float(x, y), af.inv_w);
         let (q0, q1, q2) = (b(qx, qy), b(qx + 1.0, qy), b(qx, qy + 1.0));
         frag.bary = [
             p,
@@ -129,9 +129,9 @@ pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
         let [e, ex, ey] = tri.edges_float_and_steps(x, y);
         let dx = [0, 1, 2].map(|i| ex[i] - e[i]);
         let dy = [0, 1, 2].map(|i| ey[i] - e[i]);
-        frag.bary = perspective_bary_derivs_f64(e, dx, dy, a.inv_w_f);
+        frag.bary = perspective_bary_derivs_f64(e, dx, dy, af.inv_w);
     } else {
-        frag.bary[0] = perspective_bary_f64(tri.edges_float(x, y), a.inv_w_f);
+        frag.bary[0] = perspective_bary_f64(tri.edges_float(x, y), af.inv_w);
     }
 }
 

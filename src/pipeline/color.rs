@@ -71,7 +71,7 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
 /// Float twin.
 pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     for ch in 0..3 {
-        frag.color[ch] = interpolate_f64(frag.bary[0], column_f(&px.a.color_f, ch));
+        frag.color[ch] = interpolate_f64(frag.bary[0], column_f(&px.af.color, ch));
     }
     frag.out_bits = 0;
     frag.color[3] = 1.0;

@@ -309,7 +309,7 @@ fn reduction(px: &Px, m: &Machine) -> [f64; 2] {
     if !m.hw.interp.texcoord_reduce {
         return [0.0; 2];
     }
-    let uv = px.a.uv_f;
+    let uv = px.af.uv;
     [0, 1].map(|ax| texcoord_offset([uv[0][ax], uv[1][ax], uv[2][ax]], px.plan.wrap[ax]))
 }
 

@@ -7,7 +7,7 @@
 
 use super::bump::BumpAttrs;
 use super::table::RunFn;
-use super::{BumpPlan, Frag, Plan, Program, Px, StageKind, MAX_POINT_LIGHTS};
+use super::{BumpPlan, Frag, Impl, Plan, Program, Px, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{floor_exact, to_raw, to_unorm};
 use crate::maps::{FixedMipChain, MipChain};
 use crate::raster::ScreenTri;
@@ -16,7 +16,7 @@ use crate::scene::{FrameKind, Light, WrapMode};
 use crate::shading::reference as fref;
 use glam::DVec3;
 use hw_model::blinn_phong::ShadingUnits;
-use hw_model::config::HwConfig;
+use hw_model::config::{CoordArith, HwConfig};
 use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::frame::len_format;
 use hw_model::modulate::unorm_convert;
@@ -257,18 +257,16 @@ impl<'a> Machine<'a> {
     }
 }
 
-/// One screen triangle's vertex data, in float and in the hardware's input formats.
+/// One screen triangle's vertex data in the hardware's input formats (its float form, read
+/// only by float twins, is a [`TriFloat`] beside it).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TriAttrs {
     /// Plan index (the plan of the mesh the triangle came from).
     pub plan: u32,
-    pub inv_w_f: [f64; 3],
     /// 1/w normalized so the largest is exactly 1 << inv_w_bits.
     pub inv_w_x: [i64; 3],
-    pub color_f: [[f64; 3]; 3],
     /// Unorm `color_bits` (at most 16) per vertex and channel.
     pub color_x: [[u16; 3]; 3],
-    pub uv_f: [[f64; 2]; 3],
     pub uv_x: [[i64; 2]; 3],
     /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
     pub bump: u32,
@@ -295,6 +293,43 @@ pub fn texcoord_offset(vals: [f64; 3], wrap: WrapMode) -> f64 {
         WrapMode::Mirror => 2.0 * floor_exact(mid * 0.5),
         WrapMode::ClampToEdge => 0.0,
     }
+}
+
+/// One screen triangle's vertex data in float (post-clip): what the float twins of `bary`,
+/// `color` and `texcoord` and the float32 coordinate path read. A render builds them only
+/// when a stage of one of its passes reads them; otherwise its stages see [`TriFloat::NONE`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriFloat {
+    /// 1 / w_clip per vertex.
+    pub inv_w: [f64; 3],
+    /// Colour per vertex and channel.
+    pub color: [[f64; 3]; 3],
+    /// Texture coordinates per vertex.
+    pub uv: [[f64; 2]; 3],
+}
+
+impl TriFloat {
+    /// What a stage sees when the render built no float vertex data: NaN everywhere, so a
+    /// stage that reads it unexpectedly shows in every output it reaches.
+    pub const NONE: Self = Self {
+        inv_w: [f64::NAN; 3],
+        color: [[f64::NAN; 3]; 3],
+        uv: [[f64::NAN; 2]; 3],
+    };
+}
+
+/// Whether a stage of a pass with the twins `impls` on `hw` reads [`TriFloat`]: the float
+/// twins of `bary`, `color` and `texcoord`, and the float32 coordinate path
+/// (`interp.coord_arith = "float32"`, whose texture-coordinate reduction starts from the float
+/// coordinates). A render builds the float vertex data when this holds or a float pass (the
+/// reference, the truth, the signal ranges) runs; `every_float_reader_gets_the_float_vertex_data`
+/// checks the list against every stage's float twin.
+#[must_use]
+pub fn reads_tri_floats(impls: &StageImpls, hw: &HwConfig) -> bool {
+    hw.interp.coord_arith == CoordArith::Float32
+        || [StageKind::Bary, StageKind::Color, StageKind::Texcoord]
+            .iter()
+            .any(|&k| impls.of(k) == Impl::Float)
 }
 
 impl TriAttrs {
@@ -337,11 +372,8 @@ impl TriAttrs {
         }
         Self {
             plan,
-            inv_w_f: inv_w,
             inv_w_x,
-            color_f: color,
             color_x,
-            uv_f: uv,
             uv_x,
             bump: u32::MAX,
             f32_tri: u32::MAX,
@@ -378,14 +410,14 @@ pub fn run(
     plan: &Plan,
     m: &Machine,
     tri: &ScreenTri,
-    a: &TriAttrs,
+    (a, af): (&TriAttrs, &TriFloat),
     x: i64,
     y: i64,
     frag: &mut Frag,
     c: &mut Counters,
 ) {
     start(frag, plan);
-    let px = prog.px(plan, m, tri, a, x, y);
+    let px = prog.px(plan, m, tri, (a, af), x, y);
     for op in &prog.ops {
         (op.run)(&px, frag, c);
     }
@@ -416,7 +448,7 @@ pub fn run_span(
     plan: &Plan,
     m: &Machine,
     tri: &ScreenTri,
-    a: &TriAttrs,
+    (a, af): (&TriAttrs, &TriFloat),
     x: i64,
     y: i64,
     frags: &mut [Frag],
@@ -425,7 +457,7 @@ pub fn run_span(
     for frag in frags.iter_mut() {
         start(frag, plan);
     }
-    let px = prog.px(plan, m, tri, a, x, y);
+    let px = prog.px(plan, m, tri, (a, af), x, y);
     for op in &prog.ops {
         match op.span {
             Some(span) => span(&px, frags, c),

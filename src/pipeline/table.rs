@@ -9,7 +9,7 @@
 //! fixed twin on each fragment). Adding a stage is a file with those four functions and a row
 //! here (see `docs/ARCHITECTURE.md`).
 
-use super::stages::{Counters, Machine, TriAttrs};
+use super::stages::{Counters, Machine, TriAttrs, TriFloat};
 use super::{
     as_shade, bary, bump_fetch, color, env_fetch, frame, lean_fetch, lean_shade, lobe_fetch,
     lobe_shade, lod, modulate, ndf_fetch, ndf_shade, normal, perturb, phong, rough_fetch,
@@ -32,6 +32,9 @@ pub struct Px<'a> {
     pub m: &'a Machine<'a>,
     pub tri: &'a ScreenTri,
     pub a: &'a TriAttrs,
+    /// The triangle's vertex data in float ([`TriFloat::NONE`] when no stage of the render's
+    /// passes reads it).
+    pub af: &'a TriFloat,
     /// The pixel (for a span: its first fragment's; fragment `j` is at (`x + j`, `y`)).
     pub x: i64,
     pub y: i64,
@@ -350,7 +353,7 @@ impl Program {
         plan: &'a Plan,
         m: &'a Machine<'a>,
         tri: &'a ScreenTri,
-        a: &'a TriAttrs,
+        (a, af): (&'a TriAttrs, &'a TriFloat),
         x: i64,
         y: i64,
     ) -> Px<'a> {
@@ -360,6 +363,7 @@ impl Program {
             m,
             tri,
             a,
+            af,
             x,
             y,
             color_raw: self.color_raw,

@@ -68,7 +68,7 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
 pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     for s in 0..px.samples() {
         for ax in 0..2 {
-            frag.uv[s][ax] = interpolate_f64(frag.bary[s], column_f(&px.a.uv_f, ax));
+            frag.uv[s][ax] = interpolate_f64(frag.bary[s], column_f(&px.af.uv, ax));
         }
     }
 }

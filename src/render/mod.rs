@@ -31,7 +31,7 @@ pub use stats::{
 
 use crate::fixedpoint::to_unorm;
 pub use crate::maps::{bump_sources, ndf_sources, BumpSource, Maps};
-use crate::pipeline::stages::Machine;
+use crate::pipeline::stages::{reads_tri_floats, Machine};
 use crate::pipeline::{Impl, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::raster::{self, Coverage, NO_TRI};
 use crate::report::compare;
@@ -217,10 +217,18 @@ pub fn render(
     }
     let opts = &opts;
 
+    // The reference and the truth of an earlier render whose machine differs only in widths
+    // they do not read; without them, and for the signal ranges, this render runs its own.
+    let kept = opts
+        .float_passes
+        .as_deref()
+        .filter(|fp| fp.fits(scene, opts));
+    let float_pass = opts.ranges || (kept.is_none() && (opts.reference || opts.truth > 0));
     let t = Instant::now();
     let setup = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &hw.raster);
     let m0 = Machine::new(hw, &maps.float, &maps.fixed).with_lights(&scene.lights, scene.ambient);
-    let (mut attrs, mut input_sat) = tri_attrs(&setup, &geo, &m0);
+    let floats = float_pass || reads_tri_floats(&opts.hw_impls, hw);
+    let (mut attrs, floats, mut input_sat) = tri_attrs(&setup, &geo, &m0, floats);
     let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
     input_sat.add(&bsat);
     let ftris = f32_tris(&setup, &geo, &m0, &mut attrs);
@@ -239,6 +247,7 @@ pub fn render(
         vis: &vis,
         setup: &setup,
         attrs: &attrs,
+        floats: &floats,
         geo: &geo,
         m: &m,
         per_fragment: opts.per_fragment,
@@ -282,10 +291,6 @@ pub fn render(
     let mut ref_image = None;
     let mut ref_nonfinite = 0;
     let (mut e8, mut e16) = (None, None);
-    let kept = opts
-        .float_passes
-        .as_deref()
-        .filter(|fp| fp.fits(scene, opts));
     if let Some((img, nonfinite)) = kept.and_then(|fp| fp.reference.as_ref()) {
         ref_nonfinite = *nonfinite;
         e8 = Some(compare(&hw_image, img, 8, Some(&mask)));
@@ -349,6 +354,7 @@ pub fn render(
             vis: &vis,
             setup: &setup,
             attrs: &attrs,
+            floats: &floats,
             geo: &geo,
             m: &mt,
             per_fragment: opts.per_fragment,

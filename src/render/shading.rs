@@ -6,7 +6,9 @@ use super::Geometry;
 use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::clip_f32::{outcode, ShadedVertex};
 use crate::pipeline::coord_f32::{self, F32Tri};
-use crate::pipeline::stages::{output16, run, run_span, Counters, Machine, TriAttrs, SPAN_MAX};
+use crate::pipeline::stages::{
+    output16, run, run_span, Counters, Machine, TriAttrs, TriFloat, SPAN_MAX,
+};
 use crate::pipeline::{Frag, Program, StageImpls};
 #[cfg(test)]
 use crate::raster::ScreenTri;
@@ -80,11 +82,22 @@ pub(super) fn bump_attrs(
     (out, sat)
 }
 
-/// Per-triangle attributes of every screen triangle, in the machine's formats.
-pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriAttrs>, SatCounter) {
-    // Written in parallel straight into their vector; the overflow counts sum in any order.
+/// Per-triangle attributes of every screen triangle in the machine's formats and, when
+/// `floats` (a stage of the render's passes reads them), in float; else the second vector is
+/// empty.
+pub(super) fn tri_attrs(
+    setup: &Setup,
+    geo: &Geometry,
+    m: &Machine,
+    floats: bool,
+) -> (Vec<TriAttrs>, Vec<TriFloat>, SatCounter) {
+    // Written in parallel straight into their vectors; the overflow counts sum in any order.
+    let n = setup.tris.len();
     let mut out = (
-        crate::raster::vec_populated(setup.tris.len()),
+        (
+            crate::raster::vec_populated(n),
+            Floats(floats.then(|| crate::raster::vec_populated(n))),
+        ),
         SatSum::default(),
     );
     out.par_extend(setup.tris.par_iter().enumerate().map(|(i, t)| {
@@ -133,10 +146,29 @@ pub(super) fn tri_attrs(setup: &Setup, geo: &Geometry, m: &Machine) -> (Vec<TriA
         let mut sat = SatCounter::default();
         let plan = geo.draw_plan[t.src as usize];
         let wrap = geo.plans[plan as usize].wrap;
-        let a = TriAttrs::new(m, plan, t.inv_w, [c0, c1, c2], [t0, t1, t2], wrap, &mut sat);
-        (a, sat)
+        let (color, uv) = ([c0, c1, c2], [t0, t1, t2]);
+        let a = TriAttrs::new(m, plan, t.inv_w, color, uv, wrap, &mut sat);
+        let af = TriFloat {
+            inv_w: t.inv_w,
+            color,
+            uv,
+        };
+        ((a, af), sat)
     }));
-    (out.0, out.1 .0)
+    let ((attrs, Floats(af)), SatSum(sat)) = out;
+    (attrs, af.unwrap_or_default(), sat)
+}
+
+/// The float vertex data of [`tri_attrs`]: collected when `Some`, dropped otherwise.
+struct Floats(Option<Vec<TriFloat>>);
+
+impl ParallelExtend<TriFloat> for Floats {
+    fn par_extend<I: IntoParallelIterator<Item = TriFloat>>(&mut self, items: I) {
+        match &mut self.0 {
+            Some(v) => v.par_extend(items),
+            None => items.into_par_iter().for_each(drop),
+        }
+    }
 }
 
 /// The sum of overflow counters collected from a parallel iterator (nothing stored per item).
@@ -264,6 +296,8 @@ pub(super) struct ShadeInput<'a> {
     pub(super) vis: &'a VisBuffer,
     pub(super) setup: &'a Setup,
     pub(super) attrs: &'a [TriAttrs],
+    /// The triangles' float vertex data, in triangle order; empty when no stage reads it.
+    pub(super) floats: &'a [TriFloat],
     pub(super) geo: &'a Geometry,
     pub(super) m: &'a Machine<'a>,
     /// Shade one fragment at a time through [`run`] (the reference of the span path).
@@ -330,6 +364,7 @@ fn shade_row_spans(
             .take_while(|&&u| u == t)
             .count();
         let a = &inp.attrs[t as usize];
+        let af = inp.floats.get(t as usize).unwrap_or(&TriFloat::NONE);
         let pi = a.plan as usize;
         match &mut run_of {
             Some((p, k)) if *p == pi => *k += n as u64,
@@ -344,9 +379,19 @@ fn shade_row_spans(
         let (px, py) = (x as i64, y as i64);
         let span = &mut frags[..n];
         if inp.per_fragment {
-            run(&progs[pi], plan, inp.m, tri, a, px, py, &mut span[0], c);
+            run(
+                &progs[pi],
+                plan,
+                inp.m,
+                tri,
+                (a, af),
+                px,
+                py,
+                &mut span[0],
+                c,
+            );
         } else {
-            run_span(&progs[pi], plan, inp.m, tri, a, px, py, span, c);
+            run_span(&progs[pi], plan, inp.m, tri, (a, af), px, py, span, c);
         }
         for (frag, out) in span.iter().zip(&mut row[x..x + n]) {
             *out = output16(frag);

@@ -377,3 +377,64 @@ fn llvmpipe_preset_samples_8_bit_texels_with_a_lod_per_quad() {
         "but only where the level fraction moves: {differ}"
     );
 }
+
+/// A render builds the triangles' float vertex data only when a float pass runs or a stage
+/// of its hardware pass reads it (`stages::reads_tri_floats`); a stage that reads it
+/// otherwise sees NaN. Every built-in scene, and the W1 plane with its texture coordinates
+/// moved 1000 repeats away (the float32 path reduces them by an integer taken from the float
+/// coordinates: NaN would leave them beyond the format), with each stage kind's float twin
+/// alone and on the float32 coordinate path (`llvmpipe`), gives the same hardware image and
+/// stage counts without the reference (the data built only when the list says so) as with
+/// it (always).
+#[test]
+fn every_float_reader_gets_the_float_vertex_data() {
+    let texram = hw_model::HwConfig::texram16();
+    let llvmpipe = hw_model::HwConfig::llvmpipe();
+    let mut far = small("w1-plane", 48, 32);
+    for mesh in &mut far.meshes {
+        for uv in &mut mesh.uvs {
+            *uv = uv.map(|x| x + 1000.0);
+        }
+    }
+    let scenes = scene::BUILTIN
+        .iter()
+        .map(|&(name, _)| small(name, 48, 32))
+        .chain([far]);
+    for s in scenes {
+        let name = s.name.clone();
+        let maps = Maps::new(&s, texram.trilinear.texel_bits);
+        let runs = StageKind::ALL
+            .iter()
+            .map(|&k| {
+                (
+                    &texram,
+                    StageImpls::FIXED.with(k, Impl::Float),
+                    k.to_string(),
+                )
+            })
+            .chain([(&llvmpipe, StageImpls::FIXED, "float32 path".to_string())]);
+        for (hw, impls, what) in runs {
+            let maps = if hw.trilinear.texel_bits == texram.trilinear.texel_bits {
+                &maps
+            } else {
+                &Maps::new(&s, hw.trilinear.texel_bits)
+            };
+            let with = |reference| {
+                let opts = RenderOptions {
+                    hw_impls: impls,
+                    reference,
+                    timing: false,
+                    ..Default::default()
+                };
+                render(&s, maps, hw, &opts).expect("render")
+            };
+            let (built, own) = (with(true), with(false));
+            assert!(
+                built.hw_image == own.hw_image,
+                "{name}, {what}: hardware image"
+            );
+            let stages = |r: &Rendered| serde_json::to_value(&r.stats.stages).expect("json");
+            assert_eq!(stages(&built), stages(&own), "{name}, {what}: stage counts");
+        }
+    }
+}

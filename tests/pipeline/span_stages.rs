@@ -10,7 +10,7 @@ use hw_model::fixed::Rounding;
 use hw_model::wrap::WrapMode;
 use texsim::maps::{build_mip_chain, quantize_chain};
 use texsim::pipeline::bump::BumpAttrs;
-use texsim::pipeline::stages::{Counters, Machine, TriAttrs};
+use texsim::pipeline::stages::{Counters, Machine, TriAttrs, TriFloat};
 use texsim::pipeline::{
     bary, color, lod, modulate, normal, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls,
     StageKind, MAX_POINT_LIGHTS,
@@ -73,7 +73,7 @@ fn triangle(rng: &mut Rng, sub: u32) -> ScreenTri {
 
 /// Vertex data: 1/w normalized to `2^inv_w_bits` for the largest (some tiny: a vertex far
 /// behind), texture coordinates within the format or beyond it.
-fn attrs(rng: &mut Rng, hw: &HwConfig) -> TriAttrs {
+fn attrs(rng: &mut Rng, hw: &HwConfig) -> (TriAttrs, TriFloat) {
     let bits = hw.interp.inv_w_bits;
     let one = 1i64 << bits;
     let mut inv_w_x = [0i64; 3].map(|_| match rng.below(4) {
@@ -87,13 +87,17 @@ fn attrs(rng: &mut Rng, hw: &HwConfig) -> TriAttrs {
     let uv_max = 1i64 << uv_bits.min(60);
     let uv_x = [[0i64; 2]; 3].map(|_| [0, 1].map(|_| rng.int_in(-uv_max, uv_max)));
     let uv_f = uv_x.map(|t| t.map(|v| v as f64 / f64::from(1u32 << hw.interp.texcoord_frac_bits)));
-    TriAttrs {
-        inv_w_f,
+    let a = TriAttrs {
         inv_w_x,
-        uv_f,
         uv_x,
         ..TriAttrs::default()
-    }
+    };
+    let af = TriFloat {
+        inv_w: inv_w_f,
+        color: [[0.0; 3]; 3],
+        uv: uv_f,
+    };
+    (a, af)
 }
 
 /// The fields `bary` and `texcoord` write, of the first `samples` samples.
@@ -162,7 +166,7 @@ fn span_twins_match_the_per_fragment_twins() {
         let sub = hw.raster.subpixel_bits;
         for case in 0..2000u32 {
             let tri = triangle(&mut rng, sub);
-            let a = attrs(&mut rng, &hw);
+            let (a, af) = attrs(&mut rng, &hw);
             let mut pl = plan(&textured, true);
             pl.derivatives = rng.below(4) != 0;
             let impls = if rng.below(8) == 0 {
@@ -177,6 +181,7 @@ fn span_twins_match_the_per_fragment_twins() {
                 m: &m,
                 tri: &tri,
                 a: &a,
+                af: &af,
                 x,
                 y,
                 color_raw: false,
@@ -283,7 +288,7 @@ fn lookup_span_twins_match_the_per_fragment_twins() {
         let fixed_chains = [fixed_chain];
         let m = Machine::new(&hw, &float_chains, &fixed_chains);
         let tri = triangle(&mut rng, 4);
-        let a = TriAttrs::default();
+        let (a, af) = (TriAttrs::default(), TriFloat::NONE);
         let fb = hw.interp.texcoord_frac_bits;
         let levels = float_chains[0].levels.len() as f64;
         for case in 0..200u32 {
@@ -302,6 +307,7 @@ fn lookup_span_twins_match_the_per_fragment_twins() {
                 m: &m,
                 tri: &tri,
                 a: &a,
+                af: &af,
                 x: rng.int_in(-50, 50),
                 y: rng.int_in(-50, 50),
                 color_raw: false,
@@ -417,7 +423,7 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
         let (cmax, tmax) = ((1i64 << cb) - 1, (1i64 << tb) - 1);
         for case in 0..2000u32 {
             let tri = triangle(&mut rng, sub);
-            let mut a = attrs(&mut rng, &hw);
+            let (mut a, mut af) = attrs(&mut rng, &hw);
             a.color_x = [[0u16; 3]; 3].map(|_| {
                 [0; 3].map(|_| match rng.below(4) {
                     0 => 0,
@@ -425,7 +431,7 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                     _ => rng.int_in(0, cmax) as u16,
                 })
             });
-            a.color_f = a.color_x.map(|v| v.map(|c| f64::from(c) / cmax as f64));
+            af.color = a.color_x.map(|v| v.map(|c| f64::from(c) / cmax as f64));
             let mut impls = StageImpls::FIXED;
             for k in [StageKind::Bary, StageKind::Color, StageKind::Trilinear] {
                 if rng.below(8) == 0 {
@@ -439,6 +445,7 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                 m: &m,
                 tri: &tri,
                 a: &a,
+                af: &af,
                 x,
                 y,
                 color_raw: impls.of(StageKind::Color) == Impl::Fixed,
@@ -559,7 +566,7 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
         let sub = hw.raster.subpixel_bits;
         for case in 0..1000u32 {
             let tri = triangle(&mut rng, sub);
-            let mut a = attrs(&mut rng, &hw);
+            let (mut a, af) = attrs(&mut rng, &hw);
             a.bump = rng.below(battrs.len() as u64) as u32;
             let impls = if rng.below(8) == 0 {
                 StageImpls::FIXED.with(StageKind::Bary, Impl::Float)
@@ -573,6 +580,7 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
                 m: &m,
                 tri: &tri,
                 a: &a,
+                af: &af,
                 x,
                 y,
                 color_raw: false,
