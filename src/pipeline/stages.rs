@@ -309,8 +309,9 @@ pub struct TriFloat {
 }
 
 impl TriFloat {
-    /// What a stage sees when the render built no float vertex data: NaN everywhere, so a
-    /// stage that reads it unexpectedly shows in every output it reaches.
+    /// What a stage sees when the render built no float vertex data: NaN everywhere, no
+    /// value a stage could mistake for a vertex's (`every_float_reader_gets_the_float_vertex_data`
+    /// checks that no stage reads it).
     pub const NONE: Self = Self {
         inv_w: [f64::NAN; 3],
         color: [[f64::NAN; 3]; 3],
