@@ -1,6 +1,7 @@
 //! What every stage shares: the [`Machine`] (the units and formats of one hardware
-//! configuration, built once per render), the per-triangle vertex data ([`TriAttrs`], in float
-//! and in the hardware's input formats, so the per-pixel loop allocates nothing), the run's
+//! configuration, built once per render), the per-triangle vertex data ([`TriAttrs`] in the
+//! hardware's input formats and, when a stage reads it, [`TriFloat`] in float, so the per-pixel
+//! loop allocates nothing), the run's
 //! [`Counters`], [`run`], which runs a compiled [`Program`] on one fragment, and [`run_span`],
 //! which runs it on a span of fragments, stage by stage. The stages themselves are one file
 //! each, registered in [`super::table`].
@@ -309,9 +310,10 @@ pub struct TriFloat {
 }
 
 impl TriFloat {
-    /// What a stage sees when the render built no float vertex data: NaN everywhere, no
-    /// value a stage could mistake for a vertex's (`every_float_reader_gets_the_float_vertex_data`
-    /// checks that no stage reads it).
+    /// What a stage sees when the render built no float vertex data: NaN everywhere. Most
+    /// readers would turn it into visibly wrong output, but [`texcoord_offset`] takes NaN as
+    /// an offset of 0, which only coordinates beyond the format show;
+    /// `every_float_reader_gets_the_float_vertex_data` therefore also renders a plane far out.
     pub const NONE: Self = Self {
         inv_w: [f64::NAN; 3],
         color: [[f64::NAN; 3]; 3],

@@ -505,9 +505,11 @@ fn locked<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Most rows a worker of [`shade_feeding`] finishes ahead of the model before it waits to feed
-/// the model itself: it bounds the rows' events held at once to about this many rows (plus
-/// one per worker).
+/// Most rows a worker of [`shade_feeding`] finishes ahead of the model before it waits for the
+/// model's lock to feed it itself: while the model is what lags, the events held at once stay
+/// near this many rows (plus one per worker). A row still being shaded holds up the feed, and
+/// the rows finished meanwhile wait in their slots; the memory budget counts every pixel's
+/// events (`budget::BYTES_PER_EVENT_PIXEL`).
 const MAX_ROWS_AHEAD: usize = 32;
 
 /// [`shade`] on several threads with the timing model: every worker of the pool takes the
@@ -515,10 +517,10 @@ const MAX_ROWS_AHEAD: usize = 32;
 /// events into a row buffer and leaves them in the row's slot; then, when no other worker is
 /// feeding the model, it feeds it every finished row from the model's next one on, in raster
 /// order, and recycles their buffers (a worker [`MAX_ROWS_AHEAD`] rows ahead of the model
-/// waits for its turn instead). Rows a feeding worker did not see are fed by the next worker
-/// to finish a row, and whatever remains after the last row, here. The model, the stream and
-/// the counters take the rows in raster order whichever worker shaded or fed them, so the
-/// result is that of one thread.
+/// waits for the model's lock instead). Rows a feeding worker did not see are fed by the next
+/// worker to finish a row, and whatever remains after the last row, here. The model, the
+/// stream and the counters take the rows in raster order whichever worker shaded or fed them,
+/// so the result is that of one thread.
 fn shade_feeding<'h>(
     inp: &ShadeInput,
     progs: &[Program],
@@ -569,6 +571,9 @@ fn shade_feeding<'h>(
         }
         fed_rows.store(m.next, Ordering::Release);
     };
+    // Every thread of the pool runs this loop (the caller's too when it is one of them), so
+    // the frame ends once each has found no row left: a pool thread held up elsewhere delays
+    // the end, not the rows.
     rayon::broadcast(|_| {
         let mut frags = frag_scratch();
         loop {
@@ -600,7 +605,7 @@ fn shade_feeding<'h>(
     });
     let mut m = model.into_inner().unwrap_or_else(PoisonError::into_inner);
     feed(&mut m);
-    debug_assert_eq!(m.next, slots.len(), "every row fed to the model");
+    assert_eq!(m.next, slots.len(), "every row fed to the model");
     (m.counters, m.fe, m.sim)
 }
 

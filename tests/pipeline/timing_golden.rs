@@ -650,8 +650,8 @@ fn streamed_model_is_the_same_on_one_thread_and_fed_by_the_workers() {
             let (kept, ev) = timed_on(1, name, &hw, true);
             let ev = ev.expect("kept events");
             assert_eq!(simulate(&ev, &hw, name), kept, "{name}: one thread, kept");
-            let (banded, ev3) = timed_on(3, name, &hw, true);
-            assert_eq!(banded, kept, "{name}: three threads, kept");
+            let (fed, ev3) = timed_on(3, name, &hw, true);
+            assert_eq!(fed, kept, "{name}: three threads, kept");
             let ev3 = ev3.expect("kept events");
             assert_eq!(ev3.pixels, ev.pixels, "{name}: pixel events");
             assert_eq!(ev3.footprints, ev.footprints, "{name}: footprints");
