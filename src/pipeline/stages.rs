@@ -321,18 +321,18 @@ impl TriFloat {
     };
 }
 
-/// Whether a stage of a pass with the twins `impls` on `hw` reads [`TriFloat`]: the float
-/// twins of `bary`, `color` and `texcoord`, and the float32 coordinate path
-/// (`interp.coord_arith = "float32"`, whose texture-coordinate reduction starts from the float
-/// coordinates). A render builds the float vertex data when this holds or a float pass (the
-/// reference, the truth, the signal ranges) runs; `every_float_reader_gets_the_float_vertex_data`
-/// checks the list against every stage's float twin.
+/// Whether a stage of a pass with the twins `impls` on `hw` reads [`TriFloat`]: a float twin
+/// whose table row says `float_reads_vertices` (`bary`, `color`, `texcoord`), or the float32
+/// coordinate path (`interp.coord_arith = "float32"`, whose texture-coordinate reduction starts
+/// from the float coordinates). A render builds the float vertex data when this holds or a
+/// float pass (the reference, the truth, the signal ranges) runs;
+/// `every_float_reader_gets_the_float_vertex_data` checks the rows against every float twin.
 #[must_use]
 pub fn reads_tri_floats(impls: &StageImpls, hw: &HwConfig) -> bool {
     hw.interp.coord_arith == CoordArith::Float32
-        || [StageKind::Bary, StageKind::Color, StageKind::Texcoord]
+        || StageKind::ALL
             .iter()
-            .any(|&k| impls.of(k) == Impl::Float)
+            .any(|&k| k.row().float_reads_vertices && impls.of(k) == Impl::Float)
 }
 
 impl TriAttrs {

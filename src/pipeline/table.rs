@@ -85,6 +85,10 @@ pub struct StageRow {
     /// The fixed twin over a span, when the stage has one.
     pub fixed_span: Option<SpanFn>,
     pub float: RunFn,
+    /// The float twin reads the triangle's float vertex data (`Px::af`, a
+    /// [`super::stages::TriFloat`]): a render builds it when such a twin runs
+    /// ([`super::stages::reads_tri_floats`]).
+    pub float_reads_vertices: bool,
     pub cost: CostFn,
     pub lookups: LookupsFn,
 }
@@ -109,10 +113,20 @@ macro_rules! optional_span {
     };
 }
 
+/// A row's `float_reads_vertices`: `false` unless given.
+macro_rules! optional_flag {
+    () => {
+        false
+    };
+    ($flag:expr) => {
+        $flag
+    };
+}
+
 macro_rules! stage_table {
     ($( $(#[doc = $doc:literal])* $kind:ident $name:literal {
-        fixed: $fixed:expr, $(fixed_span: $span:expr,)? float: $float:expr, cost: $cost:expr,
-        lookups: $lookups:expr $(,)?
+        fixed: $fixed:expr, $(fixed_span: $span:expr,)? float: $float:expr,
+        $(float_reads_vertices: $reads:expr,)? cost: $cost:expr, lookups: $lookups:expr $(,)?
     } )*) => {
         /// The kinds of stage, in pipeline order (generated from the stage table).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -137,6 +151,7 @@ macro_rules! stage_table {
                 fixed: $fixed,
                 fixed_span: optional_span!($($span)?),
                 float: $float,
+                float_reads_vertices: optional_flag!($($reads)?),
                 cost: $cost,
                 lookups: $lookups,
             },
@@ -147,18 +162,18 @@ macro_rules! stage_table {
 stage_table! {
     /// Perspective-correct barycentrics (reciprocal unit + interpolator setup).
     Bary "bary" {
-        fixed: bary::fixed, fixed_span: bary::fixed_span, float: bary::float, cost: bary::cost,
-        lookups: no_lookups,
+        fixed: bary::fixed, fixed_span: bary::fixed_span, float: bary::float,
+        float_reads_vertices: true, cost: bary::cost, lookups: no_lookups,
     }
     /// Vertex colour interpolation (Gouraud lighting result).
     Color "color" {
         fixed: color::fixed, fixed_span: color::fixed_span, float: color::float,
-        cost: color::cost, lookups: no_lookups,
+        float_reads_vertices: true, cost: color::cost, lookups: no_lookups,
     }
     /// Texture-coordinate interpolation, with the helper samples for derivatives.
     Texcoord "texcoord" {
         fixed: texcoord::fixed, fixed_span: texcoord::fixed_span, float: texcoord::float,
-        cost: texcoord::cost, lookups: no_lookups,
+        float_reads_vertices: true, cost: texcoord::cost, lookups: no_lookups,
     }
     /// LOD from the texture-coordinate derivatives.
     Lod "lod" {

@@ -384,7 +384,7 @@ fn llvmpipe_preset_samples_8_bit_texels_with_a_lod_per_quad() {
 /// moved 1000 repeats away (the float32 path reduces them by an integer taken from the float
 /// coordinates: NaN would leave them beyond the format), with each stage kind's float twin
 /// alone and on the float32 coordinate path (`llvmpipe`), gives the same hardware image and
-/// stage counts without the reference (the data built only when the list says so) as with
+/// stage counts without the reference (the data built only when the stage rows say so) as with
 /// it (always).
 #[test]
 fn every_float_reader_gets_the_float_vertex_data() {
