@@ -5,6 +5,10 @@
 #   apt-get install -y gcc pkg-config libosmesa6-dev libpng-dev
 # Usage: scripts/compare_mesa.sh [REPEATS]    (prints one line per configuration: the median
 # of REPEATS runs, then the issue-12 ratios at equal thread counts)
+# Frames: the Mesa anchor times 5 frames after 1 warm-up frame in one process and takes their
+# median; texsim-hw and texsim-ref do the same (`texsim render --warmup 1 --frames 5`), and
+# texsim-cold is the bit-accurate path's first frame in a fresh process (`--frames 1`), which also
+# faults in the memory of every buffer.
 # Thread counts: llvmpipe-t1 rasterises in the calling thread (LP_NUM_THREADS=0), llvmpipe-t2
 # on two rasteriser threads (LP_NUM_THREADS=2); texsim-*-tT is `texsim --threads T`. Within a
 # repeat the configurations alternate, so a slow spell of a shared machine falls on all of them.
@@ -22,9 +26,10 @@ mesa() { # $1 workload, $2 driver, $3 LP_NUM_THREADS (empty: unset)
     GALLIUM_DRIVER=$2 "$ANCHOR" --workload "$1" --frames 5 --warmup 1 | grep -o 'median_ms=[0-9.]*' | cut -d= -f2
     unset LP_NUM_THREADS
 }
-texsim() { # $1 scene, $2 threads, $3 path (hw: bit-accurate, ref: the float stages)
-    local extra=(--no-reference --no-cycles)
+texsim() { # $1 scene, $2 threads, $3 path (hw: bit-accurate, ref: the float stages, cold: hw's first frame)
+    local extra=(--no-reference --no-cycles --warmup 1 --frames 5)
     [ "$3" = ref ] && extra+=(--float bary,texcoord,lod,trilinear,color,modulate)
+    [ "$3" = cold ] && extra=(--no-reference --no-cycles)
     ./target/release/texsim --threads "$2" render --scene "$1" "${extra[@]}" --out target/compare-out 2>/dev/null |
         grep -o 'hardware path [0-9.]*' | awk '{print $3}'
 }
@@ -35,7 +40,7 @@ for _ in $(seq "$REPEATS"); do
         echo "$s llvmpipe-t1 $(mesa "$m" llvmpipe 0)" >>"$raw"
         echo "$s llvmpipe-t2 $(mesa "$m" llvmpipe 2)" >>"$raw"
         for t in 1 2; do
-            for p in hw ref; do
+            for p in hw ref cold; do
                 echo "$s texsim-$p-t$t $(texsim "$s" "$t" "$p")" >>"$raw"
             done
         done
@@ -43,7 +48,8 @@ for _ in $(seq "$REPEATS"); do
 done
 declare -A med
 for s in w1-plane w2-mesh; do
-    for c in softpipe llvmpipe-t1 llvmpipe-t2 texsim-hw-t1 texsim-ref-t1 texsim-hw-t2 texsim-ref-t2; do
+    for c in softpipe llvmpipe-t1 llvmpipe-t2 texsim-hw-t1 texsim-ref-t1 texsim-cold-t1 texsim-hw-t2 \
+        texsim-ref-t2 texsim-cold-t2; do
         med[$s/$c]=$(awk -v s="$s" -v c="$c" '$1 == s && $2 == c {print $3}' "$raw" | median)
         printf "%-9s %-14s %8.1f ms\n" "$s" "$c" "${med[$s/$c]}"
     done
@@ -52,7 +58,7 @@ echo "ratios (issue 12 asks bit-accurate <= 3x llvmpipe on W1, <= 1.5x on W2, an
 for s in w1-plane w2-mesh; do
     for t in 1 2; do
         awk -v s="$s" -v t="$t" -v hw="${med[$s/texsim-hw-t$t]}" -v lp="${med[$s/llvmpipe-t$t]}" \
-            -v ref="${med[$s/texsim-ref-t$t]}" \
-            'BEGIN {printf "%-9s %d thread(s): bit-accurate / llvmpipe %5.2fx, bit-accurate / float path %5.2fx\n", s, t, hw / lp, hw / ref}'
+            -v ref="${med[$s/texsim-ref-t$t]}" -v cold="${med[$s/texsim-cold-t$t]}" \
+            'BEGIN {printf "%-9s %d thread(s): bit-accurate / llvmpipe %5.2fx, bit-accurate / float path %5.2fx, first frame / llvmpipe %5.2fx\n", s, t, hw / lp, hw / ref, cold / lp}'
     done
 done

@@ -367,7 +367,19 @@ pub struct RenderArgs {
     /// which costs about as much as the reference pass.
     #[arg(long)]
     pub no_flip: bool,
+    /// Render the frame this many times in one process after the warm-up frames and report
+    /// the median frame's wall times (every frame's output is the same); with --warmup, the
+    /// method of the Mesa anchor's `--frames N --warmup W`: warm frames reuse the memory of
+    /// earlier ones instead of faulting in fresh pages.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_FRAMES))]
+    pub frames: u32,
+    /// Frames rendered and not timed before the --frames timed ones.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=MAX_FRAMES))]
+    pub warmup: u32,
 }
+
+/// Most frames `texsim render --frames` or `--warmup` takes.
+pub const MAX_FRAMES: i64 = 1000;
 
 #[derive(Args, Debug, Clone)]
 pub struct SweepArgs {
@@ -539,6 +551,8 @@ pub fn run(cli: Cli) -> Result<()> {
             truth_samples: None,
             ranges: false,
             no_flip: false,
+            frames: 1,
+            warmup: 0,
         }),
         Some(Command::Render(a)) => render_cmd(&a),
         Some(Command::Scenes) => {
@@ -684,7 +698,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         ranges: a.ranges,
         ..RenderOptions::default()
     };
-    let mut r = render(&sc, &maps, &hw, &opts)?;
+    let (mut r, frames) = render_frames(&sc, &maps, &hw, &opts, a.warmup, a.frames)?;
     let t = std::time::Instant::now();
     let mut out = OutputSet::new();
     let error_map = stage_images(&r, a.png16, &mut out)?;
@@ -747,6 +761,7 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         "provenance": &prov,
         "scene": &r.stats.scene,
         "timings": &r.stats.timings,
+        "frames": &frames,
     });
     out.add(
         "timings.json",
@@ -757,6 +772,9 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let written = out.write_to(&a.scene.out)?;
     progress_line("writing outputs", elapsed_ms(t));
     print!("{}", crate::summary::text(&r.stats));
+    if frames.timed.len() > 1 || frames.warmup > 0 {
+        println!("{}", frames.line());
+    }
     if let Some(rg) = &r.stats.ranges {
         print!("{}", crate::render::ranges::table(rg, &r.stats.stages));
     }
@@ -777,6 +795,82 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The frames of one `texsim render`: how many warm-up frames ran untimed and the hardware
+/// path's wall time of each timed one (`timings.json`'s `frames`).
+#[derive(Debug, serde::Serialize)]
+struct Frames {
+    warmup: u32,
+    /// `hw_total_ms` of each timed frame, in the order they ran.
+    timed: Vec<f64>,
+    /// The index in `timed` of the median frame, whose timings the render reports (the lower
+    /// of the two middle ones for an even count).
+    median: usize,
+}
+
+impl Frames {
+    fn line(&self) -> String {
+        let ms = |i: usize| self.timed[i];
+        let (lo, hi) = self
+            .timed
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
+                (lo.min(t), hi.max(t))
+            });
+        format!(
+            "frames: {} timed after {} warm-up; hardware path median {:.1} ms (min {lo:.1}, max {hi:.1}); the wall times above are the median frame's",
+            self.timed.len(),
+            self.warmup,
+            ms(self.median),
+        )
+    }
+}
+
+/// Renders `warmup + frames` frames one after the other (each dropped before the next starts,
+/// so the memory budget holds) and returns the last with the timings of the median timed
+/// frame. The progress lines are the last frame's.
+fn render_frames(
+    sc: &Scene,
+    maps: &Maps,
+    hw: &HwConfig,
+    opts: &RenderOptions,
+    warmup: u32,
+    frames: u32,
+) -> Result<(Rendered, Frames)> {
+    let total = warmup + frames.max(1);
+    let quiet = RenderOptions {
+        progress: None,
+        ..opts.clone()
+    };
+    let mut timings = Vec::with_capacity(frames as usize);
+    let mut last = None;
+    for i in 0..total {
+        drop(last.take());
+        let r = render(sc, maps, hw, if i + 1 == total { opts } else { &quiet })?;
+        if i >= warmup {
+            timings.push(r.stats.timings.clone());
+        }
+        if total > 1 {
+            let what = if i < warmup { "warm-up" } else { "timed" };
+            progress_line(
+                &format!("frame {}/{total} ({what})", i + 1),
+                r.stats.timings.hw_total_ms,
+            );
+        }
+        last = Some(r);
+    }
+    let mut order: Vec<usize> = (0..timings.len()).collect();
+    order.sort_by(|&a, &b| timings[a].hw_total_ms.total_cmp(&timings[b].hw_total_ms));
+    let median = order[(order.len() - 1) / 2];
+    let mut r = last.expect("at least one frame");
+    r.stats.timings = timings[median].clone();
+    let frames = Frames {
+        warmup,
+        timed: timings.iter().map(|t| t.hw_total_ms).collect(),
+        median,
+    };
+    Ok((r, frames))
 }
 
 /// Ground-truth sub-samples per pixel axis of `texsim render --truth` without `--truth-samples`.

@@ -605,6 +605,73 @@ fn truth_samples_without_truth_is_an_error() {
     assert!(!d.join("out").exists());
 }
 
+/// `--warmup W --frames N` renders the frame `W + N` times in one process: the outputs are
+/// those of one frame (summary.json but its command line, every image byte for byte, with
+/// cycles and the reference on), timings.json lists the timed frames and names the median,
+/// and a frame count of 0 or above the limit is refused before anything is written.
+#[test]
+fn repeated_frames_give_one_frames_outputs_and_the_median_timings() {
+    let d = tmp("frames");
+    let base = [
+        "render", "--scene", "demo", "--width", "96", "--height", "72", "--out",
+    ];
+    let run = |out: &str, extra: &[&str]| {
+        let args: Vec<&str> = base
+            .iter()
+            .copied()
+            .chain([out])
+            .chain(extra.iter().copied())
+            .collect();
+        let o = texsim(&args, &d);
+        assert!(o.status.success(), "{}", text(&o));
+        o
+    };
+    run("one", &[]);
+    let o = run("many", &["--warmup", "1", "--frames", "3"]);
+    let t = text(&o);
+    assert!(t.contains("frame 4/4 (timed)"), "{t}");
+    assert!(
+        t.contains("frames: 3 timed after 1 warm-up; hardware path median"),
+        "{t}"
+    );
+    let json = |dir: &str, file: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(d.join(dir).join(file)).unwrap()).unwrap()
+    };
+    let mut one = json("one", "summary.json");
+    let mut many = json("many", "summary.json");
+    for j in [&mut one, &mut many] {
+        j.as_object_mut().unwrap().remove("provenance");
+    }
+    assert!(
+        one == many,
+        "summary.json differs between one frame and four"
+    );
+    for f in ["hw.png", "ref.png", "error.png", "flip.png"] {
+        let (a, b) = (d.join("one").join(f), d.join("many").join(f));
+        assert!(
+            std::fs::read(a).unwrap() == std::fs::read(b).unwrap(),
+            "{f} differs"
+        );
+    }
+    let times = json("many", "timings.json");
+    let timed = times["frames"]["timed"].as_array().unwrap();
+    assert_eq!(timed.len(), 3, "{times}");
+    assert_eq!(times["frames"]["warmup"], 1, "{times}");
+    let median = times["frames"]["median"].as_u64().unwrap() as usize;
+    let mut sorted: Vec<f64> = timed.iter().map(|v| v.as_f64().unwrap()).collect();
+    sorted.sort_by(f64::total_cmp);
+    assert_eq!(timed[median].as_f64(), Some(sorted[1]), "{times}");
+    assert_eq!(times["timings"]["hw_total_ms"], timed[median], "{times}");
+    for bad in [["--frames", "0"], ["--warmup", "1001"]] {
+        let args: Vec<&str> = base.iter().copied().chain(["bad"]).chain(bad).collect();
+        let o = texsim(&args, &d);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{t}");
+        assert!(t.contains(bad[0]), "{t}");
+        assert!(!d.join("bad").exists());
+    }
+}
+
 /// Two runs of the same command write byte-identical summary.json files (wall times live in
 /// timings.json), and every JSON carries its provenance.
 #[test]
