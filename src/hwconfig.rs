@@ -399,6 +399,70 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
     Ok(cfg)
 }
 
+/// A configuration held as its TOML table for setting integer fields one after another
+/// (`texsim tune`'s knobs): [`IntFields::set`] is [`set_field`] of an integer field given by
+/// its dotted path, without serialising the configuration and listing its fields again per
+/// field.
+#[derive(Clone, Debug)]
+pub struct IntFields {
+    table: toml::Table,
+}
+
+impl IntFields {
+    /// The fields of `c`.
+    #[must_use]
+    pub fn of(c: &HwConfig) -> Self {
+        Self { table: to_table(c) }
+    }
+
+    /// The integer at the dotted `path`; `None` when there is none.
+    #[must_use]
+    pub fn get(&self, path: &str) -> Option<i64> {
+        let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
+        let mut cur = &self.table;
+        for p in tables.split('.').filter(|p| !p.is_empty()) {
+            cur = cur.get(p)?.as_table()?;
+        }
+        cur.get(leaf)?.as_integer()
+    }
+
+    /// The integer at the dotted `path`, to change it.
+    fn get_mut(&mut self, path: &str) -> Option<&mut i64> {
+        let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
+        let mut cur = &mut self.table;
+        for p in tables.split('.').filter(|p| !p.is_empty()) {
+            cur = cur.get_mut(p)?.as_table_mut()?;
+        }
+        match cur.get_mut(leaf)? {
+            toml::Value::Integer(v) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// Sets the integer at the dotted `path` to `value` and returns the configuration it makes,
+    /// validated, as [`set_field`] does; an error, the field left as it was, when `path` is
+    /// not an integer field or the configuration does not validate.
+    pub fn set(&mut self, path: &str, value: i64) -> Result<HwConfig> {
+        let slot = self
+            .get_mut(path)
+            .ok_or_else(|| Error::field(path, "not an integer field"))?;
+        let old = std::mem::replace(slot, value);
+        let made = (|| {
+            let cfg: HwConfig = toml::Value::Table(self.table.clone()).try_into().map_err(
+                |e: toml::de::Error| Error::field(path, format!("'{value}': {}", e.message())),
+            )?;
+            cfg.validate()?;
+            Ok(cfg)
+        })();
+        if made.is_err() {
+            if let Some(slot) = self.get_mut(path) {
+                *slot = old;
+            }
+        }
+        made
+    }
+}
+
 /// Fields that earlier versions had, with what replaced them: (dotted path, message).
 pub const REMOVED_FIELDS: &[(&str, &str)] = &[(
     "timing.texel_bytes",

@@ -352,8 +352,9 @@ pub fn knob(base: &HwConfig, name: &str) -> Result<Knob> {
 }
 
 fn knob_range(base: &HwConfig, path: &str, hi: u32) -> Result<Knob> {
+    let mut fields = hwconfig::IntFields::of(base);
     let mut lo = hi;
-    while lo > 0 && hwconfig::set_field(base, path, &(lo - 1).to_string()).is_ok() {
+    while lo > 0 && fields.set(path, i64::from(lo - 1)).is_ok() {
         lo -= 1;
     }
     Ok(Knob {
@@ -363,23 +364,19 @@ fn knob_range(base: &HwConfig, path: &str, hi: u32) -> Result<Knob> {
     })
 }
 
-/// The machine of `base` with the knobs at `values`; `None` when the combination does not
-/// validate (a field range that depends on another field).
+/// The machine of `base` with the knobs at `values`, set one after another in knob order,
+/// each change validated; `None` when one does not validate (a field range that depends on
+/// another field).
 fn machine(base: &HwConfig, knobs: &[Knob], values: &[u32]) -> Option<HwConfig> {
-    let mut c = base.clone();
+    let mut fields = hwconfig::IntFields::of(base);
+    let mut c = None;
     for (k, v) in knobs.iter().zip(values) {
-        if *v != field_u32(&c, &k.field)? {
-            c = hwconfig::set_field(&c, &k.field, &v.to_string()).ok()?;
+        let v = i64::from(*v);
+        if v != fields.get(&k.field)? {
+            c = Some(fields.set(&k.field, v).ok()?);
         }
     }
-    Some(c)
-}
-
-fn field_u32(c: &HwConfig, path: &str) -> Option<u32> {
-    hwconfig::fields(c)
-        .into_iter()
-        .find(|(p, _)| p == path)
-        .and_then(|(_, v)| v.parse().ok())
+    Some(c.unwrap_or_else(|| base.clone()))
 }
 
 fn area(c: &HwConfig) -> u64 {

@@ -320,3 +320,55 @@ fn texel_bytes_was_removed_with_a_message() {
         .to_string();
     assert!(e.contains("cache_line_bytes") && e.contains("8..="), "{e}");
 }
+
+/// `IntFields::set`, which `texsim tune` sets its knobs with, is `set_field` of an integer
+/// field: seeded chains of settings of every width field of three presets, values from 0 to 4
+/// above the preset's, give the same configuration or both an error, and a refused setting
+/// leaves the fields as they were.
+#[test]
+fn int_fields_set_like_set_field() {
+    use crate::rng_common::Rng;
+    use texsim::hwconfig::{fields, is_width, IntFields};
+    let mut rng = Rng(0x1e7_f1e1d5);
+    let (mut same, mut refused) = (0, 0);
+    for name in ["texram16", "d3d11", "llvmpipe"] {
+        let base = preset(name);
+        let widths: Vec<(String, i64)> = fields(&base)
+            .into_iter()
+            .filter(|(p, _)| is_width(p))
+            .filter_map(|(p, v)| Some((p, v.parse().ok()?)))
+            .collect();
+        assert!(widths.len() > 40, "{name}: {}", widths.len());
+        for _ in 0..60 {
+            let mut fast = IntFields::of(&base);
+            let mut slow = base.clone();
+            for _ in 0..6 {
+                let (path, v0) = &widths[rng.below(widths.len() as u64) as usize];
+                let v = rng.int_in(0, v0 + 4);
+                assert_eq!(fast.get(path), Some(slow_get(&slow, path)), "{name} {path}");
+                match (fast.set(path, v), set_field(&slow, path, &v.to_string())) {
+                    (Ok(a), Ok(b)) => {
+                        assert_eq!(a, b, "{name}: {path} = {v}");
+                        slow = b;
+                        same += 1;
+                    }
+                    (Err(_), Err(_)) => refused += 1,
+                    (a, b) => panic!("{name}: {path} = {v}: {:?} against {:?}", a.err(), b.err()),
+                }
+            }
+        }
+    }
+    assert!(same > 500 && refused > 50, "{same} set, {refused} refused");
+    let mut f = IntFields::of(&preset("texram16"));
+    assert!(f.set("trilinear.filter_rounding", 1).is_err());
+    assert!(f.set("trilinear.no_such_bits", 1).is_err());
+    assert_eq!(f.get("no_such.table"), None);
+}
+
+fn slow_get(c: &HwConfig, path: &str) -> i64 {
+    texsim::hwconfig::fields(c)
+        .into_iter()
+        .find(|(p, _)| p == path)
+        .and_then(|(_, v)| v.parse().ok())
+        .expect("an integer field")
+}
