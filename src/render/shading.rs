@@ -34,51 +34,52 @@ pub(super) fn bump_attrs(
     m: &Machine,
     attrs: &mut [TriAttrs],
 ) -> (Vec<BumpAttrs>, SatCounter) {
-    let mut sat = SatCounter::default();
     if geo.bump.is_empty() {
-        return (Vec::new(), sat);
+        return (Vec::new(), SatCounter::default());
     }
-    let bumped: Vec<(usize, BumpAttrs, SatCounter)> = setup
-        .tris
-        .par_iter()
-        .zip(attrs.par_iter())
-        .enumerate()
-        .filter(|(_, (_, a))| geo.plans[a.plan as usize].bump.is_some())
-        .map(|(i, (t, _))| {
-            let d = &geo.draws[t.src as usize];
-            let src_bary = setup.src_bary(i);
-            let blend = |k: usize| -> BumpVertex {
-                let w = src_bary[k];
-                let mut r = BumpVertex::default();
-                for (&wj, &vi) in w.iter().zip(&d.v) {
-                    let Some(b) = geo.bump.get(vi as usize) else {
-                        continue;
-                    };
-                    for c in 0..3 {
-                        r.n[c] += wj * b.n[c];
-                        r.du[c] += wj * b.du[c];
-                        r.dv[c] += wj * b.dv[c];
-                        r.m[c] += wj * b.m[c];
-                        r.p[c] += wj * b.p[c];
-                    }
-                    for c in 0..2 {
-                        r.len[c] += wj * b.len[c];
-                    }
-                }
-                r
-            };
-            let verts = [blend(0), blend(1), blend(2)];
-            let mut s = SatCounter::default();
-            let b = BumpAttrs::new(m, &verts, geo.eye, &geo.point_lights, &mut s);
-            (i, b, s)
-        })
+    // The triangles of a bump plan, in order; their data is written straight into its slots
+    // (each is about 1.4 KB: no intermediate copy).
+    let bumped: Vec<u32> = (0..attrs.len() as u32)
+        .into_par_iter()
+        .filter(|&i| geo.plans[attrs[i as usize].plan as usize].bump.is_some())
         .collect();
-    let mut out = Vec::with_capacity(bumped.len());
-    for (i, b, s) in bumped {
-        attrs[i].bump = out.len() as u32;
-        out.push(b);
-        sat.add(&s);
+    let mut out = (
+        crate::raster::vec_populated(bumped.len()),
+        SatSum::default(),
+    );
+    out.par_extend(bumped.par_iter().map(|&i| {
+        let i = i as usize;
+        let d = &geo.draws[setup.tris[i].src as usize];
+        let src_bary = setup.src_bary(i);
+        let blend = |k: usize| -> BumpVertex {
+            let w = src_bary[k];
+            let mut r = BumpVertex::default();
+            for (&wj, &vi) in w.iter().zip(&d.v) {
+                let Some(b) = geo.bump.get(vi as usize) else {
+                    continue;
+                };
+                for c in 0..3 {
+                    r.n[c] += wj * b.n[c];
+                    r.du[c] += wj * b.du[c];
+                    r.dv[c] += wj * b.dv[c];
+                    r.m[c] += wj * b.m[c];
+                    r.p[c] += wj * b.p[c];
+                }
+                for c in 0..2 {
+                    r.len[c] += wj * b.len[c];
+                }
+            }
+            r
+        };
+        let verts = [blend(0), blend(1), blend(2)];
+        let mut s = SatCounter::default();
+        let b = BumpAttrs::new(m, &verts, geo.eye, &geo.point_lights, &mut s);
+        (b, s)
+    }));
+    for (k, &i) in bumped.iter().enumerate() {
+        attrs[i as usize].bump = k as u32;
     }
+    let (out, SatSum(sat)) = out;
     (out, sat)
 }
 
