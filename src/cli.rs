@@ -811,18 +811,13 @@ struct Frames {
 
 impl Frames {
     fn line(&self) -> String {
-        let ms = |i: usize| self.timed[i];
-        let (lo, hi) = self
-            .timed
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
-                (lo.min(t), hi.max(t))
-            });
+        let lo = self.timed.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = self.timed.iter().copied().fold(0.0, f64::max);
         format!(
             "frames: {} timed after {} warm-up; hardware path median {:.1} ms (min {lo:.1}, max {hi:.1}); the wall times above are the median frame's",
             self.timed.len(),
             self.warmup,
-            ms(self.median),
+            self.timed[self.median],
         )
     }
 }
