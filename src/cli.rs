@@ -701,19 +701,26 @@ fn render_cmd(a: &RenderArgs) -> Result<()> {
     let (mut r, frames) = render_frames(&sc, &maps, &hw, &opts, a.warmup, a.frames)?;
     let t = std::time::Instant::now();
     let mut out = OutputSet::new();
-    let error_map = stage_images(&r, a.png16, &mut out)?;
+    // FLIP beside the images' encoding (the truth outputs change neither image nor mask).
+    let (error_map, (flip, flip_ms)) = rayon::join(
+        || stage_images(&r, a.png16, &mut out),
+        || {
+            let t_flip = std::time::Instant::now();
+            let flip = r
+                .ref_image
+                .as_ref()
+                .filter(|_| !a.no_flip)
+                .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)));
+            (flip, elapsed_ms(t_flip))
+        },
+    );
+    let error_map = error_map?;
     if a.truth {
         truth_outputs(&sc, &maps, &hw, &mut r, &mut out)?;
     }
-    let t_flip = std::time::Instant::now();
-    let flip = r
-        .ref_image
-        .as_ref()
-        .filter(|_| !a.no_flip)
-        .and_then(|rf| crate::flip::flip(&r.hw_image, rf, Some(&r.mask)));
     if let Some(f) = &flip {
         out.add("flip.png", crate::flip::error_map_png(f, Some(&r.mask))?);
-        progress_line("FLIP", elapsed_ms(t_flip));
+        progress_line("FLIP", flip_ms);
     }
     let flip_stats = flip.as_ref().map(|f| &f.stats);
     let mut rep_row = crate::summary::SweepRow::new(Vec::new(), &r.stats);

@@ -6,9 +6,11 @@
 //! The images are compared as sRGB 8-bit RGB (alpha dropped), at the paper's default viewing
 //! condition ([`PIXELS_PER_DEGREE`]: a 0.7 m distance from a 24" 4K monitor). The statistics
 //! pool the covered pixels only (the mask of the LSB metrics), so the FLIP mean and the LSB
-//! mean describe the same pixels; the filters still see the whole image.
+//! mean describe the same pixels; the filters still see the whole image (computed in bands of
+//! rows in parallel, the same map bit for bit).
 
 use image::ImageEncoder as _;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::report::Image;
@@ -40,13 +42,63 @@ pub struct Flip {
     pub map: Vec<f32>,
 }
 
-fn rgb8(img: &Image) -> nv_flip::FlipImageRgb8 {
-    let rgb: Vec<u8> = img
-        .to_rgba8()
+/// The image as sRGB 8-bit RGB rows (alpha dropped).
+fn rgb8(img: &Image) -> Vec<u8> {
+    img.to_rgba8()
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
-        .collect();
-    nv_flip::FlipImageRgb8::with_data(img.width, img.height, &rgb)
+        .collect()
+}
+
+/// Rows of context a band of the error map needs on each side: a FLIP pixel depends on the
+/// pixels within the larger of its two filter radii (at [`PIXELS_PER_DEGREE`]: the spatial
+/// filter's `ceil(3 sqrt(b_max / (2 pi^2)) ppd)` = 10 with `b_max` = 0.04, the feature
+/// filter's `ceil(3 * 0.5 * 0.082 * ppd)` = 9), both separable and clamped at the image's
+/// edges; 16 leaves a margin.
+const BAND_CONTEXT: usize = 16;
+
+/// The fewest rows of the error map in a band computed apart.
+const MIN_BAND_ROWS: usize = 64;
+
+/// FLIP's per-pixel error map of `test` against `reference` (RGB8 rows of a `w` x `h`
+/// image): on one thread one call on the whole image, else in two bands per thread (at least
+/// [`MIN_BAND_ROWS`] rows each) computed in parallel ([`banded_error_map`]).
+fn error_map(reference: &[u8], test: &[u8], w: usize, h: usize) -> Vec<f32> {
+    let threads = rayon::current_num_threads();
+    if threads == 1 {
+        return flip_rows(reference, test, w, h);
+    }
+    let rows = h.div_ceil(2 * threads).max(MIN_BAND_ROWS);
+    banded_error_map(reference, test, w, h, rows)
+}
+
+/// One call of NVIDIA's FLIP on `rows` rows of RGB8 pixels.
+fn flip_rows(reference: &[u8], test: &[u8], w: usize, rows: usize) -> Vec<f32> {
+    let img = |d: &[u8]| nv_flip::FlipImageRgb8::with_data(w as u32, rows as u32, d);
+    nv_flip::flip(img(reference), img(test), PIXELS_PER_DEGREE).to_vec()
+}
+
+/// [`error_map`] in bands of `rows` rows computed in parallel, each from its rows and
+/// [`BAND_CONTEXT`] rows of context on each side: a band's pixels read only rows within the
+/// filters' radii, which the context holds, and the image's own first and last rows clamp as
+/// in one call on the whole image, so the map is the same bit for bit whatever `rows`
+/// (`banded_flip_is_the_whole_image_flip`).
+fn banded_error_map(reference: &[u8], test: &[u8], w: usize, h: usize, rows: usize) -> Vec<f32> {
+    if h <= rows + 2 * BAND_CONTEXT {
+        return flip_rows(reference, test, w, h);
+    }
+    let mut map = vec![0.0f32; w * h];
+    map.par_chunks_mut(rows * w)
+        .enumerate()
+        .for_each(|(k, out)| {
+            let y0 = k * rows;
+            let y1 = y0 + out.len() / w;
+            let (c0, c1) = (y0.saturating_sub(BAND_CONTEXT), (y1 + BAND_CONTEXT).min(h));
+            let (a, b) = (c0 * w * 3, c1 * w * 3);
+            let band = flip_rows(&reference[a..b], &test[a..b], w, c1 - c0);
+            out.copy_from_slice(&band[(y0 - c0) * w..(y1 - c0) * w]);
+        });
+    map
 }
 
 /// LDR-FLIP of `test` against `reference`, pooled over the pixels `mask` selects (all when
@@ -60,7 +112,7 @@ pub fn flip(test: &Image, reference: &Image, mask: Option<&[bool]>) -> Option<Fl
     if !test.is_consistent() || !reference.is_consistent() {
         return None;
     }
-    let map = nv_flip::flip(rgb8(reference), rgb8(test), PIXELS_PER_DEGREE).to_vec();
+    let map = error_map(&rgb8(reference), &rgb8(test), w as usize, h as usize);
     let mut pooled: Vec<f32> = map
         .iter()
         .enumerate()
@@ -118,4 +170,54 @@ pub fn error_map_png(f: &Flip, mask: Option<&[bool]>) -> crate::Result<Vec<u8>> 
         .write_image(&rgba, f.width, f.height, image::ExtendedColorType::Rgba8)
         .map_err(|e| crate::Error::msg(format!("flip.png: {e}")))?;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An image with structure at every scale: smooth gradients, hard edges and noise.
+    fn pattern(w: usize, h: usize, seed: u64) -> Vec<u8> {
+        let mut rng = crate::rng::SplitMix64(seed);
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| {
+                let edge = if (x / 7 + y / 5) % 2 == 0 { 200 } else { 30 };
+                [(x * 255 / w) as u8, edge, ((y * 3) % 256) as u8]
+            })
+            .map(|c| c.wrapping_add((rng.next_u64() % 9) as u8))
+            .collect()
+    }
+
+    #[test]
+    fn banded_flip_is_the_whole_image_flip() {
+        let cases = [
+            (37, 161, 64),
+            (64, 300, 40),
+            (23, 417, 100),
+            (96, 321, 17),
+            (50, 96, 1),
+        ];
+        for (w, h, rows) in cases {
+            let (a, b) = (pattern(w, h, 1), pattern(w, h, 2));
+            let whole = flip_rows(&a, &b, w, h);
+            assert!(
+                whole.iter().any(|&v| v > 0.05),
+                "{w}x{h}: the images differ"
+            );
+            for banded in [
+                banded_error_map(&a, &b, w, h, rows),
+                error_map(&a, &b, w, h),
+            ] {
+                let same = whole
+                    .iter()
+                    .zip(&banded)
+                    .all(|(x, y)| x.to_bits() == y.to_bits());
+                assert!(
+                    same && banded.len() == w * h,
+                    "{w}x{h} in bands of {rows}: differs"
+                );
+            }
+        }
+    }
 }
