@@ -31,7 +31,7 @@ texsim() { # $1 scene, $2 threads, $3 path (hw: bit-accurate, ref: the float sta
     [ "$3" = ref ] && extra+=(--float bary,texcoord,lod,trilinear,color,modulate)
     [ "$3" = cold ] && extra=(--no-reference --no-cycles)
     ./target/release/texsim --threads "$2" render --scene "$1" "${extra[@]}" --out target/compare-out 2>/dev/null |
-        grep -o 'hardware path [0-9.]*' | awk '{print $3}'
+        grep -o 'wall time: hardware path [0-9.]*' | awk '{print $5}'
 }
 for _ in $(seq "$REPEATS"); do
     for w in plane:w1-plane mesh:w2-mesh; do
