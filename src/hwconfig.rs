@@ -363,15 +363,8 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
         }
     };
     let mut table = to_table(c);
-    let mut cur = &mut table;
-    let parts: Vec<&str> = path.split('.').collect();
-    for p in &parts[..parts.len() - 1] {
-        cur = match cur.get_mut(*p) {
-            Some(toml::Value::Table(t)) => t,
-            _ => return Err(Error::field(&path, "not a table")),
-        };
-    }
-    let leaf = parts[parts.len() - 1];
+    let (cur, leaf) =
+        parent_table(&mut table, &path).ok_or_else(|| Error::field(&path, "not a table"))?;
     let new = match cur.get(leaf) {
         // A hand-set cycle field going back to its derived value.
         Some(toml::Value::Integer(_)) if value.trim() == "derived" => {
@@ -392,9 +385,29 @@ pub fn set_field(c: &HwConfig, name: &str, value: &str) -> Result<HwConfig> {
         _ => toml::Value::String(value.trim().to_string()),
     };
     cur.insert(leaf.to_string(), new);
+    config_of(table, &path, value)
+}
+
+/// The table holding the field at the dotted `path`, and the field's own name; `None` when a
+/// part of the path before it is not a table.
+fn parent_table<'t, 'p>(
+    table: &'t mut toml::Table,
+    path: &'p str,
+) -> Option<(&'t mut toml::Table, &'p str)> {
+    let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
+    let mut cur = table;
+    for p in tables.split('.').filter(|p| !p.is_empty()) {
+        cur = cur.get_mut(p)?.as_table_mut()?;
+    }
+    Some((cur, leaf))
+}
+
+/// The configuration `table` describes, validated; an error names `path`, the field just set
+/// to `value`.
+fn config_of(table: toml::Table, path: &str, value: &str) -> Result<HwConfig> {
     let cfg: HwConfig = toml::Value::Table(table)
         .try_into()
-        .map_err(|e: toml::de::Error| Error::field(&path, format!("'{value}': {}", e.message())))?;
+        .map_err(|e: toml::de::Error| Error::field(path, format!("'{value}': {}", e.message())))?;
     cfg.validate()?;
     Ok(cfg)
 }
@@ -428,12 +441,8 @@ impl IntFields {
 
     /// The integer at the dotted `path`, to change it.
     fn get_mut(&mut self, path: &str) -> Option<&mut i64> {
-        let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
-        let mut cur = &mut self.table;
-        for p in tables.split('.').filter(|p| !p.is_empty()) {
-            cur = cur.get_mut(p)?.as_table_mut()?;
-        }
-        match cur.get_mut(leaf)? {
+        let (t, leaf) = parent_table(&mut self.table, path)?;
+        match t.get_mut(leaf)? {
             toml::Value::Integer(v) => Some(v),
             _ => None,
         }
@@ -447,13 +456,7 @@ impl IntFields {
             .get_mut(path)
             .ok_or_else(|| Error::field(path, "not an integer field"))?;
         let old = std::mem::replace(slot, value);
-        let made = (|| {
-            let cfg: HwConfig = toml::Value::Table(self.table.clone()).try_into().map_err(
-                |e: toml::de::Error| Error::field(path, format!("'{value}': {}", e.message())),
-            )?;
-            cfg.validate()?;
-            Ok(cfg)
-        })();
+        let made = config_of(self.table.clone(), path, &value.to_string());
         if made.is_err() {
             if let Some(slot) = self.get_mut(path) {
                 *slot = old;
