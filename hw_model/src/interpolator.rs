@@ -342,9 +342,9 @@ fn derivs_lane<M: ConstRounding>(
     perspective_bary_derivs_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat)
 }
 
-/// A span length the span datapaths are tuned for (the row loop's spans have at most 16
+/// A span length the span datapaths are tuned for (the row loop's spans have at most 32
 /// fragments); they take any length.
-pub const SPAN_LANES: usize = 16;
+pub const SPAN_LANES: usize = 32;
 
 /// [`perspective_bary_derivs_span`] compiled for the rounding modes `M` (`interp_rounding`)
 /// and `R` (the reciprocal's `recip_rounding`).

@@ -437,7 +437,7 @@ fn start(frag: &mut Frag, plan: &Plan) {
 }
 
 /// Most fragments in one span of [`run_span`].
-pub const SPAN_MAX: usize = 16;
+pub const SPAN_MAX: usize = 32;
 
 /// [`run`] on a span: `frags[j]` is the fragment at pixel (`x + j`, `y`) of `tri` (consecutive
 /// covered pixels of one triangle in one row, at most [`SPAN_MAX`]). The program runs stage by
