@@ -19,10 +19,12 @@ pub fn to_raw(x: f64, fmt: &Format, sat: &mut SatCounter) -> i64 {
         let t = y as i64;
         let fl = t - i64::from(t as f64 > y);
         let rem = y - fl as f64;
+        // `|` and `&`, not `||` and `&&`: the fraction of a vertex attribute is as likely
+        // above one half as below, and a branch on it was mispredicted half the time.
         let up = match fmt.rounding {
             Rounding::Truncate => false,
             Rounding::HalfUp => rem >= 0.5,
-            Rounding::HalfEven => rem > 0.5 || (rem == 0.5 && fl & 1 == 1),
+            Rounding::HalfEven => (rem > 0.5) | ((rem == 0.5) & (fl & 1 == 1)),
         };
         return fmt.fit(fl + i64::from(up), sat);
     }
