@@ -337,13 +337,15 @@ pub fn reads_tri_floats(impls: &StageImpls, hw: &HwConfig) -> bool {
 
 impl TriAttrs {
     /// Converts float vertex data (post-clip) into the machine's formats. Host-to-hardware
-    /// conversions that overflow are counted in `sat`.
+    /// conversions that overflow are counted in `sat`. `color` is `None` when the plan has no
+    /// `color` stage: no stage reads the colours then, and they stay 0 (an absent effect costs
+    /// no conversion).
     #[must_use]
     pub fn new(
         m: &Machine,
         plan: u32,
         inv_w: [f64; 3],
-        color: [[f64; 3]; 3],
+        color: Option<[[f64; 3]; 3]>,
         uv: [[f64; 2]; 3],
         wrap: [WrapMode; 2],
         sat: &mut SatCounter,
@@ -365,12 +367,16 @@ impl TriAttrs {
         let mut uv_x = [[0i64; 2]; 3];
         for v in 0..3 {
             inv_w_x[v] = to_raw(inv_w[v] / max, &norm, sat).max(1);
-            for ch in 0..3 {
-                // `color.color_bits <= 16` (validated), so the unorm fits.
-                color_x[v][ch] = to_unorm(color[v][ch], cb) as u16;
-            }
             for ax in 0..2 {
                 uv_x[v][ax] = to_raw(uv[v][ax] - off[ax], &m.uv_fmt, sat);
+            }
+        }
+        if let Some(color) = color {
+            for v in 0..3 {
+                for ch in 0..3 {
+                    // `color.color_bits <= 16` (validated), so the unorm fits.
+                    color_x[v][ch] = to_unorm(color[v][ch], cb) as u16;
+                }
             }
         }
         Self {

@@ -9,7 +9,7 @@ use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{
     output16, run, run_span, Counters, Machine, TriAttrs, TriFloat, SPAN_MAX,
 };
-use crate::pipeline::{Frag, Program, StageImpls};
+use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 #[cfg(test)]
 use crate::raster::ScreenTri;
 use crate::raster::VertexSource;
@@ -94,6 +94,7 @@ pub(super) fn tri_attrs(
 ) -> (Vec<TriAttrs>, Vec<TriFloat>, SatCounter) {
     // Written in parallel straight into their vectors; the overflow counts sum in any order.
     let n = setup.tris.len();
+    let reads_color: Vec<bool> = geo.plans.iter().map(|p| p.has(StageKind::Color)).collect();
     let mut out = (
         (
             crate::raster::vec_populated(n),
@@ -148,7 +149,8 @@ pub(super) fn tri_attrs(
         let plan = geo.draw_plan[t.src as usize];
         let wrap = geo.plans[plan as usize].wrap;
         let (color, uv) = ([c0, c1, c2], [t0, t1, t2]);
-        let a = TriAttrs::new(m, plan, t.inv_w, color, uv, wrap, &mut sat);
+        let fixed_color = reads_color[plan as usize].then_some(color);
+        let a = TriAttrs::new(m, plan, t.inv_w, fixed_color, uv, wrap, &mut sat);
         let af = TriFloat {
             inv_w: t.inv_w,
             color,
