@@ -45,7 +45,7 @@ fn restore_sigpipe() {}
 /// about 18 MB). By default glibc serves such a buffer from its own mapping or trims it
 /// off a heap when it is freed (thresholds of 128 KiB that glibc raises as it goes), so a
 /// later frame may get new pages that the kernel zeroes and maps one by one: at two threads
-/// about one W2 frame in two spent 2-3 ms more in setup that way. Buffers below 32 MiB
+/// about one W2 frame in two spent 2-4 ms more in setup that way. Buffers below 32 MiB
 /// (glibc's largest threshold) now come from the heaps and go back to them, and up to 1 GiB of
 /// free memory stays mapped; the process's peak memory is unchanged. The CLI sets it; a library
 /// user keeps their own allocator's settings.

@@ -266,7 +266,8 @@ pub struct TriAttrs {
     pub plan: u32,
     /// 1/w normalized so the largest is exactly 1 << inv_w_bits.
     pub inv_w_x: [i64; 3],
-    /// Unorm `color_bits` (at most 16) per vertex and channel.
+    /// Unorm `color_bits` (at most 16) per vertex and channel; 0 when the plan has no `color`
+    /// stage (its only reader).
     pub color_x: [[u16; 3]; 3],
     pub uv_x: [[i64; 2]; 3],
     /// Index into [`Machine::bump_attrs`] (bump materials only; `u32::MAX` otherwise).
