@@ -394,12 +394,18 @@ fn parent_table<'t, 'p>(
     table: &'t mut toml::Table,
     path: &'p str,
 ) -> Option<(&'t mut toml::Table, &'p str)> {
-    let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
+    let (tables, leaf) = split_path(path);
     let mut cur = table;
-    for p in tables.split('.').filter(|p| !p.is_empty()) {
+    for p in tables {
         cur = cur.get_mut(p)?.as_table_mut()?;
     }
     Some((cur, leaf))
+}
+
+/// The dotted `path` as the names of the tables it walks through and the field's own name.
+fn split_path(path: &str) -> (impl Iterator<Item = &str>, &str) {
+    let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
+    (tables.split('.').filter(|p| !p.is_empty()), leaf)
 }
 
 /// The configuration `table` describes, validated; an error names `path`, the field just set
@@ -431,9 +437,9 @@ impl IntFields {
     /// The integer at the dotted `path`; `None` when there is none.
     #[must_use]
     pub fn get(&self, path: &str) -> Option<i64> {
-        let (tables, leaf) = path.rsplit_once('.').unwrap_or(("", path));
+        let (tables, leaf) = split_path(path);
         let mut cur = &self.table;
-        for p in tables.split('.').filter(|p| !p.is_empty()) {
+        for p in tables {
             cur = cur.get(p)?.as_table()?;
         }
         cur.get(leaf)?.as_integer()
