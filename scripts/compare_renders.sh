@@ -3,6 +3,8 @@
 # configuration with both binaries (2 threads, reference and cycles on) and compares every
 # PNG and summary.json (without its provenance: the command line and commit differ). A change
 # that must not alter any output (a faster path, a refactor) passes with 0 differences.
+# RENDER_ARGS adds arguments to every render (e.g. `--no-reference`: the hardware pass alone,
+# which converts only the attributes of the triangles it shades).
 # Usage: scripts/compare_renders.sh OLD_TEXSIM NEW_TEXSIM HW...
 #   e.g. scripts/compare_renders.sh /tmp/texsim-main target/release/texsim \
 #        texram16 d3d11 vulkan-min llvmpipe my_aniso.toml
@@ -28,7 +30,7 @@ for hw in "$@"; do
         n=$((n + 1)); tag=$(basename "$hw" .toml)-$s; ok=1
         for side in old new; do
             bin=$OLD; [ $side = new ] && bin=$NEW
-            "$bin" --threads 2 render --scene "$s" --hw "$hw" --out "$W/$side-$tag" >/dev/null \
+            "$bin" --threads 2 render --scene "$s" --hw "$hw" ${RENDER_ARGS:-} --out "$W/$side-$tag" >/dev/null \
                 2>"$W/$side-$tag.err" || { ok=0; echo "FAILED $side $tag (see $W/$side-$tag.err)"; }
         done
         for f in $(cd "$W/old-$tag" 2>/dev/null && ls -- *.png); do

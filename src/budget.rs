@@ -44,7 +44,8 @@ pub const BYTES_PER_TRIANGLE: u64 = (std::mem::size_of::<crate::raster::ScreenTr
     as u64
     + BYTES_PER_DRAW;
 /// ...of which the input triangle's indices (12 B), draw (16 B), plan index (4 B), the
-/// setup's outcome and output order (16 B) and the loader's working copies, with headroom.
+/// setup's outcome and output order (16 B), the marks of the triangles the hardware pass
+/// shades (2 B while they are built) and the loader's working copies, with headroom.
 pub const BYTES_PER_DRAW: u64 = 96;
 /// Bytes per vertex of a whole run: the mesh (32 B), the transformed and lit vertex of the
 /// geometry (84 B) and its projection in the setup (48 B), with headroom.

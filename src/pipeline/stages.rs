@@ -389,6 +389,64 @@ impl TriAttrs {
             f32_tri: u32::MAX,
         }
     }
+
+    /// A triangle no stage reads (hidden behind others in the frame's only shading pass): its
+    /// plan, nothing converted. The caller keeps the overflow counts exact by taking it only
+    /// where [`TriAttrs::new`] would count nothing ([`QuietSetup`]).
+    #[must_use]
+    pub fn unshaded(plan: u32) -> Self {
+        Self {
+            plan,
+            bump: u32::MAX,
+            f32_tri: u32::MAX,
+            ..Self::default()
+        }
+    }
+}
+
+/// Bounds on a mesh's texture coordinates within which [`TriAttrs::new`] counts no overflow
+/// for a triangle whose 1/w are finite and positive, whatever its wrap modes. The 1/w
+/// normalized by the largest are in [0, 1], which the unsigned `1.inv_w_bits` format holds.
+/// A coordinate in `[lo, hi]` less its offset (0, or an integer within 2 below the middle of
+/// the triangle's own coordinates) is within `b = max(hi - lo + 2, |lo|, |hi|)` of 0; one
+/// unit more covers the roundings of the subtraction and of a clipped triangle's blend of its
+/// source's coordinates (`b <= 2^40`, so each is far below one unit). When `(b + 1) 2^frac`
+/// is at least one LSB inside the coordinate format's range (and below 2^52), every rounded
+/// value fits and nothing is counted.
+#[derive(Clone, Copy, Debug)]
+pub struct QuietSetup {
+    quiet: bool,
+}
+
+impl QuietSetup {
+    /// The bounds `lo`, `hi` (per axis; `None` when a coordinate is not finite) against the
+    /// machine's coordinate format.
+    #[must_use]
+    pub fn new(m: &Machine, bounds: Option<([f64; 2], [f64; 2])>) -> Self {
+        let fmt = &m.uv_fmt;
+        let scale = crate::fixedpoint::pow2(fmt.frac_bits as i32);
+        const LIMIT: i64 = 1 << 52;
+        let (top, bottom) = (
+            (fmt.max_raw().min(LIMIT) - 1) as f64,
+            (fmt.min_raw().max(-LIMIT) + 1) as f64,
+        );
+        let quiet = bounds.is_some_and(|(lo, hi)| {
+            (0..2).all(|ax| {
+                let (l, h) = (lo[ax], hi[ax]);
+                let b = (h - l + 2.0).max(l.abs()).max(h.abs()) + 1.0;
+                l <= h && b <= 1e12 && b * scale <= top && -b * scale >= bottom
+            })
+        });
+        Self { quiet }
+    }
+
+    /// Whether [`TriAttrs::new`] with these 1/w (and coordinates within the bounds) counts
+    /// nothing.
+    #[inline]
+    #[must_use]
+    pub fn holds(&self, inv_w: [f64; 3]) -> bool {
+        self.quiet && inv_w.iter().all(|&w| w.is_finite() && w > 0.0)
+    }
 }
 
 /// Component `c` of three vertices' attributes, as the interpolator's `i64` inputs.

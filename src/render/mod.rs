@@ -22,7 +22,7 @@ mod stats;
 
 pub use float_passes::{float_blind, float_pass_budget, FloatPassCache, FloatPasses};
 pub use geometry::Geometry;
-use shading::{bump_attrs, f32_tris, shade, tri_attrs, ShadeInput};
+use shading::{bump_attrs, f32_tris, shade, shaded_triangles, tri_attrs, ShadeInput};
 use stats::bump_frames;
 pub use stats::{
     BumpStats, DatapathCost, IssueCycles, RenderStats, Rendered, RoughStats, StageStats, Timings,
@@ -228,11 +228,6 @@ pub fn render(
     let setup = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &hw.raster);
     let m0 = Machine::new(hw, &maps.float, &maps.fixed).with_lights(&scene.lights, scene.ambient);
     let floats = float_pass || reads_tri_floats(&opts.hw_impls, hw);
-    let (mut attrs, floats, mut input_sat) = tri_attrs(&setup, &geo, &m0, floats);
-    let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
-    input_sat.add(&bsat);
-    let ftris = f32_tris(&setup, &geo, &m0, &mut attrs);
-    let m = m0.with_bump_attrs(&battrs).with_f32_tris(&ftris);
     tm.setup_ms = ms(t);
     progress("setup", ms(t_start));
 
@@ -240,6 +235,20 @@ pub fn render(
     let (vis, raster_stats) = raster::rasterize(&setup, Coverage::Fixed, true);
     tm.raster_ms = ms(t);
     progress("raster", tm.raster_ms);
+
+    // The attributes (part of the setup's time) after the raster, which needs only the screen
+    // triangles: when the hardware pass is the frame's only shading pass, the triangles it
+    // leaves hidden need none converted.
+    let t = Instant::now();
+    let shaded = (!floats).then(|| shaded_triangles(&vis, setup.tris.len()));
+    let (mut attrs, floats, mut input_sat) =
+        tri_attrs(&setup, &geo, &m0, floats, shaded.as_deref());
+    let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
+    input_sat.add(&bsat);
+    let ftris = f32_tris(&setup, &geo, &m0, &mut attrs);
+    let m = m0.with_bump_attrs(&battrs).with_f32_tris(&ftris);
+    tm.setup_ms += ms(t);
+    progress("attributes", ms(t));
 
     let bg = scene.background.map(|c| to_unorm(f64::from(c), 16) as u16);
     let t = Instant::now();

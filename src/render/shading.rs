@@ -7,7 +7,7 @@ use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::clip_f32::{outcode, ShadedVertex};
 use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{
-    output16, run, run_span, Counters, Machine, TriAttrs, TriFloat, SPAN_MAX,
+    output16, run, run_span, Counters, Machine, QuietSetup, TriAttrs, TriFloat, SPAN_MAX,
 };
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
 #[cfg(test)]
@@ -83,18 +83,72 @@ pub(super) fn bump_attrs(
     (out, sat)
 }
 
+/// Which screen triangles cover a pixel of `vis` (`n` triangles): the only ones a shading
+/// pass over `vis` reads the attributes of.
+pub(super) fn shaded_triangles(vis: &VisBuffer, n: usize) -> Vec<bool> {
+    // One mark more, for the empty pixels ([`NO_TRI`] and any id beyond): every pixel stores
+    // without a branch (a branch on the id changing mispredicts at every span's end).
+    let marks: Vec<AtomicBool> = (0..=n).map(|_| AtomicBool::new(false)).collect();
+    vis.tri.par_chunks(1 << 14).for_each(|ids| {
+        for &t in ids {
+            marks[(t as usize).min(n)].store(true, Ordering::Relaxed);
+        }
+    });
+    let mut marks: Vec<bool> = marks.into_iter().map(AtomicBool::into_inner).collect();
+    marks.truncate(n);
+    marks
+}
+
+/// The bounds of the texture coordinates of `geo`'s vertices, `None` if one is not finite.
+fn uv_bounds(geo: &Geometry) -> Option<([f64; 2], [f64; 2])> {
+    let none = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let (lo, hi) = geo
+        .uv
+        .par_iter()
+        .fold(
+            || Some(none),
+            |b, uv| {
+                let (mut lo, mut hi) = b?;
+                for ax in 0..2 {
+                    if !uv[ax].is_finite() {
+                        return None;
+                    }
+                    lo[ax] = lo[ax].min(uv[ax]);
+                    hi[ax] = hi[ax].max(uv[ax]);
+                }
+                Some((lo, hi))
+            },
+        )
+        .reduce(
+            || Some(none),
+            |a, b| {
+                let ((la, ha), (lb, hb)) = (a?, b?);
+                Some((
+                    [0, 1].map(|i| la[i].min(lb[i])),
+                    [0, 1].map(|i| ha[i].max(hb[i])),
+                ))
+            },
+        )?;
+    Some((lo, hi))
+}
+
 /// Per-triangle attributes of every screen triangle in the machine's formats and, when
 /// `floats` (a stage of the render's passes reads them), in float; else the second vector is
-/// empty.
+/// empty. With `shaded` (the frame's one shading pass reads only the triangles marked there,
+/// [`shaded_triangles`]) a triangle it does not read is [`TriAttrs::unshaded`] where that
+/// leaves the overflow counts as they were ([`QuietSetup`]): hidden triangles cost no
+/// conversion.
 pub(super) fn tri_attrs(
     setup: &Setup,
     geo: &Geometry,
     m: &Machine,
     floats: bool,
+    shaded: Option<&[bool]>,
 ) -> (Vec<TriAttrs>, Vec<TriFloat>, SatCounter) {
     // Written in parallel straight into their vectors; the overflow counts sum in any order.
     let n = setup.tris.len();
     let reads_color: Vec<bool> = geo.plans.iter().map(|p| p.has(StageKind::Color)).collect();
+    let quiet = shaded.map(|s| (s, QuietSetup::new(m, uv_bounds(geo))));
     let mut out = (
         (
             crate::raster::vec_populated(n),
@@ -103,6 +157,13 @@ pub(super) fn tri_attrs(
         SatSum::default(),
     );
     out.par_extend(setup.tris.par_iter().enumerate().map(|(i, t)| {
+        let plan = geo.draw_plan[t.src as usize];
+        if let Some((shaded, q)) = quiet {
+            if !shaded[i] && q.holds(t.inv_w) {
+                let a = TriAttrs::unshaded(plan);
+                return ((a, TriFloat::NONE), SatCounter::default());
+            }
+        }
         let d = &geo.draws[t.src as usize];
         let blend = |k: usize| -> ([f64; 3], [f64; 2]) {
             let w = setup.src_bary(i)[k];
@@ -146,7 +207,6 @@ pub(super) fn tri_attrs(
         };
         let [(c0, t0), (c1, t1), (c2, t2)] = direct.unwrap_or_else(|| [0, 1, 2].map(blend));
         let mut sat = SatCounter::default();
-        let plan = geo.draw_plan[t.src as usize];
         let wrap = geo.plans[plan as usize].wrap;
         let (color, uv) = ([c0, c1, c2], [t0, t1, t2]);
         let fixed_color = reads_color[plan as usize].then_some(color);

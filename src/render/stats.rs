@@ -57,6 +57,9 @@ pub(super) fn bump_frames(geo: &Geometry, hw: &HwConfig) -> String {
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Timings {
     pub geometry_ms: f64,
+    /// Triangle setup (clip, snap) and the per-triangle attributes, which are converted after
+    /// the raster (only the visible triangles' when the hardware pass is the only shading
+    /// pass).
     pub setup_ms: f64,
     pub raster_ms: f64,
     /// Hardware shading; with cycles on it includes the timing model fed row by row beside

@@ -438,3 +438,40 @@ fn every_float_reader_gets_the_float_vertex_data() {
         }
     }
 }
+
+/// The hardware pass alone converts the attributes of the triangles it shades only: the
+/// image, the stage counters and the setup's overflow counts are those of a render whose
+/// reference pass has every triangle converted, on the torus (about half its triangles
+/// hidden) and on coordinate formats narrow enough to overflow.
+#[test]
+fn hidden_triangles_skip_their_conversion_and_keep_every_count() {
+    let s = small("w2-mesh", 160, 160);
+    let maps = Maps::new(&s, 16);
+    for (int_bits, reduce) in [(8, true), (1, true), (1, false)] {
+        let mut hw = hw_model::HwConfig::texram16();
+        hw.interp.texcoord_int_bits = int_bits;
+        hw.interp.texcoord_reduce = reduce;
+        let run = |reference| {
+            let opts = RenderOptions {
+                reference,
+                ..Default::default()
+            };
+            render(&s, &maps, &hw, &opts).expect("render")
+        };
+        let (alone, with_ref) = (run(false), run(true));
+        assert!(alone.stats.covered_pixels > 5000);
+        assert_eq!(alone.hw_image, with_ref.hw_image, "{int_bits} {reduce}");
+        let counts = |r: &Rendered| {
+            let st = &r.stats;
+            (
+                st.input_saturated,
+                st.input_wrapped,
+                serde_json::to_string(&st.stages).expect("json"),
+            )
+        };
+        assert_eq!(counts(&alone), counts(&with_ref), "{int_bits} {reduce}");
+        // The one-bit format without the offset reduction overflows, at setup and after.
+        let overflows = alone.stats.input_saturated > 0;
+        assert_eq!(overflows, !reduce, "{int_bits} {reduce}");
+    }
+}

@@ -241,3 +241,77 @@ fn to_raw_matches_the_previous_routine() {
     assert!(fast > 2_500_000 && wide > 300_000, "{fast} {wide}");
     assert!(sat.saturated > 100_000 && sat.wrapped > 10_000, "{sat:?}");
 }
+
+/// `QuietSetup`: for coordinates within its bounds (the bounds themselves and blends of them
+/// included) and finite positive 1/w, `TriAttrs::new` counts no overflow, for every wrap mode,
+/// rounding and offset reduction, on coordinate formats down to the narrowest the bounds
+/// allow; a format too narrow for the bounds, and 1/w that are zero, negative or not finite,
+/// are not quiet.
+#[test]
+fn quiet_setup_keeps_every_attribute_conversion_in_range() {
+    use hw_model::HwConfig;
+    use texsim::pipeline::stages::{Machine, QuietSetup, TriAttrs};
+    use texsim::scene::WrapMode;
+    let mut rng = Rng(0x0051_e7a7_7e5e_7001);
+    let (mut quiet, mut checked) = (0, 0u64);
+    for (int_bits, frac_bits, lo, hi) in [
+        (8, 24, 0.0, 1.0),
+        (3, 12, -1.0, 2.0),
+        (4, 20, 3.0, 9.0),
+        (2, 8, 0.0, 0.5),
+        (6, 40, -20.0, 20.0),
+        (1, 4, 0.0, 1.0),
+        (2, 30, 0.0, 8.0),
+    ] {
+        for rounding in [Rounding::Truncate, Rounding::HalfUp, Rounding::HalfEven] {
+            for reduce in [true, false] {
+                let mut hw = HwConfig::texram16();
+                hw.interp.texcoord_int_bits = int_bits;
+                hw.interp.texcoord_frac_bits = frac_bits;
+                hw.interp.interp_rounding = rounding;
+                hw.interp.texcoord_reduce = reduce;
+                let m = Machine::new(&hw, &[], &[]);
+                let q = QuietSetup::new(&m, Some(([lo, lo], [hi, hi])));
+                assert!(!QuietSetup::new(&m, None).holds([1.0; 3]));
+                for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+                    assert!(!q.holds([1.0, bad, 0.5]));
+                }
+                if !q.holds([1.0; 3]) {
+                    continue;
+                }
+                quiet += 1;
+                for _ in 0..20_000 {
+                    let mut uv = [[0.0; 2]; 3];
+                    for v in &mut uv {
+                        for c in v.iter_mut() {
+                            *c = match rng.below(8) {
+                                0 => lo,
+                                1 => hi,
+                                // A clipped vertex: a blend of two within the bounds.
+                                2 => {
+                                    let t = rng.unit();
+                                    (1.0 - t) * lo + t * hi
+                                }
+                                _ => rng.range(lo, hi),
+                            };
+                        }
+                    }
+                    let inv_w = [0, 1, 2].map(|_| rng.range(1e-6, 4.0));
+                    assert!(q.holds(inv_w));
+                    let wrap = [WrapMode::Repeat, WrapMode::Mirror, WrapMode::ClampToEdge];
+                    let w = [0, 1].map(|_| wrap[rng.below(3) as usize]);
+                    let mut sat = SatCounter::default();
+                    let _ = TriAttrs::new(&m, 0, inv_w, None, uv, w, &mut sat);
+                    assert_eq!(
+                        sat,
+                        SatCounter::default(),
+                        "{int_bits}.{frac_bits} [{lo}, {hi}] {rounding:?} {w:?} {uv:?} {inv_w:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    // The bounds fit all but the two narrowest formats (1.4 for [0, 1], 2.30 for [0, 8]).
+    assert_eq!(quiet, 5 * 6, "{checked} triangles checked");
+}
