@@ -426,6 +426,7 @@ impl QuietSetup {
         let fmt = &m.uv_fmt;
         let scale = crate::fixedpoint::pow2(fmt.frac_bits as i32);
         const LIMIT: i64 = 1 << 52;
+        const TWO_40: f64 = (1u64 << 40) as f64;
         let (top, bottom) = (
             (fmt.max_raw().min(LIMIT) - 1) as f64,
             (fmt.min_raw().max(-LIMIT) + 1) as f64,
@@ -434,10 +435,16 @@ impl QuietSetup {
             (0..2).all(|ax| {
                 let (l, h) = (lo[ax], hi[ax]);
                 let b = (h - l + 2.0).max(l.abs()).max(h.abs()) + 1.0;
-                l <= h && b <= 1e12 && b * scale <= top && -b * scale >= bottom
+                l <= h && b <= TWO_40 && b * scale <= top && -b * scale >= bottom
             })
         });
         Self { quiet }
+    }
+
+    /// Whether the bounds fit the format: without it no triangle skips its conversion.
+    #[must_use]
+    pub fn is_quiet(&self) -> bool {
+        self.quiet
     }
 
     /// Whether [`TriAttrs::new`] with these 1/w (and coordinates within the bounds) counts

@@ -22,7 +22,7 @@ mod stats;
 
 pub use float_passes::{float_blind, float_pass_budget, FloatPassCache, FloatPasses};
 pub use geometry::Geometry;
-use shading::{bump_attrs, f32_tris, shade, shaded_triangles, tri_attrs, ShadeInput};
+use shading::{bump_attrs, f32_tris, shade, tri_attrs, ShadeInput};
 use stats::bump_frames;
 pub use stats::{
     BumpStats, DatapathCost, IssueCycles, RenderStats, Rendered, RoughStats, StageStats, Timings,
@@ -240,9 +240,8 @@ pub fn render(
     // triangles: when the hardware pass is the frame's only shading pass, the triangles it
     // leaves hidden need none converted.
     let t = Instant::now();
-    let shaded = (!floats).then(|| shaded_triangles(&vis, setup.tris.len()));
-    let (mut attrs, floats, mut input_sat) =
-        tri_attrs(&setup, &geo, &m0, floats, shaded.as_deref());
+    let only_pass = (!floats).then_some(&vis);
+    let (mut attrs, floats, mut input_sat) = tri_attrs(&setup, &geo, &m0, floats, only_pass);
     let (battrs, bsat) = bump_attrs(&setup, &geo, &m0, &mut attrs);
     input_sat.add(&bsat);
     let ftris = f32_tris(&setup, &geo, &m0, &mut attrs);

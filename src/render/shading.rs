@@ -85,7 +85,7 @@ pub(super) fn bump_attrs(
 
 /// Which screen triangles cover a pixel of `vis` (`n` triangles): the only ones a shading
 /// pass over `vis` reads the attributes of.
-pub(super) fn shaded_triangles(vis: &VisBuffer, n: usize) -> Vec<bool> {
+fn shaded_triangles(vis: &VisBuffer, n: usize) -> Vec<bool> {
     // One mark more, for the empty pixels ([`NO_TRI`] and any id beyond): every pixel stores
     // without a branch (a branch on the id changing mispredicts at every span's end).
     let marks: Vec<AtomicBool> = (0..=n).map(|_| AtomicBool::new(false)).collect();
@@ -134,21 +134,24 @@ fn uv_bounds(geo: &Geometry) -> Option<([f64; 2], [f64; 2])> {
 
 /// Per-triangle attributes of every screen triangle in the machine's formats and, when
 /// `floats` (a stage of the render's passes reads them), in float; else the second vector is
-/// empty. With `shaded` (the frame's one shading pass reads only the triangles marked there,
-/// [`shaded_triangles`]) a triangle it does not read is [`TriAttrs::unshaded`] where that
+/// empty. With `vis`, the visibility buffer of the frame's only shading pass, a triangle
+/// that covers none of its pixels ([`shaded_triangles`]) is [`TriAttrs::unshaded`] where that
 /// leaves the overflow counts as they were ([`QuietSetup`]): hidden triangles cost no
-/// conversion.
+/// conversion. The pixels are not scanned when the mesh's coordinates could overflow.
 pub(super) fn tri_attrs(
     setup: &Setup,
     geo: &Geometry,
     m: &Machine,
     floats: bool,
-    shaded: Option<&[bool]>,
+    vis: Option<&VisBuffer>,
 ) -> (Vec<TriAttrs>, Vec<TriFloat>, SatCounter) {
     // Written in parallel straight into their vectors; the overflow counts sum in any order.
     let n = setup.tris.len();
     let reads_color: Vec<bool> = geo.plans.iter().map(|p| p.has(StageKind::Color)).collect();
-    let quiet = shaded.map(|s| (s, QuietSetup::new(m, uv_bounds(geo))));
+    let quiet = vis.and_then(|vis| {
+        let q = QuietSetup::new(m, uv_bounds(geo));
+        q.is_quiet().then(|| (shaded_triangles(vis, n), q))
+    });
     let mut out = (
         (
             crate::raster::vec_populated(n),
@@ -158,7 +161,7 @@ pub(super) fn tri_attrs(
     );
     out.par_extend(setup.tris.par_iter().enumerate().map(|(i, t)| {
         let plan = geo.draw_plan[t.src as usize];
-        if let Some((shaded, q)) = quiet {
+        if let Some((shaded, q)) = &quiet {
             if !shaded[i] && q.holds(t.inv_w) {
                 let a = TriAttrs::unshaded(plan);
                 return ((a, TriFloat::NONE), SatCounter::default());
