@@ -328,18 +328,26 @@ fn lane_q(e: [i64; 3], inv_w: [i64; 3]) -> Option<[i64; 3]> {
     Some([q[1], q[2], d])
 }
 
-/// [`perspective_bary_derivs_in`] out of line: a span lane outside the fast form.
+/// [`perspective_bary_derivs_in`] of lane `j` of `span` out of line: a span lane outside the
+/// fast form.
 #[inline(never)]
 fn derivs_lane<M: ConstRounding>(
-    edge: [i64; 3],
-    edge_dx: [i64; 3],
-    edge_dy: [i64; 3],
+    span: &EdgeSpan,
+    j: usize,
     inv_w: [i64; 3],
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
 ) -> [[i64; 3]; 3] {
-    perspective_bary_derivs_in::<M>(edge, edge_dx, edge_dy, inv_w, cfg, recip, sat)
+    let e = lane_edges(span.edge, span.dx, j);
+    perspective_bary_derivs_in::<M>(e, span.dx, span.dy, inv_w, cfg, recip, sat)
+}
+
+/// A lane's barycentrics `[1 - p_1 - p_2, p_1, p_2]` and those of its neighbours along x and
+/// y from `p` and the neighbours' `x`, `y` (`one` = 1 in the barycentrics' format).
+#[inline(always)]
+fn lane_result(one: i64, p: [i64; 2], x: [i64; 2], y: [i64; 2]) -> [[i64; 3]; 3] {
+    [p, x, y].map(|[b1, b2]| [one - b1 - b2, b1, b2])
 }
 
 /// A span length the span datapaths are tuned for (the row loop's spans have at most 32
@@ -350,18 +358,19 @@ pub const SPAN_LANES: usize = 32;
 /// and `R` (the reciprocal's `recip_rounding`).
 #[inline(always)]
 fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
-    &EdgeSpan {
-        edge,
-        dx: edge_dx,
-        dy: edge_dy,
-        lanes,
-    }: &EdgeSpan,
+    span: &EdgeSpan,
     inv_w: [i64; 3],
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
     mut out: impl FnMut(usize, [[i64; 3]; 3]),
 ) {
+    let &EdgeSpan {
+        edge,
+        dx: edge_dx,
+        dy: edge_dy,
+        lanes,
+    } = span;
     let times_w = |e: [i64; 3]| -> Option<[i64; 3]> {
         Some([
             e[0].checked_mul(inv_w[0])?,
@@ -382,11 +391,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     })();
     let Some((a, b, s, t, steps_mag)) = steps else {
         for j in 0..lanes {
-            let e = lane_edges(edge, edge_dx, j);
-            out(
-                j,
-                derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
-            );
+            out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
         }
         return;
     };
@@ -428,13 +433,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
             t,
             y_step,
         };
-        let lanes_at = EdgeSpan {
-            edge,
-            dx: edge_dx,
-            dy: edge_dy,
-            lanes,
-        };
-        return derivs_span_steady::<M, R>(&lanes_at, &steady, inv_w, cfg, recip, sat, out);
+        return derivs_span_steady::<M, R>(span, &steady, inv_w, cfg, recip, sat, out);
     }
     let mut stepped = ends.map(|(f, _)| f);
     // From the first fast lane on: the x numerators' top bits (the same at every fast lane)
@@ -479,11 +478,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
             })
         });
         let Some(([q1, q2, d], pj, r2)) = fast else {
-            let e = lane_edges(edge, edge_dx, j);
-            out(
-                j,
-                derivs_lane::<M>(e, edge_dx, edge_dy, inv_w, cfg, recip, sat),
-            );
+            out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
             continue;
         };
         let (nx, ny) = *numerators.get_or_insert_with(|| {
@@ -503,7 +498,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
         let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
         let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
         let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
-        out(j, [pj, [one - x1 - x2, x1, x2], [one - y1 - y2, y1, y2]]);
+        out(j, lane_result(one, [pj[1], pj[2]], [x1, x2], [y1, y2]));
     }
 }
 
@@ -588,14 +583,9 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
             let x2 = p2 + derivative_of_top::<M>(nx[1], r2, bb, sat);
             let y1 = p1 + derivative::<M>(ny[0], r2, bb, sat);
             let y2 = p2 + derivative::<M>(ny[1], r2, bb, sat);
-            let x = [one - x1 - x2, x1, x2];
-            out(j, [[one - p1 - p2, p1, p2], x, [one - y1 - y2, y1, y2]]);
+            out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
         } else {
-            let e = lane_edges(span.edge, span.dx, j);
-            out(
-                j,
-                derivs_lane::<M>(e, span.dx, span.dy, inv_w, cfg, recip, sat),
-            );
+            out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
         }
         q1 = q1.wrapping_add(a[1]);
         q2 = q2.wrapping_add(a[2]);
@@ -722,14 +712,9 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                         p2 + derivative_of_top::<M>(ty[1], r2, bb, sat),
                     )
                 };
-                let x = [one - x1 - x2, x1, x2];
-                out(j, [[one - p1 - p2, p1, p2], x, [one - y1 - y2, y1, y2]]);
+                out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
             } else {
-                let e = lane_edges(span.edge, span.dx, j);
-                out(
-                    j,
-                    derivs_lane::<M>(e, span.dx, span.dy, inv_w, cfg, recip, sat),
-                );
+                out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
             }
             q1 = q1.wrapping_add(a[1]);
             q2 = q2.wrapping_add(a[2]);
