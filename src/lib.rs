@@ -49,6 +49,7 @@ pub mod hwconfig;
 pub mod maps;
 pub mod pareto;
 pub mod pipeline;
+mod prefetch;
 pub mod probe;
 pub mod provenance;
 pub mod raster;

@@ -3,6 +3,7 @@
 //! horizontal bands. Conventions are in the parent module header.
 
 use super::setup::{ScreenTri, Setup};
+use crate::prefetch::prefetch;
 use rayon::prelude::*;
 
 /// No triangle covers this pixel.
@@ -598,7 +599,12 @@ fn for_spans(
     s: u32,
     mut f: impl FnMut(u32, i64, i64, i64, Prep<'_>),
 ) {
-    for &id in ids.bins.lists.iter().flat_map(|c| &c[ids.band]) {
+    let mut ids = ids.bins.lists.iter().flat_map(|c| &c[ids.band]).peekable();
+    while let Some(&id) = ids.next() {
+        // The next triangle's data is read while this one is walked.
+        if let Some(&&next) = ids.peek() {
+            prefetch(&setup.tris, next as usize);
+        }
         let t = &setup.tris[id as usize];
         let ya = t.bbox[1].max(y0);
         let yb = t.bbox[3].min(y1);

@@ -10,6 +10,7 @@ use crate::pipeline::stages::{
     output16, run, run_span, Counters, Machine, QuietSetup, TriAttrs, TriFloat, SPAN_MAX,
 };
 use crate::pipeline::{Frag, Program, StageImpls, StageKind};
+use crate::prefetch::prefetch;
 #[cfg(test)]
 use crate::raster::ScreenTri;
 use crate::raster::VertexSource;
@@ -429,6 +430,11 @@ fn shade_row_spans(
             .iter()
             .take_while(|&&u| u == t)
             .count();
+        // The next span's triangle is read while this one is shaded.
+        if let Some(&next) = tris.get(x + n) {
+            prefetch(inp.attrs, next as usize);
+            prefetch(&inp.setup.tris, next as usize);
+        }
         let a = &inp.attrs[t as usize];
         let af = inp.floats.get(t as usize).unwrap_or(&TriFloat::NONE);
         let pi = a.plan as usize;
