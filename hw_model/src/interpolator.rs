@@ -624,8 +624,9 @@ struct Tops {
 /// barycentrics and derivatives. Each reciprocal is a chain of dependent steps (the seed's
 /// table read, the Newton steps, the normalization, the square); in a loop of those alone the
 /// core overlaps the chains of several lanes, which the whole lane's loop body is too long
-/// for. Measured on W1, one thread: the frame 52.5 -> 48.8 ms (minima of 15-frame runs);
-/// batches of 4 and 32 lanes did as well on W1, 32 none better on W2's short spans.
+/// for. Measured at one thread (the fastest of 15 frames, 6 runs): W1's frame 51.5-53.6 ->
+/// 47.7-49.1 ms, W2's 90.7-94.5 -> 88.5-91.2 ms; batches of 4 and 32 lanes did as well on W1,
+/// and 32 gained nothing on W2's short spans.
 const RECIP_BATCH: usize = 8;
 
 /// The `N` of [`derivs_span_held`] that evaluates each `1/D` with
