@@ -237,7 +237,7 @@ pub fn round_shift_right_mid<M: ConstRounding>(x: i64, shift: u32) -> i64 {
 /// values (e.g. per span), its rounding constants resolved once: [`ShiftRound::apply`] adds
 /// [`round_bias`] moved below the cut (plus the floor's lowest bit where that bias takes it)
 /// before one arithmetic shift, for inputs `|x| < 2^62` (no overflow).
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 pub struct ShiftRound<M> {
     shift: u32,
     /// `round_bias(false, M::MODE) >> (64 - shift)`: below one half of the dropped part.
@@ -246,6 +246,15 @@ pub struct ShiftRound<M> {
     odd: i64,
     mode: std::marker::PhantomData<M>,
 }
+
+// Written out: a derive would ask `M` (a mode marker) to be `Copy` too.
+impl<M> Clone for ShiftRound<M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<M> Copy for ShiftRound<M> {}
 
 impl<M: ConstRounding> ShiftRound<M> {
     /// The rounding by `shift`; `None` unless `shift` is in 1..=63.
@@ -257,7 +266,7 @@ impl<M: ConstRounding> ShiftRound<M> {
 
     /// [`ShiftRound::new`] for a `shift` the caller has checked to lie in 1..=63.
     #[inline(always)]
-    fn at(shift: u32) -> Self {
+    pub(crate) fn at(shift: u32) -> Self {
         debug_assert!((1..64).contains(&shift), "shift {shift}");
         Self {
             shift,

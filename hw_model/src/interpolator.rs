@@ -20,8 +20,8 @@ use crate::config::{InterpConfig, ReciprocalConfig};
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{
-    round_shift_right, round_shift_right_mid, round_shift_right_small, round_shift_right_wide,
-    ConstRounding, Format, SatCounter,
+    round_shift_right, round_shift_right_mid, round_shift_right_wide, ConstRounding, Format,
+    SatCounter, ShiftRound,
 };
 use crate::reciprocal::{apply_i64_in, apply_i64_small_in, apply_in, square, Recip, Reciprocal};
 
@@ -639,7 +639,8 @@ const ANY_ITERATIONS: u32 = u32::MAX;
 /// iteration count, else [`ANY_ITERATIONS`]: `eval`), the barycentrics
 /// [`apply_i64_small_in`] (else [`apply_i64_in`]), the y tops are a shift of the stepped
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
-/// [`derivative_held`]'s 64-bit rounding (else each takes [`derivative_of_top`]). Checked
+/// [`derivative_held`]'s 64-bit rounding, their four [`held_rounding`]s kept while that
+/// exponent holds (else each takes [`derivative_of_top`]). Checked
 /// against one call per lane in `derivs_span_stepping_matches_per_lane_calls`. The lanes'
 /// reciprocals run ahead of the rest in batches of [`RECIP_BATCH`].
 #[inline(always)]
@@ -670,6 +671,9 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     // Lanes in batches of [`RECIP_BATCH`]: first each lane's `1/D` and its square, then the
     // rest of each lane in lane order.
     let mut recips = [(Recip { mant: 0, shift: 0 }, Recip { mant: 0, shift: 0 }); RECIP_BATCH];
+    // The derivatives' roundings ([`held_rounding`]) for the last exponent of `1/D^2`: along a
+    // span `D` rarely crosses a power of two.
+    let mut rounds: Option<(i32, [ShiftRound<M>; 4])> = None;
     let mut j0 = 0;
     while j0 < span.lanes {
         let n = (span.lanes - j0).min(RECIP_BATCH);
@@ -695,16 +699,29 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                 _ => (apply_i64_in::<M>(r, q1, bb), apply_i64_in::<M>(r, q2, bb)),
             };
             // |p_1|, |p_2| <= 2^60 as one unsigned compare of the larger of `p_i + 2^60`.
-            let off = |p: i64| p.wrapping_add(BARY_LIMIT) as u64;
-            if off(p1).max(off(p2)) <= 2 * limit {
+            if bary_offset(p1).max(bary_offset(p2)) <= 2 * limit {
                 let ty = [(ny[0] >> (ny1 & 63), ny1), (ny[1] >> (ny2 & 63), ny2)];
                 let (x1, x2, y1, y2) = if (lo..hi).contains(&r2.shift) {
-                    (
-                        p1 + derivative_held::<M>(nx[0], r2, bb, sat),
-                        p2 + derivative_held::<M>(nx[1], r2, bb, sat),
-                        p1 + derivative_held::<M>(ty[0], r2, bb, sat),
-                        p2 + derivative_held::<M>(ty[1], r2, bb, sat),
-                    )
+                    // The four roundings of `1/D^2`'s exponent, kept while it holds.
+                    let rd = match rounds {
+                        Some((at, rd)) if at == r2.shift => rd,
+                        _ => {
+                            let rd = [nx[0].1, nx[1].1, ny1, ny2]
+                                .map(|ns| held_rounding::<M>(r2.shift, bb, ns));
+                            rounds = Some((r2.shift, rd));
+                            rd
+                        }
+                    };
+                    let d = clamp_four(
+                        [
+                            derivative_held::<M>(nx[0].0, r2, &rd[0]),
+                            derivative_held::<M>(nx[1].0, r2, &rd[1]),
+                            derivative_held::<M>(ty[0].0, r2, &rd[2]),
+                            derivative_held::<M>(ty[1].0, r2, &rd[3]),
+                        ],
+                        sat,
+                    );
+                    (p1 + d[0], p2 + d[1], p1 + d[2], p2 + d[3])
                 } else {
                     (
                         p1 + derivative_of_top::<M>(nx[0], r2, bb, sat),
@@ -847,23 +864,58 @@ fn product_top(x: i128, r2: Recip) -> i64 {
     (prod >> 62) as i64 | i64::from((prod as u64) << 2 != 0)
 }
 
-/// [`derivative_short`] for a mantissa below 2^29 (the span lanes of [`derivs_span_held`]):
-/// the top bits are below 2^61, so the rounding is [`round_shift_right_small`]'s.
+/// The rounding of [`derivative_held`] for `1/D^2`'s exponent `r2_shift` and a numerator's
+/// drop `ns`: by `r2_shift - (bary_bits + ns) - 62`, which [`derivs_span_held`] has checked to
+/// lie in 2..=63.
 #[inline(always)]
-fn derivative_held<M: ConstRounding>(
-    (x, ns): NumeratorTop,
-    r2: Recip,
-    bary_bits: u32,
-    sat: &mut SatCounter,
-) -> i64 {
-    let sh = r2.shift - (bary_bits + ns) as i32;
-    debug_assert!(r2.mant >> 29 == 0 && (64..126).contains(&sh));
-    let v = round_shift_right_small::<M>(product_top(x, r2), (sh - 62) as u32);
-    // |v| <= 2^60 as one unsigned compare (|v| < 2^61).
-    if v.wrapping_add(BARY_LIMIT) as u64 > 2 * BARY_LIMIT as u64 {
-        return clamp_counted(v, sat);
+fn held_rounding<M: ConstRounding>(r2_shift: i32, bary_bits: u32, ns: u32) -> ShiftRound<M> {
+    let sh = r2_shift - (bary_bits + ns) as i32;
+    debug_assert!((64..126).contains(&sh));
+    ShiftRound::at((sh - 62) as u32)
+}
+
+/// [`derivative_short`] before its clamp ([`clamp_four`]), for a mantissa below 2^29 (the span
+/// lanes of [`derivs_span_held`]) and a numerator's top `x` (below 2^94), rounded by `round`
+/// ([`held_rounding`] of the numerator's drop, a shift of at least 2): the product is below
+/// 2^123 and its top bits below 2^61, so the rounding is
+/// [`crate::fixed::round_shift_right_small`]'s.
+#[inline(always)]
+fn derivative_held<M: ConstRounding>(x: i128, r2: Recip, round: &ShiftRound<M>) -> i64 {
+    debug_assert!(r2.mant >> 29 == 0 && x.unsigned_abs() >> 94 == 0);
+    round.apply(product_top(x, r2))
+}
+
+/// The offset of `v` from `-BARY_LIMIT`: `|v| <= BARY_LIMIT` iff it is at most `2 BARY_LIMIT`
+/// (one unsigned compare).
+#[inline(always)]
+fn bary_offset(v: i64) -> u64 {
+    v.wrapping_add(BARY_LIMIT) as u64
+}
+
+/// The clamp of four [`derivative_held`] results to +-[`BARY_LIMIT`], each clamp counted: one
+/// test of the largest offset. (Their bounds keep them within 2^59, so it never clamps; the
+/// test, the per-sample datapath's clamp, also keeps the compiler from vectorizing the four
+/// 128-bit products, which without it cost W1's bary stage 40% more instructions.)
+#[inline(always)]
+fn clamp_four(d: [i64; 4], sat: &mut SatCounter) -> [i64; 4] {
+    let o = |k: usize| bary_offset(d[k]);
+    if o(0).max(o(1)).max(o(2).max(o(3))) <= 2 * BARY_LIMIT as u64 {
+        return d;
     }
-    v
+    clamp_each(d, sat)
+}
+
+/// [`clamp_four`] when one derivative or more is beyond the limit.
+#[cold]
+#[inline(never)]
+fn clamp_each(d: [i64; 4], sat: &mut SatCounter) -> [i64; 4] {
+    d.map(|v| {
+        if bary_offset(v) > 2 * BARY_LIMIT as u64 {
+            clamp_counted(v, sat)
+        } else {
+            v
+        }
+    })
 }
 
 /// A derivative beyond +-[`BARY_LIMIT`]: the clamp, counted.
