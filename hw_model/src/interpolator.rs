@@ -640,9 +640,9 @@ const ANY_ITERATIONS: u32 = u32::MAX;
 /// [`apply_i64_small_in`] (else [`apply_i64_in`]), the y tops are a shift of the stepped
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
 /// [`derivative_held`]'s 64-bit rounding, their four [`held_rounding`]s kept while that
-/// exponent holds (else each takes [`derivative_of_top`]). Checked
-/// against one call per lane in `derivs_span_stepping_matches_per_lane_calls`. The lanes'
-/// reciprocals run ahead of the rest in batches of [`RECIP_BATCH`].
+/// exponent holds (else each takes [`derivative_of_top`]). Checked against one call per lane
+/// in `derivs_span_stepping_matches_per_lane_calls`. The lanes' reciprocals run ahead of the
+/// rest in batches of [`RECIP_BATCH`].
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
@@ -882,7 +882,9 @@ fn held_rounding<M: ConstRounding>(r2_shift: i32, bary_bits: u32, ns: u32) -> Sh
 #[inline(always)]
 fn derivative_held<M: ConstRounding>(x: i128, r2: Recip, round: &ShiftRound<M>) -> i64 {
     debug_assert!(r2.mant >> 29 == 0 && x.unsigned_abs() >> 94 == 0);
-    round.apply(product_top(x, r2))
+    let v = round.apply(product_top(x, r2));
+    debug_assert!(v.unsigned_abs() <= 1 << 59, "{v}");
+    v
 }
 
 /// The offset of `v` from `-BARY_LIMIT`: `|v| <= BARY_LIMIT` iff it is at most `2 BARY_LIMIT`
@@ -1909,6 +1911,19 @@ mod tests {
     /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
     /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
     /// small and positive), so that many lanes of the held loop need the clamp of `p_i`.
+    /// [`clamp_four`] clamps and counts each derivative beyond +-[`BARY_LIMIT`] and passes
+    /// the others (the span datapath's derivatives never reach it).
+    #[test]
+    fn clamp_four_clamps_and_counts_each_derivative_beyond_the_limit() {
+        let mut sat = SatCounter::default();
+        let within = [BARY_LIMIT, -BARY_LIMIT, 0, -5];
+        assert_eq!(clamp_four(within, &mut sat), within);
+        assert_eq!(sat.saturated, 0);
+        let d = [BARY_LIMIT + 1, -3, i64::MIN / 2, 7];
+        assert_eq!(clamp_four(d, &mut sat), [BARY_LIMIT, -3, -BARY_LIMIT, 7]);
+        assert_eq!(sat.saturated, 2);
+    }
+
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
