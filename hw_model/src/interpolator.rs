@@ -712,7 +712,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                             rd
                         }
                     };
-                    let d = clamp_four(
+                    let dp = clamp_four(
                         [
                             derivative_held::<M>(nx[0].0, r2, &rd[0]),
                             derivative_held::<M>(nx[1].0, r2, &rd[1]),
@@ -721,7 +721,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                         ],
                         sat,
                     );
-                    (p1 + d[0], p2 + d[1], p1 + d[2], p2 + d[3])
+                    (p1 + dp[0], p2 + dp[1], p1 + dp[2], p2 + dp[3])
                 } else {
                     (
                         p1 + derivative_of_top::<M>(nx[0], r2, bb, sat),
@@ -912,7 +912,7 @@ fn clamp_four(d: [i64; 4], sat: &mut SatCounter) -> [i64; 4] {
 #[inline(never)]
 fn clamp_each(d: [i64; 4], sat: &mut SatCounter) -> [i64; 4] {
     d.map(|v| {
-        if bary_offset(v) > 2 * BARY_LIMIT as u64 {
+        if v.unsigned_abs() > BARY_LIMIT as u64 {
             clamp_counted(v, sat)
         } else {
             v
@@ -1903,14 +1903,6 @@ mod tests {
         assert!(held > 50_000 && nonzero > 10_000, "{held} {nonzero}");
     }
 
-    /// 480k seeded spans of 1 to 24 lanes over 6 configurations x 3 interpolator roundings,
-    /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
-    /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
-    /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
-    /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
-    /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
-    /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
-    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`.
     /// [`clamp_four`] clamps and counts each derivative beyond +-[`BARY_LIMIT`] and passes
     /// the others (the span datapath's derivatives never reach it).
     #[test]
@@ -1924,6 +1916,14 @@ mod tests {
         assert_eq!(sat.saturated, 2);
     }
 
+    /// 480k seeded spans of 1 to 24 lanes over 6 configurations x 3 interpolator roundings,
+    /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
+    /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
+    /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
+    /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
+    /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
+    /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
+    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`.
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
