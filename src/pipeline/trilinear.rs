@@ -42,8 +42,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         c.cost[k] = per_pixel_probes(c.cost[k], m, took);
     }
     let tb = m.hw.trilinear.texel_bits;
-    frag.texel_x = r.map(u32::from);
-    frag.out_x = frag.texel_x;
+    let texel = r.map(u32::from);
+    frag.texel_x = texel;
+    frag.out_x = texel;
     frag.out_bits = tb;
     if px.carriers {
         frag.texel = frag.texel_x.map(|x| unorm(x, tb));
@@ -97,9 +98,12 @@ fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     };
     for frag in frags.iter_mut() {
         let [u, v] = frag.uv_x[0];
-        frag.texel_x =
+        // Both fields from the value: reading `texel_x` back after its four 32-bit stores
+        // stalled on store forwarding (a 128-bit load over four stores).
+        let texel =
             unit_traced::<F, W, POW2_REPEAT>(unit, levels, u, v, frag.lod_x, &mut frag.trace, at);
-        frag.out_x = frag.texel_x;
+        frag.texel_x = texel;
+        frag.out_x = texel;
         frag.out_bits = tb;
         if carriers {
             frag.texel = frag.texel_x.map(|x| unorm(x, tb));
