@@ -49,9 +49,9 @@
 //! - Float coverage draws only the triangles fixed setup kept (same list, same culling
 //!   decision); a sliver whose snapped orientation is flipped (`area2_f < 0`) is drawn in float
 //!   with its own orientation. Float depth is f64, cleared to 1.0, strictly-less as well.
-//! - Traversal runs on bands of `BAND_ROWS` rows in parallel; triangles are binned per band in
-//!   submission order and each band owns its rows, so the output is bit-identical for any
-//!   thread count.
+//! - Traversal runs on bands of rows in parallel (16 to 64 rows, [`band_rows`]); triangles
+//!   are binned per band in submission order and each band owns its rows, so the output is
+//!   bit-identical for any thread count and band size.
 
 mod setup;
 mod traverse;
@@ -61,5 +61,5 @@ pub use setup::{
     setup, DrawTri, ScreenTri, Setup, SetupStats, VertexSource, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
 };
 pub use traverse::{
-    coverage_count, rasterize, Coverage, RasterStats, VisBuffer, BAND_ROWS, NO_TRI,
+    band_rows, coverage_count, rasterize, Coverage, RasterStats, VisBuffer, BAND_ROWS, NO_TRI,
 };

@@ -8,8 +8,20 @@ use rayon::prelude::*;
 
 /// No triangle covers this pixel.
 pub const NO_TRI: u32 = u32::MAX;
-/// Rows per parallel band.
-pub const BAND_ROWS: u32 = 16;
+/// Fewest and most rows per parallel band ([`band_rows`]).
+pub const BAND_ROWS: (u32, u32) = (16, 64);
+
+/// Rows per parallel band of an image `height` rows high on `threads` threads: about eight
+/// bands per thread, within [`BAND_ROWS`]. A triangle is set up again in each band it
+/// reaches, so fewer bands cost less where the threads do not need them: W2 (65,536
+/// triangles, 1024 rows) rasterized in 11.5-12.5 ms with 64 rows against 12.5-13.3 ms with
+/// 16 on one thread, and 5.7-6.4 against 6.3-7.2 ms on two. The output does not depend on
+/// the band size: each pixel is in one band, which walks its triangles in submission order.
+#[must_use]
+pub fn band_rows(height: u32, threads: usize) -> u32 {
+    let per_thread = height / (8 * threads.max(1)).min(u32::MAX as usize) as u32;
+    per_thread.clamp(BAND_ROWS.0, BAND_ROWS.1)
+}
 
 /// Which coverage and depth model traversal uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -455,14 +467,15 @@ struct BandIds<'a> {
 /// Triangles per parallel binning task.
 const BIN_CHUNK: usize = 16384;
 
-fn bin(setup: &Setup, bands: usize) -> Bins {
+/// The triangles of `setup` binned into `bands` bands of `per_band` rows.
+fn bin(setup: &Setup, per_band: u32, bands: usize) -> Bins {
     let band_range = |t: &ScreenTri| -> Option<(usize, usize)> {
         let y0 = t.bbox[1];
         let y1 = t.bbox[3].min(setup.height);
         if y0 >= y1 || t.bbox[0] >= t.bbox[2].min(setup.width) {
             return None;
         }
-        Some(((y0 / BAND_ROWS) as usize, ((y1 - 1) / BAND_ROWS) as usize))
+        Some(((y0 / per_band) as usize, ((y1 - 1) / per_band) as usize))
     };
     let lists = setup
         .tris
@@ -651,13 +664,14 @@ fn run(setup: &Setup, coverage: Coverage, out: &mut [u32], vis: Option<bool>) ->
     if w == 0 || h == 0 {
         return RasterStats::default();
     }
-    let bands = h.div_ceil(BAND_ROWS) as usize;
-    let bins = bin(setup, bands);
-    out.par_chunks_mut(BAND_ROWS as usize * w)
+    let per_band = band_rows(h, rayon::current_num_threads());
+    let bands = h.div_ceil(per_band) as usize;
+    let bins = bin(setup, per_band, bands);
+    out.par_chunks_mut(per_band as usize * w)
         .enumerate()
         .map(|(b, rows)| {
-            let y0 = b as u32 * BAND_ROWS;
-            let y1 = (y0 + BAND_ROWS).min(h);
+            let y0 = b as u32 * per_band;
+            let y1 = (y0 + per_band).min(h);
             let ids = BandIds {
                 bins: &bins,
                 band: b,

@@ -3,7 +3,9 @@
 use crate::raster_common::*;
 use glam::{DMat4, DVec3};
 use std::time::Instant;
-use texsim::raster::{coverage_count, rasterize, setup, Coverage, DrawTri, Setup, NO_TRI};
+use texsim::raster::{
+    band_rows, coverage_count, rasterize, setup, Coverage, DrawTri, Setup, NO_TRI,
+};
 
 fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new()
@@ -50,14 +52,22 @@ fn random_scene(seed: u64, n: usize, w: u32, h: u32) -> Setup {
     setup(&v, &d, w, h, &cfg(8, 24))
 }
 
+/// The bands' height follows the thread count (`band_rows`): 64, 37 and 18 rows for the
+/// 600-row image on 1, 2 and 4 threads, 31, 16 and 16 for the 250-row one.
 #[test]
 fn identical_for_any_thread_count() {
-    for (seed, w, h) in [(1u64, 333u32, 250u32), (2, 128, 17), (3, 64, 300)] {
+    for (seed, w, h) in [
+        (1u64, 333u32, 250u32),
+        (2, 128, 17),
+        (3, 64, 300),
+        (5, 96, 600),
+    ] {
         let s = random_scene(seed, 4000, w, h);
         for cov in [Coverage::Fixed, Coverage::Float] {
             for depth in [true, false] {
                 let r1 = in_pool(1, || rasterize(&s, cov, depth));
                 for threads in [2, 4] {
+                    assert!(h < 32 || band_rows(h, threads) < band_rows(h, 1));
                     let r = in_pool(threads, || rasterize(&s, cov, depth));
                     assert_eq!(r.0, r1.0, "{cov:?} depth={depth} threads={threads}");
                     assert_eq!(r.1, r1.1);
