@@ -520,9 +520,10 @@ fn cross_float(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
 /// Pixel range [lo, hi) whose centres may lie in [min, max] (snapped units).
 fn pixel_range_fixed(min: i64, max: i64, s: u32, limit: u32) -> (i64, i64) {
     let h = 1i64 << (s - 1);
-    let step = 1i64 << s;
-    let lo = -((-(min - h)).div_euclid(step));
-    let hi = (max - h).div_euclid(step) + 1;
+    // `floor(x / 2^s)` is the arithmetic shift `x >> s` (a division by `1 << s` with `s`
+    // known only at run time is a divide instruction).
+    let lo = -((h - min) >> s);
+    let hi = ((max - h) >> s) + 1;
     (lo.max(0), hi.min(i64::from(limit)))
 }
 
