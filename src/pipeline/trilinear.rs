@@ -42,9 +42,8 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
         c.cost[k] = per_pixel_probes(c.cost[k], m, took);
     }
     let tb = m.hw.trilinear.texel_bits;
-    let texel = r.map(u32::from);
-    frag.texel_x = texel;
-    frag.out_x = texel;
+    frag.texel_x = r.map(u32::from);
+    frag.out_x = frag.texel_x;
     frag.out_bits = tb;
     if px.carriers {
         frag.texel = frag.texel_x.map(|x| unorm(x, tb));
@@ -98,12 +97,9 @@ fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     };
     for frag in frags.iter_mut() {
         let [u, v] = frag.uv_x[0];
-        // Both fields from the value: reading `texel_x` back after its four 32-bit stores
-        // stalled on store forwarding (a 128-bit load over four stores).
-        let texel =
+        frag.texel_x =
             unit_traced::<F, W, POW2_REPEAT>(unit, levels, u, v, frag.lod_x, &mut frag.trace, at);
-        frag.texel_x = texel;
-        frag.out_x = texel;
+        frag.out_x = frag.texel_x;
         frag.out_bits = tb;
         if carriers {
             frag.texel = frag.texel_x.map(|x| unorm(x, tb));
