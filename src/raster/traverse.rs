@@ -19,8 +19,8 @@ pub const BAND_ROWS: (u32, u32) = (16, 64);
 /// the band size: each pixel is in one band, which walks its triangles in submission order.
 #[must_use]
 pub fn band_rows(height: u32, threads: usize) -> u32 {
-    let per_thread = height / (8 * threads.max(1)).min(u32::MAX as usize) as u32;
-    per_thread.clamp(BAND_ROWS.0, BAND_ROWS.1)
+    let bands = u32::try_from(8 * threads.max(1)).unwrap_or(u32::MAX);
+    (height / bands).clamp(BAND_ROWS.0, BAND_ROWS.1)
 }
 
 /// Which coverage and depth model traversal uses.
