@@ -829,10 +829,7 @@ fn derivative_of_top<M: ConstRounding>(
     } else {
         apply_in::<M>(r2, x, bary_bits + ns)
     };
-    if v.unsigned_abs() > BARY_LIMIT as u64 {
-        return clamp_counted(v, sat);
-    }
-    v
+    clamp_derivative(v, sat)
 }
 
 /// [`derivative_of_top`] when `r2`'s mantissa is below 2^31 and `sh = r2.shift - (bary_bits +
@@ -849,10 +846,7 @@ fn derivative_short<M: ConstRounding>(
     let sh = r2.shift - (bary_bits + ns) as i32;
     debug_assert!(r2.mant >> 31 == 0 && (64..126).contains(&sh));
     let v = round_shift_right_mid::<M>(product_top(x, r2), (sh - 62) as u32);
-    if v.unsigned_abs() > BARY_LIMIT as u64 {
-        return clamp_counted(v, sat);
-    }
-    v
+    clamp_derivative(v, sat)
 }
 
 /// `x * r2.mant` (|x| <= 2^94, a mantissa below 2^31) from bit 62 up, the 62 bits below
@@ -911,13 +905,16 @@ fn clamp_four(d: [i64; 4], sat: &mut SatCounter) -> [i64; 4] {
 #[cold]
 #[inline(never)]
 fn clamp_each(d: [i64; 4], sat: &mut SatCounter) -> [i64; 4] {
-    d.map(|v| {
-        if v.unsigned_abs() > BARY_LIMIT as u64 {
-            clamp_counted(v, sat)
-        } else {
-            v
-        }
-    })
+    d.map(|v| clamp_derivative(v, sat))
+}
+
+/// A derivative clamped to +-[`BARY_LIMIT`], the clamp counted ([`clamp_counted`]).
+#[inline(always)]
+fn clamp_derivative(v: i64, sat: &mut SatCounter) -> i64 {
+    if v.unsigned_abs() > BARY_LIMIT as u64 {
+        return clamp_counted(v, sat);
+    }
+    v
 }
 
 /// A derivative beyond +-[`BARY_LIMIT`]: the clamp, counted.

@@ -740,7 +740,6 @@ pub(crate) fn vec_populated<T>(n: usize) -> Vec<T> {
     let v: Vec<T> = Vec::with_capacity(n);
     #[cfg(target_os = "linux")]
     {
-        const PAGE: usize = 4096;
         const PIECE: usize = 2 << 20;
         let bytes = n.saturating_mul(std::mem::size_of::<T>());
         let start = v.as_ptr() as usize;
@@ -773,11 +772,17 @@ pub(crate) fn vec_populated<T>(n: usize) -> Vec<T> {
     v
 }
 
+/// The page size `vec_populated` and `resident_pages` assume (Linux on x86-64). With larger
+/// pages `mincore` writes fewer bytes and the population is a less precise hint; no content
+/// changes.
+#[cfg(target_os = "linux")]
+const PAGE: usize = 4096;
+
 /// Whether each page of the `len` bytes from the page-aligned `addr` is resident (bit 0 of its
 /// byte, Linux `mincore`); `None` if the call fails (every page then counts as not resident).
 #[cfg(target_os = "linux")]
 fn resident_pages(addr: usize, len: usize) -> Option<Vec<u8>> {
-    let mut pages = vec![0u8; len.div_ceil(4096)];
+    let mut pages = vec![0u8; len.div_ceil(PAGE)];
     // SAFETY: [addr, addr + len) is page-aligned and lies inside an allocation of the caller;
     // `pages` has one byte per page of it, which is all `mincore` writes.
     let rc = unsafe { libc::mincore(addr as *mut libc::c_void, len, pages.as_mut_ptr()) };
@@ -950,7 +955,7 @@ mod tests {
         }
         #[cfg(target_os = "linux")]
         {
-            let page = |v: &[u8]| (v.as_ptr() as usize).next_multiple_of(4096);
+            let page = |v: &[u8]| (v.as_ptr() as usize).next_multiple_of(PAGE);
             let written = vec![1u8; 1 << 22];
             let r = resident_pages(page(&written), 1 << 21).expect("mincore");
             assert!(r.iter().all(|&b| b & 1 == 1));
