@@ -7,17 +7,18 @@ about as many times as it has spans is work per span. This sums each function's 
 instructions (inlined code included, callees not) into those classes and prints, per class,
 the instructions per event:
 
+    cargo build --profile profiling
     valgrind --tool=callgrind --dump-instr=yes --callgrind-out-file=cg.out \\
         target/profiling/texsim --threads 1 render --scene w2-mesh --no-reference \\
         --no-cycles --warmup 0 --frames 1
     python3 scripts/callgrind_split.py cg.out fragment=685714 span=165055
 
-(the counts are the render's `fragments` shaded and its spans: `visible` and the shading
-spans, e.g. from callgrind's call count of `bary::fixed_span`). An instruction is put in the
-class whose count is nearest to its own on a log scale, if within a factor of four of it (a
-fragment's three samples count as per fragment, three times; a second texture level run by
-half the fragments, at half weight); the rest is "other". Build with `cargo build --profile profiling` for function names that
-survive inlining.
+The counts are the frame's shaded fragments (`visible` in summary.json) and its shading spans
+(e.g. callgrind's call count of `bary::fixed_span`). An instruction goes to the class whose
+count is nearest to its own on a log scale, if within a factor of four of it (a fragment's
+three samples count as per fragment, three times; a second texture level run by half the
+fragments, at half weight); the rest is "other". The profiling build keeps the function names
+that inlining would otherwise merge.
 """
 import argparse
 import collections
@@ -27,13 +28,16 @@ import sys
 
 
 def parse_counts(path):
-    """{function name: {instruction address: execution count}} of the functions' own costs."""
+    """{function name: {instruction address: execution count}} of the functions' own costs
+    (the `Ir` event at each instruction address)."""
     names = {}
+    ir = None
     own = collections.defaultdict(lambda: collections.defaultdict(int))
     fn = None
     addr = 0
     after_calls = False
     name_line = re.compile(r"(c?fn)=\((\d+)\)(?: (.*))?$")
+    positions = ["line"]
 
     def position(tok, prev):
         if tok == "*":
@@ -46,6 +50,19 @@ def parse_counts(path):
     with open(path) as f:
         for line in f:
             line = line.rstrip("\n")
+            if line.startswith("positions:"):
+                positions = line.split()[1:]
+                continue
+            if line.startswith("events:"):
+                if positions[:1] != ["instr"]:
+                    sys.exit(f"callgrind_split: '{path}' has no instruction addresses "
+                             "(record with --dump-instr=yes)")
+                events = line.split()[1:]
+                if "Ir" not in events:
+                    sys.exit(f"callgrind_split: '{path}' has no Ir event")
+                # A cost line is the positions, then the events in this order.
+                ir = len(positions) + events.index("Ir")
+                continue
             m = name_line.match(line)
             if m:
                 kind, ident, name = m.groups()
@@ -65,8 +82,9 @@ def parse_counts(path):
                 # The cost line of a call: the callee's inclusive cost, not this function's.
                 after_calls = False
                 continue
-            if fn is not None and len(fields) >= 3:
-                own[fn][addr] += int(fields[-1])
+            # Trailing zero costs may be left out of a line.
+            if fn is not None and ir is not None and len(fields) > ir:
+                own[fn][addr] += int(fields[ir])
     return own
 
 
