@@ -4,7 +4,8 @@
 # Needs the anchor built once: (cd ../shared/anchors/mesa && ./build.sh), which needs
 #   apt-get install -y gcc pkg-config libosmesa6-dev libpng-dev
 # Usage: scripts/compare_mesa.sh [REPEATS]    (prints one line per configuration: the median
-# of REPEATS runs, then the issue-12 ratios at equal thread counts)
+# of REPEATS runs, then the issue-12 ratios at equal thread counts: the ratio of the medians and
+# the range of the ratios within each repeat, whose runs ran side by side)
 # Frames: the Mesa anchor times 5 frames after 1 warm-up frame in one process and takes their
 # median; texsim-hw and texsim-ref do the same (`texsim render --warmup 1 --frames 5`), and
 # texsim-cold is the bit-accurate path's first frame in a fresh process (`--frames 1`), which also
@@ -33,15 +34,15 @@ texsim() { # $1 scene, $2 threads, $3 path (hw: bit-accurate, ref: the float sta
     ./target/release/texsim --threads "$2" render --scene "$1" "${extra[@]}" --out target/compare-out 2>/dev/null |
         grep -o 'wall time: hardware path [0-9.]*' | awk '{print $5}'
 }
-for _ in $(seq "$REPEATS"); do
+for r in $(seq "$REPEATS"); do
     for w in plane:w1-plane mesh:w2-mesh; do
         m=${w%%:*}; s=${w##*:}
-        echo "$s softpipe $(mesa "$m" softpipe '')" >>"$raw"
-        echo "$s llvmpipe-t1 $(mesa "$m" llvmpipe 0)" >>"$raw"
-        echo "$s llvmpipe-t2 $(mesa "$m" llvmpipe 2)" >>"$raw"
+        echo "$r $s softpipe $(mesa "$m" softpipe '')" >>"$raw"
+        echo "$r $s llvmpipe-t1 $(mesa "$m" llvmpipe 0)" >>"$raw"
+        echo "$r $s llvmpipe-t2 $(mesa "$m" llvmpipe 2)" >>"$raw"
         for t in 1 2; do
             for p in hw ref cold; do
-                echo "$s texsim-$p-t$t $(texsim "$s" "$t" "$p")" >>"$raw"
+                echo "$r $s texsim-$p-t$t $(texsim "$s" "$t" "$p")" >>"$raw"
             done
         done
     done
@@ -50,15 +51,24 @@ declare -A med
 for s in w1-plane w2-mesh; do
     for c in softpipe llvmpipe-t1 llvmpipe-t2 texsim-hw-t1 texsim-ref-t1 texsim-cold-t1 texsim-hw-t2 \
         texsim-ref-t2 texsim-cold-t2; do
-        med[$s/$c]=$(awk -v s="$s" -v c="$c" '$1 == s && $2 == c {print $3}' "$raw" | median)
+        med[$s/$c]=$(awk -v s="$s" -v c="$c" '$2 == s && $3 == c {print $4}' "$raw" | median)
         printf "%-9s %-14s %8.1f ms\n" "$s" "$c" "${med[$s/$c]}"
     done
 done
-echo "ratios (issue 12 asks bit-accurate <= 3x llvmpipe on W1, <= 1.5x on W2, and <= the float path):"
+echo "ratios (issue 12 asks bit-accurate <= 3x llvmpipe on W1, <= 1.5x on W2, and <= the float path;"
+echo "        in brackets the lowest and highest ratio within one repeat):"
+# The lowest and highest ratio `num / den` of configurations `num` and `den` of scene `s` within
+# one repeat.
+spread() {
+    awk -v s="$1" -v num="$2" -v den="$3" '$2 == s && $3 == num {n[$1] = $4} $2 == s && $3 == den {d[$1] = $4}
+        END {for (r in n) if ((r in d) && d[r] > 0) {q = n[r] / d[r]; lo = (lo == "" || q < lo) ? q : lo; hi = (q > hi) ? q : hi}
+             printf "%.2fx-%.2fx", lo, hi}' "$raw"
+}
 for s in w1-plane w2-mesh; do
     for t in 1 2; do
         awk -v s="$s" -v t="$t" -v hw="${med[$s/texsim-hw-t$t]}" -v lp="${med[$s/llvmpipe-t$t]}" \
             -v ref="${med[$s/texsim-ref-t$t]}" -v cold="${med[$s/texsim-cold-t$t]}" \
-            'BEGIN {printf "%-9s %d thread(s): bit-accurate / llvmpipe %5.2fx, bit-accurate / float path %5.2fx, first frame / llvmpipe %5.2fx\n", s, t, hw / lp, hw / ref, cold / lp}'
+            -v lps="$(spread "$s" "texsim-hw-t$t" "llvmpipe-t$t")" -v refs="$(spread "$s" "texsim-hw-t$t" "texsim-ref-t$t")" \
+            'BEGIN {printf "%-9s %d thread(s): bit-accurate / llvmpipe %5.2fx [%s], bit-accurate / float path %5.2fx [%s], first frame / llvmpipe %5.2fx\n", s, t, hw / lp, lps, hw / ref, refs, cold / lp}'
     done
 done
