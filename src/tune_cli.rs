@@ -175,20 +175,27 @@ pub fn summary_text(r: &TuneResult, texram16_area: u64) -> String {
     );
     let _ = writeln!(
         o,
-        "{:<34} {:>6} {:>6} {:>6}",
-        "knob", "found", "base", "least"
+        "{:<34} {:>6} {:>6} {:>6} {:>9}",
+        "knob", "found", "base", "least", "exercised"
     );
-    for (k, v) in r.knobs.iter().zip(&best.values) {
+    for (i, (k, v)) in r.knobs.iter().zip(&best.values).enumerate() {
+        let exercised = r.exercised.get(i).copied().unwrap_or(true);
         let _ = writeln!(
             o,
-            "{:<34} {:>6} {:>6} {:>6}{}",
+            "{:<34} {:>6} {:>6} {:>6} {:>9}{}",
             k.field,
             v,
             k.hi,
             k.lo,
+            if exercised { "yes" } else { "no" },
             if *v == k.hi { "" } else { "  *" }
         );
     }
+    let _ = writeln!(
+        o,
+        "*: found differs from base; exercised no: the knob's least value moved no metric of \
+         any scene (its unit is unused there): add a scene that uses it before trusting that width"
+    );
     o
 }
 

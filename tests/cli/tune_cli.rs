@@ -38,6 +38,23 @@ fn tune_writes_its_trials_and_a_machine_render_accepts() {
     assert_eq!(grid, 17.0 * 16.0 * 17.0, "{line}");
     assert!(renders > 0.0 && renders < grid / 10.0, "{line}");
     assert!(out.contains("verified (knobs vs base): #"), "{out}");
+    // The knob table: each knob's found, base and least value and whether the scene exercises it.
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("knob ") && l.ends_with(" exercised")),
+        "{out}"
+    );
+    for knob in ["weight_bits", "texel_bits", "lod_frac_bits"] {
+        let row = out
+            .lines()
+            .find(|l| {
+                l.split_whitespace()
+                    .next()
+                    .is_some_and(|f| f.ends_with(knob))
+            })
+            .unwrap_or_else(|| panic!("no row of {knob}: {out}"));
+        assert_eq!(row.split_whitespace().nth(4), Some("yes"), "{row}");
+    }
     for f in ["tune.json", "tune.csv", "tuned.toml"] {
         assert!(d.join("t").join(f).is_file(), "{f}");
     }
