@@ -70,6 +70,16 @@ pub const BYTES_PER_PIXEL: u64 = 32;
 /// side-by-side sheet and their PNGs (measured in all: about 45 B per pixel on w2-mesh at
 /// 2048x2048).
 pub const BYTES_PER_REFERENCE_PIXEL: u64 = 32;
+/// Bytes per triangle, vertex and pixel of the float passes' exact depth test when the
+/// machine's depth buffer is narrower (`render`'s `exact_depth_vis`): the triangles set up
+/// again with 30-bit depths (the screen triangle, its outcome and order), the vertices'
+/// projections, and the second visibility buffer with its depth while it is rasterized.
+pub const BYTES_PER_EXACT_DEPTH_TRIANGLE: u64 =
+    std::mem::size_of::<crate::raster::ScreenTri>() as u64 + 16;
+/// ...per vertex...
+pub const BYTES_PER_EXACT_DEPTH_VERTEX: u64 = 48;
+/// ...and per pixel.
+pub const BYTES_PER_EXACT_DEPTH_PIXEL: u64 = 8;
 /// Bytes per pixel of the timing model's event stream: the pixel event and its bookkeeping...
 pub const BYTES_PER_EVENT_PIXEL: u64 = 16;
 /// ...and per texture lookup of the most demanding material, two bilinear footprints (24 B
@@ -232,8 +242,25 @@ impl RunNeed {
                 Some(mul(u64::from(t.width) * u64::from(t.height), k))
             })
             .fold(0u64, u64::saturating_add);
+        // The float passes' exact depth test sets the scene up and rasterizes it again.
+        let exact_depth = reference && hw.raster.depth_bits < crate::raster::MAX_DEPTH_BITS;
+        let (exact_tris, exact_pixels) = if exact_depth {
+            let (tris, verts) = scene.meshes.iter().fold((0u64, 0u64), |(t, v), m| {
+                (
+                    t.saturating_add(m.indices.len() as u64),
+                    v.saturating_add(m.positions.len() as u64),
+                )
+            });
+            (
+                mul(tris, BYTES_PER_EXACT_DEPTH_TRIANGLE)
+                    .saturating_add(mul(verts, BYTES_PER_EXACT_DEPTH_VERTEX)),
+                mul(pixels, BYTES_PER_EXACT_DEPTH_PIXEL),
+            )
+        } else {
+            (0, 0)
+        };
         Self {
-            triangles: mesh_bytes(scene),
+            triangles: mesh_bytes(scene).saturating_add(exact_tris),
             texels: mul(texels, BYTES_PER_TEXEL)
                 .saturating_add(mul(lobe_texels, BYTES_PER_LOBE_TEXEL)),
             framebuffer: mul(
@@ -244,7 +271,8 @@ impl RunNeed {
                     } else {
                         0
                     },
-            ),
+            )
+            .saturating_add(exact_pixels),
             events: if timing {
                 let per_pixel = BYTES_PER_EVENT_PIXEL
                     + BYTES_PER_EVENT_LOOKUP * u64::from(max_lookups(scene, hw));

@@ -58,7 +58,8 @@ mod traverse;
 
 pub(crate) use setup::vec_populated;
 pub use setup::{
-    setup, DrawTri, ScreenTri, Setup, SetupStats, VertexSource, GUARD_BAND, MAX_VIEWPORT, W_EPSILON,
+    setup, DrawTri, ScreenTri, Setup, SetupStats, VertexSource, GUARD_BAND, MAX_DEPTH_BITS,
+    MAX_VIEWPORT, W_EPSILON,
 };
 pub use traverse::{
     band_rows, coverage_count, rasterize, Coverage, RasterStats, VisBuffer, BAND_ROWS, NO_TRI,

@@ -622,6 +622,9 @@ struct Ctx<'a> {
     vp: Viewport,
 }
 
+/// The widest depth buffer the rasterizer models (`depth_bits` is clamped to 8..=30).
+pub const MAX_DEPTH_BITS: u32 = 30;
+
 /// Sets up every triangle of `draws` (see the module header for the conventions).
 /// `width`/`height` are clamped to `0..=MAX_VIEWPORT`, the config widths to their valid ranges.
 ///
@@ -639,7 +642,7 @@ pub fn setup(
     let width = width.min(MAX_VIEWPORT);
     let height = height.min(MAX_VIEWPORT);
     let s = cfg.subpixel_bits.clamp(1, 12);
-    let depth_bits = cfg.depth_bits.clamp(8, 30);
+    let depth_bits = cfg.depth_bits.clamp(8, MAX_DEPTH_BITS);
     let vp = Viewport {
         w: f64::from(width),
         h: f64::from(height),

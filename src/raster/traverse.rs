@@ -533,7 +533,7 @@ fn band(
             let n = ((y1 - y0) as usize) * w;
             match coverage {
                 Coverage::Fixed => {
-                    let zmax = (1u32 << setup.depth_bits.clamp(8, 30)) - 1;
+                    let zmax = (1u32 << setup.depth_bits.clamp(8, super::MAX_DEPTH_BITS)) - 1;
                     let mut depth = vec![zmax; if depth_test { n } else { 0 }];
                     for_spans(setup, ids, y0, y1, coverage, s, |id, py, xl, xr, span| {
                         st.spans += 1;

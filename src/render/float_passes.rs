@@ -12,7 +12,8 @@ use std::sync::Arc;
 /// The widths that reach the float passes: the stored encodings both passes read (bump
 /// offsets, NDF moments and their variance floor) and the degenerate-frame threshold, which
 /// the float frame applies too. The rasterizer's fields reach them as well (they pick the
-/// fragments both passes shade).
+/// fragments both passes shade), but for `depth_bits`: the float passes' depth test is exact
+/// (`render::exact_depth_vis`).
 const FLOAT_WIDTHS: [&str; 5] = [
     "shading.vector.offset_int_bits",
     "ndf.moment_bits",
@@ -22,8 +23,8 @@ const FLOAT_WIDTHS: [&str; 5] = [
 ];
 
 /// True for the hw config fields (dotted paths) that do not reach the float passes (the
-/// reference and the ground truth): the timing model's, and every width
-/// ([`crate::hwconfig::is_width`]) but the rasterizer's and [`FLOAT_WIDTHS`]. Two machines
+/// reference and the ground truth): the timing model's, the depth buffer's width, and every
+/// width ([`crate::hwconfig::is_width`]) but the rasterizer's and [`FLOAT_WIDTHS`]. Two machines
 /// that differ only in such fields have the same float passes, so a sweep or a search over
 /// them renders those once ([`FloatPasses`]). `tests/scenes/float_passes.rs` renders every
 /// built-in scene with all of them changed at once and checks that both passes keep their
@@ -31,6 +32,7 @@ const FLOAT_WIDTHS: [&str; 5] = [
 #[must_use]
 pub fn float_blind(path: &str) -> bool {
     path.starts_with("timing.")
+        || path == "raster.depth_bits"
         || (crate::hwconfig::is_width(path)
             && !path.starts_with("raster.")
             && !FLOAT_WIDTHS.contains(&path))
@@ -48,6 +50,9 @@ pub struct FloatPasses {
     truth_samples: u32,
     pub(super) reference: Option<(Image, u64)>,
     pub(super) truth: Option<Image>,
+    /// The pixels compared with them: those the hardware or the float passes covered (the
+    /// float passes' depth test is exact, so they may cover more).
+    pub(super) mask: Vec<bool>,
 }
 
 impl FloatPasses {
@@ -66,6 +71,7 @@ impl FloatPasses {
                 .clone()
                 .map(|img| (img, r.stats.bump.ref_nonfinite)),
             truth: r.truth_image.clone(),
+            mask: r.mask.clone(),
         })
     }
 
@@ -119,7 +125,9 @@ impl<K: Hash + Eq> FloatPassCache<K> {
     /// key has some or they do not fit the budget.
     pub fn keep(&mut self, key: K, scene: &Scene, r: &Rendered, opts: &RenderOptions) {
         let px = |img: &Image| (img.px.len() * std::mem::size_of::<[u16; 4]>()) as u64;
-        let bytes = r.ref_image.as_ref().map_or(0, px) + r.truth_image.as_ref().map_or(0, px);
+        let bytes = r.ref_image.as_ref().map_or(0, px)
+            + r.truth_image.as_ref().map_or(0, px)
+            + r.mask.len() as u64;
         if self.kept.contains_key(&key) || self.bytes + bytes > self.budget {
             return;
         }

@@ -235,6 +235,17 @@ pub fn render(
     let (vis, raster_stats) = raster::rasterize(&setup, Coverage::Fixed, true);
     tm.raster_ms = ms(t);
     progress("raster", tm.raster_ms);
+    // The float passes of Shared coverage shade the hardware's fragments with the depth test
+    // at full precision, the depth buffer's float twin: `Some` when that picks other surfaces.
+    let t = Instant::now();
+    let exact_vis = exact_vis_ran(opts, kept.is_some(), hw)
+        .then(|| exact_depth_vis(&geo, scene, hw, &setup, &vis))
+        .flatten();
+    let exact_ms = ms(t);
+    if exact_vis_ran(opts, kept.is_some(), hw) {
+        progress("exact depth test", exact_ms);
+    }
+    let float_vis = exact_vis.as_ref().unwrap_or(&vis);
 
     // The attributes (part of the setup's time) after the raster, which needs only the screen
     // triangles: when the hardware pass is the frame's only shading pass, the triangles it
@@ -295,7 +306,18 @@ pub fn render(
     progress("hardware shading", tm.shade_hw_ms);
     tm.hw_total_ms = tm.setup_ms + tm.raster_ms + tm.shade_hw_ms;
 
-    let mut mask: Vec<bool> = vis.tri.iter().map(|&t| t != NO_TRI).collect();
+    // The compared pixels: those the hardware or the float passes cover.
+    let mut mask: Vec<bool> = vis
+        .tri
+        .iter()
+        .zip(&float_vis.tri)
+        .map(|(&h, &f)| h != NO_TRI || f != NO_TRI)
+        .collect();
+    if let Some(fp) = kept {
+        for (mk, &k) in mask.iter_mut().zip(&fp.mask) {
+            *mk |= k;
+        }
+    }
     let mut ref_image = None;
     let mut ref_nonfinite = 0;
     let (mut e8, mut e16) = (None, None);
@@ -309,8 +331,8 @@ pub fn render(
         let ref_vis;
         let rv = match opts.coverage {
             CoverageMode::Shared => {
-                tm.raster_ref_ms = tm.raster_ms;
-                &vis
+                tm.raster_ref_ms = tm.raster_ms + exact_ms;
+                float_vis
             }
             CoverageMode::Independent => {
                 let t = Instant::now();
@@ -359,7 +381,7 @@ pub fn render(
             .with_f32_tris(&ftris)
             .with_ndf_truth(&ndf_truth);
         let tin = ShadeInput {
-            vis: &vis,
+            vis: float_vis,
             setup: &setup,
             attrs: &attrs,
             floats: &floats,
@@ -484,4 +506,35 @@ pub fn render(
             },
         },
     })
+}
+
+/// Whether a render runs [`exact_depth_vis`]: its own float passes (none `kept`) with shared
+/// coverage, on a depth buffer narrower than [`raster::MAX_DEPTH_BITS`].
+fn exact_vis_ran(opts: &RenderOptions, kept: bool, hw: &HwConfig) -> bool {
+    !kept
+        && (opts.reference || opts.truth > 0)
+        && opts.coverage == CoverageMode::Shared
+        && hw.raster.depth_bits < raster::MAX_DEPTH_BITS
+}
+
+/// The visibility of `vis`'s fragments with the depth test at full precision (the depth
+/// buffer's float twin): the triangles of `setup` set up again with
+/// [`raster::MAX_DEPTH_BITS`]-bit vertex depths and rasterized (the same triangles in the same
+/// order, the same edges, hence the same fragments). `None` when it picks the surface `vis`
+/// shows at every pixel (at 24 bits on every built-in scene).
+fn exact_depth_vis(
+    geo: &Geometry,
+    scene: &Scene,
+    hw: &HwConfig,
+    setup: &raster::Setup,
+    vis: &raster::VisBuffer,
+) -> Option<raster::VisBuffer> {
+    let cfg = hw_model::config::RasterConfig {
+        depth_bits: raster::MAX_DEPTH_BITS,
+        ..hw.raster.clone()
+    };
+    let exact = raster::setup(&geo.clip, &geo.draws, scene.width, scene.height, &cfg);
+    debug_assert_eq!(exact.tris.len(), setup.tris.len());
+    let exact = raster::rasterize(&exact, Coverage::Fixed, true).0;
+    (exact.tri != vis.tri).then_some(exact)
 }

@@ -65,6 +65,8 @@ pub struct Timings {
     /// Hardware shading; with cycles on it includes the timing model fed row by row beside
     /// it (the part that did not overlap the shading).
     pub shade_hw_ms: f64,
+    /// The reference's raster: with shared coverage the hardware's, plus its exact depth test
+    /// on a depth buffer narrower than 30 bits (the scene set up and rasterized again).
     pub raster_ref_ms: f64,
     pub shade_ref_ms: f64,
     /// Setup + raster + hardware shading.

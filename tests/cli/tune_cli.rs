@@ -94,6 +94,74 @@ fn tune_writes_its_trials_and_a_machine_render_accepts() {
     assert!(s["stats"]["error_8bit"]["max_abs_lsb"].as_u64().unwrap() <= 1);
 }
 
+/// A depth buffer too narrow for the scene is an error the search sees (the float passes'
+/// depth test is exact): at 8 bits the far part of the demo's ground plane rounds to the
+/// cleared maximum and vanishes, so the search keeps more bits, and the found machine covers
+/// every pixel texram16 covers.
+#[test]
+fn tune_keeps_the_depth_bits_the_scene_needs() {
+    let d = tmp("tune-depth");
+    let o = texsim(
+        &[
+            "tune",
+            "--scene",
+            "demo",
+            "--budget",
+            "max8=1",
+            "--knob",
+            "depth_bits",
+            "--size",
+            "160x120",
+            "--out",
+            "t",
+        ],
+        &d,
+    );
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let row = out
+        .lines()
+        .find(|l| {
+            l.split_whitespace()
+                .next()
+                .is_some_and(|f| f.ends_with("depth_bits"))
+        })
+        .unwrap_or_else(|| panic!("no depth_bits row: {out}"));
+    let cols: Vec<&str> = row.split_whitespace().collect();
+    let found: u32 = cols[1].parse().unwrap();
+    assert!(found > 8 && found <= 24, "{row}");
+    assert_eq!(cols[4], "yes", "{row}");
+    let covered = |hw: &str, dir: &str| -> u64 {
+        let r = texsim(
+            &[
+                "render",
+                "--scene",
+                "demo",
+                "--width",
+                "160",
+                "--height",
+                "120",
+                "--hw",
+                hw,
+                "--no-cycles",
+                "--no-flip",
+                "--out",
+                dir,
+            ],
+            &d,
+        );
+        assert!(r.status.success(), "{}", text(&r));
+        let s: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join(dir).join("summary.json")).unwrap())
+                .unwrap();
+        s["stats"]["raster"]["visible"].as_u64().unwrap()
+    };
+    assert_eq!(
+        covered("t/tuned.toml", "found"),
+        covered("texram16", "base")
+    );
+}
+
 #[test]
 fn tune_bad_budget_and_knob_fail_with_the_flag_named() {
     let d = tmp("tune-bad");

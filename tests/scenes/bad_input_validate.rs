@@ -117,3 +117,40 @@ fn run_budget_names_the_largest_part() {
         .to_string();
     assert!(e.contains("field 'textures'"), "{e}");
 }
+
+/// The float reference's exact depth test sets the scene up and rasterizes it again when the
+/// depth buffer is narrower than 30 bits: the estimate counts its triangles, vertices and
+/// pixels then, and only then.
+#[test]
+fn run_budget_counts_the_exact_depth_test() {
+    use texsim::budget::{
+        RunNeed, BYTES_PER_EXACT_DEPTH_PIXEL, BYTES_PER_EXACT_DEPTH_TRIANGLE,
+        BYTES_PER_EXACT_DEPTH_VERTEX,
+    };
+    let narrow = hw_model::HwConfig::preset("texram16").unwrap();
+    assert!(narrow.raster.depth_bits < 30);
+    let mut wide = narrow.clone();
+    wide.raster.depth_bits = 30;
+    let s = base();
+    let (tris, verts) = s.meshes.iter().fold((0, 0), |(t, v), m| {
+        (t + m.indices.len() as u64, v + m.positions.len() as u64)
+    });
+    let pixels = u64::from(s.width) * u64::from(s.height);
+    let (n, w) = (
+        RunNeed::of(&s, &narrow, true, false),
+        RunNeed::of(&s, &wide, true, false),
+    );
+    assert_eq!(
+        n.triangles - w.triangles,
+        tris * BYTES_PER_EXACT_DEPTH_TRIANGLE + verts * BYTES_PER_EXACT_DEPTH_VERTEX
+    );
+    assert_eq!(
+        n.framebuffer - w.framebuffer,
+        pixels * BYTES_PER_EXACT_DEPTH_PIXEL
+    );
+    assert_eq!(
+        RunNeed::of(&s, &narrow, false, false),
+        RunNeed::of(&s, &wide, false, false),
+        "no reference, no second pass"
+    );
+}

@@ -178,3 +178,50 @@ fn float_passes_of_another_render_are_not_used() {
     let r = render_on(&demo, &maps, &hw, &with(no_truth));
     assert!(r.stats.timings.shade_ref_ms > 0.0);
 }
+
+/// The float passes' depth test is exact: a depth buffer too narrow for the scene shows as
+/// error. The demo's ground plane runs to the horizon; at 8 bits its far part rounds to the
+/// cleared maximum and fails the depth test, so the hardware shows the background there while
+/// the reference shows the plane. Those pixels are compared (and count as large errors), the
+/// reference is the one the 24-bit machine gets, and at 24 bits every pixel shows the surface
+/// the exact test picks (the error is the shading's alone, as before).
+#[test]
+fn a_narrow_depth_buffer_shows_as_error_against_the_exact_depth_test() {
+    let base = HwConfig::texram16();
+    let mut s = builtin("demo").unwrap();
+    (s.width, s.height) = (160, 120);
+    let maps = Maps::new(&s, base.trilinear.texel_bits);
+    let opts = RenderOptions::default();
+    let wide = render_on(&s, &maps, &base, &opts);
+    let narrow_hw = set_field(&base, "raster.depth_bits", "8").unwrap();
+    let narrow = render_on(&s, &maps, &narrow_hw, &opts);
+    let covered = |r: &Rendered| r.stats.raster.visible;
+    assert!(
+        covered(&narrow) < covered(&wide),
+        "8-bit depth drops no pixel: {} against {}",
+        covered(&narrow),
+        covered(&wide)
+    );
+    assert_eq!(
+        narrow.ref_image, wide.ref_image,
+        "the reference's depth test"
+    );
+    assert_eq!(narrow.mask, wide.mask, "the compared pixels");
+    let (e_wide, e_narrow) = (
+        wide.stats.error_8bit.clone().unwrap(),
+        narrow.stats.error_8bit.clone().unwrap(),
+    );
+    assert_eq!(e_narrow.pixels, e_wide.pixels);
+    assert!(e_wide.max_abs_lsb <= 1, "{e_wide:?}");
+    assert!(e_narrow.max_abs_lsb >= 32, "{e_narrow:?}");
+    let lost = covered(&wide) - covered(&narrow);
+    let big = e_narrow
+        .histogram
+        .iter()
+        .find(|(label, _)| label == "32+")
+        .map_or(0, |(_, n)| *n);
+    assert!(
+        big >= lost,
+        "{lost} pixels lost, {big} errors of 32 LSB or more"
+    );
+}
