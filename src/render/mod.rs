@@ -238,11 +238,12 @@ pub fn render(
     // The float passes of Shared coverage shade the hardware's fragments with the depth test
     // at full precision, the depth buffer's float twin: `Some` when that picks other surfaces.
     let t = Instant::now();
-    let exact_vis = exact_vis_ran(opts, kept.is_some(), hw)
+    let runs_exact_depth = runs_exact_depth(opts, kept.is_some(), hw);
+    let exact_vis = runs_exact_depth
         .then(|| exact_depth_vis(&geo, scene, hw, &setup, &vis))
         .flatten();
     let exact_ms = ms(t);
-    if exact_vis_ran(opts, kept.is_some(), hw) {
+    if runs_exact_depth {
         progress("exact depth test", exact_ms);
     }
     let float_vis = exact_vis.as_ref().unwrap_or(&vis);
@@ -510,7 +511,7 @@ pub fn render(
 
 /// Whether a render runs [`exact_depth_vis`]: its own float passes (none `kept`) with shared
 /// coverage, on a depth buffer narrower than [`raster::MAX_DEPTH_BITS`].
-fn exact_vis_ran(opts: &RenderOptions, kept: bool, hw: &HwConfig) -> bool {
+fn runs_exact_depth(opts: &RenderOptions, kept: bool, hw: &HwConfig) -> bool {
     !kept
         && (opts.reference || opts.truth > 0)
         && opts.coverage == CoverageMode::Shared
