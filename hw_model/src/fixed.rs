@@ -287,6 +287,54 @@ impl<M: ConstRounding> ShiftRound<M> {
     }
 }
 
+/// [`round_shift_right`] of the two 32-bit lanes of a `u64` at once (the trilinear filter's
+/// packed channel pairs): each lane, non-negative and at most `2^32 - 2^shift`, becomes its
+/// floor by `2^shift` plus the carry of [`round_shift_right`] (HalfUp: a bias of one half;
+/// HalfEven: one half less one, plus the floor's lowest bit; Truncate: none), in the same lane.
+/// `shift` at most 31; built once per configuration.
+#[derive(Clone, Copy, Debug)]
+pub struct LaneRound {
+    shift: u32,
+    /// The bias in both lanes.
+    bias: u64,
+    /// Each lane's lowest bit where the floor's lowest bit joins the bias (HalfEven), else 0.
+    odd: u64,
+    /// Each lane's result bits (`32 - shift`), which drops what the upper lane shifted into the
+    /// lower.
+    mask: u64,
+}
+
+impl LaneRound {
+    /// The lowest bit of each 32-bit lane.
+    pub const LANE_LSB: u64 = 0x0000_0001_0000_0001;
+
+    /// The rounding by `shift` (at most 31) in `mode`.
+    #[must_use]
+    pub fn new(shift: u32, mode: Rounding) -> Self {
+        debug_assert!(shift < 32, "shift {shift}");
+        let half = (1u64 << shift) >> 1;
+        let (bias, odd) = match mode {
+            Rounding::Truncate => (0, 0),
+            Rounding::HalfUp => (half * Self::LANE_LSB, 0),
+            Rounding::HalfEven if shift > 0 => ((half - 1) * Self::LANE_LSB, Self::LANE_LSB),
+            Rounding::HalfEven => (0, 0),
+        };
+        Self {
+            shift,
+            bias,
+            odd,
+            mask: ((1u64 << (32 - shift)) - 1) * Self::LANE_LSB,
+        }
+    }
+
+    /// Both lanes of `x` rounded.
+    #[inline(always)]
+    #[must_use]
+    pub fn apply(&self, x: u64) -> u64 {
+        ((x + self.bias + ((x >> self.shift) & self.odd)) >> self.shift) & self.mask
+    }
+}
+
 /// [`round_shift_right_mid`] for `|x| < 2^62` and a `shift` in 1..=63 checked by the caller:
 /// one value through [`ShiftRound`] (the bias added before the shift; no overflow at these
 /// magnitudes), the same value with fewer operations.
@@ -522,6 +570,36 @@ mod tests {
             Rounding::HalfUp => twice >= den,
             Rounding::HalfEven => twice > den || (twice == den && q & 1 == 1),
         })
+    }
+
+    /// 1.9M seeded lane pairs (with 0, the largest lane values and exact halves) at every shift
+    /// 0 to 31 and every mode: each lane of `LaneRound::apply` is `round_shift_right` of it.
+    #[test]
+    fn lane_round_matches_round_shift_right_per_lane() {
+        let mut s = 0x1a2e_0001u64;
+        let mut cases = 0u64;
+        for mode in MODES {
+            for shift in 0..32u32 {
+                let r = LaneRound::new(shift, mode);
+                let top = (1u64 << 32) - (1u64 << shift);
+                let half = (1u64 << shift) >> 1;
+                for i in 0..20_000u32 {
+                    let lane = |v: u64| match i % 8 {
+                        0 => 0,
+                        1 => top,
+                        2 => (v % (top >> shift)) << shift | half,
+                        _ => v % (top + 1),
+                    };
+                    let (lo, hi) = (lane(next(&mut s)), lane(next(&mut s)));
+                    let got = r.apply(hi << 32 | lo);
+                    let want = |v: u64| round_shift_right(v as i64, shift, mode) as u64;
+                    assert_eq!(got & 0xffff_ffff, want(lo), "{mode:?} >> {shift}: {lo}");
+                    assert_eq!(got >> 32, want(hi), "{mode:?} >> {shift}: {hi}");
+                    cases += 1;
+                }
+            }
+        }
+        assert!(cases > 1_900_000, "{cases}");
     }
 
     /// 300k seeded values (with the ends of `i64` and exact halves) at every shift 1 to 63 and

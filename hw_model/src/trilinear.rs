@@ -27,7 +27,7 @@
 use crate::config::TrilinearConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
-use crate::fixed::{round_shift_right, ConstRounding, Rounding};
+use crate::fixed::{round_shift_right, ConstRounding, LaneRound, Rounding};
 use crate::wrap::{wrap_i64_with, wrap_in, wrap_pow2_repeat, WrapMode, WrapOut, WrapShifts};
 
 /// One MIP level (borrowed texels).
@@ -117,8 +117,6 @@ impl SampleSink for TrilinearTrace {
 
 /// Lanes of one 32-bit half of a `u64` that hold a channel value (< 2^16).
 const LANE16: u64 = 0x0000_ffff_0000_ffff;
-/// The lowest bit of each 32-bit lane.
-const LANE_LSB: u64 = 0x0000_0001_0000_0001;
 
 /// The four channels of a texel as two `u64` words of two 32-bit lanes: `(c0, c2)` and
 /// `(c1, c3)`, so one multiply by a weight serves two channels (a lane's product of a
@@ -162,43 +160,28 @@ impl Lanes {
 }
 
 /// [`lerp`] with `weight_bits` = `wb` (at most 16) and a rounding mode, in both 32-bit lanes of
-/// a `u64` (values < 2^16, weights `w < 2^wb`): `a (2^wb - w) + b w` is `(a << wb) + (b - a)
-/// w`, non-negative and below 2^32 per lane, and the rounding of [`round_shift_right`] adds
-/// its carry per lane: `floor + 1` iff the dropped part reaches one half (HalfUp, a bias of
-/// one half) or exceeds it, or equals it with an odd floor (HalfEven, a bias of one half less
-/// one plus the floor's lowest bit). Built once per [`UnitSetup`].
+/// a `u64` (values < 2^16, weights `w < 2^wb`): `a (2^wb - w) + b w`, non-negative and at most
+/// `2^32 - 2^16` per lane, rounded by [`LaneRound`] (each lane as [`round_shift_right`] rounds
+/// it). Built once per [`UnitSetup`].
 #[derive(Clone, Copy, Debug)]
 struct LaneLerp {
-    wb: u32,
     one: u32,
-    /// The bias in both lanes.
-    bias: u64,
-    /// The lanes' floor bit added to the bias (HalfEven with `wb > 0`), else 0.
-    odd: u64,
+    round: LaneRound,
 }
 
 impl LaneLerp {
     #[inline(always)]
     fn new(wb: u32, mode: Rounding) -> Self {
-        let half = (1u64 << wb) >> 1;
-        let (bias, odd) = match mode {
-            Rounding::Truncate => (0, 0),
-            Rounding::HalfUp => (half * LANE_LSB, 0),
-            Rounding::HalfEven if wb > 0 => ((half - 1) * LANE_LSB, LANE_LSB),
-            Rounding::HalfEven => (0, 0),
-        };
         Self {
-            wb,
             one: 1 << wb,
-            bias,
-            odd,
+            round: LaneRound::new(wb, mode),
         }
     }
 
     #[inline(always)]
     fn lerp(&self, a: u64, b: u64, w: u32) -> u64 {
-        let num = a * u64::from(self.one - w) + b * u64::from(w);
-        ((num + self.bias + ((num >> self.wb) & self.odd)) >> self.wb) & LANE16
+        self.round
+            .apply(a * u64::from(self.one - w) + b * u64::from(w))
     }
 }
 
