@@ -16,7 +16,9 @@
 //!
 //! ERROR BOUND (relative, `e` = |1/x - result| * x): let `e_0 = 2^-(L+1) + 2^-P` and
 //! `e_{k+1} = e_k^2 + 4 * 2^-P`; then `e <= e_N + 2^-M` (in result ulps, where one ulp is
-//! `2^-shift`: at most `2^(M+1) e_N + 1`, or `+ 0.5` for the round-to-nearest modes). The seed
+//! `2^-shift`: at most `2^(M+1) e_N + 1`, or `+ 0.5` for the round-to-nearest modes;
+//! `tests/units/unit_reciprocal.rs` asserts `2^(M+1) (e_N + 2^-P) 1.001` plus those, a margin
+//! of one working ulp and 0.1% for evaluating the bound in floating point). The seed
 //! error halves per LUT bit and squares per iteration: with L = 8 and M = 24, one iteration is
 //! limited by the seed (~2^-18, 128 ulps), so texram16 (L=8, N=2, M=24) uses two, which reach
 //! the rounding floor (<= 1 ulp). Measured max error (ulps, M = 24, HalfEven;

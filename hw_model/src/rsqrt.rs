@@ -14,8 +14,11 @@
 //! ERROR BOUND (relative, against the exact `1/sqrt(x)`): with `e0 = 1.06 * 2^-(L+1)` (seed) and
 //! `e(i+1) = 1.5 e(i)^2 + 0.5 e(i)^3 + 3 * 2^-(B+4)` (NR is quadratic and undershoots), the
 //! result is within `e(iterations) + 2^-B` (output rounding, mantissa >= 1/2) `+ 2^-(B+1)`
-//! (input rounding). texram16 (L=8, 1 iteration, B=24): measured max 5.72e-6 (2^-17.4), bound
-//! 6.53e-6; exhaustive over all 2^23 mantissas x 2 parities in `tests/units/frames_rsqrt.rs`.
+//! (input rounding), for the nearest modes; `Truncate` rounds the input and every product
+//! down, one-sided errors that add up to at most 1.5 times that bound. texram16 (L=8, 1
+//! iteration, B=24): measured max 5.72e-6 (2^-17.4), bound 6.53e-6; exhaustive over all 2^23
+//! mantissas x 2 parities, and 400k seeded inputs per rounding mode (`Truncate` against the 1.5
+//! times), in `tests/units/frames_rsqrt.rs`.
 
 use crate::config::ConfigError;
 use crate::cost::UnitCost;

@@ -230,7 +230,7 @@ fn env_lod_matches_float_twin() {
     let lf = f64::from(1u32 << hw.lod.lod_frac_bits);
     let mut rng = Rng(0x10d);
     let mut worst = (0.0f64, 0.0f64);
-    for i in 0..300_000u32 {
+    for i in 0..1_000_000u32 {
         let size = 1u32 << rng.below(11);
         let s0 = [rng.range(0.0, 1.0), rng.range(0.0, 1.0)];
         let scale = 2f64.powf(rng.range(-14.0, -1.0));

@@ -1,6 +1,8 @@
-//! Power unit (log-exp tables and repeated squaring) against f64 powf, exponents 1..=1024.
+//! Power unit (log-exp tables and repeated squaring) against f64 powf, exponents 1..=2047 (all
+//! that texram16's 11 exponent bits hold), every rounding mode.
 
 use crate::rng_common::Rng;
+use hw_model::fixed::Rounding;
 use hw_model::pow::{pow_cost, Pow, PowConfig, PowMethod};
 use hw_model::SatCounter;
 
@@ -9,7 +11,12 @@ fn bound(cfg: &PowConfig, x: f64, n: u32) -> f64 {
     let p = f64::from(cfg.pow_frac_bits);
     let g = -(p + f64::from(cfg.pow_guard_bits));
     let h2 = (-2.0 * f64::from(cfg.pow_lut_bits)).exp2();
-    let half = (-(p + 1.0)).exp2();
+    // The output's rounding: half an ulp, a whole one when truncating.
+    let half = if cfg.pow_rounding == Rounding::Truncate {
+        (-p).exp2()
+    } else {
+        (-(p + 1.0)).exp2()
+    };
     let xn = x.powf(f64::from(n));
     match cfg.pow_method {
         PowMethod::LogExp => {
@@ -37,7 +44,7 @@ fn inputs(p: u32, s: &mut Rng, count: usize) -> Vec<u64> {
     v
 }
 
-/// (max abs error, max error/bound) over exponents 1..=1024 with `per_n` inputs each.
+/// (max abs error, max error/bound) over the exponents `exps` with `per_n` inputs each.
 fn measure(cfg: &PowConfig, per_n: usize, exps: &[u32]) -> (f64, f64) {
     let u = Pow::new(cfg);
     let p = cfg.pow_frac_bits;
@@ -58,31 +65,32 @@ fn measure(cfg: &PowConfig, per_n: usize, exps: &[u32]) -> (f64, f64) {
     (worst, ratio)
 }
 
+/// Every exponent texram16 holds (1..=2047), 600 inputs each (1.2M cases) per rounding mode.
+fn within_bound_every_exponent_and_mode(method: PowMethod, name: &str) {
+    let exps: Vec<u32> = (1..=2047).collect();
+    for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
+        let cfg = PowConfig {
+            pow_method: method,
+            pow_rounding: mode,
+            ..PowConfig::texram16()
+        };
+        let (w, r) = measure(&cfg, 600, &exps);
+        println!(
+            "pow {name} texram16 {mode:?}: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}",
+            w * 65536.0
+        );
+        assert!(r <= 1.0, "{name} {mode:?}: {r}");
+    }
+}
+
 #[test]
 fn log_exp_within_bound_all_exponents() {
-    let cfg = PowConfig::texram16();
-    let exps: Vec<u32> = (1..=1024).collect();
-    let (w, r) = measure(&cfg, 1200, &exps);
-    println!(
-        "pow log-exp texram16: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}",
-        w * 65536.0
-    );
-    assert!(r <= 1.0);
+    within_bound_every_exponent_and_mode(PowMethod::LogExp, "log-exp");
 }
 
 #[test]
 fn squaring_within_bound_all_exponents() {
-    let cfg = PowConfig {
-        pow_method: PowMethod::Squaring,
-        ..PowConfig::texram16()
-    };
-    let exps: Vec<u32> = (1..=1024).collect();
-    let (w, r) = measure(&cfg, 1200, &exps);
-    println!(
-        "pow squaring texram16: max abs err {:.2} ulp(2^-16), max err/bound {r:.3}",
-        w * 65536.0
-    );
-    assert!(r <= 1.0);
+    within_bound_every_exponent_and_mode(PowMethod::Squaring, "squaring");
 }
 
 #[test]

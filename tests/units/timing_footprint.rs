@@ -40,7 +40,7 @@ fn lod_and_offsets_match_the_f64_twin() {
             lod_log2: hw_model::config::LodLog2::Exact,
             lod_per_quad: false,
         };
-        for _ in 0..200_000 {
+        for _ in 0..400_000 {
             let base = [signed(&mut s, 26), signed(&mut s, 26)];
             let uv = [
                 base,
