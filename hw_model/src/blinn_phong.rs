@@ -15,9 +15,10 @@
 //!
 //! ERROR BOUND (absolute, per channel, colours in [0, 1], texram16: F = 14, C = 16, power unit
 //! L = 8, G = 24, P = 16; against the float twin on the same quantized `n`, `l`, `v`,
-//! colours; asserted in `tests/units/frames_shade.rs`, exponents 1..=1024, 1M cases log-exp and 300k
-//! squaring, grazing light and view and `l = -v` included), with `x = n.h` and `s` the
-//! exponent: `light * (ks * (E + s x^(s-1) 2.5 * 2^-F) + kd * 2^-F + T) + 1 / (2^C - 1)`, where
+//! colours; asserted in `tests/units/frames_shade.rs`, exponents 1..=2047 (all that texram16's
+//! 11 bits hold), 1M cases each for log-exp and squaring, grazing light and view and `l = -v`
+//! included), with `x = n.h` and `s` the exponent:
+//! `light * (ks * (E + s x^(s-1) 2.5 * 2^-F) + kd * 2^-F + T) + 1 / (2^C - 1)`, where
 //! `E = x^s (2^(s (0.1803 * 2^-2L + 2^-G)) - 1) + 2 s 2^-G + 2^-(P+1)` is the power unit's
 //! error, `2.5 * 2^-F` that of `n.h` (and `2^-F` of `n.l`), and `T = ks x^s` where
 //! `n.l < 1.5 * 2^-F` (at the terminator the specular term may switch on or off), else 0.

@@ -128,7 +128,7 @@ fn one_probe_is_plain_trilinear_and_the_average_rounds_once() {
         .collect();
     let wrap = [WrapMode::Repeat, WrapMode::Mirror];
     let lf = hw.lod.lod_frac_bits;
-    for _ in 0..50_000 {
+    for _ in 0..1_000_000 {
         let base = [signed(&mut s, 25), signed(&mut s, 25)];
         let uv = [
             base,
