@@ -75,9 +75,9 @@ impl Reciprocal {
             .map(|i| {
                 // 2^P * 2^(L+1) / (2^(L+1) + 2i + 1), rounded to nearest (ties cannot occur:
                 // the denominator is odd).
-                let num = 1u128 << (p + l + 1);
-                let den = u128::from((1u64 << (l + 1)) + 2 * i + 1);
-                ((2 * num + den) / (2 * den)) as u64
+                let num = 1i128 << (p + l + 1);
+                let den = i128::from((1u64 << (l + 1)) + 2 * i + 1);
+                crate::fixed::round_div_i128(num, den, crate::fixed::Rounding::HalfUp) as u64
             })
             .collect();
         Self { cfg, lut, p }

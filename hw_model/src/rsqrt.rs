@@ -142,8 +142,9 @@ impl Rsqrt {
                 // M_mid = (2^L + 2j + 1) * 2^(p - L); y = sqrt(2^(2w) / M_mid), rounded.
                 let a = u128::from((1u64 << lut_bits) + 2 * j + 1);
                 let num = (1u128 << (2 * w + lut_bits - p + 2)) / a;
-                let r2 = isqrt_u128(num);
-                lut.push(((r2 + 1) >> 1) as u64);
+                // `r2`, the root with one more fraction bit, is below 2^36 (w <= 34).
+                let r2 = isqrt_u128(num) as i128;
+                lut.push(round_shift_right_wide(r2, 1, Rounding::HalfUp) as u64);
             }
         }
         Self {
