@@ -27,9 +27,11 @@
 //! [`crate::footprint`]); the perpendicular minor is exact (a swap and a negation) scaled by
 //! `|minor| / |major|` through one rounding (1/2 LSB of C per component), which moves the
 //! minor's LOD by at most `-2^F log2(1 - 2^-(C+1/2) / |minor|)` LSB either way (F =
-//! `lod_frac_bits`; e.g. 67 LSB for a minor of 1000 face ulps at F = 16). In all: within
-//! `[-3, +1]` LSB of the float twin, plus that term for `ellipse`.
-//! Tested in `tests/units/env_units.rs`.
+//! `lod_frac_bits`; e.g. 67 LSB for a minor of 1000 face ulps at F = 16). The two lengths are
+//! floored square roots with 16 fraction bits, which moves the scaled minor's length by less
+//! than `2^-15` face ulp more (the test's term uses 0.71 ulp for the rounding's `2^-1/2`). In all:
+//! within `[-3, +1]` LSB of the float twin, plus that term for `ellipse`. Tested in
+//! `tests/units/env_units.rs` (1M seeded footprints, every filter).
 
 use crate::config::LodConfig;
 use crate::cost::UnitCost;
