@@ -45,15 +45,7 @@ fn tune_writes_its_trials_and_a_machine_render_accepts() {
         "{out}"
     );
     for knob in ["weight_bits", "texel_bits", "lod_frac_bits"] {
-        let row = out
-            .lines()
-            .find(|l| {
-                l.split_whitespace()
-                    .next()
-                    .is_some_and(|f| f.ends_with(knob))
-            })
-            .unwrap_or_else(|| panic!("no row of {knob}: {out}"));
-        assert_eq!(row.split_whitespace().nth(4), Some("yes"), "{row}");
+        assert_eq!(knob_row(&out, knob)[4], "yes", "{knob}: {out}");
     }
     for f in ["tune.json", "tune.csv", "tuned.toml"] {
         assert!(d.join("t").join(f).is_file(), "{f}");
@@ -101,55 +93,19 @@ fn tune_writes_its_trials_and_a_machine_render_accepts() {
 #[test]
 fn tune_keeps_the_depth_bits_the_scene_needs() {
     let d = tmp("tune-depth");
-    let o = texsim(
-        &[
-            "tune",
-            "--scene",
-            "demo",
-            "--budget",
-            "max8=1",
-            "--knob",
-            "depth_bits",
-            "--size",
-            "160x120",
-            "--out",
-            "t",
-        ],
-        &d,
-    );
+    let args = "tune --scene demo --budget max8=1 --knob depth_bits --size 160x120 --out t";
+    let o = texsim(&args.split(' ').collect::<Vec<_>>(), &d);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
-    let row = out
-        .lines()
-        .find(|l| {
-            l.split_whitespace()
-                .next()
-                .is_some_and(|f| f.ends_with("depth_bits"))
-        })
-        .unwrap_or_else(|| panic!("no depth_bits row: {out}"));
-    let cols: Vec<&str> = row.split_whitespace().collect();
+    let cols = knob_row(&out, "depth_bits");
     let found: u32 = cols[1].parse().unwrap();
-    assert!(found > 8 && found <= 24, "{row}");
-    assert_eq!(cols[4], "yes", "{row}");
+    assert!(found > 8 && found <= 24, "{cols:?}");
+    assert_eq!(cols[4], "yes", "{cols:?}");
     let covered = |hw: &str, dir: &str| -> u64 {
-        let r = texsim(
-            &[
-                "render",
-                "--scene",
-                "demo",
-                "--width",
-                "160",
-                "--height",
-                "120",
-                "--hw",
-                hw,
-                "--no-cycles",
-                "--no-flip",
-                "--out",
-                dir,
-            ],
-            &d,
-        );
+        let args = "render --scene demo --width 160 --height 120 --no-cycles --no-flip";
+        let mut args: Vec<&str> = args.split(' ').collect();
+        args.extend(["--hw", hw, "--out", dir]);
+        let r = texsim(&args, &d);
         assert!(r.status.success(), "{}", text(&r));
         let s: serde_json::Value =
             serde_json::from_slice(&std::fs::read(d.join(dir).join("summary.json")).unwrap())
@@ -216,4 +172,12 @@ fn render_ranges_prints_and_writes_the_bits_needed() {
         .expect("perturbed normal");
     assert!(perturb["int_bits_needed"].as_u64().unwrap() <= 1);
     assert!(perturb["max"].as_f64().unwrap() <= 1.0 + 1e-9);
+}
+
+/// The columns of `knob`'s row in tune's knob table (`field found base least exercised [*]`).
+fn knob_row<'a>(out: &'a str, knob: &str) -> Vec<&'a str> {
+    out.lines()
+        .map(|l| l.split_whitespace().collect::<Vec<_>>())
+        .find(|cols| cols.first().is_some_and(|f| f.ends_with(knob)) && cols.len() >= 5)
+        .unwrap_or_else(|| panic!("no row of {knob}: {out}"))
 }
