@@ -85,9 +85,15 @@ pub const BYTES_PER_EVENT_PIXEL: u64 = 16;
 /// ...and per texture lookup of the most demanding material, two bilinear footprints (24 B
 /// each, one per MIP level blended).
 pub const BYTES_PER_EVENT_LOOKUP: u64 = 48;
-/// Bytes per row of a sweep grid (the setting, its resolved configuration and its result row)
-/// held before the first render.
+/// Bytes per row of a sweep grid (the setting and its resolved configuration) held before the
+/// first render, for the whole grid (every shard's rows).
 pub const BYTES_PER_SWEEP_ROW: u64 = 8 << 10;
+/// Bytes per row a sweep renders and keeps until it writes its outputs: the result row, its
+/// JSON with the full configuration, the report's thumbnails. Measured as the growth of the
+/// peak resident memory per row between grids of 276 and 1,104 rows: 96-98 KB at 1x1 pixels
+/// (demo and bumps, cycles on and off, `--flip`), 157 KB at 160x120 and 169 KB at 400x300
+/// (92 and 276 rows); with headroom.
+pub const BYTES_PER_SWEEP_RESULT: u64 = 256 << 10;
 
 /// 0: not set by [`set_max_memory`].
 static LIMIT: AtomicU64 = AtomicU64::new(0);

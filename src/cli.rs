@@ -1167,6 +1167,17 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         .collect::<Result<_>>()?;
     let timing = !a.no_cycles;
     crate::budget::check_run(&sc, &base, true, timing)?;
+    // The rows this run renders are kept until the outputs are written, beside one render.
+    crate::budget::check(
+        "--vary",
+        &format!(
+            "keeping the results of {} settings beside a render of '{}'",
+            settings.len(),
+            sc.name
+        ),
+        crate::budget::mul(settings.len() as u64, crate::budget::BYTES_PER_SWEEP_RESULT)
+            .saturating_add(crate::budget::RunNeed::of(&sc, &base, true, timing).total()),
+    )?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }

@@ -533,6 +533,28 @@ fn sweep_ranges_and_grids_are_budgeted() {
     assert!(!d.join("s").exists());
 }
 
+/// A sweep keeps each rendered row's results until it writes them (about 100 KB a row measured
+/// at 1x1 pixels): a grid whose settings fit the grid's own budget but whose results do not
+/// is refused before the first render, naming `--vary`, and writes nothing. (Such a grid of
+/// 4,416 settings at 1x1 once ran to 451 MB under a 64 MiB limit.)
+#[test]
+fn sweep_results_are_budgeted() {
+    let d = tmp("sweepresults");
+    let args = "--max-memory 64M sweep --scene demo --vary depth_bits=8..30 --vary \
+                subpixel_bits=1..12 --vary color_bits=1..16 --width 1 --height 1 --no-cycles \
+                --out s";
+    let o = texsim(&args.split_whitespace().collect::<Vec<_>>(), &d);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("field '--vary'")
+            && t.contains("results of 4416 settings")
+            && t.contains("over the limit of 64.00 MiB"),
+        "{t}"
+    );
+    assert!(!d.join("s").exists());
+}
+
 /// The framebuffer and timing events of an 8192x8192 `cycles` run are over the default budget:
 /// a message naming the size, before anything is allocated.
 #[test]
