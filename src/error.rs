@@ -61,7 +61,18 @@ pub fn text_position(text: &str, offset: usize) -> String {
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
     let col = before[line_start..].chars().count() + 1;
     let src = text[line_start..].lines().next().unwrap_or("").trim();
-    format!("line {line}, column {col} (`{src}`)")
+    format!("line {line}, column {col} (`{}`)", clip_line(src))
+}
+
+/// Most characters of a source line an error quotes; a longer line is cut with `...`.
+const QUOTED_LINE_CHARS: usize = 80;
+
+/// `src` cut to [`QUOTED_LINE_CHARS`] characters (a line of megabytes stays one line).
+fn clip_line(src: &str) -> std::borrow::Cow<'_, str> {
+    match src.char_indices().nth(QUOTED_LINE_CHARS) {
+        Some((cut, _)) => format!("{}...", &src[..cut]).into(),
+        None => src.into(),
+    }
 }
 
 /// One-line form of a toml error: `line L, column C (`source line`): message` (the message
@@ -69,10 +80,41 @@ pub fn text_position(text: &str, offset: usize) -> String {
 #[must_use]
 pub fn toml_message(text: &str, e: &toml::de::Error) -> String {
     let msg = nearest_field(e.message().trim_end().replace('\n', " "));
+    // toml says nothing when the text ends inside a key-value pair or a table header.
+    let msg = if msg.is_empty() {
+        "incomplete TOML: a value or a closing bracket is missing".to_string()
+    } else {
+        untagged_expected(msg)
+    };
     match e.span() {
         Some(span) => format!("{}: {msg}", text_position(text, span.start)),
         None => msg,
     }
+}
+
+/// What the scene format's untagged enums (`scene::toml_scene`) take, for serde's message that
+/// names only the Rust type.
+const UNTAGGED: [(&str, &str); 3] = [
+    (
+        "MainDirCfg",
+        "expected a direction [x, y, z] of three finite numbers, \"p_u\" or \"p_v\"",
+    ),
+    ("ScaleCfg", "expected a number or [x, y, z]"),
+    (
+        "EnvMapCfg",
+        "expected \"sky\", one image file or a list of six face files",
+    ),
+];
+
+/// serde's `data did not match any variant of untagged enum T` said as what the key takes.
+fn untagged_expected(msg: String) -> String {
+    let Some(name) = msg.strip_prefix("data did not match any variant of untagged enum ") else {
+        return msg;
+    };
+    UNTAGGED
+        .iter()
+        .find(|(n, _)| *n == name.trim())
+        .map_or(msg.clone(), |(_, what)| (*what).to_string())
 }
 
 /// serde's `unknown field `x`, expected one of `a`, `b`, ...` answered with the nearest valid
@@ -97,5 +139,42 @@ fn nearest_field(msg: String) -> String {
 impl From<hw_model::ConfigError> for Error {
     fn from(e: hw_model::ConfigError) -> Self {
         Self { msg: e.to_string() }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file cut after `key =` gets a message, not an empty one.
+    #[test]
+    fn a_cut_file_gets_a_message() {
+        let text = "[raster]\ndepth_bits =";
+        let e = toml::from_str::<toml::Table>(text).unwrap_err();
+        let m = toml_message(text, &e);
+        assert!(
+            m.ends_with("a value or a closing bracket is missing"),
+            "{m}"
+        );
+        assert!(m.starts_with("line 2"), "{m}");
+    }
+
+    /// An untagged enum's failure says what the key takes; other messages stay.
+    #[test]
+    fn untagged_enums_say_what_they_take() {
+        let m =
+            untagged_expected("data did not match any variant of untagged enum ScaleCfg".into());
+        assert_eq!(m, "expected a number or [x, y, z]");
+        let other = "data did not match any variant of untagged enum Other";
+        assert_eq!(untagged_expected(other.into()), other);
+    }
+
+    /// The quoted source line is cut at 80 characters.
+    #[test]
+    fn a_long_line_is_quoted_cut() {
+        let text = format!("a = [{}]", "1, ".repeat(100_000));
+        let m = text_position(&text, 3);
+        assert!(m.len() < 120 && m.ends_with("...`)"), "{m}");
+        assert_eq!(text_position("x = 1", 4), "line 1, column 5 (`x = 1`)");
     }
 }

@@ -120,15 +120,33 @@ fn culprit(
     leaf_values(user, "", &mut leaves);
     for (path, value) in leaves {
         let mut one = base.clone();
+        let shown = value.to_string();
+        let is_str = value.is_str();
         if !set_leaf(&mut one, &path, value) {
             continue;
         }
         if let Err(e) = toml::Value::Table(one).try_into::<HwConfig>() {
-            let msg = e.message().trim_end().replace('\n', " ");
+            let mut msg = e.message().trim_end().replace('\n', " ");
+            // A number or a table where a name belongs: serde's message lists no names.
+            if !is_str && msg.contains("variant") {
+                if let Some(names) = variant_names(base, &path) {
+                    msg = format!("{shown} is not a name: {names}");
+                }
+            }
             return at(&path, Error::field(&path, msg));
         }
     }
     Error::msg(whole.to_string().trim_end().replace('\n', " "))
+}
+
+/// `expected one of `a`, `b`, ...`: the names an enum field at dotted `path` of `base` takes,
+/// from serde's message for a name it cannot take.
+fn variant_names(base: &toml::Table, path: &str) -> Option<String> {
+    let mut one = base.clone();
+    set_leaf(&mut one, path, toml::Value::String("\u{1}".into())).then_some(())?;
+    let e = toml::Value::Table(one).try_into::<HwConfig>().err()?;
+    let msg = e.message().trim_end().replace('\n', " ");
+    msg.find("expected one of").map(|i| msg[i..].to_string())
 }
 
 /// Sets the leaf at dotted `path` of `t` (its tables must exist); false if they do not.

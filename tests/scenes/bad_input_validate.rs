@@ -154,3 +154,19 @@ fn run_budget_counts_the_exact_depth_test() {
         "no reference, no second pass"
     );
 }
+
+/// A number or a list where a hw file wants a name (a rounding mode) gets the names it takes,
+/// which serde's own message leaves out.
+#[test]
+fn hw_enum_field_of_the_wrong_type_lists_its_names() {
+    for value in ["1", "[1]", "true"] {
+        let e = texsim::hwconfig::parse(&format!("[trilinear]\nweight_rounding = {value}\n"))
+            .expect_err(value)
+            .to_string();
+        assert!(
+            e.contains("field 'trilinear.weight_rounding'")
+                && e.contains("is not a name: expected one of `truncate`, `half-up`, `half-even`"),
+            "{e}"
+        );
+    }
+}
