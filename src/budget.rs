@@ -92,7 +92,8 @@ pub const BYTES_PER_SWEEP_ROW: u64 = 8 << 10;
 /// JSON with the full configuration, the report's thumbnails. Measured as the growth of the
 /// peak resident memory per row between grids of 276 and 1,104 rows: 96-98 KB at 1x1 pixels
 /// (demo and bumps, cycles on and off, `--flip`), 157 KB at 160x120 and 169 KB at 400x300
-/// (92 and 276 rows); with headroom.
+/// (92 and 276 rows), about 155 KB at 1024x768 (23 and 69 rows: 21.3 MB, less the 14.2 MB of
+/// the two more float passes kept, which have their own budget); with headroom.
 pub const BYTES_PER_SWEEP_RESULT: u64 = 256 << 10;
 
 /// 0: not set by [`set_max_memory`].

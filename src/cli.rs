@@ -1167,17 +1167,6 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         .collect::<Result<_>>()?;
     let timing = !a.no_cycles;
     crate::budget::check_run(&sc, &base, true, timing)?;
-    // The rows this run renders are kept until the outputs are written, beside one render.
-    crate::budget::check(
-        "--vary",
-        &format!(
-            "keeping the results of {} settings beside a render of '{}'",
-            settings.len(),
-            sc.name
-        ),
-        crate::budget::mul(settings.len() as u64, crate::budget::BYTES_PER_SWEEP_RESULT)
-            .saturating_add(crate::budget::RunNeed::of(&sc, &base, true, timing).total()),
-    )?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -1194,11 +1183,25 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         .collect();
     // Keys are worth keeping only when some axis does not reach the passes (else every row
     // has its own key).
-    let mut float_passes = crate::render::FloatPassCache::new(if reaches.contains(&false) {
+    let kept_passes = if reaches.contains(&false) {
         crate::render::float_pass_budget()
     } else {
         0
-    });
+    };
+    // The rows this run renders are kept until the outputs are written, beside one render and
+    // the float passes kept for the next rows.
+    crate::budget::check(
+        "--vary",
+        &format!(
+            "keeping the results of {} settings beside a render of '{}'",
+            settings.len(),
+            sc.name
+        ),
+        crate::budget::mul(settings.len() as u64, crate::budget::BYTES_PER_SWEEP_RESULT)
+            .saturating_add(crate::budget::RunNeed::of(&sc, &base, true, timing).total())
+            .saturating_add(kept_passes),
+    )?;
+    let mut float_passes = crate::render::FloatPassCache::new(kept_passes);
     let mut rows = Vec::with_capacity(configs.len());
     let mut worst_pixels = Vec::with_capacity(configs.len());
     let mut strips: Vec<Vec<(String, Vec<u8>)>> = Vec::with_capacity(configs.len());
