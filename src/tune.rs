@@ -93,6 +93,11 @@ impl Metric {
     }
 }
 
+/// The highest `psnr8` floor a budget takes: two 8-bit images of the largest viewport (8192 x
+/// 8192) that differ by one LSB in one channel of one pixel have a PSNR of about 131 dB, so a
+/// floor above 200 dB could only be met by identical images (`max8=0` says that).
+pub const MAX_PSNR8_DB: f64 = 200.0;
+
 /// One budget: a metric and its limit (a ceiling, or a floor for `within1` and `psnr8`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Budget {
@@ -138,15 +143,20 @@ impl Budget {
             || limit < 0.0
             || (metric == Metric::Within1 && limit > 100.0)
             || (metric.is_flip() && limit > 1.0)
+            || (metric == Metric::Psnr8 && limit > MAX_PSNR8_DB)
         {
             return Err(Error::field(
                 "--budget",
                 format!(
-                    "{m}={limit} is out of range (a finite value >= 0{})",
+                    "{m}={} is out of range (a finite value >= 0{})",
+                    v.trim(),
                     if metric == Metric::Within1 {
                         ", at most 100"
                     } else if metric.is_flip() {
                         ", at most 1"
+                    } else if metric == Metric::Psnr8 {
+                        ", at most 200: different 8-bit images never come that close; max8=0 \
+                         asks for identical ones"
                     } else {
                         ""
                     }

@@ -116,6 +116,7 @@ fn budgets_parse_and_bad_ones_name_the_flag() {
         "within1=101",
         "mean8=-1",
         "flip_p99=1.5",
+        "psnr8=1e308",
     ] {
         let e = Budget::parse(bad).unwrap_err().to_string();
         assert!(e.contains("--budget"), "{bad}: {e}");
