@@ -1166,7 +1166,8 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
         })
         .collect::<Result<_>>()?;
     let timing = !a.no_cycles;
-    crate::budget::check_run(&sc, &base, true, timing)?;
+    let render_need = crate::budget::RunNeed::of(&sc, &base, true, timing);
+    render_need.check(&sc)?;
     for w in &sc.warnings {
         eprintln!("warning: {w}");
     }
@@ -1198,7 +1199,7 @@ fn sweep_cmd(a: &SweepArgs) -> Result<()> {
             sc.name
         ),
         crate::budget::mul(settings.len() as u64, crate::budget::BYTES_PER_SWEEP_RESULT)
-            .saturating_add(crate::budget::RunNeed::of(&sc, &base, true, timing).total())
+            .saturating_add(render_need.total())
             .saturating_add(kept_passes),
     )?;
     let mut float_passes = crate::render::FloatPassCache::new(kept_passes);

@@ -84,37 +84,12 @@ pub fn toml_message(text: &str, e: &toml::de::Error) -> String {
     let msg = if msg.is_empty() {
         "incomplete TOML: a value or a closing bracket is missing".to_string()
     } else {
-        untagged_expected(msg)
+        msg
     };
     match e.span() {
         Some(span) => format!("{}: {msg}", text_position(text, span.start)),
         None => msg,
     }
-}
-
-/// What the scene format's untagged enums (`scene::toml_scene`) take, for serde's message that
-/// names only the Rust type.
-const UNTAGGED: [(&str, &str); 3] = [
-    (
-        "MainDirCfg",
-        "expected a direction [x, y, z] of three finite numbers, \"p_u\" or \"p_v\"",
-    ),
-    ("ScaleCfg", "expected a number or [x, y, z]"),
-    (
-        "EnvMapCfg",
-        "expected \"sky\", one image file or a list of six face files",
-    ),
-];
-
-/// serde's `data did not match any variant of untagged enum T` said as what the key takes.
-fn untagged_expected(msg: String) -> String {
-    let Some(name) = msg.strip_prefix("data did not match any variant of untagged enum ") else {
-        return msg;
-    };
-    UNTAGGED
-        .iter()
-        .find(|(n, _)| *n == name.trim())
-        .map_or(msg.clone(), |(_, what)| (*what).to_string())
 }
 
 /// serde's `unknown field `x`, expected one of `a`, `b`, ...` answered with the nearest valid
@@ -157,16 +132,6 @@ mod tests {
             "{m}"
         );
         assert!(m.starts_with("line 2"), "{m}");
-    }
-
-    /// An untagged enum's failure says what the key takes; other messages stay.
-    #[test]
-    fn untagged_enums_say_what_they_take() {
-        let m =
-            untagged_expected("data did not match any variant of untagged enum ScaleCfg".into());
-        assert_eq!(m, "expected a number or [x, y, z]");
-        let other = "data did not match any variant of untagged enum Other";
-        assert_eq!(untagged_expected(other.into()), other);
     }
 
     /// The quoted source line is cut at 80 characters.

@@ -215,7 +215,10 @@ fn as_brdf(
 }
 
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a direction [x, y, z] of three finite numbers, \"p_u\" or \"p_v\""
+)]
 enum MainDirCfg {
     Vector([f32; 3]),
     Name(String),
@@ -242,7 +245,7 @@ fn main_direction(field: &str, c: &MainDirCfg) -> Result<MainDirection> {
 }
 
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "expected a number or [x, y, z]")]
 enum ScaleCfg {
     Uniform(f64),
     Axes([f64; 3]),
@@ -757,7 +760,10 @@ fn build_camera(c: Option<&CameraCfg>, meshes: &[Mesh], w: u32, h: u32) -> Resul
 /// The `env_map`, `env_filter` and `env_size` keys of a material.
 /// An `env_map` value: `"sky"`, one image file, or six face files.
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected \"sky\", one image file or a list of six face files"
+)]
 enum EnvMapCfg {
     One(String),
     Six(Vec<String>),

@@ -281,6 +281,17 @@ fn toml_errors_name_file_and_field() {
         format!("[output]\nwidth = -5\n{GOOD_MESH}").as_bytes(),
     );
     expect_err(move || load_toml(&p), &["neg.toml", "width"]);
+    // An untagged key (a number or a list) says what it takes, not its Rust type.
+    let p = write(
+        &dir,
+        "scale.toml",
+        b"[[meshes]]\nshape = \"cube\"\nscale = [1.0, 2.0]\n",
+    );
+    let e = expect_err(
+        move || load_toml(&p),
+        &["scale.toml", "expected a number or [x, y, z]"],
+    );
+    assert!(!e.contains("ScaleCfg"), "{e}");
     let p = write(&dir, "nomesh.toml", b"ambient = [0.1, 0.1, 0.1]\n");
     expect_err(move || load_toml(&p), &["nomesh.toml", "meshes"]);
     let p = write(&dir, "shape.toml", b"[[meshes]]\nshape = \"teapot\"\n");
