@@ -627,7 +627,7 @@ struct Tops {
 /// for. Measured at one thread (the fastest of 15 frames, 6 runs): W1's frame 51.5-53.6 ->
 /// 47.7-49.1 ms, W2's 90.7-94.5 -> 88.5-91.2 ms; batches of 4 and 32 lanes did as well on W1,
 /// and 32 gained nothing on W2's short spans.
-const RECIP_BATCH: usize = 8;
+const RECIP_BATCH: usize = crate::reciprocal::RECIP_LANES;
 
 /// The `N` of [`derivs_span_held`] that evaluates each `1/D` with
 /// [`crate::reciprocal::RecipLane::eval`] (any width and iteration count); another `N` takes
@@ -678,15 +678,29 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     while j0 < span.lanes {
         let n = (span.lanes - j0).min(RECIP_BATCH);
         let mut dj = d;
-        for lane in &mut recips[..n] {
-            // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
-            let r = if N == ANY_ITERATIONS {
-                lane_recip.eval(dj as u64, &mut SatCounter::default())
-            } else {
-                lane_recip.eval_narrow::<N>(dj as u64)
-            };
-            *lane = (r, square(r, m_bits, M::MODE));
-            dj = dj.wrapping_add(s);
+        // A full batch at a narrow width: all eight lanes at once where the CPU has the
+        // vector unit for it.
+        let wide = if N != ANY_ITERATIONS && n == RECIP_BATCH {
+            let x: [u64; RECIP_BATCH] =
+                std::array::from_fn(|c| d.wrapping_add((c as i64).wrapping_mul(s)) as u64);
+            lane_recip.eval_square_lanes_wide::<N, M>(&x)
+        } else {
+            None
+        };
+        if let Some(batch) = wide {
+            recips = std::array::from_fn(|c| batch.get(c));
+            dj = dj.wrapping_add((RECIP_BATCH as i64).wrapping_mul(s));
+        } else {
+            for lane in &mut recips[..n] {
+                // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+                let r = if N == ANY_ITERATIONS {
+                    lane_recip.eval(dj as u64, &mut SatCounter::default())
+                } else {
+                    lane_recip.eval_narrow::<N>(dj as u64)
+                };
+                *lane = (r, square(r, m_bits, M::MODE));
+                dj = dj.wrapping_add(s);
+            }
         }
         for (c, &(r, r2)) in recips[..n].iter().enumerate() {
             let j = j0 + c;

@@ -30,7 +30,7 @@ use crate::config::ReciprocalConfig;
 use crate::cost::UnitCost;
 use crate::datapath::{ceil_log2, Component, Datapath, Stage};
 use crate::fixed::{
-    round_shift_right_mid, round_shift_right_small, round_shift_right_wide,
+    round_shift_right_lane, round_shift_right_mid, round_shift_right_small, round_shift_right_wide,
     round_shift_right_wide_small, ConstRounding, Rounding, SatCounter,
 };
 use std::marker::PhantomData;
@@ -274,6 +274,135 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         }
         Recip { mant, shift }
     }
+}
+
+/// Lanes of one [`RecipLane::eval_square_lanes`] batch: eight 64-bit lanes, one AVX-512
+/// register.
+pub const RECIP_LANES: usize = 8;
+
+impl<R: ConstRounding> RecipLane<'_, R> {
+    /// [`RecipLane::eval_narrow`] of each `x[j]` (in 1..2^62; P in 1..=29 and `N` the
+    /// iteration count, as there) with its [`square`] rounded by `S`: the same bits, written
+    /// lane by lane with every per-lane choice a select (the normalizing shifts through
+    /// [`round_shift_right_lane`]), so that its loops over the lanes vectorize. Checked
+    /// against `eval_narrow` and `square` in `eval_square_lanes_match_eval_narrow`.
+    #[inline(always)]
+    #[must_use]
+    pub fn eval_square_lanes<const N: u32, S: ConstRounding>(
+        &self,
+        x: &[u64; RECIP_LANES],
+    ) -> RecipLanes {
+        debug_assert!((1..=29).contains(&self.p) && N == self.iterations);
+        let (p, m_bits) = (u64::from(self.p), u64::from(self.m_bits));
+        // 2^L entries: every masked index is in range, with no test per lane.
+        let lut = &self.lut[..=self.idx_mask as usize];
+        let (mut m, mut n, mut y) = (
+            [0i64; RECIP_LANES],
+            [0u64; RECIP_LANES],
+            [0i64; RECIP_LANES],
+        );
+        for j in 0..RECIP_LANES {
+            debug_assert!(x[j] != 0 && x[j] >> 62 == 0, "{}", x[j]);
+            // m with P fraction bits in [2^P, 2^(P+1)]: `x` moved up, or rounded down.
+            let nj = 63 - u64::from(x[j].leading_zeros());
+            let (up, down) = (p.saturating_sub(nj), nj.saturating_sub(p));
+            let mj = round_shift_right_lane::<R>((x[j] << up) as i64, down as u32);
+            // The seed: m brought below 2^(P+1), its top L fraction bits the index.
+            let carry = (mj >> (p + 1)) as u64;
+            let mj = mj >> carry;
+            let idx = ((mj << self.idx_up) >> self.idx_down) & self.idx_mask;
+            (m[j], n[j], y[j]) = (mj, nj + carry, lut[idx as usize] as i64);
+        }
+        let two = 2i64 << p;
+        for _ in 0..N {
+            for j in 0..RECIP_LANES {
+                let t = round_shift_right_small::<R>(m[j] * y[j], p as u32);
+                y[j] = round_shift_right_small::<R>(y[j] * (two - t), p as u32);
+            }
+        }
+        let mut out = RecipLanes::default();
+        for j in 0..RECIP_LANES {
+            // [`RecipLane::normalized`]: `y` to M + 1 significant bits (a drop of 1 to 3).
+            let b = 64 - u64::from((y[j] as u64).leading_zeros());
+            let drop = b - (m_bits + 1);
+            debug_assert!(drop < 64, "{drop}");
+            let mant = round_shift_right_lane::<R>(y[j], drop as u32) as u64;
+            let over = mant >> (m_bits + 1);
+            let (mant, shift) = (mant >> over, (p + n[j]) as i64 - (drop + over) as i64);
+            // [`square`]: a mantissa below 2^31, its square below 2^62.
+            let sq = (mant * mant) as i64;
+            let drop2 = (64 - u64::from(sq.leading_zeros())).saturating_sub(m_bits + 1);
+            let mant2 = round_shift_right_lane::<S>(sq, drop2 as u32) as u64;
+            let over2 = mant2 >> (m_bits + 1);
+            out.mant[j] = mant;
+            out.shift[j] = shift;
+            out.mant2[j] = mant2 >> over2;
+            out.shift2[j] = 2 * shift - (drop2 + over2) as i64;
+        }
+        out
+    }
+}
+
+/// The results of one [`RecipLane::eval_square_lanes`] batch, lane by lane: `1/x` and its
+/// square as mantissas and shifts ([`Recip`]'s fields), in arrays (what the vector unit writes).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RecipLanes {
+    mant: [u64; RECIP_LANES],
+    shift: [i64; RECIP_LANES],
+    mant2: [u64; RECIP_LANES],
+    shift2: [i64; RECIP_LANES],
+}
+
+impl RecipLanes {
+    /// Lane `j`'s `1/x` and its square.
+    #[inline(always)]
+    #[must_use]
+    pub fn get(&self, j: usize) -> (Recip, Recip) {
+        (
+            Recip {
+                mant: self.mant[j],
+                shift: self.shift[j] as i32,
+            },
+            Recip {
+                mant: self.mant2[j],
+                shift: self.shift2[j] as i32,
+            },
+        )
+    }
+}
+
+impl<R: ConstRounding> RecipLane<'_, R> {
+    /// [`RecipLane::eval_square_lanes`] built for AVX-512 (eight 64-bit lanes per
+    /// instruction, `vplzcntq` and `vpmullq`) when this CPU has it, else `None`: the same
+    /// bits, checked in `eval_square_lanes_match_eval_narrow` on every CPU that has it.
+    #[inline(always)]
+    #[must_use]
+    pub fn eval_square_lanes_wide<const N: u32, S: ConstRounding>(
+        &self,
+        x: &[u64; RECIP_LANES],
+    ) -> Option<RecipLanes> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512cd")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+        {
+            // SAFETY: the CPU has every feature the function is built for.
+            return Some(unsafe { eval_square_lanes_avx512::<R, N, S>(self, x) });
+        }
+        let _ = x;
+        None
+    }
+}
+
+/// [`RecipLane::eval_square_lanes`] compiled with AVX-512 enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+fn eval_square_lanes_avx512<R: ConstRounding, const N: u32, S: ConstRounding>(
+    lane: &RecipLane<'_, R>,
+    x: &[u64; RECIP_LANES],
+) -> RecipLanes {
+    lane.eval_square_lanes::<N, S>(x)
 }
 
 /// One Newton-Raphson step `y (2 - m y)` with each product rounded to `p` fraction bits.
@@ -626,6 +755,91 @@ mod tests {
             }
         }
         assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
+    }
+
+    /// `eval_square_lanes::<N, S>` of the batch `x` (the portable build and, on a CPU with
+    /// AVX-512, `eval_square_lanes_wide`), each lane against `eval_narrow` and `square`.
+    fn check_lanes<R: ConstRounding, S: ConstRounding, const N: u32>(
+        lane: &RecipLane<'_, R>,
+        x: &[u64; RECIP_LANES],
+    ) -> u64 {
+        let lanes = lane.eval_square_lanes::<N, S>(x);
+        let wide = lane.eval_square_lanes_wide::<N, S>(x);
+        for (j, &xj) in x.iter().enumerate() {
+            let r = lane.eval_narrow::<N>(xj);
+            let want = (r, square(r, lane.m_bits, S::MODE));
+            assert_eq!(
+                lanes.get(j),
+                want,
+                "1/{xj} lane {j} {:?} {:?}",
+                R::MODE,
+                S::MODE
+            );
+            if let Some(w) = &wide {
+                assert_eq!(
+                    w.get(j),
+                    want,
+                    "1/{xj} lane {j} {:?} {:?}",
+                    R::MODE,
+                    S::MODE
+                );
+            }
+        }
+        RECIP_LANES as u64
+    }
+
+    /// 4.3M seeded lanes in 1..2^62 (every bit length; 1, 2^62 - 1 and runs of steps along a
+    /// span included) over every pair of rounding modes of the reciprocal and of the square,
+    /// LUT widths 1..=16, iteration counts 0..=4 and the mantissa widths 8..=26: each lane of
+    /// `eval_square_lanes` (portable, and built for AVX-512 where the CPU has it) gives
+    /// `eval_narrow` and its `square`.
+    #[test]
+    fn eval_square_lanes_match_eval_narrow() {
+        let mut s = 0x5eed_0018;
+        let base = HwConfig::texram16().reciprocal;
+        let mut cases = 0u64;
+        for mode in MODES {
+            for sq_mode in MODES {
+                for l in [1, 3, 6, 8, 11, 16] {
+                    for n in 0..=4 {
+                        for mb in [8, 13, 16, 21, 24, 26] {
+                            let u = Reciprocal::new(&config(&base, (l, n, mb), mode));
+                            for i in 0..330u32 {
+                                let x: [u64; RECIP_LANES] = match i {
+                                    0 => [1, (1 << 62) - 1, 2, 3, 1 << 61, 7, 255, 256],
+                                    1..=29 => std::array::from_fn(|_| {
+                                        (next(&mut s) >> 2 >> (next(&mut s) % 62)).max(1)
+                                    }),
+                                    _ => {
+                                        // A span: `D` stepping by `S` (either sign).
+                                        let d = (next(&mut s) >> 2 >> (i % 40)).max(1 << 9);
+                                        let st =
+                                            (next(&mut s) >> (i % 60 + 4)) as i64 - (d >> 4) as i64;
+                                        std::array::from_fn(|c| {
+                                            (d as i64 + c as i64 * st).clamp(1, (1 << 62) - 1)
+                                                as u64
+                                        })
+                                    }
+                                };
+                                crate::with_rounding!(mode, R => {
+                                    crate::with_rounding!(sq_mode, S => {
+                                        let lane = u.lane::<R>();
+                                        cases += match n {
+                                            0 => check_lanes::<R, S, 0>(&lane, &x),
+                                            1 => check_lanes::<R, S, 1>(&lane, &x),
+                                            2 => check_lanes::<R, S, 2>(&lane, &x),
+                                            3 => check_lanes::<R, S, 3>(&lane, &x),
+                                            _ => check_lanes::<R, S, 4>(&lane, &x),
+                                        };
+                                    })
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(cases > 4_000_000, "{cases}");
     }
 
     /// 4.6M seeded arguments in 1..2^62 (every bit length, 1 and 2^62 - 1 included) over every
