@@ -384,6 +384,28 @@ pub fn round_shift_right_wide_small<M: ConstRounding>(x: i128, shift: u32) -> Op
     (hi >> s == q >> 63).then_some(q)
 }
 
+/// [`round_shift_right_wide_small`] of the 128-bit `x = hi 2^64 + lo` (`|x| < 2^126`) by a
+/// `shift` in 1..=63 that may differ from one value to the next, written without a branch so
+/// that a loop over lanes vectorizes: the value and whether it fits `i64` (where
+/// `round_shift_right_wide_small` gives `None`, the value is not meaningful).
+#[inline(always)]
+#[must_use]
+pub fn round_shift_right_wide_lane<M: ConstRounding>(hi: i64, lo: u64, shift: u32) -> (i64, bool) {
+    debug_assert!((1..64).contains(&shift), "shift {shift}");
+    let s = shift & 63;
+    let half = 1u64 << ((s + 63) & 63);
+    // [`ShiftRound`]'s bias and the floor's lowest bit (HalfEven), in the low word.
+    let bias = match M::MODE {
+        Rounding::Truncate => 0,
+        Rounding::HalfUp => half,
+        Rounding::HalfEven => half - 1 + ((lo >> s) & 1),
+    };
+    let low = lo.wrapping_add(bias);
+    let high = hi.wrapping_add(i64::from(low < lo));
+    let q = ((low >> s) | ((high as u64) << ((64 - s) & 63))) as i64;
+    (q, high >> s == q >> 63)
+}
+
 /// [`round_shift_right`] for a `shift` in 1..=63: the floor plus the carry out of the dropped
 /// bits, left-aligned in 64 bits (one half = 2^63), when [`round_bias`] is added to them.
 #[inline(always)]
@@ -692,7 +714,8 @@ mod tests {
     /// 400k seeded values below 2^126 in magnitude (with the ends of that range, exact halves
     /// and results at the ends of `i64`) at every shift 1 to 63 and every mode:
     /// `round_shift_right_wide_small` gives `round_shift_right_wide` where it fits `i64`, and
-    /// `None` where that saturates.
+    /// `None` where that saturates; `round_shift_right_wide_lane` gives the same value and says
+    /// whether it fits.
     #[test]
     fn wide_small_shift_matches_round_shift_right_wide() {
         let mut s = 0x5eed_5a12;
@@ -713,6 +736,9 @@ mod tests {
             for mode in MODES {
                 let got =
                     crate::with_rounding!(mode, M => round_shift_right_wide_small::<M>(x, shift));
+                let (hi, lo) = ((x >> 64) as i64, x as u64);
+                let (lane, fits) = crate::with_rounding!(mode, M => round_shift_right_wide_lane::<M>(hi, lo, shift));
+                assert_eq!(fits.then_some(lane), got, "{x} {shift} {mode:?}");
                 let want = round_shift_right_wide(x, shift, mode);
                 let exact = round_div_i128(x, 1i128 << shift, mode);
                 match got {

@@ -20,8 +20,8 @@ use crate::config::{InterpConfig, ReciprocalConfig};
 use crate::cost::UnitCost;
 use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{
-    round_shift_right, round_shift_right_mid, round_shift_right_wide, ConstRounding, Format,
-    SatCounter, ShiftRound,
+    round_shift_right, round_shift_right_lane, round_shift_right_mid, round_shift_right_wide,
+    round_shift_right_wide_lane, ConstRounding, Format, SatCounter, ShiftRound,
 };
 use crate::reciprocal::{apply_i64_in, apply_i64_small_in, apply_in, square, Recip, Reciprocal};
 
@@ -627,7 +627,15 @@ struct Tops {
 /// for. Measured at one thread (the fastest of 15 frames, 6 runs): W1's frame 51.5-53.6 ->
 /// 47.7-49.1 ms, W2's 90.7-94.5 -> 88.5-91.2 ms; batches of 4 and 32 lanes did as well on W1,
 /// and 32 gained nothing on W2's short spans.
-const RECIP_BATCH: usize = crate::reciprocal::RECIP_LANES;
+const RECIP_BATCH: usize = 8;
+
+/// Lanes of one vector batch of [`derivs_span_held`] ([`held_batch_lanes`]): two AVX-512
+/// registers of 64-bit lanes, so that each step has two independent chains.
+const HELD_LANES: usize = 2 * crate::reciprocal::RECIP_LANES;
+
+/// The fewest lanes [`derivs_span_held`] runs as a vector batch (the lanes past the span
+/// repeat its last).
+const HELD_MIN_LANES: usize = 8;
 
 /// The `N` of [`derivs_span_held`] that evaluates each `1/D` with
 /// [`crate::reciprocal::RecipLane::eval`] (any width and iteration count); another `N` takes
@@ -641,8 +649,10 @@ const ANY_ITERATIONS: u32 = u32::MAX;
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
 /// [`derivative_held`]'s 64-bit rounding, their four [`held_rounding`]s kept while that
 /// exponent holds (else each takes [`derivative_of_top`]). Checked against one call per lane
-/// in `derivs_span_stepping_matches_per_lane_calls`. The lanes' reciprocals run ahead of the
-/// rest in batches of [`RECIP_BATCH`].
+/// in `derivs_span_stepping_matches_per_lane_calls`. The lanes run in batches of
+/// [`RECIP_BATCH`]: a full batch at a narrow width as vector lanes where the CPU has AVX-512
+/// ([`held_batch_wide`]; a lane outside its fast form takes the scalar lane), else each
+/// batch's reciprocals ahead of the rest of its lanes.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
@@ -667,86 +677,91 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     let ns_min = nx[0].1.min(nx[1].1).min(ny1.min(ny2));
     let lo = 64 + (bb + ns_max) as i32;
     let hi = 126 + (bb + ns_min) as i32;
-    let limit = BARY_LIMIT as u64;
-    // Lanes in batches of [`RECIP_BATCH`]: first each lane's `1/D` and its square, then the
-    // rest of each lane in lane order.
-    let mut recips = [(Recip { mant: 0, shift: 0 }, Recip { mant: 0, shift: 0 }); RECIP_BATCH];
-    // The derivatives' roundings ([`held_rounding`]) for the last exponent of `1/D^2`: along a
-    // span `D` rarely crosses a power of two.
     let mut rounds: Option<(i32, [ShiftRound<M>; 4])> = None;
+    let ctx = HeldLane {
+        bb,
+        one,
+        r2_shifts: (lo, hi),
+        nx,
+        ns_y: (ny1, ny2),
+    };
+    let mut recips = [(Recip { mant: 0, shift: 0 }, Recip { mant: 0, shift: 0 }); RECIP_BATCH];
     let mut j0 = 0;
     while j0 < span.lanes {
-        let n = (span.lanes - j0).min(RECIP_BATCH);
-        let mut dj = d;
-        // A full batch at a narrow width: all eight lanes at once where the CPU has the
-        // vector unit for it.
-        let wide = if N != ANY_ITERATIONS && n == RECIP_BATCH {
-            let x: [u64; RECIP_BATCH] =
-                std::array::from_fn(|c| d.wrapping_add((c as i64).wrapping_mul(s)) as u64);
-            lane_recip.eval_square_lanes_wide::<N, M>(&x)
-        } else {
-            None
-        };
-        if let Some(batch) = wide {
-            recips = std::array::from_fn(|c| batch.get(c));
-            dj = dj.wrapping_add((RECIP_BATCH as i64).wrapping_mul(s));
-        } else {
-            for lane in &mut recips[..n] {
-                // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
-                let r = if N == ANY_ITERATIONS {
-                    lane_recip.eval(dj as u64, &mut SatCounter::default())
-                } else {
-                    lane_recip.eval_narrow::<N>(dj as u64)
-                };
-                *lane = (r, square(r, m_bits, M::MODE));
-                dj = dj.wrapping_add(s);
+        // A vector batch (of at least [`HELD_MIN_LANES`] lanes) at a narrow width where the
+        // CPU has the vector unit for it.
+        let n = (span.lanes - j0).min(HELD_LANES);
+        if N != ANY_ITERATIONS && n >= HELD_MIN_LANES {
+            // Each lane's y numerators' tops; the lanes past the span repeat its last.
+            let mut ty = [[(0i64, 0u64); HELD_LANES]; 2];
+            for (k, (tops, ns)) in ty.iter_mut().zip([ny1, ny2]).enumerate() {
+                let mut nyj = ny[k];
+                for (c, top) in tops.iter_mut().enumerate() {
+                    let t = nyj >> (ns & 63);
+                    *top = ((t >> 64) as i64, t as u64);
+                    if c + 1 < n {
+                        nyj = nyj.wrapping_add(st.y_step[k]);
+                    }
+                }
             }
+            let input = HeldBatch {
+                n,
+                d,
+                s,
+                q: [q1, q2],
+                a: [a[1], a[2]],
+                nx: [nx[0].0, nx[1].0].map(|x| ((x >> 64) as i64, x as u64)),
+                ty,
+                ns: [nx[0].1, nx[1].1, ny1, ny2],
+                bb,
+                r2_shifts: (lo, hi),
+            };
+            let mut wide = HeldLanes::<HELD_LANES>::default();
+            if held_batch_wide::<M, R, N, HELD_LANES>(&lane_recip, &input, &mut wide) {
+                let b = &wide;
+                for c in 0..n {
+                    let j = j0 + c;
+                    if b.ok >> c & 1 == 1 {
+                        let (p1, p2) = (b.p[0][c], b.p[1][c]);
+                        let (x1, x2) = (p1 + b.dp[0][c], p2 + b.dp[1][c]);
+                        let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
+                        out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
+                    } else {
+                        let (r, r2) = b.recips.get(c);
+                        match held_lane::<M>(&ctx, &mut rounds, (r, r2), [q1, q2], ny, sat) {
+                            Some(v) => out(j, v),
+                            None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
+                        }
+                    }
+                    q1 = q1.wrapping_add(a[1]);
+                    q2 = q2.wrapping_add(a[2]);
+                    ny = [
+                        ny[0].wrapping_add(st.y_step[0]),
+                        ny[1].wrapping_add(st.y_step[1]),
+                    ];
+                }
+                d = d.wrapping_add((n as i64).wrapping_mul(s));
+                j0 += n;
+                continue;
+            }
+        }
+        let n = n.min(RECIP_BATCH);
+        let mut dj = d;
+        for lane in &mut recips[..n] {
+            // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
+            let r = if N == ANY_ITERATIONS {
+                lane_recip.eval(dj as u64, &mut SatCounter::default())
+            } else {
+                lane_recip.eval_narrow::<N>(dj as u64)
+            };
+            *lane = (r, square(r, m_bits, M::MODE));
+            dj = dj.wrapping_add(s);
         }
         for (c, &(r, r2)) in recips[..n].iter().enumerate() {
             let j = j0 + c;
-            // `q_1`, `q_2` below 2^62 and the mantissa below 2^29.
-            let (p1, p2) = match (
-                apply_i64_small_in::<M>(r, q1, bb),
-                apply_i64_small_in::<M>(r, q2, bb),
-            ) {
-                (Some(p1), Some(p2)) => (p1, p2),
-                _ => (apply_i64_in::<M>(r, q1, bb), apply_i64_in::<M>(r, q2, bb)),
-            };
-            // |p_1|, |p_2| <= 2^60 as one unsigned compare of the larger of `p_i + 2^60`.
-            if bary_offset(p1).max(bary_offset(p2)) <= 2 * limit {
-                let ty = [(ny[0] >> (ny1 & 63), ny1), (ny[1] >> (ny2 & 63), ny2)];
-                let (x1, x2, y1, y2) = if (lo..hi).contains(&r2.shift) {
-                    // The four roundings of `1/D^2`'s exponent, kept while it holds.
-                    let rd = match rounds {
-                        Some((at, rd)) if at == r2.shift => rd,
-                        _ => {
-                            let rd = [nx[0].1, nx[1].1, ny1, ny2]
-                                .map(|ns| held_rounding::<M>(r2.shift, bb, ns));
-                            rounds = Some((r2.shift, rd));
-                            rd
-                        }
-                    };
-                    let dp = clamp_four(
-                        [
-                            derivative_held::<M>(nx[0].0, r2, &rd[0]),
-                            derivative_held::<M>(nx[1].0, r2, &rd[1]),
-                            derivative_held::<M>(ty[0].0, r2, &rd[2]),
-                            derivative_held::<M>(ty[1].0, r2, &rd[3]),
-                        ],
-                        sat,
-                    );
-                    (p1 + dp[0], p2 + dp[1], p1 + dp[2], p2 + dp[3])
-                } else {
-                    (
-                        p1 + derivative_of_top::<M>(nx[0], r2, bb, sat),
-                        p2 + derivative_of_top::<M>(nx[1], r2, bb, sat),
-                        p1 + derivative_of_top::<M>(ty[0], r2, bb, sat),
-                        p2 + derivative_of_top::<M>(ty[1], r2, bb, sat),
-                    )
-                };
-                out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
-            } else {
-                out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
+            match held_lane::<M>(&ctx, &mut rounds, (r, r2), [q1, q2], ny, sat) {
+                Some(v) => out(j, v),
+                None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
             }
             q1 = q1.wrapping_add(a[1]);
             q2 = q2.wrapping_add(a[2]);
@@ -758,6 +773,215 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
         d = dj;
         j0 += n;
     }
+}
+
+/// The span constants of [`held_lane`]: `bary_bits`, 1 in its format, the range of `1/D^2`'s
+/// exponent that keeps the derivatives' shifts in 64..126, the x numerators' tops and the y
+/// numerators' drops.
+struct HeldLane {
+    bb: u32,
+    one: i64,
+    r2_shifts: (i32, i32),
+    nx: [NumeratorTop; 2],
+    ns_y: (u32, u32),
+}
+
+/// One lane of [`derivs_span_held`] from its `1/D`, `1/D^2`, `q_1`, `q_2` and y numerators;
+/// `None`: the lane takes the per-sample datapath. `rounds` keeps the derivatives' roundings
+/// ([`held_rounding`]) for the last exponent of `1/D^2`: along a span `D` rarely crosses a
+/// power of two.
+#[inline(always)]
+fn held_lane<M: ConstRounding>(
+    c: &HeldLane,
+    rounds: &mut Option<(i32, [ShiftRound<M>; 4])>,
+    (r, r2): (Recip, Recip),
+    [q1, q2]: [i64; 2],
+    ny: [i128; 2],
+    sat: &mut SatCounter,
+) -> Option<[[i64; 3]; 3]> {
+    let (bb, nx, (ny1, ny2)) = (c.bb, c.nx, c.ns_y);
+    // `q_1`, `q_2` below 2^62 and the mantissa below 2^29.
+    let (p1, p2) = match (
+        apply_i64_small_in::<M>(r, q1, bb),
+        apply_i64_small_in::<M>(r, q2, bb),
+    ) {
+        (Some(p1), Some(p2)) => (p1, p2),
+        _ => (apply_i64_in::<M>(r, q1, bb), apply_i64_in::<M>(r, q2, bb)),
+    };
+    // |p_1|, |p_2| <= 2^60 as one unsigned compare of the larger of `p_i + 2^60`.
+    if bary_offset(p1).max(bary_offset(p2)) > 2 * BARY_LIMIT as u64 {
+        return None;
+    }
+    let ty = [(ny[0] >> (ny1 & 63), ny1), (ny[1] >> (ny2 & 63), ny2)];
+    let (x1, x2, y1, y2) = if (c.r2_shifts.0..c.r2_shifts.1).contains(&r2.shift) {
+        // The four roundings of `1/D^2`'s exponent, kept while it holds.
+        let rd = match *rounds {
+            Some((at, rd)) if at == r2.shift => rd,
+            _ => {
+                let rd =
+                    [nx[0].1, nx[1].1, ny1, ny2].map(|ns| held_rounding::<M>(r2.shift, bb, ns));
+                *rounds = Some((r2.shift, rd));
+                rd
+            }
+        };
+        let dp = clamp_four(
+            [
+                derivative_held::<M>(nx[0].0, r2, &rd[0]),
+                derivative_held::<M>(nx[1].0, r2, &rd[1]),
+                derivative_held::<M>(ty[0].0, r2, &rd[2]),
+                derivative_held::<M>(ty[1].0, r2, &rd[3]),
+            ],
+            sat,
+        );
+        (p1 + dp[0], p2 + dp[1], p1 + dp[2], p2 + dp[3])
+    } else {
+        (
+            p1 + derivative_of_top::<M>(nx[0], r2, bb, sat),
+            p2 + derivative_of_top::<M>(nx[1], r2, bb, sat),
+            p1 + derivative_of_top::<M>(ty[0], r2, bb, sat),
+            p2 + derivative_of_top::<M>(ty[1], r2, bb, sat),
+        )
+    };
+    Some(lane_result(c.one, [p1, p2], [x1, x2], [y1, y2]))
+}
+
+/// The span constants of one full batch of [`derivs_span_held`] ([`held_batch_lanes`]): `D`,
+/// `q_1` and `q_2` at its first lane and their steps, the x numerators' tops and each lane's
+/// y numerators' tops (as high and low words, below 2^94), the four drops `ns` (x then y),
+/// `bary_bits` and the range of `1/D^2`'s exponent that keeps the derivatives' shifts in
+/// 64..126.
+struct HeldBatch<const L: usize> {
+    n: usize,
+    d: i64,
+    s: i64,
+    q: [i64; 2],
+    a: [i64; 2],
+    nx: [(i64, u64); 2],
+    ty: [[(i64, u64); L]; 2],
+    ns: [u32; 4],
+    bb: u32,
+    r2_shifts: (i32, i32),
+}
+
+/// What [`held_batch_lanes`] gives per lane: `1/D` and `1/D^2`, the barycentrics `p_1`, `p_2`,
+/// the four derivative steps (x then y), and in bit `c` of `ok` whether lane `c` took the fast
+/// form (a lane that did not takes the scalar lane from its `1/D` and `1/D^2`).
+struct HeldLanes<const L: usize> {
+    recips: crate::reciprocal::RecipLanes<L>,
+    p: [[i64; L]; 2],
+    dp: [[i64; L]; 4],
+    ok: u64,
+}
+
+impl<const L: usize> Default for HeldLanes<L> {
+    fn default() -> Self {
+        Self {
+            recips: crate::reciprocal::RecipLanes::default(),
+            p: [[0; L]; 2],
+            dp: [[0; L]; 4],
+            ok: 0,
+        }
+    }
+}
+
+/// `q mant` for `|q| < 2^62` and a mantissa below 2^32 as the 128-bit `(high, low)` words: two
+/// 32 x 32-bit products and a carry, with no branch (a vector lane).
+#[inline(always)]
+fn mul_wide_lane(q: i64, mant: u64) -> (i64, u64) {
+    let high = (q >> 32) * mant as i64;
+    let low = (q as u64 & 0xffff_ffff) * mant;
+    let lo = (high as u64) << 32;
+    let sum = lo.wrapping_add(low);
+    ((high >> 32) + i64::from(sum < low), sum)
+}
+
+/// [`product_top`] of `x = hi 2^64 + lo` (below 2^94) and a mantissa below 2^29 with no
+/// branch (a vector lane): three 32 x 32-bit products.
+#[inline(always)]
+fn product_top_lane((hi, lo): (i64, u64), mant: u64) -> i64 {
+    let p0 = (lo & 0xffff_ffff) * mant;
+    let p1 = (lo >> 32) * mant;
+    let low = (p1 << 32).wrapping_add(p0);
+    let high = hi * mant as i64 + (p1 >> 32) as i64 + i64::from(low < p0);
+    (high << 2) | (low >> 62) as i64 | i64::from(low << 2 != 0)
+}
+
+/// One full batch of [`derivs_span_held`] written lane by lane with every per-lane choice a
+/// select, so that its loops vectorize: [`crate::reciprocal::RecipLane::eval_square_lanes`],
+/// the barycentrics ([`apply_i64_small_in`]'s product and rounding as [`mul_wide_lane`] and
+/// [`round_shift_right_wide_lane`]) and the four derivatives ([`derivative_held`] as
+/// [`product_top_lane`] and [`round_shift_right_lane`]). A lane is fast (its bit of `ok`) when
+/// the scalar lane would take those forms and clamp nothing; its values are then the scalar
+/// lane's (checked in `derivs_span_stepping_matches_per_lane_calls`).
+#[inline(always)]
+fn held_batch_lanes<M: ConstRounding, R: ConstRounding, const N: u32, const L: usize>(
+    lane: &crate::reciprocal::RecipLane<'_, R>,
+    b: &HeldBatch<L>,
+    out: &mut HeldLanes<L>,
+) {
+    // The lanes past the span's `n` repeat its last.
+    let lane_at = |c: usize| c.min(b.n - 1) as i64;
+    let x: [u64; L] =
+        std::array::from_fn(|c| b.d.wrapping_add(lane_at(c).wrapping_mul(b.s)) as u64);
+    lane.eval_square_lanes::<N, M, L>(&x, &mut out.recips);
+    let mut ok = 0u64;
+    let limit = 2 * BARY_LIMIT as u64;
+    for c in 0..L {
+        let (r, r2) = out.recips.get(c);
+        // The barycentrics: `q_i / D` at `bary_bits`, a shift in 1..=63 that fits `i64`.
+        let sh = i64::from(r.shift) - i64::from(b.bb);
+        let mut fast = (1..64).contains(&sh);
+        for i in 0..2 {
+            let q = b.q[i].wrapping_add(lane_at(c).wrapping_mul(b.a[i]));
+            let (hi, lo) = mul_wide_lane(q, r.mant);
+            let (v, fits) = round_shift_right_wide_lane::<M>(hi, lo, sh.clamp(1, 63) as u32);
+            fast &= fits && bary_offset(v) <= limit;
+            out.p[i][c] = v;
+        }
+        // The derivatives: each top rounded by `1/D^2`'s exponent less its drop.
+        fast &= (b.r2_shifts.0..b.r2_shifts.1).contains(&r2.shift);
+        for k in 0..4 {
+            let top = if k < 2 { b.nx[k] } else { b.ty[k - 2][c] };
+            let shift = i64::from(r2.shift) - i64::from(b.bb + b.ns[k]) - 62;
+            let v = round_shift_right_lane::<M>(
+                product_top_lane(top, r2.mant),
+                shift.clamp(2, 63) as u32,
+            );
+            fast &= bary_offset(v) <= limit;
+            out.dp[k][c] = v;
+        }
+        ok |= u64::from(fast) << c;
+    }
+    out.ok = ok;
+}
+
+/// [`held_batch_lanes`] built for AVX-512 into `out` when this CPU has it (and `true`), else
+/// `false`.
+#[inline(always)]
+fn held_batch_wide<M: ConstRounding, R: ConstRounding, const N: u32, const L: usize>(
+    lane: &crate::reciprocal::RecipLane<'_, R>,
+    b: &HeldBatch<L>,
+    out: &mut HeldLanes<L>,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if crate::reciprocal::has_avx512() {
+        // SAFETY: the CPU has every feature the function is built for.
+        unsafe { held_batch_avx512::<M, R, N, L>(lane, b, out) };
+        return true;
+    }
+    let _ = (lane, b, out);
+    false
+}
+
+/// [`held_batch_lanes`] compiled with AVX-512 enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+fn held_batch_avx512<M: ConstRounding, R: ConstRounding, const N: u32, const L: usize>(
+    lane: &crate::reciprocal::RecipLane<'_, R>,
+    b: &HeldBatch<L>,
+    out: &mut HeldLanes<L>,
+) {
+    held_batch_lanes::<M, R, N, L>(lane, b, out);
 }
 
 /// [`perspective_bary`] at the samples of a row span: `out(j, result)` gets lane `j`'s result
@@ -1914,6 +2138,59 @@ mod tests {
         assert!(held > 50_000 && nonzero > 10_000, "{held} {nonzero}");
     }
 
+    /// 2M seeded operands (magnitudes of every bit length up to the bounds, low words of
+    /// zeros and of ones, so that the carries and the sticky bit are at their edges): the
+    /// vector lanes' products give the 128-bit ones, `mul_wide_lane` the product of `q`
+    /// (below 2^62) and a mantissa below 2^32, `product_top_lane` the `product_top` of a
+    /// numerator top (below 2^94) and a mantissa below 2^29.
+    #[test]
+    fn lane_products_match_the_wide_products() {
+        let mut s = 0x5eed_0b48;
+        let mut sticky_edge = 0u32;
+        for i in 0..1_000_000u32 {
+            let low_bits = |s: &mut u64, k: u32| match k % 4 {
+                0 => 0,
+                1 => u64::MAX >> (k % 64),
+                _ => next(s),
+            };
+            let q = ((next(&mut s) as i64 >> 2) >> (i % 62)) & !((1i64 << (i % 40)) - 1);
+            let q = if i % 7 == 0 {
+                q | low_bits(&mut s, i) as i64 >> 2
+            } else {
+                q
+            };
+            let mant = next(&mut s) >> (32 + i % 32);
+            let (hi, lo) = mul_wide_lane(q, mant);
+            let want = i128::from(q) * i128::from(mant);
+            assert_eq!(i128::from(hi) << 64 | i128::from(lo), want, "{q} {mant}");
+            // A top below 2^94: random, or a multiple of 2^62 with at most one bit below
+            // (and a power-of-two mantissa), so that the product's low 62 bits are zero or one
+            // bit at any place.
+            let top = (next(&mut s) as i64 >> (32 + i % 31)) as i128;
+            let (x, m2) = match i % 3 {
+                0 => {
+                    let x = (i128::from(next(&mut s) as i64) << 32)
+                        | i128::from(low_bits(&mut s, i / 3) >> 32);
+                    (x >> (i % 5), (next(&mut s) >> (35 + i % 29)).max(1))
+                }
+                1 => (top << 62, (next(&mut s) >> (35 + i % 29)).max(1)),
+                _ => {
+                    let k = (next(&mut s) % 62) as u32;
+                    let sign = if i % 2 == 0 { 1 } else { -1 };
+                    (
+                        (top << 62) + sign * (1i128 << k),
+                        1 << (next(&mut s) % (62 - u64::from(k)).min(29)),
+                    )
+                }
+            };
+            let r2 = Recip { mant: m2, shift: 0 };
+            let got = product_top_lane(((x >> 64) as i64, x as u64), m2);
+            assert_eq!(got, product_top(x, r2), "{x} {m2}");
+            sticky_edge += u32::from(((x * i128::from(m2)) as u64) << 2 == 0);
+        }
+        assert!(sticky_edge > 100_000, "{sticky_edge}");
+    }
+
     /// [`clamp_four`] clamps and counts each derivative beyond +-[`BARY_LIMIT`] and passes
     /// the others (the span datapath's derivatives never reach it).
     #[test]
@@ -1934,13 +2211,15 @@ mod tests {
     /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
     /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
     /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
-    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`.
+    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`. Spans
+    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX-512: many
+    /// of their lanes take the batch's fast form, and many the scalar lane (the clamp).
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
         let (mut held_lanes, mut steady_lanes) = (0u64, 0u64);
         let (mut stepped, mut tested, mut held_small) = (0u64, 0u64, 0u64);
-        let mut held_clamped = 0u64;
+        let (mut held_clamped, mut held_batched) = (0u64, [0u64; 2]);
         let mut got = [[[0i64; 3]; 3]; 24];
         // The widest mantissa of the held loop, with the reciprocal truncating.
         let mut widest = HwConfig::texram16();
@@ -2047,8 +2326,12 @@ mod tests {
                         {
                             if held {
                                 held_lanes += 1;
-                                held_clamped +=
-                                    u64::from(want[0][1..].iter().any(|v| v.abs() == BARY_LIMIT));
+                                let clamped = want[0][1..].iter().any(|v| v.abs() == BARY_LIMIT);
+                                held_clamped += u64::from(clamped);
+                                // Lanes of the vector batches (on a CPU with AVX-512).
+                                if n >= HELD_MIN_LANES {
+                                    held_batched[usize::from(clamped)] += 1;
+                                }
                                 // The lanes whose barycentrics take `apply_i64_small_in`.
                                 let r = recip.eval(d as u64, &mut SatCounter::default());
                                 let sh = r.shift - cfg.bary_bits as i32;
@@ -2071,6 +2354,11 @@ mod tests {
              {steady_lanes} stepped {stepped} tested {tested}"
         );
         assert!(held_clamped > 50_000, "{held_clamped}");
+        // Batched lanes of both forms: the batch's own and the scalar lane's.
+        assert!(
+            held_batched[0] > 200_000 && held_batched[1] > 20_000,
+            "{held_batched:?}"
+        );
         assert!(
             held_lanes > 500_000 && steady_lanes > 100_000 && held_small > 200_000,
             "{held_lanes} {held_small} {steady_lanes}"

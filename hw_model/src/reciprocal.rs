@@ -276,32 +276,29 @@ impl<R: ConstRounding> RecipLane<'_, R> {
     }
 }
 
-/// Lanes of one [`RecipLane::eval_square_lanes`] batch: eight 64-bit lanes, one AVX-512
-/// register.
+/// 64-bit lanes in one AVX-512 register: a batch of [`RecipLane::eval_square_lanes`] is a
+/// multiple of it.
 pub const RECIP_LANES: usize = 8;
 
 impl<R: ConstRounding> RecipLane<'_, R> {
     /// [`RecipLane::eval_narrow`] of each `x[j]` (in 1..2^62; P in 1..=29 and `N` the
     /// iteration count, as there) with its [`square`] rounded by `S`: the same bits, written
     /// lane by lane with every per-lane choice a select (the normalizing shifts through
-    /// [`round_shift_right_lane`]), so that its loops over the lanes vectorize. Checked
-    /// against `eval_narrow` and `square` in `eval_square_lanes_match_eval_narrow`.
+    /// [`round_shift_right_lane`]), so that its loops over the lanes vectorize (several
+    /// registers of lanes each step: independent chains the core overlaps). Checked against
+    /// `eval_narrow` and `square` in `eval_square_lanes_match_eval_narrow`.
     #[inline(always)]
-    #[must_use]
-    pub fn eval_square_lanes<const N: u32, S: ConstRounding>(
+    pub fn eval_square_lanes<const N: u32, S: ConstRounding, const L: usize>(
         &self,
-        x: &[u64; RECIP_LANES],
-    ) -> RecipLanes {
+        x: &[u64; L],
+        out: &mut RecipLanes<L>,
+    ) {
         debug_assert!((1..=29).contains(&self.p) && N == self.iterations);
         let (p, m_bits) = (u64::from(self.p), u64::from(self.m_bits));
         // 2^L entries: every masked index is in range, with no test per lane.
         let lut = &self.lut[..=self.idx_mask as usize];
-        let (mut m, mut n, mut y) = (
-            [0i64; RECIP_LANES],
-            [0u64; RECIP_LANES],
-            [0i64; RECIP_LANES],
-        );
-        for j in 0..RECIP_LANES {
+        let (mut m, mut n, mut y) = ([0i64; L], [0u64; L], [0i64; L]);
+        for j in 0..L {
             debug_assert!(x[j] != 0 && x[j] >> 62 == 0, "{}", x[j]);
             // m with P fraction bits in [2^P, 2^(P+1)]: `x` moved up, or rounded down.
             let nj = 63 - u64::from(x[j].leading_zeros());
@@ -315,13 +312,12 @@ impl<R: ConstRounding> RecipLane<'_, R> {
         }
         let two = 2i64 << p;
         for _ in 0..N {
-            for j in 0..RECIP_LANES {
+            for j in 0..L {
                 let t = round_shift_right_small::<R>(m[j] * y[j], p as u32);
                 y[j] = round_shift_right_small::<R>(y[j] * (two - t), p as u32);
             }
         }
-        let mut out = RecipLanes::default();
-        for j in 0..RECIP_LANES {
+        for j in 0..L {
             // [`RecipLane::normalized`]: `y` to M + 1 significant bits (a drop of 1 to 3).
             let b = 64 - u64::from((y[j] as u64).leading_zeros());
             let drop = b - (m_bits + 1);
@@ -339,21 +335,31 @@ impl<R: ConstRounding> RecipLane<'_, R> {
             out.mant2[j] = mant2 >> over2;
             out.shift2[j] = 2 * shift - (drop2 + over2) as i64;
         }
-        out
     }
 }
 
 /// The results of one [`RecipLane::eval_square_lanes`] batch, lane by lane: `1/x` and its
 /// square as mantissas and shifts ([`Recip`]'s fields), in arrays (what the vector unit writes).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RecipLanes {
-    mant: [u64; RECIP_LANES],
-    shift: [i64; RECIP_LANES],
-    mant2: [u64; RECIP_LANES],
-    shift2: [i64; RECIP_LANES],
+#[derive(Clone, Copy, Debug)]
+pub struct RecipLanes<const L: usize> {
+    mant: [u64; L],
+    shift: [i64; L],
+    mant2: [u64; L],
+    shift2: [i64; L],
 }
 
-impl RecipLanes {
+impl<const L: usize> Default for RecipLanes<L> {
+    fn default() -> Self {
+        Self {
+            mant: [0; L],
+            shift: [0; L],
+            mant2: [0; L],
+            shift2: [0; L],
+        }
+    }
+}
+
+impl<const L: usize> RecipLanes<L> {
     /// Lane `j`'s `1/x` and its square.
     #[inline(always)]
     #[must_use]
@@ -371,38 +377,16 @@ impl RecipLanes {
     }
 }
 
-impl<R: ConstRounding> RecipLane<'_, R> {
-    /// [`RecipLane::eval_square_lanes`] built for AVX-512 (eight 64-bit lanes per
-    /// instruction, `vplzcntq` and `vpmullq`) when this CPU has it, else `None`: the same
-    /// bits, checked in `eval_square_lanes_match_eval_narrow` on every CPU that has it.
-    #[inline(always)]
-    #[must_use]
-    pub fn eval_square_lanes_wide<const N: u32, S: ConstRounding>(
-        &self,
-        x: &[u64; RECIP_LANES],
-    ) -> Option<RecipLanes> {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512dq")
-            && std::arch::is_x86_feature_detected!("avx512cd")
-            && std::arch::is_x86_feature_detected!("avx512vl")
-        {
-            // SAFETY: the CPU has every feature the function is built for.
-            return Some(unsafe { eval_square_lanes_avx512::<R, N, S>(self, x) });
-        }
-        let _ = x;
-        None
-    }
-}
-
-/// [`RecipLane::eval_square_lanes`] compiled with AVX-512 enabled.
+/// Whether this CPU has the AVX-512 subsets the vector batches are built for (F, DQ, CD, VL;
+/// std caches the detection).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-fn eval_square_lanes_avx512<R: ConstRounding, const N: u32, S: ConstRounding>(
-    lane: &RecipLane<'_, R>,
-    x: &[u64; RECIP_LANES],
-) -> RecipLanes {
-    lane.eval_square_lanes::<N, S>(x)
+#[inline(always)]
+#[must_use]
+pub fn has_avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && std::arch::is_x86_feature_detected!("avx512cd")
+        && std::arch::is_x86_feature_detected!("avx512vl")
 }
 
 /// One Newton-Raphson step `y (2 - m y)` with each product rounded to `p` fraction bits.
@@ -757,14 +741,40 @@ mod tests {
         assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
     }
 
+    /// `eval_square_lanes` built for AVX-512 (as the vector batches of
+    /// `interpolator::derivs_span_held` are) when this CPU has it.
+    fn eval_square_lanes_wide<R: ConstRounding, const N: u32, S: ConstRounding>(
+        lane: &RecipLane<'_, R>,
+        x: &[u64; 2 * RECIP_LANES],
+    ) -> Option<RecipLanes<{ 2 * RECIP_LANES }>> {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx512() {
+            #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+            fn avx512<R: ConstRounding, const N: u32, S: ConstRounding>(
+                lane: &RecipLane<'_, R>,
+                x: &[u64; 2 * RECIP_LANES],
+                out: &mut RecipLanes<{ 2 * RECIP_LANES }>,
+            ) {
+                lane.eval_square_lanes::<N, S, { 2 * RECIP_LANES }>(x, out);
+            }
+            let mut out = RecipLanes::default();
+            // SAFETY: the CPU has every feature the function is built for.
+            unsafe { avx512::<R, N, S>(lane, x, &mut out) };
+            return Some(out);
+        }
+        let _ = (lane, x);
+        None
+    }
+
     /// `eval_square_lanes::<N, S>` of the batch `x` (the portable build and, on a CPU with
     /// AVX-512, `eval_square_lanes_wide`), each lane against `eval_narrow` and `square`.
     fn check_lanes<R: ConstRounding, S: ConstRounding, const N: u32>(
         lane: &RecipLane<'_, R>,
-        x: &[u64; RECIP_LANES],
+        x: &[u64; 2 * RECIP_LANES],
     ) -> u64 {
-        let lanes = lane.eval_square_lanes::<N, S>(x);
-        let wide = lane.eval_square_lanes_wide::<N, S>(x);
+        let mut lanes = RecipLanes::default();
+        lane.eval_square_lanes::<N, S, { 2 * RECIP_LANES }>(x, &mut lanes);
+        let wide = eval_square_lanes_wide::<R, N, S>(lane, x);
         for (j, &xj) in x.iter().enumerate() {
             let r = lane.eval_narrow::<N>(xj);
             let want = (r, square(r, lane.m_bits, S::MODE));
@@ -785,7 +795,7 @@ mod tests {
                 );
             }
         }
-        RECIP_LANES as u64
+        2 * RECIP_LANES as u64
     }
 
     /// 4.3M seeded lanes in 1..2^62 (every bit length; 1, 2^62 - 1 and runs of steps along a
@@ -804,9 +814,13 @@ mod tests {
                     for n in 0..=4 {
                         for mb in [8, 13, 16, 21, 24, 26] {
                             let u = Reciprocal::new(&config(&base, (l, n, mb), mode));
-                            for i in 0..330u32 {
-                                let x: [u64; RECIP_LANES] = match i {
-                                    0 => [1, (1 << 62) - 1, 2, 3, 1 << 61, 7, 255, 256],
+                            for i in 0..165u32 {
+                                let x: [u64; 2 * RECIP_LANES] = match i {
+                                    0 => std::array::from_fn(|c| {
+                                        [1u64, (1 << 62) - 1, 2, 3, 1 << 61, 7, 255, 256][c % 8]
+                                            .saturating_sub(c as u64 / 8)
+                                            .max(1)
+                                    }),
                                     1..=29 => std::array::from_fn(|_| {
                                         (next(&mut s) >> 2 >> (next(&mut s) % 62)).max(1)
                                     }),
