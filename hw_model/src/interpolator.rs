@@ -694,13 +694,14 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
         if N != ANY_ITERATIONS && n >= HELD_MIN_LANES {
             // Each lane's y numerators' tops; the lanes past the span repeat its last.
             let mut ty = [[(0i64, 0u64); HELD_LANES]; 2];
-            for (k, (tops, ns)) in ty.iter_mut().zip([ny1, ny2]).enumerate() {
-                let mut nyj = ny[k];
-                for (c, top) in tops.iter_mut().enumerate() {
-                    let t = nyj >> (ns & 63);
-                    *top = ((t >> 64) as i64, t as u64);
+            let mut nyj = ny;
+            #[allow(clippy::needless_range_loop)]
+            for c in 0..HELD_LANES {
+                for k in 0..2 {
+                    let t = nyj[k] >> ([ny1, ny2][k] & 63);
+                    ty[k][c] = ((t >> 64) as i64, t as u64);
                     if c + 1 < n {
-                        nyj = nyj.wrapping_add(st.y_step[k]);
+                        nyj[k] = nyj[k].wrapping_add(st.y_step[k]);
                     }
                 }
             }
