@@ -695,6 +695,8 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
             // Each lane's y numerators' tops; the lanes past the span repeat its last.
             let mut ty = [[(0i64, 0u64); HELD_LANES]; 2];
             let mut nyj = ny;
+            // Lane by lane with indices: the iterator form clippy prefers made this function's
+            // short spans (no batch) 1.5 ms a W2 frame slower at one thread.
             #[allow(clippy::needless_range_loop)]
             for c in 0..HELD_LANES {
                 for k in 0..2 {
