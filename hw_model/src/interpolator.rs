@@ -967,7 +967,7 @@ fn held_batch_wide<M: ConstRounding, R: ConstRounding, const N: u32, const L: us
     out: &mut HeldLanes<L>,
 ) -> bool {
     #[cfg(target_arch = "x86_64")]
-    if crate::reciprocal::has_avx512() {
+    if crate::has_avx512() {
         // SAFETY: the CPU has every feature the function is built for.
         unsafe { held_batch_avx512::<M, R, N, L>(lane, b, out) };
         return true;

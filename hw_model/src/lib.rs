@@ -46,6 +46,18 @@ pub use config::{ConfigError, HwConfig};
 pub use cost::UnitCost;
 pub use fixed::{Format, Overflow, Rounding, SatCounter};
 
+/// Whether this CPU has the AVX-512 subsets the vector batches are built for (F, DQ, CD, VL;
+/// std caches the detection).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+#[must_use]
+pub fn has_avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && std::arch::is_x86_feature_detected!("avx512cd")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+}
+
 /// The seeded generator of the unit tests (splitmix64, as `tests/rng_common`).
 #[cfg(test)]
 pub(crate) mod test_rng {

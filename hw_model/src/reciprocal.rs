@@ -377,18 +377,6 @@ impl<const L: usize> RecipLanes<L> {
     }
 }
 
-/// Whether this CPU has the AVX-512 subsets the vector batches are built for (F, DQ, CD, VL;
-/// std caches the detection).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-#[must_use]
-pub fn has_avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-        && std::arch::is_x86_feature_detected!("avx512cd")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-}
-
 /// One Newton-Raphson step `y (2 - m y)` with each product rounded to `p` fraction bits.
 /// Operands are below 2^(p+2), so for p <= 29 the products fit `i64` (same bits as `i128`).
 #[inline(always)]
@@ -748,7 +736,7 @@ mod tests {
         x: &[u64; 2 * RECIP_LANES],
     ) -> Option<RecipLanes<{ 2 * RECIP_LANES }>> {
         #[cfg(target_arch = "x86_64")]
-        if has_avx512() {
+        if crate::has_avx512() {
             #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
             fn avx512<R: ConstRounding, const N: u32, S: ConstRounding>(
                 lane: &RecipLane<'_, R>,
