@@ -649,10 +649,11 @@ const ANY_ITERATIONS: u32 = u32::MAX;
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
 /// [`derivative_held`]'s 64-bit rounding, their four [`held_rounding`]s kept while that
 /// exponent holds (else each takes [`derivative_of_top`]). Checked against one call per lane
-/// in `derivs_span_stepping_matches_per_lane_calls`. The lanes run in batches of
-/// [`RECIP_BATCH`]: a full batch at a narrow width as vector lanes where the CPU has AVX-512
-/// ([`held_batch_wide`]; a lane outside its fast form takes the scalar lane), else each
-/// batch's reciprocals ahead of the rest of its lanes.
+/// in `derivs_span_stepping_matches_per_lane_calls`. At a narrow width on a CPU with AVX-512,
+/// the next [`HELD_MIN_LANES`] to [`HELD_LANES`] lanes run as one batch of vector lanes
+/// ([`held_batch_wide`]; a lane outside its fast form takes the scalar lane, [`held_lane`]);
+/// other lanes run in batches of [`RECIP_BATCH`], each batch's reciprocals ahead of the rest
+/// of its lanes.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
@@ -848,8 +849,9 @@ fn held_lane<M: ConstRounding>(
     Some(lane_result(c.one, [p1, p2], [x1, x2], [y1, y2]))
 }
 
-/// The span constants of one full batch of [`derivs_span_held`] ([`held_batch_lanes`]): `D`,
-/// `q_1` and `q_2` at its first lane and their steps, the x numerators' tops and each lane's
+/// The span constants of one batch of [`derivs_span_held`] ([`held_batch_lanes`]): the span's
+/// lanes it takes (`n`, 1 to `L`; the lanes past them repeat its last), `D`, `q_1` and `q_2`
+/// at its first lane and their steps, the x numerators' tops and each lane's
 /// y numerators' tops (as high and low words, below 2^94), the four drops `ns` (x then y),
 /// `bary_bits` and the range of `1/D^2`'s exponent that keeps the derivatives' shifts in
 /// 64..126.
@@ -909,7 +911,7 @@ fn product_top_lane((hi, lo): (i64, u64), mant: u64) -> i64 {
     (high << 2) | (low >> 62) as i64 | i64::from(low << 2 != 0)
 }
 
-/// One full batch of [`derivs_span_held`] written lane by lane with every per-lane choice a
+/// One batch of [`derivs_span_held`] written lane by lane with every per-lane choice a
 /// select, so that its loops vectorize: [`crate::reciprocal::RecipLane::eval_square_lanes`],
 /// the barycentrics ([`apply_i64_small_in`]'s product and rounding as [`mul_wide_lane`] and
 /// [`round_shift_right_wide_lane`]) and the four derivatives ([`derivative_held`] as

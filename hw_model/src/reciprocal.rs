@@ -295,7 +295,7 @@ impl<R: ConstRounding> RecipLane<'_, R> {
     ) {
         debug_assert!((1..=29).contains(&self.p) && N == self.iterations);
         let (p, m_bits) = (u64::from(self.p), u64::from(self.m_bits));
-        // 2^L entries: every masked index is in range, with no test per lane.
+        // 2^recip_lut_bits entries: every masked index is in range, with no test per lane.
         let lut = &self.lut[..=self.idx_mask as usize];
         let (mut m, mut n, mut y) = ([0i64; L], [0u64; L], [0i64; L]);
         for j in 0..L {
@@ -304,7 +304,8 @@ impl<R: ConstRounding> RecipLane<'_, R> {
             let nj = 63 - u64::from(x[j].leading_zeros());
             let (up, down) = (p.saturating_sub(nj), nj.saturating_sub(p));
             let mj = round_shift_right_lane::<R>((x[j] << up) as i64, down as u32);
-            // The seed: m brought below 2^(P+1), its top L fraction bits the index.
+            // The seed: m brought below 2^(P+1), its top `recip_lut_bits` fraction bits the
+            // index.
             let carry = (mj >> (p + 1)) as u64;
             let mj = mj >> carry;
             let idx = ((mj << self.idx_up) >> self.idx_down) & self.idx_mask;
