@@ -819,8 +819,8 @@ mod tests {
                                         let st =
                                             (next(&mut s) >> (i % 60 + 4)) as i64 - (d >> 4) as i64;
                                         std::array::from_fn(|c| {
-                                            (d as i64 + c as i64 * st).clamp(1, (1 << 62) - 1)
-                                                as u64
+                                            let x = i128::from(d) + c as i128 * i128::from(st);
+                                            x.clamp(1, (1 << 62) - 1) as u64
                                         })
                                     }
                                 };

@@ -7,7 +7,7 @@ use hw_model::pow::{pow_cost, Pow, PowConfig, PowMethod};
 use hw_model::SatCounter;
 
 /// The documented absolute bound for `x^n` (x, result in [0, 1]).
-fn bound(cfg: &PowConfig, x: f64, n: u32) -> f64 {
+pub(crate) fn bound(cfg: &PowConfig, x: f64, n: u32) -> f64 {
     let p = f64::from(cfg.pow_frac_bits);
     let g = -(p + f64::from(cfg.pow_guard_bits));
     let h2 = (-2.0 * f64::from(cfg.pow_lut_bits)).exp2();
