@@ -539,7 +539,7 @@ pub fn rough_cos_d(
 
 /// `cos a'` raised to the mode's exponent `n` by the power unit (`P = pow_frac_bits`).
 ///
-/// ERROR BOUND (absolute, against the float twin's `cos a'`, `c`, raised to `n` in f64 on the
+/// ERROR BOUND (absolute, against the float twin's `cos a'`, `c`, raised to `n` exactly on the
 /// same quantized inputs): the power unit's own bound (`hw_model::pow`) at the unit's
 /// `cos a'`, `c'`, plus the cosine's bound (module doc, `B`) carried through `x^n`:
 /// `n B max(c, c')^(n-1)` (the mean value theorem on [0, 1]). Measured over 1M cases (every
