@@ -514,6 +514,21 @@ struct Steady {
     y_step: [i128; 2],
 }
 
+impl Steady {
+    /// `q_1`, `q_2` and the y numerators of the next lane from this lane's (wrapping steps,
+    /// exact at every lane of the span).
+    #[inline(always)]
+    fn next_lane(&self, [q1, q2]: [i64; 2], ny: [i128; 2]) -> ([i64; 2], [i128; 2]) {
+        (
+            [q1.wrapping_add(self.a[1]), q2.wrapping_add(self.a[2])],
+            [
+                ny[0].wrapping_add(self.y_step[0]),
+                ny[1].wrapping_add(self.y_step[1]),
+            ],
+        )
+    }
+}
+
 /// [`perspective_bary_derivs_span_in`] for a span whose `q_1`, `q_2` and `D` are below 2^62
 /// (and `D` positive) at both ends, hence at every lane: the lane loop without the per-lane
 /// tests of the general form; a lane whose `p_i` needs the clamp takes the per-sample
@@ -731,18 +746,13 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                         let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
                         out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
                     } else {
-                        let (r, r2) = b.recips.get(c);
-                        match held_lane::<M>(&ctx, &mut rounds, (r, r2), [q1, q2], ny, sat) {
+                        let rr = b.recips.get(c);
+                        match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
                             Some(v) => out(j, v),
                             None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
                         }
                     }
-                    q1 = q1.wrapping_add(a[1]);
-                    q2 = q2.wrapping_add(a[2]);
-                    ny = [
-                        ny[0].wrapping_add(st.y_step[0]),
-                        ny[1].wrapping_add(st.y_step[1]),
-                    ];
+                    ([q1, q2], ny) = st.next_lane([q1, q2], ny);
                 }
                 d = d.wrapping_add((n as i64).wrapping_mul(s));
                 j0 += n;
@@ -761,18 +771,13 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
             *lane = (r, square(r, m_bits, M::MODE));
             dj = dj.wrapping_add(s);
         }
-        for (c, &(r, r2)) in recips[..n].iter().enumerate() {
+        for (c, &rr) in recips[..n].iter().enumerate() {
             let j = j0 + c;
-            match held_lane::<M>(&ctx, &mut rounds, (r, r2), [q1, q2], ny, sat) {
+            match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
                 Some(v) => out(j, v),
                 None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
             }
-            q1 = q1.wrapping_add(a[1]);
-            q2 = q2.wrapping_add(a[2]);
-            ny = [
-                ny[0].wrapping_add(st.y_step[0]),
-                ny[1].wrapping_add(st.y_step[1]),
-            ];
+            ([q1, q2], ny) = st.next_lane([q1, q2], ny);
         }
         d = dj;
         j0 += n;
@@ -791,9 +796,9 @@ struct HeldLane {
 }
 
 /// One lane of [`derivs_span_held`] from its `1/D`, `1/D^2`, `q_1`, `q_2` and y numerators;
-/// `None`: the lane takes the per-sample datapath. `rounds` keeps the derivatives' roundings
-/// ([`held_rounding`]) for the last exponent of `1/D^2`: along a span `D` rarely crosses a
-/// power of two.
+/// `None`: the lane's barycentrics need the clamp, and it takes the per-sample datapath
+/// ([`derivs_lane`]). `rounds` keeps the derivatives' roundings ([`held_rounding`]) for the last exponent of
+/// `1/D^2`: along a span `D` rarely crosses a power of two.
 #[inline(always)]
 fn held_lane<M: ConstRounding>(
     c: &HeldLane,
