@@ -278,7 +278,7 @@ impl<R: ConstRounding> RecipLane<'_, R> {
 
 /// 64-bit lanes in one AVX-512 register: a batch of [`RecipLane::eval_square_lanes`] is a
 /// multiple of it.
-pub const RECIP_LANES: usize = 8;
+pub(crate) const RECIP_LANES: usize = 8;
 
 impl<R: ConstRounding> RecipLane<'_, R> {
     /// [`RecipLane::eval_narrow`] of each `x[j]` (in 1..2^62; P in 1..=29 and `N` the
@@ -288,7 +288,7 @@ impl<R: ConstRounding> RecipLane<'_, R> {
     /// registers of lanes each step: independent chains the core overlaps). Checked against
     /// `eval_narrow` and `square` in `eval_square_lanes_match_eval_narrow`.
     #[inline(always)]
-    pub fn eval_square_lanes<const N: u32, S: ConstRounding, const L: usize>(
+    pub(crate) fn eval_square_lanes<const N: u32, S: ConstRounding, const L: usize>(
         &self,
         x: &[u64; L],
         out: &mut RecipLanes<L>,
@@ -342,7 +342,7 @@ impl<R: ConstRounding> RecipLane<'_, R> {
 /// The results of one [`RecipLane::eval_square_lanes`] batch, lane by lane: `1/x` and its
 /// square as mantissas and shifts ([`Recip`]'s fields), in arrays (what the vector unit writes).
 #[derive(Clone, Copy, Debug)]
-pub struct RecipLanes<const L: usize> {
+pub(crate) struct RecipLanes<const L: usize> {
     mant: [u64; L],
     shift: [i64; L],
     mant2: [u64; L],
@@ -364,7 +364,7 @@ impl<const L: usize> RecipLanes<L> {
     /// Lane `j`'s `1/x` and its square.
     #[inline(always)]
     #[must_use]
-    pub fn get(&self, j: usize) -> (Recip, Recip) {
+    pub(crate) fn get(&self, j: usize) -> (Recip, Recip) {
         (
             Recip {
                 mant: self.mant[j],
