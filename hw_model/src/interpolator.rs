@@ -308,6 +308,107 @@ pub fn perspective_bary_derivs_span(
     })
 }
 
+/// One span of [`perspective_bary_derivs_spans`]: its edges and its triangle's `1/w`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DerivSpan {
+    pub span: EdgeSpan,
+    pub inv_w: [i64; 3],
+}
+
+/// [`perspective_bary_derivs_span`] of each span of `spans` (e.g. the spans of one row, each
+/// of its own triangle): `out(i, j, result)` gets lane `j` of span `i`, each lane once, in no
+/// promised order. Bit-identical to one call per lane, with the same saturation counts.
+///
+/// At a narrow width on a CPU with AVX-512 the lanes of every span of at most
+/// [`GATHER_MAX_LANES`] lanes in the held form ([`derivs_span_held`]) are gathered across the
+/// spans into vector batches of [`HELD_LANES`] lanes ([`Gather`]), so that the short spans of
+/// a mesh fill a batch as a long span does; each lane carries its span's constants. The
+/// other spans, and every span elsewhere, take [`perspective_bary_derivs_span`]'s forms span
+/// by span.
+pub fn perspective_bary_derivs_spans(
+    spans: &[DerivSpan],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    out: impl FnMut(usize, usize, [[i64; 3]; 3]),
+) {
+    crate::with_rounding!(cfg.interp_rounding, M => {
+        crate::with_rounding!(recip.config().recip_rounding, R => {
+            spans_in::<M, R>(spans, cfg, recip, sat, out)
+        })
+    })
+}
+
+/// [`perspective_bary_derivs_spans`] compiled for the rounding modes `M` (`interp_rounding`)
+/// and `R` (the reciprocal's `recip_rounding`).
+#[inline(always)]
+fn spans_in<M: ConstRounding, R: ConstRounding>(
+    spans: &[DerivSpan],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    mut out: impl FnMut(usize, usize, [[i64; 3]; 3]),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::has_avx512() && recip.config().recip_mantissa_bits <= 28 {
+        // The reciprocal's iteration count as a constant for the common widths.
+        match recip.lane::<R>().narrow_iterations() {
+            Some(1) => return spans_gathered::<M, R, 1>(spans, cfg, recip, sat, out),
+            Some(2) => return spans_gathered::<M, R, 2>(spans, cfg, recip, sat, out),
+            _ => {}
+        }
+    }
+    for (i, ds) in spans.iter().enumerate() {
+        let out = |j: usize, v| out(i, j, v);
+        perspective_bary_derivs_span_in::<M, R>(&ds.span, ds.inv_w, cfg, recip, sat, out);
+    }
+}
+
+/// [`spans_in`] with the held lanes of the short `spans` gathered into vector batches
+/// (AVX-512, `1/D` by `eval_narrow::<N>`): each span of at most [`GATHER_MAX_LANES`] lanes in
+/// the held form ([`held_form`]) pushes its lanes into the [`Gather`], which runs a batch
+/// whenever it is full and once more at the end; any other span takes
+/// [`perspective_bary_derivs_span_in`] at once.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn spans_gathered<M: ConstRounding, R: ConstRounding, const N: u32>(
+    spans: &[DerivSpan],
+    cfg: &InterpConfig,
+    recip: &Reciprocal,
+    sat: &mut SatCounter,
+    mut out: impl FnMut(usize, usize, [[i64; 3]; 3]),
+) {
+    let bb = cfg.bary_bits;
+    let m_bits = recip.config().recip_mantissa_bits;
+    let lane_recip = recip.lane::<R>();
+    let mut g = Gather::<HELD_LANES>::default();
+    for (i, ds) in spans.iter().enumerate() {
+        // A longer span fills its own batches ([`derivs_span_held`]).
+        let held = (ds.span.lanes <= GATHER_MAX_LANES)
+            .then(|| held_form(&ds.span, ds.inv_w, m_bits))
+            .flatten();
+        let Some((st, tops)) = held else {
+            let out = |j: usize, v| out(i, j, v);
+            perspective_bary_derivs_span_in::<M, R>(&ds.span, ds.inv_w, cfg, recip, sat, out);
+            continue;
+        };
+        let k = LaneConsts::new(&tops, bb);
+        let [mut q1, mut q2, mut d] = st.first;
+        let mut ny = tops.ny;
+        for j in 0..ds.span.lanes {
+            g.push((i, j), d, [q1, q2], ny, &k);
+            if g.n == HELD_LANES {
+                g.run::<M, R, N>(&lane_recip, (spans, cfg, recip), sat, &mut out);
+            }
+            ([q1, q2], ny) = st.next_lane([q1, q2], ny);
+            d = d.wrapping_add(st.s);
+        }
+    }
+    if g.n > 0 {
+        g.run::<M, R, N>(&lane_recip, (spans, cfg, recip), sat, &mut out);
+    }
+}
+
 /// The edges of lane `j` of a span: `edge + j edge_dx`.
 #[inline(always)]
 fn lane_edges(edge: [i64; 3], edge_dx: [i64; 3], j: usize) -> [i64; 3] {
@@ -368,28 +469,18 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     let &EdgeSpan {
         edge,
         dx: edge_dx,
-        dy: edge_dy,
         lanes,
+        ..
     } = span;
-    let times_w = |e: [i64; 3]| -> Option<[i64; 3]> {
-        Some([
-            e[0].checked_mul(inv_w[0])?,
-            e[1].checked_mul(inv_w[1])?,
-            e[2].checked_mul(inv_w[2])?,
-        ])
-    };
-    let sum = |v: [i64; 3]| v[0].checked_add(v[1])?.checked_add(v[2]);
-    // The lane-independent operands: `a_i`, `b_i` (the y steps), `S`, `T` and the OR of the
-    // magnitudes that enter the scale, all below 2^62 for the fast form.
-    let steps = (|| {
-        let (a, b) = (times_w(edge_dx)?, times_w(edge_dy)?);
-        let (s, t) = (sum(a)?, sum(b)?);
-        let mag = [a[1], a[2], s, b[1], b[2], t]
-            .into_iter()
-            .fold(0u64, |m, v| m | v.unsigned_abs());
-        (mag >> 62 == 0).then_some((a, b, s, t, mag))
-    })();
-    let Some((a, b, s, t, steps_mag)) = steps else {
+    let Some(SpanSteps {
+        a,
+        b,
+        s,
+        t,
+        mag: steps_mag,
+        y_step,
+    }) = span_steps(span, inv_w)
+    else {
         for j in 0..lanes {
             out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
         }
@@ -399,32 +490,13 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
     let wide = i128::from;
-    // Written out: an array `map` here is a call per span. A lone lane does not step.
-    let y_step = if lanes > 1 {
-        [
-            wide(b[1]) * wide(s) - wide(a[1]) * wide(t),
-            wide(b[2]) * wide(s) - wide(a[2]) * wide(t),
-        ]
-    } else {
-        [0; 2]
-    };
-    // `q_1`, `q_2` and `D` of every lane when each lane's products and sums fit `i64` (what
-    // the per-lane `times_w` and `sum` test): they are linear in the lane, so they do when
-    // they do at the first and the last lane, and then they step by `a_1`, `a_2` and `S`
-    // (wrapping adds, exact). `None`: each lane tests its own.
-    let first = lane_q(edge, inv_w);
-    let ends = match lanes {
-        0 => return,
-        1 => first.map(|f| (f, f)),
-        _ => first.zip(lane_q(lane_edges(edge, edge_dx, lanes - 1), inv_w)),
-    };
-    // Every lane of the fast form (up to the clamp of `p_i`) when both ends are: `q_1`, `q_2`
-    // and `D` are linear in the lane, so their magnitudes are at most those at the ends and
-    // `D` is positive between two positive ends.
-    let small_end = |[q1, q2, d]: [i64; 3]| {
-        d > 0 && (d as u64 | q1.unsigned_abs() | q2.unsigned_abs() | steps_mag) >> 62 == 0
-    };
-    if let Some((first, _)) = ends.filter(|&(f, l)| small_end(f) && small_end(l)) {
+    if lanes == 0 {
+        return;
+    }
+    let ends = span_ends(span, inv_w);
+    if let Some((first, _)) =
+        ends.filter(|&(f, l)| small_end(f, steps_mag) && small_end(l, steps_mag))
+    {
         let steady = Steady {
             first,
             a,
@@ -502,6 +574,115 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     }
 }
 
+/// The lane-independent operands of a span ([`perspective_bary_derivs_span_in`]): `a_i`, `b_i`
+/// (the x and y steps of `q_i`), `S`, `T`, the OR of the magnitudes that enter the scale and
+/// the y numerators' step (0 for a lone lane, which does not step).
+struct SpanSteps {
+    a: [i64; 3],
+    b: [i64; 3],
+    s: i64,
+    t: i64,
+    mag: u64,
+    y_step: [i128; 2],
+}
+
+/// The [`SpanSteps`] of a span, when each is below 2^62 (the fast form); else `None`.
+#[inline(always)]
+fn span_steps(span: &EdgeSpan, inv_w: [i64; 3]) -> Option<SpanSteps> {
+    let times_w = |e: [i64; 3]| -> Option<[i64; 3]> {
+        Some([
+            e[0].checked_mul(inv_w[0])?,
+            e[1].checked_mul(inv_w[1])?,
+            e[2].checked_mul(inv_w[2])?,
+        ])
+    };
+    let sum = |v: [i64; 3]| v[0].checked_add(v[1])?.checked_add(v[2]);
+    let (a, b) = (times_w(span.dx)?, times_w(span.dy)?);
+    let (s, t) = (sum(a)?, sum(b)?);
+    let mag = [a[1], a[2], s, b[1], b[2], t]
+        .into_iter()
+        .fold(0u64, |m, v| m | v.unsigned_abs());
+    if mag >> 62 != 0 {
+        return None;
+    }
+    let wide = i128::from;
+    // Written out: an array `map` here is a call per span.
+    let y_step = if span.lanes > 1 {
+        [
+            wide(b[1]) * wide(s) - wide(a[1]) * wide(t),
+            wide(b[2]) * wide(s) - wide(a[2]) * wide(t),
+        ]
+    } else {
+        [0; 2]
+    };
+    Some(SpanSteps {
+        a,
+        b,
+        s,
+        t,
+        mag,
+        y_step,
+    })
+}
+
+/// `[q_1, q_2, D]` at the first and the last lane of a span of at least one lane, when each
+/// lane's products and sums fit `i64` there ([`lane_q`]): they are linear in the lane, so
+/// they do when they do at both ends, and then they step by `a_1`, `a_2` and `S` (wrapping
+/// adds, exact). `None`: each lane tests its own.
+#[inline(always)]
+fn span_ends(span: &EdgeSpan, inv_w: [i64; 3]) -> Option<([i64; 3], [i64; 3])> {
+    let first = lane_q(span.edge, inv_w)?;
+    if span.lanes <= 1 {
+        return Some((first, first));
+    }
+    let last = lane_q(lane_edges(span.edge, span.dx, span.lanes - 1), inv_w)?;
+    Some((first, last))
+}
+
+/// Whether the lane `[q_1, q_2, D]` at an end of a span with steps of magnitude `mag` is in
+/// the fast form: `D` positive and every operand below 2^62. Every lane of the span is when
+/// both ends are: `q_1`, `q_2` and `D` are linear in the lane, so their magnitudes are at
+/// most those at the ends and `D` is positive between two positive ends.
+#[inline(always)]
+fn small_end([q1, q2, d]: [i64; 3], mag: u64) -> bool {
+    d > 0 && (d as u64 | q1.unsigned_abs() | q2.unsigned_abs() | mag) >> 62 == 0
+}
+
+/// The held form of a span ([`derivs_span_held`]), when it takes it: its [`Steady`]
+/// operands and the [`Tops`] of its derivative numerators (with mantissas below 2^29,
+/// `m_bits <= 28`). `None`: the span takes another form of
+/// [`perspective_bary_derivs_span_in`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn held_form(span: &EdgeSpan, inv_w: [i64; 3], m_bits: u32) -> Option<(Steady, Tops)> {
+    let SpanSteps {
+        a,
+        b,
+        s,
+        t,
+        mag,
+        y_step,
+    } = span_steps(span, inv_w)?;
+    if span.lanes == 0 {
+        return None;
+    }
+    let (first, last) = span_ends(span, inv_w)?;
+    if !(small_end(first, mag) && small_end(last, mag)) {
+        return None;
+    }
+    let st = Steady {
+        first,
+        a,
+        b,
+        s,
+        t,
+        y_step,
+    };
+    let (nx, ny) = st.numerators();
+    let ns_y = held_drops(&st, ny, span.lanes, m_bits)?;
+    Some((st, Tops { nx, ny, ns_y }))
+}
+
 /// The lane-independent operands of a span whose lanes all take the fast form
 /// ([`derivs_span_steady`]): `q_1`, `q_2`, `D` at its first lane, `a_i` and `b_i` (the x and
 /// y steps of `q_i`), `S`, `T`, and the y numerators' step.
@@ -515,6 +696,27 @@ struct Steady {
 }
 
 impl Steady {
+    /// The derivative numerators at the first lane: the x numerators' tops (the same at every
+    /// lane) and the y numerators (which step by `y_step`, exact at every lane, below 2^125;
+    /// the wrapping steps are exact modulo 2^128).
+    #[inline(always)]
+    fn numerators(&self) -> ([NumeratorTop; 2], [i128; 2]) {
+        let wide = i128::from;
+        let (a, b, s, t) = (self.a, self.b, self.s, self.t);
+        let [q1, q2, d] = self.first;
+        let dw = wide(d);
+        (
+            [
+                numerator_top(wide(a[1]) * dw - wide(q1) * wide(s)),
+                numerator_top(wide(a[2]) * dw - wide(q2) * wide(s)),
+            ],
+            [
+                wide(b[1]) * dw - wide(q1) * wide(t),
+                wide(b[2]) * dw - wide(q2) * wide(t),
+            ],
+        )
+    }
+
     /// `q_1`, `q_2` and the y numerators of the next lane from this lane's (wrapping steps,
     /// exact at every lane of the span).
     #[inline(always)]
@@ -546,35 +748,10 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
     let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
-    let wide = i128::from;
-    let (a, b, s, t) = (st.a, st.b, st.s, st.t);
+    let (a, s) = (st.a, st.s);
     let [mut q1, mut q2, mut d] = st.first;
-    // The x numerators are the same at every lane; the y numerators step (exact at every
-    // lane, below 2^125; the wrapping steps are exact modulo 2^128).
-    let dw = wide(d);
-    let nx = [
-        numerator_top(wide(a[1]) * dw - wide(q1) * wide(s)),
-        numerator_top(wide(a[2]) * dw - wide(q2) * wide(s)),
-    ];
-    let mut ny = [
-        wide(b[1]) * dw - wide(q1) * wide(t),
-        wide(b[2]) * dw - wide(q2) * wide(t),
-    ];
-    // Every mantissa below 2^29 (`Reciprocal` results and their squares have
-    // `recip_mantissa_bits + 1` bits) and the y numerators' drops held along the span.
-    let last = span.lanes.saturating_sub(1);
-    let held = if m_bits <= 28 {
-        match (
-            held_drop(ny[0], st.y_step[0], last),
-            held_drop(ny[1], st.y_step[1], last),
-        ) {
-            (Some(n1), Some(n2)) => Some((n1, n2)),
-            _ => None,
-        }
-    } else {
-        None
-    };
-    if let Some(ns_y) = held {
+    let (nx, mut ny) = st.numerators();
+    if let Some(ns_y) = held_drops(st, ny, span.lanes, m_bits) {
         let tops = Tops { nx, ny, ns_y };
         // The reciprocal's iteration count as a constant for the common widths.
         return match recip.lane::<R>().narrow_iterations() {
@@ -612,6 +789,22 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
     }
 }
 
+/// The y numerators' drops of a span of `lanes` lanes whose y numerators at the first lane
+/// are `ny`, when the span takes the held form: every mantissa below 2^29 (`m_bits <= 28`:
+/// `Reciprocal` results and their squares have `recip_mantissa_bits + 1` bits) and each drop
+/// the same along the span ([`held_drop`]).
+#[inline(always)]
+fn held_drops(st: &Steady, ny: [i128; 2], lanes: usize, m_bits: u32) -> Option<(u32, u32)> {
+    if m_bits > 28 {
+        return None;
+    }
+    let last = lanes.saturating_sub(1);
+    Some((
+        held_drop(ny[0], st.y_step[0], last)?,
+        held_drop(ny[1], st.y_step[1], last)?,
+    ))
+}
+
 /// The drop `ns` of [`numerator_top`] at every lane of a numerator `n + j step` (`j` up to
 /// `last`, every value exact below 2^125) when it is the same at both ends and they have the
 /// same sign: the numerator is linear in the lane, so its magnitude is monotonic between
@@ -635,6 +828,19 @@ struct Tops {
     ns_y: (u32, u32),
 }
 
+impl Tops {
+    /// The range of `1/D^2`'s exponent that keeps the derivatives' shifts
+    /// `r2.shift - (bary_bits + ns)` in 64..126: they are for all four drops when they are
+    /// for the largest and the smallest.
+    #[inline(always)]
+    fn r2_shifts(&self, bb: u32) -> (i32, i32) {
+        let (nx, (ny1, ny2)) = (self.nx, self.ns_y);
+        let ns_max = nx[0].1.max(nx[1].1).max(ny1.max(ny2));
+        let ns_min = nx[0].1.min(nx[1].1).min(ny1.min(ny2));
+        (64 + (bb + ns_max) as i32, 126 + (bb + ns_min) as i32)
+    }
+}
+
 /// Lanes whose `1/D` and `1/D^2` [`derivs_span_held`] evaluates in one loop before their
 /// barycentrics and derivatives. Each reciprocal is a chain of dependent steps (the seed's
 /// table read, the Newton steps, the normalization, the square); in a loop of those alone the
@@ -644,9 +850,13 @@ struct Tops {
 /// and 32 gained nothing on W2's short spans.
 const RECIP_BATCH: usize = 8;
 
-/// Lanes of one vector batch of [`derivs_span_held`] ([`held_batch_lanes`]): two AVX-512
-/// registers of 64-bit lanes, so that each step has two independent chains.
+/// Lanes of one vector batch of held lanes ([`held_batch_lanes`]): two AVX-512 registers of
+/// 64-bit lanes, so that each step has two independent chains.
 const HELD_LANES: usize = 2 * crate::reciprocal::RECIP_LANES;
+
+/// The most lanes of a span whose held lanes [`perspective_bary_derivs_spans`] gathers with
+/// other spans' ([`Gather`]); a longer span fills its own vector batches.
+pub const GATHER_MAX_LANES: usize = HELD_LANES - 1;
 
 /// The fewest lanes [`derivs_span_held`] runs as a vector batch (the lanes past the span
 /// repeat its last).
@@ -668,7 +878,8 @@ const ANY_ITERATIONS: u32 = u32::MAX;
 /// the next [`HELD_MIN_LANES`] to [`HELD_LANES`] lanes run as one batch of vector lanes
 /// ([`held_batch_wide`]; a lane outside its fast form takes the scalar lane, [`held_lane`]);
 /// other lanes run in batches of [`RECIP_BATCH`], each batch's reciprocals ahead of the rest
-/// of its lanes.
+/// of its lanes. ([`perspective_bary_derivs_spans`] gathers the held lanes of short spans
+/// across spans instead: [`Gather`].)
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
@@ -684,15 +895,10 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
-    let (a, s) = (st.a, st.s);
+    let s = st.s;
     let [mut q1, mut q2, mut d] = st.first;
     let (nx, mut ny, (ny1, ny2)) = (tops.nx, tops.ny, tops.ns_y);
-    // `sh = r2.shift - (bary_bits + ns)` is in 64..126 for all four when it is for the
-    // largest and the smallest drop.
-    let ns_max = nx[0].1.max(nx[1].1).max(ny1.max(ny2));
-    let ns_min = nx[0].1.min(nx[1].1).min(ny1.min(ny2));
-    let lo = 64 + (bb + ns_max) as i32;
-    let hi = 126 + (bb + ns_min) as i32;
+    let (lo, hi) = tops.r2_shifts(bb);
     let mut rounds: Option<(i32, [ShiftRound<M>; 4])> = None;
     let ctx = HeldLane {
         bb,
@@ -728,15 +934,14 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                 d,
                 s,
                 q: [q1, q2],
-                a: [a[1], a[2]],
+                a: [st.a[1], st.a[2]],
                 nx: [nx[0].0, nx[1].0].map(|x| ((x >> 64) as i64, x as u64)),
                 ty,
-                ns: [nx[0].1, nx[1].1, ny1, ny2],
-                bb,
-                r2_shifts: (lo, hi),
+                drop: [nx[0].1, nx[1].1, ny1, ny2].map(|ns| i64::from(bb + ns) + 62),
+                r2_shifts: (i64::from(lo), i64::from(hi)),
             };
             let mut wide = HeldLanes::<HELD_LANES>::default();
-            if held_batch_wide::<M, R, N, HELD_LANES>(&lane_recip, &input, &mut wide) {
+            if held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
                 let b = &wide;
                 for c in 0..n {
                     let j = j0 + c;
@@ -854,12 +1059,22 @@ fn held_lane<M: ConstRounding>(
     Some(lane_result(c.one, [p1, p2], [x1, x2], [y1, y2]))
 }
 
-/// The span constants of one batch of [`derivs_span_held`] ([`held_batch_lanes`]): the span's
-/// lanes it takes (`n`, 1 to `L`; the lanes past them repeat its last), `D`, `q_1` and `q_2`
-/// at its first lane and their steps, the x numerators' tops and each lane's
-/// y numerators' tops (as high and low words, below 2^94), the four drops `ns` (x then y),
-/// `bary_bits` and the range of `1/D^2`'s exponent that keeps the derivatives' shifts in
-/// 64..126.
+/// The inputs of one vector batch ([`held_batch_lanes`]) lane by lane: `D`, `q_1` and `q_2`,
+/// the four derivative tops (x then y) as high and low words (below 2^94), each derivative's
+/// drop plus `bary_bits` and 62 (the shift of its top's product is `1/D^2`'s exponent less
+/// it), and the range of `1/D^2`'s exponent that keeps the derivatives' shifts in 64..126.
+trait HeldInputs<const L: usize> {
+    fn x(&self) -> [u64; L];
+    fn q(&self, i: usize, c: usize) -> i64;
+    fn top(&self, k: usize, c: usize) -> (i64, u64);
+    fn drop(&self, k: usize, c: usize) -> i64;
+    fn r2_shifts(&self, c: usize) -> (i64, i64);
+}
+
+/// The inputs of one batch of a span's lanes in [`derivs_span_held`]: the lanes it takes
+/// (`n`, 1 to `L`; the lanes past them repeat its last), `D`, `q_1` and `q_2` at its first
+/// lane and their steps, the x numerators' tops, each lane's y numerators' tops, and the
+/// span's drops and range of `1/D^2`'s exponent ([`HeldInputs`]).
 struct HeldBatch<const L: usize> {
     n: usize,
     d: i64,
@@ -868,9 +1083,208 @@ struct HeldBatch<const L: usize> {
     a: [i64; 2],
     nx: [(i64, u64); 2],
     ty: [[(i64, u64); L]; 2],
-    ns: [u32; 4],
-    bb: u32,
-    r2_shifts: (i32, i32),
+    drop: [i64; 4],
+    r2_shifts: (i64, i64),
+}
+
+impl<const L: usize> HeldBatch<L> {
+    /// The span's lane of batch lane `c` (the lanes past `n` repeat the last).
+    #[inline(always)]
+    fn lane(&self, c: usize) -> i64 {
+        c.min(self.n - 1) as i64
+    }
+}
+
+impl<const L: usize> HeldInputs<L> for HeldBatch<L> {
+    #[inline(always)]
+    fn x(&self) -> [u64; L] {
+        std::array::from_fn(|c| self.d.wrapping_add(self.lane(c).wrapping_mul(self.s)) as u64)
+    }
+    #[inline(always)]
+    fn q(&self, i: usize, c: usize) -> i64 {
+        self.q[i].wrapping_add(self.lane(c).wrapping_mul(self.a[i]))
+    }
+    #[inline(always)]
+    fn top(&self, k: usize, c: usize) -> (i64, u64) {
+        if k < 2 {
+            self.nx[k]
+        } else {
+            self.ty[k - 2][c]
+        }
+    }
+    #[inline(always)]
+    fn drop(&self, k: usize, _: usize) -> i64 {
+        self.drop[k]
+    }
+    #[inline(always)]
+    fn r2_shifts(&self, _: usize) -> (i64, i64) {
+        self.r2_shifts
+    }
+}
+
+/// A span's constants as each of its lanes carries them in a [`Gather`]: the x numerators'
+/// tops as high and low words (below 2^94), each derivative's drop plus `bary_bits` and 62
+/// (x then y: the shift of its top's product is `1/D^2`'s exponent less it), the range of
+/// `1/D^2`'s exponent that keeps the derivatives' shifts in 64..126, and the y numerators'
+/// drops.
+#[cfg(target_arch = "x86_64")]
+struct LaneConsts {
+    nx: [(i64, u64); 2],
+    drop: [i64; 4],
+    r2_shifts: (i64, i64),
+    ns_y: [u32; 2],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl LaneConsts {
+    #[inline(always)]
+    fn new(tops: &Tops, bb: u32) -> Self {
+        let (nx, (ny1, ny2)) = (tops.nx, tops.ns_y);
+        let (lo, hi) = tops.r2_shifts(bb);
+        Self {
+            nx: [nx[0].0, nx[1].0].map(|x| ((x >> 64) as i64, x as u64)),
+            drop: [nx[0].1, nx[1].1, ny1, ny2].map(|ns| i64::from(bb + ns) + 62),
+            r2_shifts: (i64::from(lo), i64::from(hi)),
+            ns_y: [ny1, ny2],
+        }
+    }
+}
+
+/// Held lanes ([`held_form`]) gathered across spans for one vector batch of `L` lanes
+/// ([`held_batch_lanes`]), lane by lane: where it comes from (span, lane), `D`, `q_1`, `q_2`,
+/// the four derivative tops as high and low words (x then y; the y tops are the lane's own),
+/// and its span's [`LaneConsts`]; `n` lanes are filled.
+#[cfg(target_arch = "x86_64")]
+struct Gather<const L: usize> {
+    n: usize,
+    at: [(u32, u32); L],
+    x: [u64; L],
+    q: [[i64; L]; 2],
+    top_hi: [[i64; L]; 4],
+    top_lo: [[u64; L]; 4],
+    drop: [[i64; L]; 4],
+    r2_lo: [i64; L],
+    r2_hi: [i64; L],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<const L: usize> Default for Gather<L> {
+    fn default() -> Self {
+        Self {
+            n: 0,
+            at: [(0, 0); L],
+            x: [0; L],
+            q: [[0; L]; 2],
+            top_hi: [[0; L]; 4],
+            top_lo: [[0; L]; 4],
+            drop: [[0; L]; 4],
+            r2_lo: [0; L],
+            r2_hi: [0; L],
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<const L: usize> HeldInputs<L> for Gather<L> {
+    #[inline(always)]
+    fn x(&self) -> [u64; L] {
+        self.x
+    }
+    #[inline(always)]
+    fn q(&self, i: usize, c: usize) -> i64 {
+        self.q[i][c]
+    }
+    #[inline(always)]
+    fn top(&self, k: usize, c: usize) -> (i64, u64) {
+        (self.top_hi[k][c], self.top_lo[k][c])
+    }
+    #[inline(always)]
+    fn drop(&self, k: usize, c: usize) -> i64 {
+        self.drop[k][c]
+    }
+    #[inline(always)]
+    fn r2_shifts(&self, c: usize) -> (i64, i64) {
+        (self.r2_lo[c], self.r2_hi[c])
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<const L: usize> Gather<L> {
+    /// Adds lane `j` of span `i` (`at`), with its `D`, `q_1`, `q_2`, y numerators and its
+    /// span's constants `k`; the gather must not be full.
+    #[inline(always)]
+    fn push(&mut self, at: (usize, usize), d: i64, q: [i64; 2], ny: [i128; 2], k: &LaneConsts) {
+        let c = self.n;
+        self.at[c] = (at.0 as u32, at.1 as u32);
+        // `D` is positive (the held form).
+        self.x[c] = d as u64;
+        for i in 0..2 {
+            self.q[i][c] = q[i];
+            (self.top_hi[i][c], self.top_lo[i][c]) = k.nx[i];
+            let t = ny[i] >> (k.ns_y[i] & 63);
+            (self.top_hi[2 + i][c], self.top_lo[2 + i][c]) = ((t >> 64) as i64, t as u64);
+        }
+        for i in 0..4 {
+            self.drop[i][c] = k.drop[i];
+        }
+        (self.r2_lo[c], self.r2_hi[c]) = k.r2_shifts;
+        self.n = c + 1;
+    }
+
+    /// Copies lane `from` into lane `to` (a lane past `n` repeats a filled one).
+    #[inline(always)]
+    fn repeat(&mut self, from: usize, to: usize) {
+        self.x[to] = self.x[from];
+        for i in 0..2 {
+            self.q[i][to] = self.q[i][from];
+        }
+        for i in 0..4 {
+            self.top_hi[i][to] = self.top_hi[i][from];
+            self.top_lo[i][to] = self.top_lo[i][from];
+            self.drop[i][to] = self.drop[i][from];
+        }
+        self.r2_lo[to] = self.r2_lo[from];
+        self.r2_hi[to] = self.r2_hi[from];
+    }
+
+    /// Runs the batch of the `n` filled lanes (the lanes past them repeat the last) on the
+    /// vector unit ([`held_batch_avx512`]) and gives each lane's result to `out(span, lane,
+    /// result)`: the batch's own where the lane took its fast form, else the per-sample
+    /// datapath's ([`derivs_lane`], of `spans`); then empties the gather.
+    #[inline(always)]
+    fn run<M: ConstRounding, R: ConstRounding, const N: u32>(
+        &mut self,
+        lane: &crate::reciprocal::RecipLane<'_, R>,
+        (spans, cfg, recip): (&[DerivSpan], &InterpConfig, &Reciprocal),
+        sat: &mut SatCounter,
+        out: &mut impl FnMut(usize, usize, [[i64; 3]; 3]),
+    ) {
+        let n = self.n;
+        for to in n..L {
+            self.repeat(n - 1, to);
+        }
+        let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
+        let mut b = HeldLanes::<L>::default();
+        // SAFETY: the caller ([`spans_in`]) found every feature the function is built for.
+        unsafe { held_batch_avx512::<M, R, N, L, Self>(lane, self, bb, &mut b) };
+        for c in 0..n {
+            let (i, j) = (self.at[c].0 as usize, self.at[c].1 as usize);
+            if b.ok >> c & 1 == 1 {
+                let (p1, p2) = (b.p[0][c], b.p[1][c]);
+                let (x1, x2) = (p1 + b.dp[0][c], p2 + b.dp[1][c]);
+                let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
+                out(i, j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
+            } else {
+                let ds = &spans[i];
+                out(
+                    i,
+                    j,
+                    derivs_lane::<M>(&ds.span, j, ds.inv_w, cfg, recip, sat),
+                );
+            }
+        }
+        self.n = 0;
+    }
 }
 
 /// What [`held_batch_lanes`] gives per lane: `1/D` and `1/D^2`, the barycentrics `p_1`, `p_2`,
@@ -916,45 +1330,48 @@ fn product_top_lane((hi, lo): (i64, u64), mant: u64) -> i64 {
     (high << 2) | (low >> 62) as i64 | i64::from(low << 2 != 0)
 }
 
-/// One batch of [`derivs_span_held`] written lane by lane with every per-lane choice a
-/// select, so that its loops vectorize: [`crate::reciprocal::RecipLane::eval_square_lanes`],
-/// the barycentrics ([`apply_i64_small_in`]'s product and rounding as [`mul_wide_lane`] and
+/// One batch of held lanes ([`HeldInputs`]: a span's, [`HeldBatch`], or gathered across
+/// spans, [`Gather`]) written lane by lane with every per-lane choice a select, so that its
+/// loops vectorize: [`crate::reciprocal::RecipLane::eval_square_lanes`], the barycentrics
+/// ([`apply_i64_small_in`]'s product and rounding as [`mul_wide_lane`] and
 /// [`round_shift_right_wide_lane`]) and the four derivatives ([`derivative_held`] as
 /// [`product_top_lane`] and [`round_shift_right_lane`]). A lane is fast (its bit of `ok`) when
-/// the scalar lane would take those forms and clamp nothing; its values are then the scalar
-/// lane's (checked in `derivs_span_stepping_matches_per_lane_calls`).
+/// the scalar lane ([`held_lane`]) would take those forms and clamp nothing; its values are
+/// then the scalar lane's (checked in `derivs_span_stepping_matches_per_lane_calls` and
+/// `gathered_spans_match_per_lane_calls`).
 #[inline(always)]
-fn held_batch_lanes<M: ConstRounding, R: ConstRounding, const N: u32, const L: usize>(
+fn held_batch_lanes<M, R, const N: u32, const L: usize, I>(
     lane: &crate::reciprocal::RecipLane<'_, R>,
-    b: &HeldBatch<L>,
+    b: &I,
+    bb: u32,
     out: &mut HeldLanes<L>,
-) {
-    // The lanes past the span's `n` repeat its last.
-    let lane_at = |c: usize| c.min(b.n - 1) as i64;
-    let x: [u64; L] =
-        std::array::from_fn(|c| b.d.wrapping_add(lane_at(c).wrapping_mul(b.s)) as u64);
-    lane.eval_square_lanes::<N, M, L>(&x, &mut out.recips);
+) where
+    M: ConstRounding,
+    R: ConstRounding,
+    I: HeldInputs<L>,
+{
+    lane.eval_square_lanes::<N, M, L>(&b.x(), &mut out.recips);
     let mut ok = 0u64;
     let limit = 2 * BARY_LIMIT as u64;
     for c in 0..L {
         let (r, r2) = out.recips.get(c);
         // The barycentrics: `q_i / D` at `bary_bits`, a shift in 1..=63 that fits `i64`.
-        let sh = i64::from(r.shift) - i64::from(b.bb);
+        let sh = i64::from(r.shift) - i64::from(bb);
         let mut fast = (1..64).contains(&sh);
         for i in 0..2 {
-            let q = b.q[i].wrapping_add(lane_at(c).wrapping_mul(b.a[i]));
-            let (hi, lo) = mul_wide_lane(q, r.mant);
+            let (hi, lo) = mul_wide_lane(b.q(i, c), r.mant);
             let (v, fits) = round_shift_right_wide_lane::<M>(hi, lo, sh.clamp(1, 63) as u32);
             fast &= fits && bary_offset(v) <= limit;
             out.p[i][c] = v;
         }
         // The derivatives: each top rounded by `1/D^2`'s exponent less its drop.
-        fast &= (b.r2_shifts.0..b.r2_shifts.1).contains(&r2.shift);
+        let r2_shift = i64::from(r2.shift);
+        let (lo, hi) = b.r2_shifts(c);
+        fast &= (lo..hi).contains(&r2_shift);
         for k in 0..4 {
-            let top = if k < 2 { b.nx[k] } else { b.ty[k - 2][c] };
-            let shift = i64::from(r2.shift) - i64::from(b.bb + b.ns[k]) - 62;
+            let shift = r2_shift - b.drop(k, c);
             let v = round_shift_right_lane::<M>(
-                product_top_lane(top, r2.mant),
+                product_top_lane(b.top(k, c), r2.mant),
                 shift.clamp(2, 63) as u32,
             );
             fast &= bary_offset(v) <= limit;
@@ -968,30 +1385,44 @@ fn held_batch_lanes<M: ConstRounding, R: ConstRounding, const N: u32, const L: u
 /// [`held_batch_lanes`] built for AVX-512 into `out` when this CPU has it (and `true`), else
 /// `false`.
 #[inline(always)]
-fn held_batch_wide<M: ConstRounding, R: ConstRounding, const N: u32, const L: usize>(
+fn held_batch_wide<M, R, const N: u32, const L: usize, I>(
     lane: &crate::reciprocal::RecipLane<'_, R>,
-    b: &HeldBatch<L>,
+    b: &I,
+    bb: u32,
     out: &mut HeldLanes<L>,
-) -> bool {
+) -> bool
+where
+    M: ConstRounding,
+    R: ConstRounding,
+    I: HeldInputs<L>,
+{
     #[cfg(target_arch = "x86_64")]
     if crate::has_avx512() {
         // SAFETY: the CPU has every feature the function is built for.
-        unsafe { held_batch_avx512::<M, R, N, L>(lane, b, out) };
+        unsafe { held_batch_avx512::<M, R, N, L, I>(lane, b, bb, out) };
         return true;
     }
-    let _ = (lane, b, out);
+    let _ = (lane, b, bb, out);
     false
 }
 
 /// [`held_batch_lanes`] compiled with AVX-512 enabled.
+///
+/// # Safety
+/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-fn held_batch_avx512<M: ConstRounding, R: ConstRounding, const N: u32, const L: usize>(
+unsafe fn held_batch_avx512<M, R, const N: u32, const L: usize, I>(
     lane: &crate::reciprocal::RecipLane<'_, R>,
-    b: &HeldBatch<L>,
+    b: &I,
+    bb: u32,
     out: &mut HeldLanes<L>,
-) {
-    held_batch_lanes::<M, R, N, L>(lane, b, out);
+) where
+    M: ConstRounding,
+    R: ConstRounding,
+    I: HeldInputs<L>,
+{
+    held_batch_lanes::<M, R, N, L, I>(lane, b, bb, out);
 }
 
 /// [`perspective_bary`] at the samples of a row span: `out(j, result)` gets lane `j`'s result
@@ -2339,9 +2770,7 @@ mod tests {
                                 let clamped = want[0][1..].iter().any(|v| v.abs() == BARY_LIMIT);
                                 held_clamped += u64::from(clamped);
                                 // Lanes of the vector batches (on a CPU with AVX-512).
-                                if n >= HELD_MIN_LANES {
-                                    held_batched[usize::from(clamped)] += 1;
-                                }
+                                held_batched[usize::from(clamped)] += 1;
                                 // The lanes whose barycentrics take `apply_i64_small_in`.
                                 let r = recip.eval(d as u64, &mut SatCounter::default());
                                 let sh = r.shift - cfg.bary_bits as i32;
@@ -2374,6 +2803,112 @@ mod tests {
             "{held_lanes} {held_small} {steady_lanes}"
         );
         assert!(stepped > 100_000 && tested > 40_000, "{stepped} {tested}");
+    }
+
+    /// 40k seeded rows of 1 to 24 spans of 1 to 12 lanes (about 3.2M lanes; the rows of a
+    /// mesh), each span with its own `1/w`, over 6 configurations x 3 interpolator roundings,
+    /// edges and steps as in `derivs_span_stepping_matches_per_lane_calls` (a quarter of the
+    /// spans near the horizon): one `perspective_bary_derivs_spans` call per row gives each
+    /// lane once, with the bits of one [`perspective_bary_derivs`] call per lane and the
+    /// row's saturation counts. Many lanes are in the held form (gathered across the spans
+    /// into vector batches where the CPU has AVX-512), many of those need the clamp (the
+    /// per-sample datapath from a batch), and many spans take the other forms.
+    #[test]
+    fn gathered_spans_match_per_lane_calls() {
+        let mut s = 0x6a7e_42ed;
+        let (mut lanes, mut held, mut held_clamped, mut other) = (0u64, 0u64, 0u64, 0u64);
+        let mut widest = HwConfig::texram16();
+        widest.reciprocal.recip_mantissa_bits = 28;
+        widest.reciprocal.recip_lut_bits = 4;
+        widest.reciprocal.recip_iterations = 2;
+        widest.reciprocal.recip_rounding = Rounding::Truncate;
+        widest.interp.bary_bits = 20;
+        let mut cfgs = previous_configs();
+        cfgs.push(widest);
+        let mut rows = 0u64;
+        for (c, hw0) in cfgs.into_iter().enumerate() {
+            for mode in [Rounding::HalfEven, Rounding::HalfUp, Rounding::Truncate] {
+                let mut hw = hw0.clone();
+                hw.interp.interp_rounding = mode;
+                let (cfg, recip) = (&hw.interp, Reciprocal::new(&hw.reciprocal));
+                let (wb, m_bits) = (cfg.inv_w_bits, recip.config().recip_mantissa_bits);
+                for r in 0..(40_000 / 18) {
+                    let mut spans = Vec::new();
+                    for i in 0..1 + next(&mut s) % 24 {
+                        let i = (r * 24 + i) as usize;
+                        let n = 1 + (next(&mut s) % 12) as usize;
+                        let eb = [20, 40, 62 - wb - 1, 62 - wb, 20, 40][i % 6];
+                        let (db, dsh) =
+                            [(4, 5), (30, 5), (eb.saturating_sub(3).max(1), 5)][i / 6 % 3];
+                        let Some((mut span, inv_w)) =
+                            random_span(&mut s, (n, eb, db, dsh), (i, c, wb), None)
+                        else {
+                            continue;
+                        };
+                        if i % 4 == 3 {
+                            // Near the horizon, as in the stepping test: many lanes clamp.
+                            let w = inv_w.map(i128::from);
+                            let d0 = (0..3)
+                                .map(|k| i128::from(span.edge[k]) * w[k])
+                                .sum::<i128>();
+                            let sx = (0..3).map(|k| i128::from(span.dx[k]) * w[k]).sum::<i128>();
+                            let t = i128::from(next(&mut s) % (1 << 20)) + 1;
+                            let e0 = i128::from(span.edge[0]) - (d0 - t).div_euclid(w[0]);
+                            let dx0 = i128::from(span.dx[0]) - sx.div_euclid(w[0]);
+                            let (Ok(e0), Ok(dx0)) = (i64::try_from(e0), i64::try_from(dx0)) else {
+                                continue;
+                            };
+                            (span.edge[0], span.dx[0]) = (e0, dx0);
+                            if !last_lane_fits(&span) {
+                                continue;
+                            }
+                        }
+                        spans.push(DerivSpan { span, inv_w });
+                    }
+                    let mut got = vec![vec![None; 12]; spans.len()];
+                    let mut sa = SatCounter::default();
+                    perspective_bary_derivs_spans(&spans, cfg, &recip, &mut sa, |i, j, v| {
+                        assert!(got[i][j].replace(v).is_none(), "lane {j} of span {i} twice");
+                    });
+                    let mut sb = SatCounter::default();
+                    for (ds, got) in spans.iter().zip(&got) {
+                        let DerivSpan { span, inv_w } = *ds;
+                        #[cfg(target_arch = "x86_64")]
+                        let is_held = held_form(&span, inv_w, m_bits).is_some();
+                        #[cfg(not(target_arch = "x86_64"))]
+                        let is_held = false;
+                        for (j, lane) in got.iter().enumerate() {
+                            if j >= span.lanes {
+                                assert_eq!(*lane, None);
+                                continue;
+                            }
+                            let e = lane_at(&span, j).map(|v| v as i64);
+                            let (dx, dy) = (span.dx, span.dy);
+                            let want =
+                                perspective_bary_derivs(e, dx, dy, inv_w, cfg, &recip, &mut sb);
+                            assert_eq!(*lane, Some(want), "{:?}", (span, inv_w, mode, c, j));
+                            lanes += 1;
+                            if is_held {
+                                held += 1;
+                                let clamped = want[0][1..].iter().any(|v| v.abs() == BARY_LIMIT);
+                                held_clamped += u64::from(clamped);
+                            } else {
+                                other += 1;
+                            }
+                        }
+                    }
+                    assert_eq!(sa, sb, "row {r} of configuration {c}, {mode:?}");
+                    rows += 1;
+                }
+            }
+        }
+        println!("rows {rows} lanes {lanes}: held {held} (clamped {held_clamped}), other {other}");
+        assert!(rows > 35_000 && lanes > 2_500_000, "{rows} {lanes}");
+        assert!(
+            held > 1_000_000 && held_clamped > 100_000,
+            "{held} {held_clamped}"
+        );
+        assert!(other > 1_000_000, "{other}");
     }
 
     /// 270k seeded spans of 1 to 8 lanes (the short spans of a mesh) over 5 configurations x

@@ -3,13 +3,16 @@
 //! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad;
 //! with `attr_subpixel_bits` the edges come from the float positions on that finer grid.
 
+use super::stages::TriAttrs;
 use super::stages::{each_fragment, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
+use crate::raster::ScreenTri;
 use crate::reference::{perspective_bary_derivs_f64, perspective_bary_f64};
 use hw_model::interpolator::{
     perspective_bary, perspective_bary_cost, perspective_bary_derivs, perspective_bary_derivs_cost,
-    perspective_bary_derivs_span, perspective_bary_span, EdgeSpan,
+    perspective_bary_derivs_span, perspective_bary_derivs_spans, perspective_bary_span, DerivSpan,
+    EdgeSpan, GATHER_MAX_LANES,
 };
 use hw_model::UnitCost;
 
@@ -74,6 +77,13 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
 /// fragment without them (the span's setup costs more than it saves), `lod_per_quad`,
 /// `attr_subpixel_bits` and spans beyond the edges' `i64` bounds run [`fixed`] per fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    if let Some(row) = px.row_bary {
+        // Computed with the row's other spans ([`Row`]).
+        for (frag, b) in frags.iter_mut().zip(row) {
+            frag.bary_x = *b;
+        }
+        return carriers(px, frags);
+    }
     let hw = px.m.hw;
     let sub = hw.raster.subpixel_bits;
     let grid = hw.interp.attr_subpixel_bits;
@@ -101,13 +111,112 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
         let out = |j: usize, b| frags[j].bary_x[0] = b;
         perspective_bary_span(&span, inv_w, cfg, recip, sat, out);
     }
+    carriers(px, frags);
+}
+
+/// The float carriers of the span's raw barycentrics, when the run reads them.
+#[inline]
+fn carriers(px: &Px, frags: &mut [Frag]) {
     if px.carriers {
-        let bb = hw.interp.bary_bits;
+        let bb = px.m.hw.interp.bary_bits;
         for frag in frags.iter_mut() {
             for s in 0..px.samples() {
                 frag.bary[s] = frag.bary_x[s].map(|r| from_raw(r, bb));
             }
         }
+    }
+}
+
+/// Whether the Fixed barycentrics of `plan` run as one pass over each row's spans ([`Row`]):
+/// with derivatives, on the span datapath (neither `lod_per_quad` nor an `attr_subpixel_bits`
+/// grid).
+#[must_use]
+pub fn row_pass(m: &Machine, plan: &Plan) -> bool {
+    let hw = m.hw;
+    let grid = hw.interp.attr_subpixel_bits;
+    plan.derivatives && !hw.lod.lod_per_quad && (grid == 0 || grid == hw.raster.subpixel_bits)
+}
+
+/// The barycentrics and derivatives of one row's spans, computed before the row is shaded by
+/// one call of the interpolator's multi-span datapath
+/// ([`perspective_bary_derivs_spans`]), so that the lanes of short spans (a mesh's) fill the
+/// vector batches across the spans as a long span's do; [`fixed_span`] then takes each
+/// span's from here (`Px::row_bary`). Bit-identical to [`fixed_span`] span by span, with the
+/// same saturation counts (`frames_in_spans_equal_frames_per_fragment` in the pipeline tests;
+/// the datapath's own test is `gathered_spans_match_per_lane_calls`). A worker keeps one and
+/// reuses its buffers row after row.
+#[derive(Default)]
+pub struct Row {
+    spans: Vec<DerivSpan>,
+    /// The first pixel of each of `spans`.
+    starts: Vec<usize>,
+    /// Per pixel of the row: its barycentrics when its span is in `spans`.
+    bary: Vec<[[i64; 3]; 3]>,
+    /// Per pixel of the row: a span computed here starts at it.
+    ready: Vec<bool>,
+}
+
+impl Row {
+    /// Empties the row for one of `width` pixels.
+    pub fn start(&mut self, width: usize) {
+        self.spans.clear();
+        self.starts.clear();
+        self.ready.clear();
+        self.ready.resize(width, false);
+        self.bary.resize(width, [[0; 3]; 3]);
+    }
+
+    /// Adds the span of `n` pixels from (`x`, `y`) of `tri` (attributes `a`), a span of a
+    /// plan with [`row_pass`]. A span of more than `GATHER_MAX_LANES` (which fills its own
+    /// vector batches) or beyond the `i64` bounds of its edges' steps is left to
+    /// [`fixed_span`].
+    pub fn push(
+        &mut self,
+        m: &Machine,
+        tri: &ScreenTri,
+        a: &TriAttrs,
+        (x, y): (usize, i64),
+        n: usize,
+    ) {
+        if n > GATHER_MAX_LANES {
+            return;
+        }
+        let sub = m.hw.raster.subpixel_bits;
+        if let Some((edge, dx, dy)) = tri.edges_fixed_span(x as i64, y, n, sub) {
+            let span = EdgeSpan {
+                edge,
+                dx,
+                dy,
+                lanes: n,
+            };
+            self.spans.push(DerivSpan {
+                span,
+                inv_w: a.inv_w_x,
+            });
+            self.starts.push(x);
+        }
+    }
+
+    /// Computes every span added since [`Row::start`], its saturations counted in `c`.
+    pub fn run(&mut self, m: &Machine, c: &mut Counters) {
+        if self.spans.is_empty() {
+            return;
+        }
+        let (cfg, recip) = (&m.hw.interp, &m.recip);
+        let sat = &mut c.sat[StageKind::Bary.index()];
+        let (starts, bary) = (&self.starts, &mut self.bary);
+        perspective_bary_derivs_spans(&self.spans, cfg, recip, sat, |i, j, b| {
+            bary[starts[i] + j] = b;
+        });
+        for &x in starts {
+            self.ready[x] = true;
+        }
+    }
+
+    /// The barycentrics of the span of `n` pixels from `x`, when [`Row::run`] computed them.
+    #[must_use]
+    pub fn get(&self, x: usize, n: usize) -> Option<&[[[i64; 3]; 3]]> {
+        (*self.ready.get(x)?).then(|| &self.bary[x..x + n])
     }
 }
 

@@ -492,7 +492,7 @@ pub fn run(
     c: &mut Counters,
 ) {
     start(frag, plan);
-    let px = prog.px(plan, m, tri, (a, af), x, y);
+    let px = prog.px(plan, m, tri, (a, af), (x, y), None);
     for op in &prog.ops {
         (op.run)(&px, frag, c);
     }
@@ -515,7 +515,8 @@ pub const SPAN_MAX: usize = 32;
 /// covered pixels of one triangle in one row, at most [`SPAN_MAX`]). The program runs stage by
 /// stage, each over the whole span: its span twin ([`super::table::SpanFn`]) when it has one,
 /// else its per-fragment twin on each fragment in turn. Every fragment ends as [`run`] leaves
-/// it, and the counters get the same sums.
+/// it, and the counters get the same sums. `row_bary`: the span's barycentrics when its row
+/// computed them ([`super::bary::Row`]; their saturations are counted there).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn run_span(
@@ -524,15 +525,15 @@ pub fn run_span(
     m: &Machine,
     tri: &ScreenTri,
     (a, af): (&TriAttrs, &TriFloat),
-    x: i64,
-    y: i64,
+    (x, y): (i64, i64),
     frags: &mut [Frag],
+    row_bary: Option<&[[[i64; 3]; 3]]>,
     c: &mut Counters,
 ) {
     for frag in frags.iter_mut() {
         start(frag, plan);
     }
-    let px = prog.px(plan, m, tri, (a, af), x, y);
+    let px = prog.px(plan, m, tri, (a, af), (x, y), row_bary);
     for op in &prog.ops {
         match op.span {
             Some(span) => span(&px, frags, c),
@@ -587,7 +588,7 @@ const fn max_unorm(bits: u32) -> u32 {
 
 /// The fragment's output as a 16-bit unorm pixel: exact integer conversion of a Fixed
 /// stage's raw output, rounded conversion of a float carrier.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn output16(frag: &Frag) -> [u16; 4] {
     if frag.out_bits == 0 {

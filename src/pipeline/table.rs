@@ -43,6 +43,9 @@ pub struct Px<'a> {
     /// A stage of this run may read the float carriers of a Fixed producer (see
     /// [`Program::carriers`]); when false, the Fixed twins write their raw values only.
     pub carriers: bool,
+    /// The span's barycentrics when its row computed them in one pass
+    /// ([`super::bary::Row`], [`Program::row_bary`]).
+    pub row_bary: Option<&'a [[[i64; 3]; 3]]>,
 }
 
 impl Px<'_> {
@@ -341,6 +344,9 @@ pub struct Program {
     /// `texcoord`, `lod`, `trilinear`, `modulate`, whose Fixed twins read their producers'
     /// raw values only (and the fragment's output is then the last stage's raw value).
     pub carriers: bool,
+    /// The plan's barycentrics run Fixed as one pass over each row's spans
+    /// ([`super::bary::Row`]) before the row is shaded.
+    pub row_bary: bool,
 }
 
 impl Program {
@@ -369,8 +375,8 @@ impl Program {
         m: &'a Machine<'a>,
         tri: &'a ScreenTri,
         (a, af): (&'a TriAttrs, &'a TriFloat),
-        x: i64,
-        y: i64,
+        (x, y): (i64, i64),
+        row_bary: Option<&'a [[[i64; 3]; 3]]>,
     ) -> Px<'a> {
         Px {
             plan,
@@ -383,6 +389,7 @@ impl Program {
             y,
             color_raw: self.color_raw,
             carriers: self.carriers,
+            row_bary,
         }
     }
 
@@ -423,6 +430,9 @@ impl Program {
             impls: *impls,
             color_raw: plan.has(StageKind::Color) && impls.of(StageKind::Color) == Impl::Fixed,
             carriers: !raw_only,
+            row_bary: plan.has(StageKind::Bary)
+                && impls.of(StageKind::Bary) == Impl::Fixed
+                && super::bary::row_pass(m, plan),
         }
     }
 }

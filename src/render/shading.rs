@@ -9,7 +9,7 @@ use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{
     output16, run, run_span, Counters, Machine, QuietSetup, TriAttrs, TriFloat, SPAN_MAX,
 };
-use crate::pipeline::{Frag, Program, StageImpls, StageKind};
+use crate::pipeline::{bary, Frag, Program, StageImpls, StageKind};
 use crate::prefetch::prefetch;
 use crate::raster::{ScreenTri, Setup, VertexSource, VisBuffer, NO_TRI};
 use crate::report::Image;
@@ -380,20 +380,20 @@ pub(super) struct ShadeInput<'a> {
 /// footprints the stages traced when `trace`). The covered pixels run in spans of up to
 /// [`SPAN_MAX`] consecutive pixels of one triangle ([`run_span`]), or one at a time
 /// ([`run`]) with `inp.per_fragment`: the same image, counters and fragments.
-/// `frags` is the caller's scratch ([`frag_scratch`], one per worker: a fragment is ~3 KB, so
-/// a span's worth is not built per row).
+/// `scratch` is the caller's ([`frag_scratch`], one per worker: a fragment is ~3 KB, so a
+/// span's worth is not built per row, nor the row's barycentrics).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn shade_row(
     inp: &ShadeInput,
     progs: &[Program],
     y: usize,
     row: &mut [[u16; 4]],
-    frags: &mut [Frag],
+    scratch: &mut RowScratch,
     c: &mut Counters,
     trace: bool,
     mut on_pixel: impl FnMut(u32, u32, &Frag),
 ) {
-    shade_row_spans(inp, progs, y, row, frags, c, trace, |pi, t, span| {
+    shade_row_spans(inp, progs, y, row, scratch, c, trace, |pi, t, span| {
         for frag in span {
             on_pixel(pi, t, frag);
         }
@@ -408,18 +408,44 @@ fn shade_row_spans(
     progs: &[Program],
     y: usize,
     row: &mut [[u16; 4]],
-    frags: &mut [Frag],
+    scratch: &mut RowScratch,
     c: &mut Counters,
     trace: bool,
     mut on_span: impl FnMut(u32, u32, &[Frag]),
 ) {
     let w = inp.vis.width as usize;
     let cap = if inp.per_fragment { 1 } else { SPAN_MAX };
+    let RowScratch { frags, bary } = scratch;
     let frags = &mut frags[..cap];
     for frag in frags.iter_mut() {
         frag.trace.on = trace;
     }
     let tris = &inp.vis.tri[y * w..(y + 1) * w];
+    // The barycentrics of the row's spans whose plans take them in one pass.
+    let row_bary = !inp.per_fragment && progs.iter().any(|p| p.row_bary);
+    if row_bary {
+        bary.start(w);
+        let mut x = 0;
+        while x < w {
+            let t = tris[x];
+            if t == NO_TRI {
+                x += 1;
+                continue;
+            }
+            let n = span_len(tris, x, cap);
+            // The next span's triangle is read while this one is added.
+            if let Some(&next) = tris.get(x + n) {
+                prefetch(inp.attrs, next as usize);
+                prefetch(&inp.setup.tris, next as usize);
+            }
+            let a = &inp.attrs[t as usize];
+            if progs[a.plan as usize].row_bary {
+                bary.push(inp.m, &inp.setup.tris[t as usize], a, (x, y as i64), n);
+            }
+            x += n;
+        }
+        bary.run(inp.m, c);
+    }
     // The fragments of each run of one program, charged when the run ends.
     let mut run_of: Option<(usize, u64)> = None;
     let mut x = 0;
@@ -429,10 +455,7 @@ fn shade_row_spans(
             x += 1;
             continue;
         }
-        let n = tris[x..(x + cap).min(w)]
-            .iter()
-            .take_while(|&&u| u == t)
-            .count();
+        let n = span_len(tris, x, cap);
         // The next span's triangle is read while this one is shaded.
         if let Some(&next) = tris.get(x + n) {
             prefetch(inp.attrs, next as usize);
@@ -466,7 +489,18 @@ fn shade_row_spans(
                 c,
             );
         } else {
-            run_span(&progs[pi], plan, inp.m, tri, (a, af), px, py, span, c);
+            let pre = if row_bary { bary.get(x, n) } else { None };
+            run_span(
+                &progs[pi],
+                plan,
+                inp.m,
+                tri,
+                (a, af),
+                (px, py),
+                span,
+                pre,
+                c,
+            );
         }
         for (frag, out) in span.iter().zip(&mut row[x..x + n]) {
             *out = output16(frag);
@@ -479,9 +513,30 @@ fn shade_row_spans(
     }
 }
 
-/// The fragments [`shade_row`] works in: one span's worth.
-pub(super) fn frag_scratch() -> Vec<Frag> {
-    vec![Frag::default(); SPAN_MAX]
+/// The pixels from `x` of a row's `tris` that one span takes: those of the triangle at `x`
+/// up to the next pixel of another (or of none), at most `cap`.
+#[inline]
+fn span_len(tris: &[u32], x: usize, cap: usize) -> usize {
+    let t = tris[x];
+    tris[x..(x + cap).min(tris.len())]
+        .iter()
+        .take_while(|&&u| u == t)
+        .count()
+}
+
+/// What [`shade_row`] works in, one per worker: one span's fragments and the row's
+/// barycentrics ([`bary::Row`]).
+pub(super) struct RowScratch {
+    frags: Vec<Frag>,
+    bary: bary::Row,
+}
+
+/// A worker's [`RowScratch`].
+pub(super) fn frag_scratch() -> RowScratch {
+    RowScratch {
+        frags: vec![Frag::default(); SPAN_MAX],
+        bary: bary::Row::default(),
+    }
 }
 
 /// Shades every covered pixel with `impls`; returns the image, the counters and, when `timing`

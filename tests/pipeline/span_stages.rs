@@ -186,6 +186,7 @@ fn span_twins_match_the_per_fragment_twins() {
                 y,
                 color_raw: false,
                 carriers: rng.below(2) == 0,
+                row_bary: None,
             };
             let mut span = vec![Frag::default(); n];
             let mut c_span = Counters::default();
@@ -312,6 +313,7 @@ fn lookup_span_twins_match_the_per_fragment_twins() {
                 y: rng.int_in(-50, 50),
                 color_raw: false,
                 carriers: rng.below(2) == 0,
+                row_bary: None,
             };
             let n = rng.int_in(1, 16) as usize;
             // Coordinates mostly within a few textures of the origin, some anywhere in the
@@ -450,6 +452,7 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                 y,
                 color_raw: impls.of(StageKind::Color) == Impl::Fixed,
                 carriers: rng.below(2) == 0,
+                row_bary: None,
             };
             let input: Vec<Frag> = (0..n)
                 .map(|_| Frag {
@@ -585,6 +588,7 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
                 y,
                 color_raw: false,
                 carriers: rng.below(2) == 0,
+                row_bary: None,
             };
             let input = vec![Frag::default(); n];
             let mut span = input.clone();
@@ -637,6 +641,7 @@ fn stats_json(r: &Rendered) -> serde_json::Value {
 
 /// Scenes of every kind of plan, on the fixed-point presets, llvmpipe's float32 path, footprint
 /// assembly with adaptive probes, `lod_per_quad` and a finer attribute grid: shading in spans
+/// (with each row's barycentrics in one pass, `bary::Row`, where the plan has derivatives)
 /// gives the per-fragment frame (hardware and reference images, statistics with every stage's
 /// counters, and the timing model's cycles).
 #[test]
