@@ -2047,6 +2047,23 @@ mod tests {
         [0, 1, 2].map(|k| i128::from(span.edge[k]) + j as i128 * i128::from(span.dx[k]))
     }
 
+    /// `span` moved near the horizon: `E_0` and its x step changed so that `D` is small and
+    /// positive along the span while `q_1`, `q_2` stay large (the barycentrics beyond the
+    /// clamp); `None` when the moved edges leave `i64`.
+    fn near_horizon(s: &mut u64, span: &EdgeSpan, inv_w: [i64; 3]) -> Option<EdgeSpan> {
+        let w = inv_w.map(i128::from);
+        let d0 = (0..3)
+            .map(|k| i128::from(span.edge[k]) * w[k])
+            .sum::<i128>();
+        let sx = (0..3).map(|k| i128::from(span.dx[k]) * w[k]).sum::<i128>();
+        let t = i128::from(next(s) % (1 << 20)) + 1;
+        let e0 = i128::from(span.edge[0]) - (d0 - t).div_euclid(w[0]);
+        let dx0 = i128::from(span.dx[0]) - sx.div_euclid(w[0]);
+        let mut moved = *span;
+        (moved.edge[0], moved.dx[0]) = (i64::try_from(e0).ok()?, i64::try_from(dx0).ok()?);
+        last_lane_fits(&moved).then_some(moved)
+    }
+
     /// Whether the last lane's edges of `span` fit `i64` (the first lane's do).
     fn last_lane_fits(span: &EdgeSpan) -> bool {
         lane_at(span, span.lanes.max(1) - 1)
@@ -2692,24 +2709,10 @@ mod tests {
                         continue;
                     };
                     if i % 4 == 3 {
-                        // Near the horizon: `E_0` and its x step moved so that `D` is small
-                        // and positive along the span while `q_1`, `q_2` stay large (the
-                        // barycentrics beyond the clamp).
-                        let w = inv_w.map(i128::from);
-                        let d0 = (0..3)
-                            .map(|k| i128::from(span.edge[k]) * w[k])
-                            .sum::<i128>();
-                        let sx = (0..3).map(|k| i128::from(span.dx[k]) * w[k]).sum::<i128>();
-                        let t = i128::from(next(&mut s) % (1 << 20)) + 1;
-                        let e0 = i128::from(span.edge[0]) - (d0 - t).div_euclid(w[0]);
-                        let dx0 = i128::from(span.dx[0]) - sx.div_euclid(w[0]);
-                        let (Ok(e0), Ok(dx0)) = (i64::try_from(e0), i64::try_from(dx0)) else {
+                        let Some(moved) = near_horizon(&mut s, &span, inv_w) else {
                             continue;
                         };
-                        (span.edge[0], span.dx[0]) = (e0, dx0);
-                        if !last_lane_fits(&span) {
-                            continue;
-                        }
+                        span = moved;
                     }
                     let EdgeSpan { edge, dx, dy, .. } = span;
                     let at = |j: usize| lane_at(&span, j);
@@ -2846,22 +2849,10 @@ mod tests {
                             continue;
                         };
                         if i % 4 == 3 {
-                            // Near the horizon, as in the stepping test: many lanes clamp.
-                            let w = inv_w.map(i128::from);
-                            let d0 = (0..3)
-                                .map(|k| i128::from(span.edge[k]) * w[k])
-                                .sum::<i128>();
-                            let sx = (0..3).map(|k| i128::from(span.dx[k]) * w[k]).sum::<i128>();
-                            let t = i128::from(next(&mut s) % (1 << 20)) + 1;
-                            let e0 = i128::from(span.edge[0]) - (d0 - t).div_euclid(w[0]);
-                            let dx0 = i128::from(span.dx[0]) - sx.div_euclid(w[0]);
-                            let (Ok(e0), Ok(dx0)) = (i64::try_from(e0), i64::try_from(dx0)) else {
+                            let Some(moved) = near_horizon(&mut s, &span, inv_w) else {
                                 continue;
                             };
-                            (span.edge[0], span.dx[0]) = (e0, dx0);
-                            if !last_lane_fits(&span) {
-                                continue;
-                            }
+                            span = moved;
                         }
                         spans.push(DerivSpan { span, inv_w });
                     }
