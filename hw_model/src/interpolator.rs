@@ -472,15 +472,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
         lanes,
         ..
     } = span;
-    let Some(SpanSteps {
-        a,
-        b,
-        s,
-        t,
-        mag: steps_mag,
-        y_step,
-    }) = span_steps(span, inv_w)
-    else {
+    let Some(steps) = span_steps(span, inv_w) else {
         for j in 0..lanes {
             out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
         }
@@ -494,19 +486,17 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
         return;
     }
     let ends = span_ends(span, inv_w);
-    if let Some((first, _)) =
-        ends.filter(|&(f, l)| small_end(f, steps_mag) && small_end(l, steps_mag))
-    {
-        let steady = Steady {
-            first,
-            a,
-            b,
-            s,
-            t,
-            y_step,
-        };
+    if let Some(steady) = steps.steady(ends) {
         return derivs_span_steady::<M, R>(span, &steady, inv_w, cfg, recip, sat, out);
     }
+    let SpanSteps {
+        a,
+        b,
+        s,
+        t,
+        mag: steps_mag,
+        y_step,
+    } = steps;
     let mut stepped = ends.map(|(f, _)| f);
     // From the first fast lane on: the x numerators' top bits (the same at every fast lane)
     // and the y numerators at the current lane (exact at every fast lane, below 2^125: the
@@ -625,6 +615,24 @@ fn span_steps(span: &EdgeSpan, inv_w: [i64; 3]) -> Option<SpanSteps> {
     })
 }
 
+impl SpanSteps {
+    /// The [`Steady`] operands of the span with these steps whose `[q_1, q_2, D]` at its first
+    /// and last lane are `ends` ([`span_ends`]), when both ends are in the fast form
+    /// ([`small_end`]), hence every lane; else `None`.
+    #[inline(always)]
+    fn steady(&self, ends: Option<([i64; 3], [i64; 3])>) -> Option<Steady> {
+        let (first, last) = ends?;
+        (small_end(first, self.mag) && small_end(last, self.mag)).then_some(Steady {
+            first,
+            a: self.a,
+            b: self.b,
+            s: self.s,
+            t: self.t,
+            y_step: self.y_step,
+        })
+    }
+}
+
 /// `[q_1, q_2, D]` at the first and the last lane of a span of at least one lane, when each
 /// lane's products and sums fit `i64` there ([`lane_q`]): they are linear in the lane, so
 /// they do when they do at both ends, and then they step by `a_1`, `a_2` and `S` (wrapping
@@ -655,29 +663,7 @@ fn small_end([q1, q2, d]: [i64; 3], mag: u64) -> bool {
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn held_form(span: &EdgeSpan, inv_w: [i64; 3], m_bits: u32) -> Option<(Steady, Tops)> {
-    let SpanSteps {
-        a,
-        b,
-        s,
-        t,
-        mag,
-        y_step,
-    } = span_steps(span, inv_w)?;
-    if span.lanes == 0 {
-        return None;
-    }
-    let (first, last) = span_ends(span, inv_w)?;
-    if !(small_end(first, mag) && small_end(last, mag)) {
-        return None;
-    }
-    let st = Steady {
-        first,
-        a,
-        b,
-        s,
-        t,
-        y_step,
-    };
+    let st = span_steps(span, inv_w)?.steady(span_ends(span, inv_w))?;
     let (nx, ny) = st.numerators();
     let ns_y = held_drops(&st, ny, span.lanes, m_bits)?;
     Some((st, Tops { nx, ny, ns_y }))

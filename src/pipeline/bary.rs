@@ -86,11 +86,8 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     }
     let hw = px.m.hw;
     let sub = hw.raster.subpixel_bits;
-    let grid = hw.interp.attr_subpixel_bits;
-    let regrid = grid != 0 && grid != sub;
-    let quad = px.plan.derivatives && hw.lod.lod_per_quad;
     let n = frags.len();
-    let steps = (!regrid && !quad && (n > 1 || px.plan.derivatives))
+    let steps = (span_edges(px.m, px.plan) && (n > 1 || px.plan.derivatives))
         .then(|| px.tri.edges_fixed_span(px.x, px.y, n, sub))
         .flatten();
     let Some((e, dx, dy)) = steps else {
@@ -127,14 +124,21 @@ fn carriers(px: &Px, frags: &mut [Frag]) {
     }
 }
 
-/// Whether the Fixed barycentrics of `plan` run as one pass over each row's spans ([`Row`]):
-/// with derivatives, on the span datapath (neither `lod_per_quad` nor an `attr_subpixel_bits`
-/// grid).
-#[must_use]
-pub fn row_pass(m: &Machine, plan: &Plan) -> bool {
+/// Whether a span of `plan` takes its edges and their steps on the raster's grid (the span
+/// datapath): neither `lod_per_quad` with derivatives nor an `attr_subpixel_bits` grid.
+fn span_edges(m: &Machine, plan: &Plan) -> bool {
     let hw = m.hw;
     let grid = hw.interp.attr_subpixel_bits;
-    plan.derivatives && !hw.lod.lod_per_quad && (grid == 0 || grid == hw.raster.subpixel_bits)
+    let regrid = grid != 0 && grid != hw.raster.subpixel_bits;
+    let quad = plan.derivatives && hw.lod.lod_per_quad;
+    !(regrid || quad)
+}
+
+/// Whether the Fixed barycentrics of `plan` run as one pass over each row's spans ([`Row`]):
+/// with derivatives, on the span datapath ([`span_edges`]).
+#[must_use]
+pub fn row_pass(m: &Machine, plan: &Plan) -> bool {
+    plan.derivatives && span_edges(m, plan)
 }
 
 /// The barycentrics and derivatives of one row's spans, computed before the row is shaded by
@@ -152,8 +156,9 @@ pub struct Row {
     starts: Vec<usize>,
     /// Per pixel of the row: its barycentrics when its span is in `spans`.
     bary: Vec<[[i64; 3]; 3]>,
-    /// Per pixel of the row: a span computed here starts at it.
-    ready: Vec<bool>,
+    /// The next of `starts` [`Row::take`] looks for (the row is shaded in the order its spans
+    /// were added).
+    next: usize,
 }
 
 impl Row {
@@ -161,8 +166,7 @@ impl Row {
     pub fn start(&mut self, width: usize) {
         self.spans.clear();
         self.starts.clear();
-        self.ready.clear();
-        self.ready.resize(width, false);
+        self.next = 0;
         self.bary.resize(width, [[0; 3]; 3]);
     }
 
@@ -208,15 +212,16 @@ impl Row {
         perspective_bary_derivs_spans(&self.spans, cfg, recip, sat, |i, j, b| {
             bary[starts[i] + j] = b;
         });
-        for &x in starts {
-            self.ready[x] = true;
-        }
     }
 
-    /// The barycentrics of the span of `n` pixels from `x`, when [`Row::run`] computed them.
-    #[must_use]
-    pub fn get(&self, x: usize, n: usize) -> Option<&[[[i64; 3]; 3]]> {
-        (*self.ready.get(x)?).then(|| &self.bary[x..x + n])
+    /// The barycentrics of the span of `n` pixels from `x`, when [`Row::run`] computed them;
+    /// the row's spans are asked for in order.
+    pub fn take(&mut self, x: usize, n: usize) -> Option<&[[[i64; 3]; 3]]> {
+        if self.starts.get(self.next) != Some(&x) {
+            return None;
+        }
+        self.next += 1;
+        Some(&self.bary[x..x + n])
     }
 }
 

@@ -489,7 +489,7 @@ fn shade_row_spans(
                 c,
             );
         } else {
-            let pre = if row_bary { bary.get(x, n) } else { None };
+            let pre = if row_bary { bary.take(x, n) } else { None };
             run_span(
                 &progs[pi],
                 plan,
