@@ -885,6 +885,9 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     let [mut q1, mut q2, mut d] = st.first;
     let (nx, mut ny, (ny1, ny2)) = (tops.nx, tops.ny, tops.ns_y);
     let (lo, hi) = tops.r2_shifts(bb);
+    // The span's constants of the vector batches, when it has one.
+    let consts =
+        (N != ANY_ITERATIONS && span.lanes >= HELD_MIN_LANES).then(|| LaneConsts::new(tops, bb));
     let mut rounds: Option<(i32, [ShiftRound<M>; 4])> = None;
     let ctx = HeldLane {
         bb,
@@ -899,7 +902,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
         // A vector batch (of at least [`HELD_MIN_LANES`] lanes) at a narrow width where the
         // CPU has the vector unit for it.
         let n = (span.lanes - j0).min(HELD_LANES);
-        if N != ANY_ITERATIONS && n >= HELD_MIN_LANES {
+        if let Some(k) = consts.as_ref().filter(|_| n >= HELD_MIN_LANES) {
             // Each lane's y numerators' tops; the lanes past the span repeat its last.
             let mut ty = [[(0i64, 0u64); HELD_LANES]; 2];
             let mut nyj = ny;
@@ -921,10 +924,8 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                 s,
                 q: [q1, q2],
                 a: [st.a[1], st.a[2]],
-                nx: [nx[0].0, nx[1].0].map(|x| ((x >> 64) as i64, x as u64)),
                 ty,
-                drop: [nx[0].1, nx[1].1, ny1, ny2].map(|ns| i64::from(bb + ns) + 62),
-                r2_shifts: (i64::from(lo), i64::from(hi)),
+                k,
             };
             let mut wide = HeldLanes::<HELD_LANES>::default();
             if held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
@@ -1059,21 +1060,19 @@ trait HeldInputs<const L: usize> {
 
 /// The inputs of one batch of a span's lanes in [`derivs_span_held`]: the lanes it takes
 /// (`n`, 1 to `L`; the lanes past them repeat its last), `D`, `q_1` and `q_2` at its first
-/// lane and their steps, the x numerators' tops, each lane's y numerators' tops, and the
-/// span's drops and range of `1/D^2`'s exponent ([`HeldInputs`]).
-struct HeldBatch<const L: usize> {
+/// lane and their steps, each lane's y numerators' tops, and the span's constants `k` (the
+/// x numerators' tops, the drops and the range of `1/D^2`'s exponent: [`HeldInputs`]).
+struct HeldBatch<'k, const L: usize> {
     n: usize,
     d: i64,
     s: i64,
     q: [i64; 2],
     a: [i64; 2],
-    nx: [(i64, u64); 2],
     ty: [[(i64, u64); L]; 2],
-    drop: [i64; 4],
-    r2_shifts: (i64, i64),
+    k: &'k LaneConsts,
 }
 
-impl<const L: usize> HeldBatch<L> {
+impl<const L: usize> HeldBatch<'_, L> {
     /// The span's lane of batch lane `c` (the lanes past `n` repeat the last).
     #[inline(always)]
     fn lane(&self, c: usize) -> i64 {
@@ -1081,7 +1080,7 @@ impl<const L: usize> HeldBatch<L> {
     }
 }
 
-impl<const L: usize> HeldInputs<L> for HeldBatch<L> {
+impl<const L: usize> HeldInputs<L> for HeldBatch<'_, L> {
     #[inline(always)]
     fn x(&self) -> [u64; L] {
         std::array::from_fn(|c| self.d.wrapping_add(self.lane(c).wrapping_mul(self.s)) as u64)
@@ -1093,27 +1092,26 @@ impl<const L: usize> HeldInputs<L> for HeldBatch<L> {
     #[inline(always)]
     fn top(&self, k: usize, c: usize) -> (i64, u64) {
         if k < 2 {
-            self.nx[k]
+            self.k.nx[k]
         } else {
             self.ty[k - 2][c]
         }
     }
     #[inline(always)]
     fn drop(&self, k: usize, _: usize) -> i64 {
-        self.drop[k]
+        self.k.drop[k]
     }
     #[inline(always)]
     fn r2_shifts(&self, _: usize) -> (i64, i64) {
-        self.r2_shifts
+        self.k.r2_shifts
     }
 }
 
-/// A span's constants as each of its lanes carries them in a [`Gather`]: the x numerators'
-/// tops as high and low words (below 2^94), each derivative's drop plus `bary_bits` and 62
-/// (x then y: the shift of its top's product is `1/D^2`'s exponent less it), the range of
-/// `1/D^2`'s exponent that keeps the derivatives' shifts in 64..126, and the y numerators'
-/// drops.
-#[cfg(target_arch = "x86_64")]
+/// A span's constants as the vector batches take them (a span's own [`HeldBatch`]es, or
+/// each lane of a [`Gather`]): the x numerators' tops as high and low words (below 2^94),
+/// each derivative's drop plus `bary_bits` and 62 (x then y: the shift of its top's product
+/// is `1/D^2`'s exponent less it), the range of `1/D^2`'s exponent that keeps the
+/// derivatives' shifts in 64..126, and the y numerators' drops.
 struct LaneConsts {
     nx: [(i64, u64); 2],
     drop: [i64; 4],
@@ -1121,7 +1119,6 @@ struct LaneConsts {
     ns_y: [u32; 2],
 }
 
-#[cfg(target_arch = "x86_64")]
 impl LaneConsts {
     #[inline(always)]
     fn new(tops: &Tops, bb: u32) -> Self {
