@@ -902,7 +902,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
         // A vector batch (of at least [`HELD_MIN_LANES`] lanes) at a narrow width where the
         // CPU has the vector unit for it.
         let n = (span.lanes - j0).min(HELD_LANES);
-        if let Some(k) = consts.as_ref().filter(|_| n >= HELD_MIN_LANES) {
+        if let Some(span_consts) = consts.as_ref().filter(|_| n >= HELD_MIN_LANES) {
             // Each lane's y numerators' tops; the lanes past the span repeat its last.
             let mut ty = [[(0i64, 0u64); HELD_LANES]; 2];
             let mut nyj = ny;
@@ -911,8 +911,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
             #[allow(clippy::needless_range_loop)]
             for c in 0..HELD_LANES {
                 for k in 0..2 {
-                    let t = nyj[k] >> ([ny1, ny2][k] & 63);
-                    ty[k][c] = ((t >> 64) as i64, t as u64);
+                    ty[k][c] = span_consts.y_top(k, nyj[k]);
                     if c + 1 < n {
                         nyj[k] = nyj[k].wrapping_add(st.y_step[k]);
                     }
@@ -925,7 +924,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                 q: [q1, q2],
                 a: [st.a[1], st.a[2]],
                 ty,
-                k,
+                k: span_consts,
             };
             let mut wide = HeldLanes::<HELD_LANES>::default();
             if held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
@@ -1131,6 +1130,13 @@ impl LaneConsts {
             ns_y: [ny1, ny2],
         }
     }
+
+    /// The top of y numerator `i` (`ny`, of a lane) as high and low words: `ny` less its drop.
+    #[inline(always)]
+    fn y_top(&self, i: usize, ny: i128) -> (i64, u64) {
+        let t = ny >> (self.ns_y[i] & 63);
+        ((t >> 64) as i64, t as u64)
+    }
 }
 
 /// Held lanes ([`held_form`]) gathered across spans for one vector batch of `L` lanes
@@ -1204,8 +1210,7 @@ impl<const L: usize> Gather<L> {
         for i in 0..2 {
             self.q[i][c] = q[i];
             (self.top_hi[i][c], self.top_lo[i][c]) = k.nx[i];
-            let t = ny[i] >> (k.ns_y[i] & 63);
-            (self.top_hi[2 + i][c], self.top_lo[2 + i][c]) = ((t >> 64) as i64, t as u64);
+            (self.top_hi[2 + i][c], self.top_lo[2 + i][c]) = k.y_top(i, ny[i]);
         }
         for i in 0..4 {
             self.drop[i][c] = k.drop[i];
