@@ -30,6 +30,9 @@ use crate::datapath::{Component, Datapath, Stage};
 use crate::fixed::{round_shift_right, ConstRounding, LaneRound, Rounding};
 use crate::wrap::{wrap_i64_with, wrap_in, wrap_pow2_repeat, WrapMode, WrapOut, WrapShifts};
 
+mod batch;
+pub use batch::{BatchLevels, SampleBatch, BATCH_LANES};
+
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
 pub struct Level<'a> {
@@ -118,6 +121,12 @@ impl SampleSink for TrilinearTrace {
 /// Lanes of one 32-bit half of a `u64` that hold a channel value (< 2^16).
 const LANE16: u64 = 0x0000_ffff_0000_ffff;
 
+/// A texel's channels as one word, channel `c` in bits `16c..16c + 16`.
+#[inline(always)]
+fn texel_word(t: [u16; 4]) -> u64 {
+    u64::from(t[0]) | u64::from(t[1]) << 16 | u64::from(t[2]) << 32 | u64::from(t[3]) << 48
+}
+
 /// The four channels of a texel as two `u64` words of two 32-bit lanes: `(c0, c2)` and
 /// `(c1, c3)`, so one multiply by a weight serves two channels (a lane's product of a
 /// 16-bit value and a weight of at most 2^16 stays below 2^32).
@@ -131,8 +140,12 @@ impl Lanes {
     /// The channels of a texel.
     #[inline(always)]
     fn of(t: [u16; 4]) -> Self {
-        let word =
-            u64::from(t[0]) | u64::from(t[1]) << 16 | u64::from(t[2]) << 32 | u64::from(t[3]) << 48;
+        Self::of_word(texel_word(t))
+    }
+
+    /// The channels of a texel's [`texel_word`].
+    #[inline(always)]
+    fn of_word(word: u64) -> Self {
         Self {
             even: word & LANE16,
             odd: (word >> 16) & LANE16,
@@ -1090,6 +1103,23 @@ mod tests {
         );
     }
 
+    /// The chains of the power-of-two tests: square, non-square, 1xN, one texel; short (the
+    /// 64x64 level's last rows read zeros; the batch form refuses it); not powers of two
+    /// (refused).
+    const POW2_TEST_CHAINS: [&[(u32, u32)]; 6] = [
+        &[(32, 32), (16, 16), (8, 8), (4, 4), (2, 2), (1, 1)],
+        &[(16, 4), (8, 2), (4, 1), (2, 1), (1, 1)],
+        &[(1, 1)],
+        &[(1, 64), (1, 32), (1, 16)],
+        &[(64, 64), (32, 32)],
+        &[(12, 8), (6, 4), (3, 2), (1, 1)],
+    ];
+
+    /// 6000 seeded texels.
+    fn random_texels(s: &mut u64) -> Vec<[u16; 4]> {
+        (0..6000).map(|_| [0; 4].map(|_| next(s) as u16)).collect()
+    }
+
     /// 2M seeded samples: a unit's `sample_pow2_repeat`, where `pow2_repeat` accepts the
     /// chain (Repeat on both axes, power-of-two sides), gives the bits and the whole trace of
     /// its general `sample` and of the scalar filter it replaced; the nine rounding pairs,
@@ -1100,20 +1130,8 @@ mod tests {
     #[test]
     fn pow2_repeat_matches_the_general_sample() {
         let mut s = 0x5eed_0016;
-        let texels: Vec<[u16; 4]> = (0..6000)
-            .map(|_| [0; 4].map(|_| next(&mut s) as u16))
-            .collect();
-        let sizes: [&[(u32, u32)]; 6] = [
-            &[(32, 32), (16, 16), (8, 8), (4, 4), (2, 2), (1, 1)],
-            &[(16, 4), (8, 2), (4, 1), (2, 1), (1, 1)],
-            &[(1, 1)],
-            &[(1, 64), (1, 32), (1, 16)],
-            // Short: the 64x64 level's last rows read zeros.
-            &[(64, 64), (32, 32)],
-            // Not powers of two: refused.
-            &[(12, 8), (6, 4), (3, 2), (1, 1)],
-        ];
-        let chains = chains_of(&texels, &sizes, 2000);
+        let texels = random_texels(&mut s);
+        let chains = chains_of(&texels, &POW2_TEST_CHAINS, 2000);
         let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
         let (mut fast, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
         for i in 0..2_000_000u32 {
@@ -1188,6 +1206,105 @@ mod tests {
         assert!(
             fast > 1_400_000 && refused > 300_000 && wide > 300_000 && two > 400_000,
             "{fast} {refused} {wide} {two}"
+        );
+    }
+
+    /// 2.4M seeded lanes (300,000 batches of 1 to 16) of the batch form against
+    /// [`TrilinearUnit::sample_pow2_repeat`] lane by lane: the nine rounding pairs, every
+    /// weight width, coordinates with 4 to 30 fraction bits (and 31 or more, refused), LOD
+    /// fractions of 0 to 20 bits (above 16 refused), LODs below the first level and beyond the
+    /// last, coordinates near 0 and past `2^29` (sampled by themselves), batches of 1 to 16
+    /// lanes; short and non-power-of-two chains refused by [`BatchLevels::new`].
+    #[test]
+    fn batch_matches_sample_pow2_repeat() {
+        let mut s = 0x5eed_0b17;
+        let texels = random_texels(&mut s);
+        let chains = chains_of(&texels, &POW2_TEST_CHAINS, 2000);
+        let batch_levels: Vec<_> = chains.iter().map(|c| BatchLevels::new(c)).collect();
+        assert!(batch_levels[..4].iter().all(Option::is_some));
+        assert!(batch_levels[4..].iter().all(Option::is_none));
+        let (mut lanes, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
+        for i in 0..300_000u32 {
+            let mut cfg = HwConfig::texram16().trilinear;
+            cfg.filter_rounding = MODES[(i % 3) as usize];
+            cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
+            cfg.weight_bits = i / 9 % 17;
+            let c = (i / 153 % 4) as usize;
+            let (levels, bl) = (&chains[c], batch_levels[c].as_ref().unwrap());
+            let frac = if i % 32 == 0 {
+                31 + i / 32 % 4
+            } else {
+                4 + i / 11 % 27
+            };
+            let lfb = i / 17 % 21;
+            let one = 1i64 << frac.min(62);
+            let mut batch = SampleBatch::default();
+            for j in 0..BATCH_LANES {
+                let (u, v) = match next(&mut s) % 8 {
+                    0 => {
+                        let sh = (next(&mut s) % 64) as u32;
+                        ((next(&mut s) as i64) >> sh, (next(&mut s) as i64) >> sh)
+                    }
+                    1 => {
+                        // Either side of the batch's range `[-2^29, 2^29)`.
+                        let e = |x: u64| {
+                            [-(1 << 29) - 1, -(1 << 29), (1 << 29) - 1, 1 << 29][(x % 4) as usize]
+                        };
+                        (e(next(&mut s)), e(next(&mut s)))
+                    }
+                    _ => {
+                        let r = |x: u64| (x % (4 * one as u64)) as i64 - 3 * one / 2;
+                        (r(next(&mut s)), r(next(&mut s)))
+                    }
+                };
+                let lod =
+                    (next(&mut s) % ((levels.len() as u64 + 1) << lfb)) as i64 - (1 << lfb >> 1);
+                (batch.u[j], batch.v[j], batch.lod[j]) = (u, v, lod);
+            }
+            let n = 1 + (next(&mut s) % BATCH_LANES as u64) as usize;
+            let setup = UnitSetup::new(&cfg, frac, lfb);
+            crate::with_rounding!(cfg.filter_rounding, F => {
+                crate::with_rounding!(cfg.weight_rounding, W => {
+                    let unit = TrilinearUnit::<F, W>::new(&cfg, &setup, [WrapMode::Repeat; 2]);
+                    let stale = [[0xdead_beef; 4]; BATCH_LANES];
+                    let mut out = stale;
+                    let vector = unit.sample_batch_pow2_repeat(levels, bl, &batch, n, &mut out);
+                    assert_eq!(vector, unit.batch_form());
+                    if !(frac <= 30 && lfb <= 16) {
+                        assert!(!vector);
+                        assert_eq!(out, stale);
+                        refused += 1;
+                    } else {
+                        // The portable passes (what the AVX-512 ones are compiled from) on every
+                        // CPU; they leave the wide lanes to the caller.
+                        let mut portable = stale;
+                        let at = batch::Levels { levels, shape: bl };
+                        let mut p = batch::Passes::new();
+                        batch::batch_passes(&unit, &at, &batch, n, &mut p, &mut portable);
+                        for j in 0..n {
+                            let (u, v, lod) = (batch.u[j], batch.v[j], batch.lod[j]);
+                            let want = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
+                            if vector {
+                                assert_eq!(out[j], want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
+                            }
+                            let narrow = |x: i64| (-(1 << 29)..1 << 29).contains(&x);
+                            if narrow(u) && narrow(v) {
+                                assert_eq!(portable[j], want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
+                                lanes += 1;
+                            } else {
+                                wide += 1;
+                            }
+                            let lf_mask = (1 << lfb) - 1;
+                            let inner = lod > 0 && (lod >> lfb) < levels.len() as i64 - 1;
+                            two += u32::from(inner && lod & lf_mask != 0);
+                        }
+                    }
+                })
+            });
+        }
+        assert!(
+            lanes > 1_400_000 && refused > 40_000 && wide > 300_000 && two > 600_000,
+            "{lanes} {refused} {wide} {two}"
         );
     }
 }

@@ -171,6 +171,38 @@ pub fn wrap_pow2_repeat<W: crate::fixed::ConstRounding>(
     }
 }
 
+/// [`wrap_pow2_repeat`] of one lane of a batch on an axis of `2^log2_size` texels, `(i0, i1,
+/// weight)`, without a branch (a loop over lanes vectorizes): [`address`] with the size's
+/// multiply as a shift and the carry as a select, for shifts `k` of a `frac <= 30`. The same
+/// triple for a coordinate in `[-2^29, 2^29)` (the batch's test; any other wraps, in range,
+/// to a value the batch discards).
+#[inline(always)]
+#[must_use]
+pub fn wrap_pow2_repeat_lane<W: crate::fixed::ConstRounding>(
+    coord: i64,
+    log2_size: u32,
+    k: &WrapShifts,
+) -> (u32, u32, u32) {
+    let s = coord.wrapping_shl(log2_size + 1).wrapping_sub(k.half);
+    let i0 = s >> k.sf;
+    // In [0, 2^sf), `sf <= 31`: the rounding's input range.
+    let fr = s & k.fmask;
+    let truncate = W::MODE == crate::fixed::Rounding::Truncate;
+    let w = if truncate {
+        (fr >> k.down) << k.up
+    } else {
+        crate::fixed::round_shift_right_lane::<W>(fr, k.down) << k.up
+    };
+    let carry = !truncate && w >> k.wb != 0;
+    let i0 = i0.wrapping_add(i64::from(carry));
+    let mask = (1i64 << log2_size) - 1;
+    (
+        (i0 & mask) as u32,
+        (i0.wrapping_add(1) & mask) as u32,
+        if carry { 0 } else { w as u32 },
+    )
+}
+
 /// The unwrapped first index `floor(s)` and the weight of a coordinate that [`fits_i64`] on
 /// an axis of `size >= 1` texels ([`wrap`]'s rule, the rounding carry applied).
 #[inline(always)]

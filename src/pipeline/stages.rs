@@ -22,7 +22,7 @@ use hw_model::fixed::{Format, Rounding, SatCounter};
 use hw_model::frame::len_format;
 use hw_model::modulate::unorm_convert;
 use hw_model::reciprocal::Reciprocal;
-use hw_model::trilinear::{Level, UnitSetup};
+use hw_model::trilinear::{BatchLevels, Level, UnitSetup};
 use hw_model::vector::vector_format;
 use hw_model::UnitCost;
 
@@ -81,6 +81,8 @@ pub struct Machine<'a> {
     pub tex_fixed: Vec<Vec<Level<'a>>>,
     /// Per texture: every fixed level's sides are powers of two (`trilinear::pow2_chain`).
     pub tex_pow2: Vec<bool>,
+    /// Per texture: the fixed levels' shape where the trilinear unit's batch form samples them.
+    pub tex_batch: Vec<Option<BatchLevels>>,
     /// The constants of the `trilinear` stage's unit (`hw.trilinear`, `uv_fmt`, `hw.lod`).
     pub trilinear_setup: UnitSetup,
     pub tex_float: Vec<Vec<LevelF<'a>>>,
@@ -168,6 +170,7 @@ impl<'a> Machine<'a> {
                 .iter()
                 .map(|c| hw_model::trilinear::pow2_chain(c))
                 .collect(),
+            tex_batch: tex_fixed.iter().map(|c| BatchLevels::new(c)).collect(),
             tex_fixed,
             tex_float: float.iter().map(MipChain::views).collect(),
             units: ShadingUnits::new(&hw.shading),

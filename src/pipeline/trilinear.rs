@@ -11,7 +11,9 @@ use crate::footprint_ref::{footprint_f64, footprint_filter_f64};
 use crate::reference::trilinear_f64;
 use hw_model::fixed::{ConstRounding, SatCounter};
 use hw_model::footprint::{footprint, footprint_cost, footprint_filter, MAX_PROBES};
-use hw_model::trilinear::{trilinear_cost, Level, TrilinearTrace, TrilinearUnit};
+use hw_model::trilinear::{
+    trilinear_cost, BatchLevels, Level, SampleBatch, TrilinearTrace, TrilinearUnit, BATCH_LANES,
+};
 use hw_model::{HwConfig, UnitCost};
 
 const KIND: StageKind = StageKind::Trilinear;
@@ -41,20 +43,32 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     if took != m.hw.trilinear.aniso_probes {
         c.cost[k] = per_pixel_probes(c.cost[k], m, took);
     }
-    let tb = m.hw.trilinear.texel_bits;
-    frag.texel_x = r.map(u32::from);
-    frag.out_x = frag.texel_x;
+    store_texel(
+        frag,
+        r.map(u32::from),
+        m.hw.trilinear.texel_bits,
+        px.carriers,
+    );
+}
+
+/// A sample's channels (`tb` bits) as the fragment's texel and output, and as their float
+/// carriers when the plan keeps them.
+#[inline(always)]
+fn store_texel(frag: &mut Frag, texel: [u32; 4], tb: u32, carriers: bool) {
+    frag.texel_x = texel;
+    frag.out_x = texel;
     frag.out_bits = tb;
-    if px.carriers {
-        frag.texel = frag.texel_x.map(|x| unorm(x, tb));
+    if carriers {
+        frag.texel = texel.map(|x| unorm(x, tb));
         frag.out = frag.texel;
     }
 }
 
 /// Fixed twin over a span: the unit set up once (rounding modes, wrap mode, texture levels;
 /// the lerp constants and the coordinate and LOD formats of `Machine::trilinear_setup`), then
-/// one sample per fragment. Footprint assembly and a Float `lod` producer take [`fixed`] on
-/// each fragment.
+/// one sample per fragment; an untraced span of at least [`BATCH_MIN`] fragments on a
+/// texture the unit's batch form takes (`Machine::tex_batch`) samples [`BATCH_LANES`] at a time
+/// ([`batches`]). Footprint assembly and a Float `lod` producer take [`fixed`] on each fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let Some(t) = px.plan.texture else { return };
     if aniso(px) || !px.fixed(StageKind::Lod) {
@@ -68,8 +82,18 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
         hw_model::with_rounding!(cfg.weight_rounding, W => {
             let unit = TrilinearUnit::<F, W>::new(cfg, setup, wrap);
             let levels = &m.tex_fixed[t];
+            let tb = cfg.texel_bits;
             if unit.repeats() && m.tex_pow2[t] {
-                span_lanes::<F, W, true>(&unit, levels, t, cfg.texel_bits, px.carriers, frags);
+                match m.tex_batch[t].as_ref() {
+                    Some(shape)
+                        if frags.len() >= BATCH_MIN
+                            && unit.batch_form()
+                            && !frags.iter().any(|f| f.trace.on) =>
+                    {
+                        batches(&unit, levels, shape, tb, px.carriers, frags);
+                    }
+                    _ => span_lanes::<F, W, true>(&unit, levels, t, tb, px.carriers, frags),
+                }
             } else {
                 span_lanes::<F, W, false>(&unit, levels, t, cfg.texel_bits, px.carriers, frags);
             }
@@ -97,13 +121,45 @@ fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     };
     for frag in frags.iter_mut() {
         let [u, v] = frag.uv_x[0];
-        frag.texel_x =
+        let texel =
             unit_traced::<F, W, POW2_REPEAT>(unit, levels, u, v, frag.lod_x, &mut frag.trace, at);
-        frag.out_x = frag.texel_x;
-        frag.out_bits = tb;
-        if carriers {
-            frag.texel = frag.texel_x.map(|x| unorm(x, tb));
-            frag.out = frag.texel;
+        store_texel(frag, texel, tb, carriers);
+    }
+}
+
+/// Fragments a span needs for [`batches`]: shorter spans (most of W2's) took longer in
+/// batches than sample by sample.
+const BATCH_MIN: usize = 8;
+
+/// [`span_lanes`] of an untraced span of Repeat on power-of-two `levels` of the shape `shape`,
+/// [`BATCH_LANES`] fragments at a time through [`TrilinearUnit::sample_batch_pow2_repeat`]
+/// (whose [`TrilinearUnit::batch_form`] the caller has checked).
+#[inline(always)]
+fn batches<F: ConstRounding, W: ConstRounding>(
+    unit: &TrilinearUnit<F, W>,
+    levels: &[Level],
+    shape: &BatchLevels,
+    tb: u32,
+    carriers: bool,
+    frags: &mut [Frag],
+) {
+    let mut batch = SampleBatch::default();
+    let mut out = [[0; 4]; BATCH_LANES];
+    for chunk in frags.chunks_mut(BATCH_LANES) {
+        for (j, frag) in chunk.iter().enumerate() {
+            [batch.u[j], batch.v[j]] = frag.uv_x[0];
+            batch.lod[j] = frag.lod_x;
+        }
+        let n = chunk.len();
+        if !unit.sample_batch_pow2_repeat(levels, shape, &batch, n, &mut out) {
+            // Levels of another shape than the machine's (not reached): sample by sample.
+            for (j, o) in out.iter_mut().enumerate().take(n) {
+                let (u, v, lod) = (batch.u[j], batch.v[j], batch.lod[j]);
+                *o = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
+            }
+        }
+        for (frag, &texel) in chunk.iter_mut().zip(&out) {
+            store_texel(frag, texel, tb, carriers);
         }
     }
 }
