@@ -1038,10 +1038,7 @@ mod tests {
         let (mut lanes_blend, mut scalar_blend, mut one_level) = (0u32, 0u32, 0u32);
         let (mut inside, mut wrapped, mut missing) = (0u32, 0u32, 0u32);
         for i in 0..3_000_000u32 {
-            let mut cfg = HwConfig::texram16().trilinear;
-            cfg.filter_rounding = MODES[(i % 3) as usize];
-            cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
-            cfg.weight_bits = i / 9 % 17;
+            let cfg = cycled_config(i);
             let levels = &chains[(i / 153 % 5) as usize];
             let wm = [modes[(i % 3) as usize], modes[(i / 7 % 3) as usize]];
             let frac = [24, 16, 8, 30, 12][(i / 11 % 5) as usize];
@@ -1115,6 +1112,16 @@ mod tests {
         &[(12, 8), (6, 4), (3, 2), (1, 1)],
     ];
 
+    /// The texram16 filter with case `i`'s (filter, weight) rounding pair (the nine in turn)
+    /// and weight width (0 to 16, changing every nine cases).
+    fn cycled_config(i: u32) -> TrilinearConfig {
+        let mut cfg = HwConfig::texram16().trilinear;
+        cfg.filter_rounding = MODES[(i % 3) as usize];
+        cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
+        cfg.weight_bits = i / 9 % 17;
+        cfg
+    }
+
     /// 6000 seeded texels.
     fn random_texels(s: &mut u64) -> Vec<[u16; 4]> {
         (0..6000).map(|_| [0; 4].map(|_| next(s) as u16)).collect()
@@ -1135,10 +1142,7 @@ mod tests {
         let modes = [WrapMode::Repeat, WrapMode::ClampToEdge, WrapMode::Mirror];
         let (mut fast, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
         for i in 0..2_000_000u32 {
-            let mut cfg = HwConfig::texram16().trilinear;
-            cfg.filter_rounding = MODES[(i % 3) as usize];
-            cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
-            cfg.weight_bits = i / 9 % 17;
+            let cfg = cycled_config(i);
             let levels = &chains[(i / 153 % 6) as usize];
             let wm = if i % 8 == 0 {
                 [modes[(i / 8 % 3) as usize], modes[(i / 24 % 3) as usize]]
@@ -1225,10 +1229,7 @@ mod tests {
         assert!(batch_levels[4..].iter().all(Option::is_none));
         let (mut lanes, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
         for i in 0..300_000u32 {
-            let mut cfg = HwConfig::texram16().trilinear;
-            cfg.filter_rounding = MODES[(i % 3) as usize];
-            cfg.weight_rounding = MODES[(i / 3 % 3) as usize];
-            cfg.weight_bits = i / 9 % 17;
+            let cfg = cycled_config(i);
             let c = (i / 153 % 4) as usize;
             let (levels, bl) = (&chains[c], batch_levels[c].as_ref().unwrap());
             let frac = if i % 32 == 0 {

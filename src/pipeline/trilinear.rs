@@ -95,7 +95,7 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
                     _ => span_lanes::<F, W, true>(&unit, levels, t, tb, px.carriers, frags),
                 }
             } else {
-                span_lanes::<F, W, false>(&unit, levels, t, cfg.texel_bits, px.carriers, frags);
+                span_lanes::<F, W, false>(&unit, levels, t, tb, px.carriers, frags);
             }
         })
     });
