@@ -1280,8 +1280,7 @@ mod tests {
                         // CPU; they leave the wide lanes to the caller.
                         let mut portable = stale;
                         let at = batch::Levels { levels, shape: bl };
-                        let mut p = batch::Passes::new();
-                        batch::batch_passes(&unit, &at, &batch, n, &mut p, &mut portable);
+                        batch::batch_passes(&unit, &at, &batch, n, &mut portable);
                         for j in 0..n {
                             let (u, v, lod) = (batch.u[j], batch.v[j], batch.lod[j]);
                             let want = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
