@@ -1122,6 +1122,18 @@ mod tests {
         cfg
     }
 
+    /// Case `i`'s coordinate fraction bits and its `1.0` (`2^frac`, capped at `2^62`): 4 to 30
+    /// in turn, and every `wide_every`-th case one of the `wide_kinds` formats from 31 up
+    /// (beyond the 64-bit path and the batch form).
+    fn cycled_frac(i: u32, wide_every: u32, wide_kinds: u32) -> (u32, i64) {
+        let frac = if i.is_multiple_of(wide_every) {
+            31 + i / wide_every % wide_kinds
+        } else {
+            4 + i / 11 % 27
+        };
+        (frac, 1i64 << frac.min(62))
+    }
+
     /// 6000 seeded texels.
     fn random_texels(s: &mut u64) -> Vec<[u16; 4]> {
         (0..6000).map(|_| [0; 4].map(|_| next(s) as u16)).collect()
@@ -1149,13 +1161,8 @@ mod tests {
             } else {
                 [WrapMode::Repeat; 2]
             };
-            let frac = if i % 16 == 0 {
-                31 + i / 16 % 30
-            } else {
-                4 + i / 11 % 27
-            };
+            let (frac, one) = cycled_frac(i, 16, 30);
             let lfb = i / 17 % 31;
-            let one = 1i64 << frac.min(62);
             let (u, v) = match i % 5 {
                 0 => {
                     let sh = (next(&mut s) % 64) as u32;
@@ -1232,13 +1239,8 @@ mod tests {
             let cfg = cycled_config(i);
             let c = (i / 153 % 4) as usize;
             let (levels, bl) = (&chains[c], batch_levels[c].as_ref().unwrap());
-            let frac = if i % 32 == 0 {
-                31 + i / 32 % 4
-            } else {
-                4 + i / 11 % 27
-            };
+            let (frac, one) = cycled_frac(i, 32, 4);
             let lfb = i / 17 % 21;
-            let one = 1i64 << frac.min(62);
             let mut batch = SampleBatch::default();
             for j in 0..BATCH_LANES {
                 let (u, v) = match next(&mut s) % 8 {
