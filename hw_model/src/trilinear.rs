@@ -31,7 +31,7 @@ use crate::fixed::{round_shift_right, ConstRounding, LaneRound, Rounding};
 use crate::wrap::{wrap_i64_with, wrap_in, wrap_pow2_repeat, WrapMode, WrapOut, WrapShifts};
 
 mod batch;
-pub use batch::{BatchLevels, SampleBatch, BATCH_LANES};
+pub use batch::{BatchFootprints, BatchLevels, SampleBatch, BATCH_LANES};
 
 /// One MIP level (borrowed texels).
 #[derive(Clone, Copy, Debug)]
@@ -1221,7 +1221,8 @@ mod tests {
     }
 
     /// 2.4M seeded lanes (300,000 batches of 1 to 16) of the batch form against
-    /// [`TrilinearUnit::sample_pow2_repeat`] lane by lane: the nine rounding pairs, every
+    /// [`TrilinearUnit::sample_pow2_repeat`] lane by lane (channels, and in every other batch
+    /// the footprints its sink receives): the nine rounding pairs, every
     /// weight width, coordinates with 4 to 30 fraction bits (and 31 or more, refused), LOD
     /// fractions of 0 to 20 bits (above 16 refused), LODs below the first level and beyond the
     /// last, coordinates near 0 and past `2^29` (sampled by themselves), batches of 1 to 16
@@ -1235,6 +1236,7 @@ mod tests {
         assert!(batch_levels[..4].iter().all(Option::is_some));
         assert!(batch_levels[4..].iter().all(Option::is_none));
         let (mut lanes, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
+        let mut fp_lanes = 0u32;
         for i in 0..300_000u32 {
             let cfg = cycled_config(i);
             let c = (i / 153 % 4) as usize;
@@ -1271,28 +1273,46 @@ mod tests {
                     let unit = TrilinearUnit::<F, W>::new(&cfg, &setup, [WrapMode::Repeat; 2]);
                     let stale = [[0xdead_beef; 4]; BATCH_LANES];
                     let mut out = stale;
-                    let vector = unit.sample_batch_pow2_repeat(levels, bl, &batch, n, &mut out);
+                    // Every other batch also gives its footprints.
+                    let traced = i % 2 == 1;
+                    let (mut fps, mut portable_fps) = Default::default();
+                    let vector = unit.sample_batch_pow2_repeat(
+                        levels,
+                        bl,
+                        &batch,
+                        n,
+                        &mut out,
+                        traced.then_some(&mut fps),
+                    );
                     assert_eq!(vector, unit.batch_form());
                     if !(frac <= 30 && lfb <= 16) {
                         assert!(!vector);
                         assert_eq!(out, stale);
+                        assert_eq!(fps, BatchFootprints::default());
                         refused += 1;
                     } else {
                         // The portable passes (what the AVX-512 ones are compiled from) on every
                         // CPU; they leave the wide lanes to the caller.
                         let mut portable = stale;
                         let at = batch::Levels { levels, shape: bl };
-                        batch::batch_passes(&unit, &at, &batch, n, &mut portable);
+                        let pfps = traced.then_some(&mut portable_fps);
+                        batch::batch_passes(&unit, &at, &batch, n, &mut portable, pfps);
                         for j in 0..n {
                             let (u, v, lod) = (batch.u[j], batch.v[j], batch.lod[j]);
-                            let want = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
+                            let mut trace = TrilinearTrace::default();
+                            let want = unit.sample_pow2_repeat(levels, u, v, lod, &mut trace);
+                            let want_fps = traced.then(|| footprints_of(&trace));
+                            let lane_fps = |f: &BatchFootprints| traced.then(|| lane_of(f, j));
                             if vector {
                                 assert_eq!(out[j], want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
+                                assert_eq!(lane_fps(&fps), want_fps, "{u} {v} {frac} {lod}");
                             }
                             let narrow = |x: i64| (-(1 << 29)..1 << 29).contains(&x);
                             if narrow(u) && narrow(v) {
                                 assert_eq!(portable[j], want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
+                                assert_eq!(lane_fps(&portable_fps), want_fps, "{u} {v} {lod}");
                                 lanes += 1;
+                                fp_lanes += u32::from(traced);
                             } else {
                                 wide += 1;
                             }
@@ -1308,5 +1328,28 @@ mod tests {
             lanes > 1_400_000 && refused > 40_000 && wide > 300_000 && two > 600_000,
             "{lanes} {refused} {wide} {two}"
         );
+        assert!(fp_lanes > 700_000, "{fp_lanes}");
+    }
+
+    /// A sample's footprints: (level, columns, rows) of each level it used.
+    fn footprints_of(t: &TrilinearTrace) -> Vec<(u32, [u32; 2], [u32; 2])> {
+        let fp = |b: &BilinearTrace| {
+            let [(x0, y0), (x1, _), (_, y1), _] = b.coords;
+            (b.level, [x0, x1], [y0, y1])
+        };
+        t.level
+            .iter()
+            .take(t.levels_used as usize)
+            .map(fp)
+            .collect()
+    }
+
+    /// Lane `j`'s footprints of a batch, as [`footprints_of`] gives a sample's.
+    fn lane_of(f: &BatchFootprints, j: usize) -> Vec<(u32, [u32; 2], [u32; 2])> {
+        let fp = |l: usize| {
+            let (x, y) = (&f.x[l], &f.y[l]);
+            (f.level[l][j], [x[0][j], x[1][j]], [y[0][j], y[1][j]])
+        };
+        (0..f.levels_used[j] as usize).map(fp).collect()
     }
 }

@@ -13,7 +13,7 @@ use super::StageKind;
 use hw_model::config::TrilinearConfig;
 use hw_model::fixed::ConstRounding;
 use hw_model::trilinear::{
-    trilinear_to, BilinearTrace, Level, SampleSink, TrilinearTrace, TrilinearUnit,
+    trilinear_to, BatchFootprints, BilinearTrace, Level, SampleSink, TrilinearTrace, TrilinearUnit,
 };
 use hw_model::wrap::WrapMode;
 use serde::Serialize;
@@ -86,9 +86,32 @@ impl Trace {
         }
     }
 
+    /// Appends the footprints of lane `lane` of a batch's lookup (one per level it used).
+    #[inline]
+    pub fn record_lane(&mut self, at: Lookup, fps: &BatchFootprints, lane: usize) {
+        for l in 0..fps.levels_used[lane] as usize {
+            let (x, y) = (&fps.x[l], &fps.y[l]);
+            let level = fps.level[l][lane];
+            self.push_xy(
+                at,
+                level,
+                [x[0][lane], x[1][lane]],
+                [y[0][lane], y[1][lane]],
+            );
+        }
+    }
+
     /// Appends one bilinear footprint of lookup `at`.
     #[inline]
     fn push(&mut self, at: Lookup, b: &BilinearTrace) {
+        let [(x0, y0), (x1, _), (_, y1), _] = b.coords;
+        self.push_xy(at, b.level, [x0, x1], [y0, y1]);
+    }
+
+    /// Appends the footprint of lookup `at` on level `level` with texel columns `x` and rows
+    /// `y`.
+    #[inline]
+    fn push_xy(&mut self, at: Lookup, level: u32, x: [u32; 2], y: [u32; 2]) {
         let Some(slot) = self.fps.get_mut(self.len as usize) else {
             debug_assert!(
                 false,
@@ -99,10 +122,10 @@ impl Trace {
         *slot = TexelFootprint {
             stage: at.stage.index() as u8,
             lookup: at.lookup as u8,
-            level: b.level as u8,
+            level: level as u8,
             tex: at.tex as u16,
-            x: [b.coords[0].0, b.coords[1].0],
-            y: [b.coords[0].1, b.coords[2].1],
+            x,
+            y,
         };
         self.len += 1;
     }

@@ -12,7 +12,8 @@ use crate::reference::trilinear_f64;
 use hw_model::fixed::{ConstRounding, SatCounter};
 use hw_model::footprint::{footprint, footprint_cost, footprint_filter, MAX_PROBES};
 use hw_model::trilinear::{
-    trilinear_cost, BatchLevels, Level, SampleBatch, TrilinearTrace, TrilinearUnit, BATCH_LANES,
+    trilinear_cost, BatchFootprints, BatchLevels, Level, SampleBatch, TrilinearTrace,
+    TrilinearUnit, BATCH_LANES,
 };
 use hw_model::{HwConfig, UnitCost};
 
@@ -66,7 +67,7 @@ fn store_texel(frag: &mut Frag, texel: [u32; 4], tb: u32, carriers: bool) {
 
 /// Fixed twin over a span: the unit set up once (rounding modes, wrap mode, texture levels;
 /// the lerp constants and the coordinate and LOD formats of `Machine::trilinear_setup`), then
-/// one sample per fragment; an untraced span of at least [`BATCH_MIN`] fragments on a
+/// one sample per fragment; a span of at least [`BATCH_MIN`] fragments on a
 /// texture the unit's batch form takes (`Machine::tex_batch`) samples [`BATCH_LANES`] at a time
 /// ([`batches`]). Footprint assembly and a Float `lod` producer take [`fixed`] on each fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
@@ -85,12 +86,8 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
             let tb = cfg.texel_bits;
             if unit.repeats() && m.tex_pow2[t] {
                 match m.tex_batch[t].as_ref() {
-                    Some(shape)
-                        if frags.len() >= BATCH_MIN
-                            && unit.batch_form()
-                            && !frags.iter().any(|f| f.trace.on) =>
-                    {
-                        batches(&unit, levels, shape, tb, px.carriers, frags);
+                    Some(shape) if frags.len() >= BATCH_MIN && unit.batch_form() => {
+                        batches(&unit, levels, shape, t, tb, px.carriers, frags);
                     }
                     _ => span_lanes::<F, W, true>(&unit, levels, t, tb, px.carriers, frags),
                 }
@@ -131,35 +128,48 @@ fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
 /// batches than sample by sample.
 const BATCH_MIN: usize = 8;
 
-/// [`span_lanes`] of an untraced span of Repeat on power-of-two `levels` of the shape `shape`,
+/// [`span_lanes`] of a span of Repeat on power-of-two `levels` of the shape `shape`,
 /// [`BATCH_LANES`] fragments at a time through [`TrilinearUnit::sample_batch_pow2_repeat`]
-/// (whose [`TrilinearUnit::batch_form`] the caller has checked).
+/// (whose [`TrilinearUnit::batch_form`] the caller has checked), which also gives the
+/// footprints of a batch with a traced fragment ([`Trace::record_lane`]).
 #[inline(always)]
 fn batches<F: ConstRounding, W: ConstRounding>(
     unit: &TrilinearUnit<F, W>,
     levels: &[Level],
     shape: &BatchLevels,
+    t: usize,
     tb: u32,
     carriers: bool,
     frags: &mut [Frag],
 ) {
+    let at = Lookup {
+        stage: KIND,
+        lookup: 0,
+        tex: t,
+    };
     let mut batch = SampleBatch::default();
     let mut out = [[0; 4]; BATCH_LANES];
+    // The footprints' arrays, only when a fragment is traced.
+    let mut fps = frags
+        .iter()
+        .any(|f| f.trace.on)
+        .then(BatchFootprints::default);
     for chunk in frags.chunks_mut(BATCH_LANES) {
         for (j, frag) in chunk.iter().enumerate() {
             [batch.u[j], batch.v[j]] = frag.uv_x[0];
             batch.lod[j] = frag.lod_x;
         }
-        let n = chunk.len();
-        if !unit.sample_batch_pow2_repeat(levels, shape, &batch, n, &mut out) {
+        let traced = fps.as_mut();
+        if !unit.sample_batch_pow2_repeat(levels, shape, &batch, chunk.len(), &mut out, traced) {
             // Levels of another shape than the machine's (not reached): sample by sample.
-            for (j, o) in out.iter_mut().enumerate().take(n) {
-                let (u, v, lod) = (batch.u[j], batch.v[j], batch.lod[j]);
-                *o = unit.sample_pow2_repeat(levels, u, v, lod, &mut ());
-            }
+            span_lanes::<F, W, true>(unit, levels, t, tb, carriers, chunk);
+            continue;
         }
-        for (frag, &texel) in chunk.iter_mut().zip(&out) {
+        for (j, (frag, &texel)) in chunk.iter_mut().zip(&out).enumerate() {
             store_texel(frag, texel, tb, carriers);
+            if let (Some(fps), true) = (&fps, frag.trace.on) {
+                frag.trace.record_lane(at, fps, j);
+            }
         }
     }
 }

@@ -4,7 +4,7 @@
 //! the same channels lane by lane (`batch_matches_sample_pow2_repeat`), so the error bound is
 //! the unit's (the parent module's ERROR BOUND) and its float twin is the unit's.
 
-use super::{texel_word, LaneLerp, Lanes, Level, TrilinearUnit};
+use super::{texel_word, LaneLerp, Lanes, Level, TrilinearTrace, TrilinearUnit};
 use crate::fixed::ConstRounding;
 use crate::wrap::wrap_pow2_repeat_lane;
 use std::mem::MaybeUninit;
@@ -22,6 +22,31 @@ pub struct SampleBatch {
     pub u: [i64; BATCH_LANES],
     pub v: [i64; BATCH_LANES],
     pub lod: [i64; BATCH_LANES],
+}
+
+/// The footprints of a batch's lanes, as [`TrilinearUnit::sample_pow2_repeat`] reports them
+/// to its sink (for the timing model's trace): lane `i` read `levels_used[i]` levels (1 or
+/// 2), `level[0][i]` and then `level[1][i]`; level `l`'s footprint has the wrapped columns
+/// `x[l][0][i]`, `x[l][1][i]` and rows `y[l][0][i]`, `y[l][1][i]` (texels (x0,y0), (x1,y0),
+/// (x0,y1), (x1,y1)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BatchFootprints {
+    pub levels_used: [u32; BATCH_LANES],
+    pub level: [[u32; BATCH_LANES]; 2],
+    pub x: [[[u32; BATCH_LANES]; 2]; 2],
+    pub y: [[[u32; BATCH_LANES]; 2]; 2],
+}
+
+impl BatchFootprints {
+    /// Lane `i`'s footprints as a sample's trace gives them.
+    fn set_lane(&mut self, i: usize, t: &TrilinearTrace) {
+        self.levels_used[i] = t.levels_used;
+        for (l, b) in t.level.iter().enumerate() {
+            self.level[l][i] = b.level;
+            [self.x[l][0][i], self.x[l][1][i]] = [b.coords[0].0, b.coords[1].0];
+            [self.y[l][0][i], self.y[l][1][i]] = [b.coords[0].1, b.coords[2].1];
+        }
+    }
 }
 
 /// The shape of a texture's levels checked once for the batch form (e.g. per render): a
@@ -124,10 +149,11 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
     }
 
     /// [`TrilinearUnit::sample_pow2_repeat`] of `levels` (of the shape `shape`) at the first
-    /// `n` lanes of `batch` into `out` (footprints not reported): the same channels, lane by
-    /// lane. `false`, with nothing written, where the batch form does not apply
-    /// ([`TrilinearUnit::batch_form`]) or `levels` have another number of levels than
-    /// `shape`. A lane whose coordinates leave `[-2^29, 2^29)` is sampled by itself.
+    /// `n` lanes of `batch` into `out`, and their footprints into `footprints` where given:
+    /// the same channels and footprints, lane by lane. `false`, with nothing written, where
+    /// the batch form does not apply ([`TrilinearUnit::batch_form`]) or `levels` have another
+    /// number of levels than `shape`. A lane whose coordinates leave `[-2^29, 2^29)` is
+    /// sampled by itself.
     #[inline]
     pub fn sample_batch_pow2_repeat(
         &self,
@@ -136,6 +162,7 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
         batch: &SampleBatch,
         n: usize,
         out: &mut [[u32; 4]; BATCH_LANES],
+        mut footprints: Option<&mut BatchFootprints>,
     ) -> bool {
         if !self.batch_form() || levels.len() != shape.count {
             return false;
@@ -145,9 +172,9 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
         #[cfg(target_arch = "x86_64")]
         {
             // SAFETY: the CPU has every feature the function is built for (`batch_form`).
-            unsafe { batch_avx512(self, levels, batch, n, out) };
+            unsafe { batch_avx512(self, levels, batch, n, out, footprints.as_deref_mut()) };
         }
-        self.wide_lanes(levels, batch, n, out);
+        self.wide_lanes(levels, batch, n, out, footprints);
         true
     }
 
@@ -160,11 +187,18 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
         batch: &SampleBatch,
         n: usize,
         out: &mut [[u32; 4]; BATCH_LANES],
+        mut footprints: Option<&mut BatchFootprints>,
     ) {
         for (i, o) in out.iter_mut().enumerate().take(n) {
-            let (u, v) = (batch.u[i], batch.v[i]);
+            let (u, v, lod) = (batch.u[i], batch.v[i], batch.lod[i]);
             if ((u as u64).wrapping_add(1 << 29) | (v as u64).wrapping_add(1 << 29)) >= 1 << 30 {
-                *o = self.sample_pow2_repeat(levels.levels, u, v, batch.lod[i], &mut ());
+                let Some(fps) = footprints.as_deref_mut() else {
+                    *o = self.sample_pow2_repeat(levels.levels, u, v, lod, &mut ());
+                    continue;
+                };
+                let mut t = TrilinearTrace::default();
+                *o = self.sample_pow2_repeat(levels.levels, u, v, lod, &mut t);
+                fps.set_lane(i, &t);
             }
         }
     }
@@ -182,8 +216,9 @@ unsafe fn batch_avx512<F: ConstRounding, W: ConstRounding>(
     batch: &SampleBatch,
     n: usize,
     out: &mut [[u32; 4]; BATCH_LANES],
+    footprints: Option<&mut BatchFootprints>,
 ) {
-    batch_passes(unit, levels, batch, n, out);
+    batch_passes(unit, levels, batch, n, out, footprints);
 }
 
 /// The passes of [`TrilinearUnit::sample_batch_pow2_repeat`]: the levels and LOD weight as
@@ -192,7 +227,8 @@ unsafe fn batch_avx512<F: ConstRounding, W: ConstRounding>(
 /// ([`Lanes`]) and the blend (the finer level's result where the LOD weight is 0). The
 /// arithmetic runs over every lane (a fixed count vectorizes whole; the lanes past `n` hold
 /// earlier inputs and give results nobody reads), the fetch over the first `n` (zero texels
-/// elsewhere).
+/// elsewhere); where `footprints` is given, each lane's levels and its footprints' columns and
+/// rows (taken apart from the texel indices).
 #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 #[inline(always)]
 pub(super) fn batch_passes<F: ConstRounding, W: ConstRounding>(
@@ -201,6 +237,7 @@ pub(super) fn batch_passes<F: ConstRounding, W: ConstRounding>(
     batch: &SampleBatch,
     n: usize,
     out: &mut [[u32; 4]; BATCH_LANES],
+    footprints: Option<&mut BatchFootprints>,
 ) {
     let p = &mut Passes::new();
     let k = unit.setup;
@@ -239,6 +276,9 @@ pub(super) fn batch_passes<F: ConstRounding, W: ConstRounding>(
             weight[1][i] = wy;
         }
     }
+    if let Some(fps) = footprints {
+        addresses(p, fps);
+    }
     // The fetch: each index is below its level's `width * height` (`BatchLevels::new`).
     // A lane past `n`, and the coarser level of a lane with LOD weight 0, read no texels.
     for (lev, (texel, index)) in p.texel.iter_mut().zip(&p.index).enumerate() {
@@ -264,6 +304,26 @@ pub(super) fn batch_passes<F: ConstRounding, W: ConstRounding>(
         let w = p.lod_weight[i];
         let c = if w == 0 { c0 } else { c0.lerp(c1, w, blend) };
         *o = c.channels();
+    }
+}
+
+/// Each lane's levels and footprints from the texel indices of `p` (`y << log2 w | x`).
+#[inline(always)]
+fn addresses(p: &Passes, fps: &mut BatchFootprints) {
+    for i in 0..BATCH_LANES {
+        fps.levels_used[i] = 1 + u32::from(p.lod_weight[i] != 0);
+    }
+    fps.level = p.level;
+    for lev in 0..2 {
+        for i in 0..BATCH_LANES {
+            let lw = p.log2_side[lev][i][0];
+            let index = &p.index[lev];
+            let mask = (1 << lw) - 1;
+            fps.x[lev][0][i] = index[0][i] & mask;
+            fps.x[lev][1][i] = index[1][i] & mask;
+            fps.y[lev][0][i] = index[0][i] >> lw;
+            fps.y[lev][1][i] = index[2][i] >> lw;
+        }
     }
 }
 
