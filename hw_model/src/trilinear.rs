@@ -57,6 +57,16 @@ pub struct BilinearTrace {
     pub result: [u32; 4],
 }
 
+impl BilinearTrace {
+    /// The footprint's texel columns `[x0, x1]` and rows `[y0, y1]`.
+    #[inline(always)]
+    #[must_use]
+    pub fn columns_rows(&self) -> ([u32; 2], [u32; 2]) {
+        let [(x0, y0), (x1, _), (_, y1), _] = self.coords;
+        ([x0, x1], [y0, y1])
+    }
+}
+
 /// What one trilinear sample did (for `texsim probe`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TrilinearTrace {
@@ -1334,8 +1344,8 @@ mod tests {
     /// A sample's footprints: (level, columns, rows) of each level it used.
     fn footprints_of(t: &TrilinearTrace) -> Vec<(u32, [u32; 2], [u32; 2])> {
         let fp = |b: &BilinearTrace| {
-            let [(x0, y0), (x1, _), (_, y1), _] = b.coords;
-            (b.level, [x0, x1], [y0, y1])
+            let (x, y) = b.columns_rows();
+            (b.level, x, y)
         };
         t.level
             .iter()
@@ -1346,10 +1356,6 @@ mod tests {
 
     /// Lane `j`'s footprints of a batch, as [`footprints_of`] gives a sample's.
     fn lane_of(f: &BatchFootprints, j: usize) -> Vec<(u32, [u32; 2], [u32; 2])> {
-        let fp = |l: usize| {
-            let (x, y) = (&f.x[l], &f.y[l]);
-            (f.level[l][j], [x[0][j], x[1][j]], [y[0][j], y[1][j]])
-        };
-        (0..f.levels_used[j] as usize).map(fp).collect()
+        f.lane(j).collect()
     }
 }

@@ -89,23 +89,16 @@ impl Trace {
     /// Appends the footprints of lane `lane` of a batch's lookup (one per level it used).
     #[inline]
     pub fn record_lane(&mut self, at: Lookup, fps: &BatchFootprints, lane: usize) {
-        for l in 0..fps.levels_used[lane] as usize {
-            let (x, y) = (&fps.x[l], &fps.y[l]);
-            let level = fps.level[l][lane];
-            self.push_xy(
-                at,
-                level,
-                [x[0][lane], x[1][lane]],
-                [y[0][lane], y[1][lane]],
-            );
+        for (level, x, y) in fps.lane(lane) {
+            self.push_xy(at, level, x, y);
         }
     }
 
     /// Appends one bilinear footprint of lookup `at`.
     #[inline]
     fn push(&mut self, at: Lookup, b: &BilinearTrace) {
-        let [(x0, y0), (x1, _), (_, y1), _] = b.coords;
-        self.push_xy(at, b.level, [x0, x1], [y0, y1]);
+        let (x, y) = b.columns_rows();
+        self.push_xy(at, b.level, x, y);
     }
 
     /// Appends the footprint of lookup `at` on level `level` with texel columns `x` and rows

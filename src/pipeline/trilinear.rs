@@ -19,6 +19,16 @@ use hw_model::{HwConfig, UnitCost};
 
 const KIND: StageKind = StageKind::Trilinear;
 
+/// The stage's (first) lookup, of texture `t`.
+#[inline(always)]
+fn first_lookup(t: usize) -> Lookup {
+    Lookup {
+        stage: KIND,
+        lookup: 0,
+        tex: t,
+    }
+}
+
 /// Footprint assembly runs: more than one probe and the derivatives it needs.
 #[inline]
 fn aniso(px: &Px) -> bool {
@@ -111,11 +121,7 @@ fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     carriers: bool,
     frags: &mut [Frag],
 ) {
-    let at = Lookup {
-        stage: KIND,
-        lookup: 0,
-        tex: t,
-    };
+    let at = first_lookup(t);
     for frag in frags.iter_mut() {
         let [u, v] = frag.uv_x[0];
         let texel =
@@ -142,11 +148,7 @@ fn batches<F: ConstRounding, W: ConstRounding>(
     carriers: bool,
     frags: &mut [Frag],
 ) {
-    let at = Lookup {
-        stage: KIND,
-        lookup: 0,
-        tex: t,
-    };
+    let at = first_lookup(t);
     let mut batch = SampleBatch::default();
     let mut out = [[0; 4]; BATCH_LANES];
     // The footprints' arrays, only when a fragment is traced.
@@ -270,11 +272,7 @@ fn lookup(
         return footprint_lookup(m, plan, t, uv, trace, sat);
     }
     let hw = m.hw;
-    let at = Lookup {
-        stage: KIND,
-        lookup: 0,
-        tex: t,
-    };
+    let at = first_lookup(t);
     let [u, v] = uv[0];
     let r = trilinear_traced(
         &m.tex_fixed[t],

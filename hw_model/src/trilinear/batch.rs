@@ -38,13 +38,23 @@ pub struct BatchFootprints {
 }
 
 impl BatchFootprints {
+    /// Lane `i`'s footprints, finer level first: each one's level, columns and rows.
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> impl Iterator<Item = (u32, [u32; 2], [u32; 2])> + '_ {
+        (0..self.levels_used[i] as usize).map(move |l| {
+            let (x, y) = (&self.x[l], &self.y[l]);
+            (self.level[l][i], [x[0][i], x[1][i]], [y[0][i], y[1][i]])
+        })
+    }
+
     /// Lane `i`'s footprints as a sample's trace gives them.
     fn set_lane(&mut self, i: usize, t: &TrilinearTrace) {
         self.levels_used[i] = t.levels_used;
         for (l, b) in t.level.iter().enumerate() {
             self.level[l][i] = b.level;
-            [self.x[l][0][i], self.x[l][1][i]] = [b.coords[0].0, b.coords[1].0];
-            [self.y[l][0][i], self.y[l][1][i]] = [b.coords[0].1, b.coords[2].1];
+            let (x, y) = b.columns_rows();
+            [self.x[l][0][i], self.x[l][1][i]] = x;
+            [self.y[l][0][i], self.y[l][1][i]] = y;
         }
     }
 }
