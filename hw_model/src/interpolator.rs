@@ -382,6 +382,8 @@ fn spans_gathered<M: ConstRounding, R: ConstRounding, const N: u32>(
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
     let mut g = Gather::<HELD_LANES>::default();
+    // The batches' results, zeroed once (each batch writes every lane).
+    let mut results = HeldLanes::<HELD_LANES>::default();
     for (i, ds) in spans.iter().enumerate() {
         // A longer span fills its own batches ([`derivs_span_held`]).
         let held = (ds.span.lanes <= GATHER_MAX_LANES)
@@ -398,14 +400,26 @@ fn spans_gathered<M: ConstRounding, R: ConstRounding, const N: u32>(
         for j in 0..ds.span.lanes {
             g.push((i, j), d, [q1, q2], ny, &k);
             if g.n == HELD_LANES {
-                g.run::<M, R, N>(&lane_recip, (spans, cfg, recip), sat, &mut out);
+                g.run::<M, R, N>(
+                    &lane_recip,
+                    (spans, cfg, recip),
+                    &mut results,
+                    sat,
+                    &mut out,
+                );
             }
             ([q1, q2], ny) = st.next_lane([q1, q2], ny);
             d = d.wrapping_add(st.s);
         }
     }
     if g.n > 0 {
-        g.run::<M, R, N>(&lane_recip, (spans, cfg, recip), sat, &mut out);
+        g.run::<M, R, N>(
+            &lane_recip,
+            (spans, cfg, recip),
+            &mut results,
+            sat,
+            &mut out,
+        );
     }
 }
 
@@ -898,59 +912,64 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     };
     let mut recips = [(Recip { mant: 0, shift: 0 }, Recip { mant: 0, shift: 0 }); RECIP_BATCH];
     let mut j0 = 0;
-    while j0 < span.lanes {
-        // A vector batch (of at least [`HELD_MIN_LANES`] lanes) at a narrow width where the
-        // CPU has the vector unit for it.
-        let n = (span.lanes - j0).min(HELD_LANES);
-        if let Some(span_consts) = consts.as_ref().filter(|_| n >= HELD_MIN_LANES) {
+    // The vector batches (of at least [`HELD_MIN_LANES`] lanes, so all of them come first) at
+    // a narrow width where the CPU has the vector unit for them. Their inputs and results are
+    // made once per span and refilled in place by each batch (every lane of both is written):
+    // no copy of the inputs, one zeroing of the results.
+    if let Some(span_consts) = consts.as_ref() {
+        let mut input = HeldBatch {
+            n: 0,
+            d,
+            s,
+            q: [q1, q2],
+            a: [st.a[1], st.a[2]],
+            ty: [[(0, 0); HELD_LANES]; 2],
+            k: span_consts,
+        };
+        let mut wide = HeldLanes::<HELD_LANES>::default();
+        while span.lanes - j0 >= HELD_MIN_LANES {
+            let n = (span.lanes - j0).min(HELD_LANES);
+            (input.n, input.d, input.q) = (n, d, [q1, q2]);
             // Each lane's y numerators' tops; the lanes past the span repeat its last.
-            let mut ty = [[(0i64, 0u64); HELD_LANES]; 2];
             let mut nyj = ny;
             // Lane by lane with indices: the iterator form clippy prefers made this function's
             // short spans (no batch) 1.5 ms a W2 frame slower at one thread.
             #[allow(clippy::needless_range_loop)]
             for c in 0..HELD_LANES {
                 for k in 0..2 {
-                    ty[k][c] = span_consts.y_top(k, nyj[k]);
+                    input.ty[k][c] = span_consts.y_top(k, nyj[k]);
                     if c + 1 < n {
                         nyj[k] = nyj[k].wrapping_add(st.y_step[k]);
                     }
                 }
             }
-            let input = HeldBatch {
-                n,
-                d,
-                s,
-                q: [q1, q2],
-                a: [st.a[1], st.a[2]],
-                ty,
-                k: span_consts,
-            };
-            let mut wide = HeldLanes::<HELD_LANES>::default();
-            if held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
-                let b = &wide;
-                for c in 0..n {
-                    let j = j0 + c;
-                    if b.ok >> c & 1 == 1 {
-                        let (p1, p2) = (b.p[0][c], b.p[1][c]);
-                        let (x1, x2) = (p1 + b.dp[0][c], p2 + b.dp[1][c]);
-                        let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
-                        out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
-                    } else {
-                        let rr = b.recips.get(c);
-                        match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
-                            Some(v) => out(j, v),
-                            None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
-                        }
-                    }
-                    ([q1, q2], ny) = st.next_lane([q1, q2], ny);
-                }
-                d = d.wrapping_add((n as i64).wrapping_mul(s));
-                j0 += n;
-                continue;
+            if !held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
+                break;
             }
+            let b = &wide;
+            for c in 0..n {
+                let j = j0 + c;
+                if b.ok >> c & 1 == 1 {
+                    let (p1, p2) = (b.p[0][c], b.p[1][c]);
+                    let (x1, x2) = (p1 + b.dp[0][c], p2 + b.dp[1][c]);
+                    let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
+                    out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
+                } else {
+                    let rr = b.recips.get(c);
+                    match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
+                        Some(v) => out(j, v),
+                        None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
+                    }
+                }
+                ([q1, q2], ny) = st.next_lane([q1, q2], ny);
+            }
+            d = d.wrapping_add((n as i64).wrapping_mul(s));
+            j0 += n;
         }
-        let n = n.min(RECIP_BATCH);
+    }
+    // The other lanes, [`RECIP_BATCH`] reciprocals at a time.
+    while j0 < span.lanes {
+        let n = (span.lanes - j0).min(RECIP_BATCH);
         let mut dj = d;
         for lane in &mut recips[..n] {
             // `D` < 2^62 is its own reduced argument; it is not 0, so nothing is counted.
@@ -1236,14 +1255,15 @@ impl<const L: usize> Gather<L> {
     }
 
     /// Runs the batch of the `n` filled lanes (the lanes past them repeat the last) on the
-    /// vector unit ([`held_batch_avx512`]) and gives each lane's result to `out(span, lane,
-    /// result)`: the batch's own where the lane took its fast form, else the per-sample
+    /// vector unit ([`held_batch_avx512`]) into `b` and gives each lane's result to `out(span,
+    /// lane, result)`: the batch's own where the lane took its fast form, else the per-sample
     /// datapath's ([`derivs_lane`], of `spans`); then empties the gather.
     #[inline(always)]
     fn run<M: ConstRounding, R: ConstRounding, const N: u32>(
         &mut self,
         lane: &crate::reciprocal::RecipLane<'_, R>,
         (spans, cfg, recip): (&[DerivSpan], &InterpConfig, &Reciprocal),
+        b: &mut HeldLanes<L>,
         sat: &mut SatCounter,
         out: &mut impl FnMut(usize, usize, [[i64; 3]; 3]),
     ) {
@@ -1252,9 +1272,8 @@ impl<const L: usize> Gather<L> {
             self.repeat(n - 1, to);
         }
         let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
-        let mut b = HeldLanes::<L>::default();
         // SAFETY: the caller ([`spans_in`]) found every feature the function is built for.
-        unsafe { held_batch_avx512::<M, R, N, L, Self>(lane, self, bb, &mut b) };
+        unsafe { held_batch_avx512::<M, R, N, L, Self>(lane, self, bb, b) };
         for c in 0..n {
             let (i, j) = (self.at[c].0 as usize, self.at[c].1 as usize);
             if b.ok >> c & 1 == 1 {

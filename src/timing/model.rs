@@ -1441,11 +1441,11 @@ fn quad_lane<'f>(
 ) {
     let k = one.step.k;
     // A footprint of the stage's first lookup reading four banks.
+    // (`&` rather than `&&`: one test of the combined condition.)
     let quad = |f: &TexelFootprint| {
-        usize::from(f.stage) == k
-            && f.lookup == 0
-            && (f.x[0] ^ f.x[1]) & 1 != 0
-            && (f.y[0] ^ f.y[1]) & 1 != 0
+        (usize::from(f.stage) == k)
+            & (f.lookup == 0)
+            & ((f.x[0] ^ f.x[1]) & (f.y[0] ^ f.y[1]) & 1 != 0)
     };
     let ready_after = m.pre_cycles + m.setup.0;
     let quad_occ = tex.mem.quad_occ;
@@ -1455,7 +1455,7 @@ fn quad_lane<'f>(
         let (slot, t) = st.issue(ring, stall_by, ppc);
         let fast = match fps {
             [a] => quad(a),
-            [a, b] => quad(a) && quad(b),
+            [a, b] => quad(a) & quad(b),
             _ => false,
         };
         let n = match *lazy {
@@ -1483,7 +1483,12 @@ fn quad_lane<'f>(
                 if page == q.uniform {
                     4
                 } else {
-                    let hits = q.open.iter().filter(|&&o| o == page).count();
+                    // Banks that all hold another page: no hit, nothing to count.
+                    let hits = if q.uniform == EMPTY {
+                        q.open.iter().filter(|&&o| o == page).count()
+                    } else {
+                        0
+                    };
                     q.open = [page; 4];
                     q.uniform = page;
                     hits
