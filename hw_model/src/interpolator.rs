@@ -382,8 +382,8 @@ fn spans_gathered<M: ConstRounding, R: ConstRounding, const N: u32>(
     let m_bits = recip.config().recip_mantissa_bits;
     let lane_recip = recip.lane::<R>();
     let mut g = Gather::<HELD_LANES>::default();
-    // The batches' results, zeroed once (each batch writes every lane).
-    let mut results = HeldLanes::<HELD_LANES>::default();
+    // The batches' lane results, zeroed once (each batch writes every lane).
+    let mut lanes = HeldLanes::<HELD_LANES>::default();
     for (i, ds) in spans.iter().enumerate() {
         // A longer span fills its own batches ([`derivs_span_held`]).
         let held = (ds.span.lanes <= GATHER_MAX_LANES)
@@ -400,26 +400,14 @@ fn spans_gathered<M: ConstRounding, R: ConstRounding, const N: u32>(
         for j in 0..ds.span.lanes {
             g.push((i, j), d, [q1, q2], ny, &k);
             if g.n == HELD_LANES {
-                g.run::<M, R, N>(
-                    &lane_recip,
-                    (spans, cfg, recip),
-                    &mut results,
-                    sat,
-                    &mut out,
-                );
+                g.run::<M, R, N>(&lane_recip, (spans, cfg, recip), &mut lanes, sat, &mut out);
             }
             ([q1, q2], ny) = st.next_lane([q1, q2], ny);
             d = d.wrapping_add(st.s);
         }
     }
     if g.n > 0 {
-        g.run::<M, R, N>(
-            &lane_recip,
-            (spans, cfg, recip),
-            &mut results,
-            sat,
-            &mut out,
-        );
+        g.run::<M, R, N>(&lane_recip, (spans, cfg, recip), &mut lanes, sat, &mut out);
     }
 }
 
