@@ -1312,7 +1312,9 @@ mod tests {
                             let mut trace = TrilinearTrace::default();
                             let want = unit.sample_pow2_repeat(levels, u, v, lod, &mut trace);
                             let want_fps = traced.then(|| footprints_of(&trace));
-                            let lane_fps = |f: &BatchFootprints| traced.then(|| lane_of(f, j));
+                            let lane_fps = |f: &BatchFootprints| {
+                                traced.then(|| f.lane(j).collect::<Vec<_>>())
+                            };
                             if vector {
                                 assert_eq!(out[j], want, "{u} {v} {frac} {lod} {lfb} {cfg:?}");
                                 assert_eq!(lane_fps(&fps), want_fps, "{u} {v} {frac} {lod}");
@@ -1352,10 +1354,5 @@ mod tests {
             .take(t.levels_used as usize)
             .map(fp)
             .collect()
-    }
-
-    /// Lane `j`'s footprints of a batch, as [`footprints_of`] gives a sample's.
-    fn lane_of(f: &BatchFootprints, j: usize) -> Vec<(u32, [u32; 2], [u32; 2])> {
-        f.lane(j).collect()
     }
 }
