@@ -145,7 +145,7 @@ pub fn row_pass(m: &Machine, plan: &Plan) -> bool {
 /// one call of the interpolator's multi-span datapath
 /// ([`perspective_bary_derivs_spans`]), so that the lanes of short spans (a mesh's) fill the
 /// vector batches across the spans as a long span's do; [`fixed_span`] then takes each
-/// span's from here (`Px::row_bary`). Bit-identical to [`fixed_span`] span by span, with the
+/// span's from here (`Px::row_bary`, `SpanAt::row_bary`). Bit-identical to [`fixed_span`] span by span, with the
 /// same saturation counts (`frames_in_spans_equal_frames_per_fragment` in the pipeline tests;
 /// the datapath's own test is `gathered_spans_match_per_lane_calls`). A worker keeps one and
 /// reuses its buffers row after row.
@@ -214,14 +214,20 @@ impl Row {
         });
     }
 
-    /// The barycentrics of the span of `n` pixels from `x`, when [`Row::run`] computed them;
-    /// the row's spans are asked for in order.
-    pub fn take(&mut self, x: usize, n: usize) -> Option<&[[[i64; 3]; 3]]> {
+    /// Whether [`Row::run`] computed the barycentrics of the span from pixel `x` (then in
+    /// [`Row::bary`]); the row's spans are asked for in order.
+    pub fn take(&mut self, x: usize) -> bool {
         if self.starts.get(self.next) != Some(&x) {
-            return None;
+            return false;
         }
         self.next += 1;
-        Some(&self.bary[x..x + n])
+        true
+    }
+
+    /// The row's barycentrics by pixel: those of the spans [`Row::take`] found.
+    #[must_use]
+    pub fn bary(&self) -> &[[[i64; 3]; 3]] {
+        &self.bary
     }
 }
 

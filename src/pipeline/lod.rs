@@ -58,6 +58,14 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     }
 }
 
+/// Whether the fixed twins may take several triangles' spans at once
+/// ([`super::table::AcrossFn`]): not on the float32 coordinate path, whose quad reads the
+/// pixel's position ([`super::coord_f32::lod`]).
+#[must_use]
+pub fn across(m: &Machine, _: &Plan) -> bool {
+    m.hw.interp.coord_arith != CoordArith::Float32
+}
+
 /// Float twin.
 pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let Some(l0) = px.plan.texture.and_then(|t| px.m.tex_float[t].first()) else {

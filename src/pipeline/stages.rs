@@ -2,8 +2,8 @@
 //! configuration, built once per render), the per-triangle vertex data ([`TriAttrs`] in the
 //! hardware's input formats and, when a stage reads it, [`TriFloat`] in float, so the per-pixel
 //! loop allocates nothing), the run's
-//! [`Counters`], [`run`], which runs a compiled [`Program`] on one fragment, and [`run_span`],
-//! which runs it on a span of fragments, stage by stage. The stages themselves are one file
+//! [`Counters`], [`run`], which runs a compiled [`Program`] on one fragment, and
+//! [`run_spans`], which runs it on spans of fragments, stage by stage. The stages themselves are one file
 //! each, registered in [`super::table`].
 
 use super::bump::BumpAttrs;
@@ -511,36 +511,65 @@ fn start(frag: &mut Frag, plan: &Plan) {
     frag.trace.clear();
 }
 
-/// Most fragments in one span of [`run_span`].
+/// Most fragments in one span, and in one run of [`run_spans`].
 pub const SPAN_MAX: usize = 32;
 
-/// [`run`] on a span: `frags[j]` is the fragment at pixel (`x + j`, `y`) of `tri` (consecutive
-/// covered pixels of one triangle in one row, at most [`SPAN_MAX`]). The program runs stage by
-/// stage, each over the whole span: its span twin ([`super::table::SpanFn`]) when it has one,
-/// else its per-fragment twin on each fragment in turn. Every fragment ends as [`run`] leaves
-/// it, and the counters get the same sums. `row_bary`: the span's barycentrics when its row
-/// computed them ([`super::bary::Row`]; their saturations are counted there).
-#[allow(clippy::too_many_arguments)]
+/// One span of a run of [`run_spans`]: `n` consecutive covered pixels of `tri` from (`x`, `y`)
+/// in one row.
+#[derive(Clone, Copy)]
+pub struct SpanAt<'a> {
+    pub tri: &'a ScreenTri,
+    /// The triangle's vertex data ([`TriAttrs`], [`TriFloat`]).
+    pub attrs: (&'a TriAttrs, &'a TriFloat),
+    pub x: i64,
+    pub y: i64,
+    pub n: usize,
+    /// Its row computed its barycentrics ([`super::bary::Row`]; their saturations are
+    /// counted there): they are pixels `x..x + n` of the row's.
+    pub row_bary: bool,
+}
+
+/// [`run`] on consecutive spans of one program (at most [`SPAN_MAX`] fragments in all):
+/// `frags` holds the spans' fragments one span after another, fragment `j` of a span at
+/// pixel (`x + j`, `y`) of its triangle. The program runs stage by stage over every span:
+/// its span twin ([`super::table::SpanFn`]) on each span, or on all of `frags` at once when
+/// the stage runs across triangles ([`super::table::Op::across`]); a stage without a span
+/// twin runs its per-fragment twin on each fragment in turn. Every fragment ends as [`run`]
+/// leaves it, and the counters get the same sums (`frames_in_spans_equal_frames_per_fragment`
+/// in the pipeline tests). `row_bary`: the row's barycentrics, indexed by pixel, read by the
+/// spans with [`SpanAt::row_bary`].
 #[inline]
-pub fn run_span(
-    prog: &Program,
-    plan: &Plan,
-    m: &Machine,
-    tri: &ScreenTri,
-    (a, af): (&TriAttrs, &TriFloat),
-    (x, y): (i64, i64),
+pub fn run_spans<'a>(
+    prog: &'a Program,
+    plan: &'a Plan,
+    m: &'a Machine<'a>,
+    spans: &[SpanAt<'a>],
+    row_bary: &'a [[[i64; 3]; 3]],
     frags: &mut [Frag],
-    row_bary: Option<&[[[i64; 3]; 3]]>,
     c: &mut Counters,
 ) {
     for frag in frags.iter_mut() {
         start(frag, plan);
     }
-    let px = prog.px(plan, m, tri, (a, af), (x, y), row_bary);
+    let px = |s: &SpanAt<'a>| -> Px<'a> {
+        let x = s.x as usize;
+        let bary = s.row_bary.then(|| &row_bary[x..x + s.n]);
+        prog.px(plan, m, s.tri, s.attrs, (s.x, s.y), bary)
+    };
     for op in &prog.ops {
         match op.span {
-            Some(span) => span(&px, frags, c),
-            None => each_fragment(op.run, &px, frags, c),
+            Some(span) if op.across => span(&px(&spans[0]), frags, c),
+            _ => {
+                let mut rest = &mut *frags;
+                for s in spans {
+                    let (head, tail) = rest.split_at_mut(s.n);
+                    match op.span {
+                        Some(span) => span(&px(s), head, c),
+                        None => each_fragment(op.run, &px(s), head, c),
+                    }
+                    rest = tail;
+                }
+            }
         }
     }
 }

@@ -6,8 +6,9 @@
 //! A row names the stage's fixed twin, its float twin, its cost per invocation and its texture
 //! lookups per invocation (what the timing model budgets events for), and optionally a fixed
 //! twin over a span of fragments (`fixed_span`, see [`SpanFn`]; without one, a span runs the
-//! fixed twin on each fragment). Adding a stage is a file with those four functions and a row
-//! here (see `docs/ARCHITECTURE.md`).
+//! fixed twin on each fragment) and when that span twin may take the fragments of several
+//! triangles at once (`across`, see [`AcrossFn`]). Adding a stage is a file with those four
+//! functions and a row here (see `docs/ARCHITECTURE.md`).
 
 use super::stages::{Counters, Machine, TriAttrs, TriFloat};
 use super::{
@@ -21,7 +22,8 @@ use hw_model::{HwConfig, UnitCost};
 use serde::Serialize;
 use std::fmt;
 
-/// What a stage twin sees of the pixel it shades (of the first fragment of a span).
+/// What a stage twin sees of the pixel it shades (of the first fragment of a span; of a run's
+/// first span for a stage that runs across triangles, [`AcrossFn`]).
 #[derive(Clone, Copy)]
 pub struct Px<'a> {
     /// The material's plan (maps, frame, lights and options of its stages).
@@ -71,9 +73,16 @@ impl Px<'_> {
 /// A stage twin: shades one fragment, counting into the run's counters.
 pub type RunFn = fn(&Px, &mut Frag, &mut Counters);
 /// A stage twin over a span: the fragments of consecutive pixels (`px.x + j`, `px.y`) of one
-/// triangle, `j` = index in the slice; the same results and counts as the [`RunFn`] twin on
-/// each fragment in turn.
+/// triangle, `j` = index in the slice (or, for a stage that runs across triangles, see
+/// [`AcrossFn`], the fragments of a run of such spans); the same results and counts as the
+/// [`RunFn`] twin on each fragment in turn.
 pub type SpanFn = fn(&Px, &mut [Frag], &mut Counters);
+/// Whether a stage's fixed twins (per fragment and over a span) read nothing of the pixel
+/// they shade beyond its fragment, the plan, the machine and the run's options (not
+/// `Px::tri`, `a`, `af`, `x`, `y` nor `row_bary`) in a plan on a machine: its span twin may
+/// then take the fragments of consecutive spans of one program, of several triangles, at
+/// once ([`super::stages::run_spans`]), so that short spans (a mesh's) fill its batches.
+pub type AcrossFn = fn(&Machine, &Plan) -> bool;
 /// A stage's cost per invocation in a plan on a machine (fixed units' ops, cycles, texels).
 pub type CostFn = fn(&Machine, &Plan) -> UnitCost;
 /// Texture lookups per invocation on a hardware configuration.
@@ -87,6 +96,8 @@ pub struct StageRow {
     pub fixed: RunFn,
     /// The fixed twin over a span, when the stage has one.
     pub fixed_span: Option<SpanFn>,
+    /// When `fixed_span` may take several triangles' spans at once.
+    pub across: AcrossFn,
     pub float: RunFn,
     /// The float twin reads the triangle's float vertex data (`Px::af`, a
     /// [`super::stages::TriFloat`]): a render builds it when such a twin runs
@@ -94,6 +105,16 @@ pub struct StageRow {
     pub float_reads_vertices: bool,
     pub cost: CostFn,
     pub lookups: LookupsFn,
+}
+
+/// A stage whose span twin takes one triangle's span at a time.
+fn never(_: &Machine, _: &Plan) -> bool {
+    false
+}
+
+/// A stage whose fixed twins read only the fragment, the plan, the machine and the options.
+fn always(_: &Machine, _: &Plan) -> bool {
+    true
 }
 
 /// A stage that reads no texture.
@@ -116,6 +137,16 @@ macro_rules! optional_span {
     };
 }
 
+/// A row's `across`: [`never`] unless given.
+macro_rules! optional_across {
+    () => {
+        never
+    };
+    ($across:expr) => {
+        $across
+    };
+}
+
 /// A row's `float_reads_vertices`: `false` unless given.
 macro_rules! optional_flag {
     () => {
@@ -128,7 +159,8 @@ macro_rules! optional_flag {
 
 macro_rules! stage_table {
     ($( $(#[doc = $doc:literal])* $kind:ident $name:literal {
-        fixed: $fixed:expr, $(fixed_span: $span:expr,)? float: $float:expr,
+        fixed: $fixed:expr, $(fixed_span: $span:expr,)? $(across: $across:expr,)?
+        float: $float:expr,
         $(float_reads_vertices: $reads:expr,)? cost: $cost:expr, lookups: $lookups:expr $(,)?
     } )*) => {
         /// The kinds of stage, in pipeline order (generated from the stage table).
@@ -153,6 +185,7 @@ macro_rules! stage_table {
                 name: $name,
                 fixed: $fixed,
                 fixed_span: optional_span!($($span)?),
+                across: optional_across!($($across)?),
                 float: $float,
                 float_reads_vertices: optional_flag!($($reads)?),
                 cost: $cost,
@@ -180,18 +213,18 @@ stage_table! {
     }
     /// LOD from the texture-coordinate derivatives.
     Lod "lod" {
-        fixed: lod::fixed, fixed_span: lod::fixed_span, float: lod::float, cost: lod::cost,
-        lookups: no_lookups,
+        fixed: lod::fixed, fixed_span: lod::fixed_span, across: lod::across, float: lod::float,
+        cost: lod::cost, lookups: no_lookups,
     }
     /// Wrap + trilinear MIP filtering (footprint assembly with `aniso_probes` > 1).
     Trilinear "trilinear" {
-        fixed: trilinear::fixed, fixed_span: trilinear::fixed_span, float: trilinear::float,
-        cost: trilinear::cost, lookups: trilinear::lookups,
+        fixed: trilinear::fixed, fixed_span: trilinear::fixed_span, across: always,
+        float: trilinear::float, cost: trilinear::cost, lookups: trilinear::lookups,
     }
     /// Colour x texel.
     Modulate "modulate" {
-        fixed: modulate::fixed, fixed_span: modulate::fixed_span, float: modulate::float,
-        cost: modulate::cost, lookups: no_lookups,
+        fixed: modulate::fixed, fixed_span: modulate::fixed_span, across: always,
+        float: modulate::float, cost: modulate::cost, lookups: no_lookups,
     }
     /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.
     Normal "normal" {
@@ -323,13 +356,15 @@ impl fmt::Display for StageKind {
 }
 
 /// One compiled stage: its kind, the twin that runs (per fragment and, when it has one, over
-/// a span) and its cost per invocation.
+/// a span, and whether over several triangles' spans at once) and its cost per invocation.
 #[derive(Clone, Copy)]
 pub struct Op {
     pub kind: StageKind,
     pub run: RunFn,
     /// The twin over a span (`None`: `run` on each fragment of the span).
     pub span: Option<SpanFn>,
+    /// `span` takes the fragments of several triangles' spans at once ([`AcrossFn`]).
+    pub across: bool,
     pub cost: UnitCost,
 }
 
@@ -347,6 +382,9 @@ pub struct Program {
     /// The plan's barycentrics run Fixed as one pass over each row's spans
     /// ([`super::bary::Row`]) before the row is shaded.
     pub row_bary: bool,
+    /// Some stage of the program runs across triangles ([`Op::across`]): the pixel loop
+    /// gathers consecutive spans of this program into one run ([`super::stages::run_spans`]).
+    pub gathers: bool,
 }
 
 impl Program {
@@ -396,7 +434,7 @@ impl Program {
     /// Compiles `plan` with the twins `impls` on the machine `m`.
     #[must_use]
     pub fn new(plan: &Plan, impls: &StageImpls, m: &Machine) -> Self {
-        let ops = plan
+        let ops: Vec<Op> = plan
             .stages
             .iter()
             .map(|&kind| {
@@ -409,6 +447,7 @@ impl Program {
                     kind,
                     run,
                     span,
+                    across: span.is_some() && (row.across)(m, plan),
                     cost: (row.cost)(m, plan),
                 }
             })
@@ -426,13 +465,14 @@ impl Program {
             .iter()
             .all(|&k| impls.of(k) == Impl::Fixed && RAW_ONLY.contains(&k));
         Self {
-            ops,
             impls: *impls,
             color_raw: plan.has(StageKind::Color) && impls.of(StageKind::Color) == Impl::Fixed,
             carriers: !raw_only,
             row_bary: plan.has(StageKind::Bary)
                 && impls.of(StageKind::Bary) == Impl::Fixed
                 && super::bary::row_pass(m, plan),
+            gathers: ops.iter().any(|op| op.across),
+            ops,
         }
     }
 }

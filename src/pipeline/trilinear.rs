@@ -75,7 +75,8 @@ fn store_texel(frag: &mut Frag, texel: [u32; 4], tb: u32, carriers: bool) {
     }
 }
 
-/// Fixed twin over a span: the unit set up once (rounding modes, wrap mode, texture levels;
+/// Fixed twin over a span, or over a run of a program's spans (it runs across triangles, see
+/// `table::AcrossFn`): the unit set up once (rounding modes, wrap mode, texture levels;
 /// the lerp constants and the coordinate and LOD formats of `Machine::trilinear_setup`), then
 /// one sample per fragment; a span of at least [`BATCH_MIN`] fragments on a
 /// texture the unit's batch form takes (`Machine::tex_batch`) samples [`BATCH_LANES`] at a time
@@ -130,7 +131,7 @@ fn span_lanes<F: ConstRounding, W: ConstRounding, const POW2_REPEAT: bool>(
     }
 }
 
-/// Fragments a span needs for [`batches`]: shorter spans (most of W2's) took longer in
+/// Fragments a span (or run of spans) needs for [`batches`]: shorter ones took longer in
 /// batches than sample by sample.
 const BATCH_MIN: usize = 8;
 

@@ -7,7 +7,7 @@ use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::clip_f32::{outcode, ShadedVertex};
 use crate::pipeline::coord_f32::{self, F32Tri};
 use crate::pipeline::stages::{
-    output16, run, run_span, Counters, Machine, QuietSetup, TriAttrs, TriFloat, SPAN_MAX,
+    output16, run, run_spans, Counters, Machine, QuietSetup, SpanAt, TriAttrs, TriFloat, SPAN_MAX,
 };
 use crate::pipeline::{bary, Frag, Program, StageImpls, StageKind};
 use crate::prefetch::prefetch;
@@ -448,6 +448,7 @@ fn shade_row_spans(
     }
     // The fragments of each run of one program, charged when the run ends.
     let mut run_of: Option<(usize, u64)> = None;
+    let mut group = Group::new(cap);
     let mut x = 0;
     while x < w {
         let t = tris[x];
@@ -473,43 +474,108 @@ fn shade_row_spans(
             }
         }
         let tri = &inp.setup.tris[t as usize];
-        let plan = &inp.geo.plans[pi];
         let (px, py) = (x as i64, y as i64);
-        let span = &mut frags[..n];
         if inp.per_fragment {
-            run(
-                &progs[pi],
-                plan,
-                inp.m,
-                tri,
-                (a, af),
-                px,
-                py,
-                &mut span[0],
-                c,
-            );
+            let (prog, plan) = (&progs[pi], &inp.geo.plans[pi]);
+            run(prog, plan, inp.m, tri, (a, af), px, py, &mut frags[0], c);
+            row[x] = output16(&frags[0]);
+            on_span(a.plan, t, &frags[..1]);
         } else {
-            let pre = if row_bary { bary.take(x, n) } else { None };
-            run_span(
-                &progs[pi],
-                plan,
-                inp.m,
+            if !group.takes(pi, n) {
+                group.shade(inp, progs, bary, frags, row, c, &mut on_span);
+            }
+            let span = SpanAt {
                 tri,
-                (a, af),
-                (px, py),
-                span,
-                pre,
-                c,
-            );
+                attrs: (a, af),
+                x: px,
+                y: py,
+                n,
+                row_bary: row_bary && bary.take(x),
+            };
+            group.push(pi, t, span);
+            if !progs[pi].gathers {
+                group.shade(inp, progs, bary, frags, row, c, &mut on_span);
+            }
         }
-        for (frag, out) in span.iter().zip(&mut row[x..x + n]) {
-            *out = output16(frag);
-        }
-        on_span(a.plan, t, span);
         x += n;
     }
+    group.shade(inp, progs, bary, frags, row, c, &mut on_span);
     if let Some((p, k)) = run_of {
         progs[p].charge(k, c);
+    }
+}
+
+/// Consecutive spans of a row shaded together ([`run_spans`]): of one program, one span at a
+/// time unless the program gathers them ([`Program::gathers`]), at most `cap` fragments.
+struct Group<'a> {
+    spans: Vec<SpanAt<'a>>,
+    /// The triangle of each of `spans`.
+    tris: Vec<u32>,
+    /// Their program (its index).
+    prog: usize,
+    /// Their fragments.
+    filled: usize,
+    cap: usize,
+}
+
+impl<'a> Group<'a> {
+    fn new(cap: usize) -> Self {
+        Self {
+            spans: Vec::with_capacity(cap),
+            tris: Vec::with_capacity(cap),
+            prog: 0,
+            filled: 0,
+            cap,
+        }
+    }
+
+    /// Whether a span of `n` fragments of program `prog` may join the group.
+    fn takes(&self, prog: usize, n: usize) -> bool {
+        self.spans.is_empty() || (prog == self.prog && self.filled + n <= self.cap)
+    }
+
+    /// Adds the span `span` of triangle `t` of program `prog` (which [`Group::takes`]).
+    fn push(&mut self, prog: usize, t: u32, span: SpanAt<'a>) {
+        self.prog = prog;
+        self.filled += span.n;
+        self.spans.push(span);
+        self.tris.push(t);
+    }
+
+    /// Shades the group's spans in `frags` ([`run_spans`]), writes their outputs into `row`,
+    /// shows each span to `on_span` in order (plan index, triangle, fragments), and empties
+    /// the group.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn shade(
+        &mut self,
+        inp: &ShadeInput,
+        progs: &[Program],
+        bary: &bary::Row,
+        frags: &mut [Frag],
+        row: &mut [[u16; 4]],
+        c: &mut Counters,
+        on_span: &mut impl FnMut(u32, u32, &[Frag]),
+    ) {
+        if self.spans.is_empty() {
+            return;
+        }
+        let frags = &mut frags[..self.filled];
+        let (prog, plan) = (&progs[self.prog], &inp.geo.plans[self.prog]);
+        run_spans(prog, plan, inp.m, &self.spans, bary.bary(), frags, c);
+        let mut rest = &*frags;
+        for (s, &t) in self.spans.iter().zip(&self.tris) {
+            let (span, tail) = rest.split_at(s.n);
+            let x = s.x as usize;
+            for (frag, out) in span.iter().zip(&mut row[x..x + s.n]) {
+                *out = output16(frag);
+            }
+            on_span(self.prog as u32, t, span);
+            rest = tail;
+        }
+        self.spans.clear();
+        self.tris.clear();
+        self.filled = 0;
     }
 }
 
