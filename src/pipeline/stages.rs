@@ -529,7 +529,8 @@ pub struct SpanAt<'a> {
     pub row_bary: bool,
 }
 
-/// [`run`] on consecutive spans of one program (at most [`SPAN_MAX`] fragments in all):
+/// [`run`] on consecutive spans of one program (at most [`SPAN_MAX`] fragments in all; the
+/// row loop gathers at most 16, `render::shading::GATHER_MAX`):
 /// `frags` holds the spans' fragments one span after another, fragment `j` of a span at
 /// pixel (`x + j`, `y`) of its triangle. The program runs stage by stage over every span:
 /// its span twin ([`super::table::SpanFn`]) on each span, or on all of `frags` at once when

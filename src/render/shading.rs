@@ -448,7 +448,7 @@ fn shade_row_spans(
     }
     // The fragments of each run of one program, charged when the run ends.
     let mut run_of: Option<(usize, u64)> = None;
-    let mut group = Group::new(cap);
+    let mut group = Group::new();
     let mut x = 0;
     while x < w {
         let t = tris[x];
@@ -505,8 +505,15 @@ fn shade_row_spans(
     }
 }
 
+/// Most fragments in a run of gathered spans ([`Group`]; a longer span is a run of its own):
+/// two trilinear batches (`hw_model::trilinear::BATCH_LANES`). On W2 (spans of 4.2 fragments
+/// on average) 16 took less time than 8, 24 and 32, whose runs' fragments (about 3 KB each)
+/// fall out of the L1 cache between stages (`docs/PERFORMANCE_LOG.md`, stop 54).
+const GATHER_MAX: usize = 16;
+
 /// Consecutive spans of a row shaded together ([`run_spans`]): of one program, one span at a
-/// time unless the program gathers them ([`Program::gathers`]), at most `cap` fragments.
+/// time unless the program gathers them ([`Program::gathers`]), then at most [`GATHER_MAX`]
+/// fragments.
 struct Group<'a> {
     spans: Vec<SpanAt<'a>>,
     /// The triangle of each of `spans`.
@@ -515,23 +522,21 @@ struct Group<'a> {
     prog: usize,
     /// Their fragments.
     filled: usize,
-    cap: usize,
 }
 
 impl<'a> Group<'a> {
-    fn new(cap: usize) -> Self {
+    fn new() -> Self {
         Self {
-            spans: Vec::with_capacity(cap),
-            tris: Vec::with_capacity(cap),
+            spans: Vec::with_capacity(GATHER_MAX),
+            tris: Vec::with_capacity(GATHER_MAX),
             prog: 0,
             filled: 0,
-            cap,
         }
     }
 
     /// Whether a span of `n` fragments of program `prog` may join the group.
     fn takes(&self, prog: usize, n: usize) -> bool {
-        self.spans.is_empty() || (prog == self.prog && self.filled + n <= self.cap)
+        self.spans.is_empty() || (prog == self.prog && self.filled + n <= GATHER_MAX)
     }
 
     /// Adds the span `span` of triangle `t` of program `prog` (which [`Group::takes`]).
