@@ -446,7 +446,7 @@ fn shade_row_spans(
         }
         bary.run(inp.m, c);
     }
-    // The fragments of each run of one program, charged when the run ends.
+    // The fragments of each stretch of spans of one program, charged when it ends.
     let mut run_of: Option<(usize, u64)> = None;
     let mut group = Group::new();
     let mut x = 0;
