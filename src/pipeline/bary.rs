@@ -145,10 +145,10 @@ pub fn row_pass(m: &Machine, plan: &Plan) -> bool {
 /// one call of the interpolator's multi-span datapath
 /// ([`perspective_bary_derivs_spans`]), so that the lanes of short spans (a mesh's) fill the
 /// vector batches across the spans as a long span's do; [`fixed_span`] then takes each
-/// span's from here (`Px::row_bary`, `SpanAt::row_bary`). Bit-identical to [`fixed_span`] span by span, with the
-/// same saturation counts (`frames_in_spans_equal_frames_per_fragment` in the pipeline tests;
-/// the datapath's own test is `gathered_spans_match_per_lane_calls`). A worker keeps one and
-/// reuses its buffers row after row.
+/// span's from here (`Px::row_bary`, `SpanAt::row_bary`). Bit-identical to [`fixed_span`]
+/// span by span, with the same saturation counts (`frames_in_spans_equal_frames_per_fragment`
+/// in the pipeline tests; the datapath's own test is `gathered_spans_match_per_lane_calls`). A
+/// worker keeps one and reuses its buffers row after row.
 #[derive(Default)]
 pub struct Row {
     spans: Vec<DerivSpan>,

@@ -3,8 +3,8 @@
 //! hardware's input formats and, when a stage reads it, [`TriFloat`] in float, so the per-pixel
 //! loop allocates nothing), the run's
 //! [`Counters`], [`run`], which runs a compiled [`Program`] on one fragment, and
-//! [`run_spans`], which runs it on spans of fragments, stage by stage. The stages themselves are one file
-//! each, registered in [`super::table`].
+//! [`run_spans`], which runs it on spans of fragments, stage by stage. The stages themselves
+//! are one file each, registered in [`super::table`].
 
 use super::bump::BumpAttrs;
 use super::table::RunFn;

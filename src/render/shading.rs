@@ -378,8 +378,9 @@ pub(super) struct ShadeInput<'a> {
 /// index, triangle, frag)` sees every shaded fragment in raster order (a no-op closure
 /// compiles to the plain loop; the timing model records its events through it, from the
 /// footprints the stages traced when `trace`). The covered pixels run in spans of up to
-/// [`SPAN_MAX`] consecutive pixels of one triangle ([`run_span`]), or one at a time
-/// ([`run`]) with `inp.per_fragment`: the same image, counters and fragments.
+/// [`SPAN_MAX`] consecutive pixels of one triangle, gathered into runs of one program
+/// ([`Group`], [`run_spans`]), or one at a time ([`run`]) with `inp.per_fragment`: the same
+/// image, counters and fragments.
 /// `scratch` is the caller's ([`frag_scratch`], one per worker: a fragment is ~3 KB, so a
 /// span's worth is not built per row, nor the row's barycentrics).
 #[allow(clippy::too_many_arguments)]
