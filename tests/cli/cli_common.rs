@@ -1,7 +1,8 @@
-//! Shared helpers of the command-line tests: run the binary, a fresh temp dir, its output.
+//! Shared helpers of the command-line tests: run the binary, a scratch directory, its output.
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
+use crate::tmp_common::TmpDir;
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// Runs the `texsim` binary with `args` in `cwd`.
@@ -13,24 +14,10 @@ pub fn texsim(args: &[&str], cwd: &Path) -> Output {
         .expect("run texsim")
 }
 
-/// A fresh, empty directory private to this test binary, process, calling file and `name`
-/// (the test files of one binary share a process: `render` in `cli.rs` and in `bump_cli.rs`
-/// are two directories).
+/// A fresh, empty scratch directory of the calling test ([`TmpDir`]), named after `name`.
 #[track_caller]
-pub fn tmp(name: &str) -> PathBuf {
-    let caller = Path::new(std::panic::Location::caller().file());
-    let file = caller
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("tests");
-    let d = std::env::temp_dir().join(format!(
-        "texsim-{}-{file}-{}-{name}",
-        env!("CARGO_CRATE_NAME"),
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp dir");
-    d
+pub fn tmp(name: &str) -> TmpDir {
+    TmpDir::new(name)
 }
 
 /// Standard output followed by standard error.

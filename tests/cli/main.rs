@@ -5,6 +5,8 @@
 //! One file per module below; run one with `cargo test --test cli timing_cli::`.
 
 mod cli_common;
+#[path = "../tmp_common/mod.rs"]
+mod tmp_common;
 
 mod as_cli;
 mod budget_cli;

@@ -1,31 +1,7 @@
 //! The roughness command line: `texsim render --scene lake --truth` (truth.png, baseline.png,
 //! model/quantization/baseline error in summary.json) and the `roughness` sweep with `--truth`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn texsim(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texsim"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run texsim")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-rough-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp dir");
-    d
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use crate::cli_common::{texsim, text, tmp};
 
 #[test]
 fn render_truth_writes_the_truth_and_the_three_errors() {

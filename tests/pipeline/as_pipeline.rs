@@ -204,13 +204,9 @@ const RATIO_RATIO: f64 = 2.0;
 const RATIO_EMAX: f64 = 100.0;
 const RATIO_FRESNEL: f64 = 10.0;
 
-fn write_toml(name: &str, body: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-as-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
-    let p = d.join("s.toml");
-    std::fs::write(&p, body).expect("write");
-    p
+#[track_caller]
+fn write_toml(name: &str, body: &str) -> crate::tmp_common::TmpFile {
+    crate::tmp_common::TmpFile::new(name, "s.toml", body)
 }
 
 fn with_material(fields: &str) -> String {

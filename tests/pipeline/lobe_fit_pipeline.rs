@@ -212,9 +212,7 @@ fn fitted_lobes_are_identical_on_1_and_3_threads() {
 
 #[test]
 fn toml_fournier_lobes_key() {
-    let d = std::env::temp_dir().join(format!("texsim-lobes-toml-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
+    let d = crate::tmp_common::TmpDir::new("toml");
     let body = |k: &str| {
         format!(
             "[output]\nwidth = 96\nheight = 64\n\n[[textures]]\nname = \"bricks\"\nprocedural = \"bricks-height\"\nsize = 64\n\n[[materials]]\nname = \"m\"\nbump = \"bricks\"\nks = [0.5, 0.5, 0.5]\nshininess = 48\nfournier_lobes = {k}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n\n[[lights]]\nkind = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\ncolor = [1.0, 1.0, 1.0]\n"
@@ -239,7 +237,6 @@ fn toml_fournier_lobes_key() {
         let err = texsim::scene::load(&p).expect_err(bad).to_string();
         assert!(err.contains("fournier_lobes"), "{err}");
     }
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// The run budget counts the lobe maps (K pyramids per bump-map texel) and K lookups per pixel

@@ -146,7 +146,6 @@ fn planned_only_for_lobes_and_cost_grows_with_k() {
 }
 
 fn write(dir: &std::path::Path, body: &str) -> std::path::PathBuf {
-    std::fs::create_dir_all(dir).expect("dir");
     let p = dir.join("scene.toml");
     std::fs::write(&p, body).expect("write");
     p
@@ -172,7 +171,7 @@ ks = [0.8, 0.8, 0.8]
 
 #[test]
 fn toml_lobes_parse_and_errors_name_the_field() {
-    let dir = std::env::temp_dir().join(format!("texsim-lobes-{}", std::process::id()));
+    let dir = crate::tmp_common::TmpDir::new("lobes");
     let ok = format!(
         "{HEAD}[[materials.lobes]]\ndirection = [0.3, 0.0, 1.0]\namplitude = 0.5\nexponent = 40\n\
          [[materials.lobes]]\ndirection = [-0.3, 0.0, 1.0]\namplitude = 0.5\n"
@@ -211,5 +210,4 @@ fn toml_lobes_parse_and_errors_name_the_field() {
         e.contains("materials[0].lobes") && e.contains("1..=8"),
         "{e}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }

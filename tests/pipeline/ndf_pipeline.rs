@@ -257,9 +257,7 @@ fn ground_truth_samples_every_texel() {
 /// normals) renders through the NDF stages; `ndf = "yes"` is an error naming the field.
 #[test]
 fn toml_ndf_material_from_a_height_map() {
-    let d = std::env::temp_dir().join(format!("texsim-ndf-toml-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
+    let d = crate::tmp_common::TmpDir::new("toml");
     let body = |ndf: &str| {
         format!(
             "[output]\nwidth = 96\nheight = 64\n\n[[textures]]\nname = \"bricks\"\nprocedural = \"bricks-height\"\nsize = 64\n\n[[materials]]\nname = \"m\"\nbump = \"bricks\"\nks = [0.5, 0.5, 0.5]\nshininess = 48\nndf = {ndf}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n\n[[lights]]\nkind = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\ncolor = [1.0, 1.0, 1.0]\n"

@@ -286,16 +286,12 @@ fn none_variant_is_the_plain_bump_material_and_renders_are_deterministic() {
     assert_ne!(c.hw_image, b.hw_image);
 }
 
-fn toml_scene(name: &str, roughness: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-rough-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
-    let p = d.join("s.toml");
+#[track_caller]
+fn toml_scene(name: &str, roughness: &str) -> crate::tmp_common::TmpFile {
     let body = format!(
         "[[textures]]\nname = \"b\"\nprocedural = \"bricks-height\"\nsize = 32\n\n[[materials]]\nname = \"m\"\nbump = \"b\"\nks = [0.5, 0.5, 0.5]\n{roughness}\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n"
     );
-    std::fs::write(&p, body).expect("write");
-    p
+    crate::tmp_common::TmpFile::new(name, "s.toml", body)
 }
 
 #[test]

@@ -134,9 +134,7 @@ fn toksvig_is_identical_on_1_and_3_threads() {
 
 #[test]
 fn toml_bump_filter_key() {
-    let d = std::env::temp_dir().join(format!("texsim-toksvig-toml-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
+    let d = crate::tmp_common::TmpDir::new("toml");
     let body = |filter: &str| {
         format!(
             "[output]\nwidth = 96\nheight = 64\n\n[[textures]]\nname = \"bricks\"\nprocedural = \"bricks-height\"\nsize = 64\n\n[[materials]]\nname = \"m\"\nbump = \"bricks\"\nks = [0.5, 0.5, 0.5]\nshininess = 48\nbump_filter = \"{filter}\"\n\n[[meshes]]\nshape = \"sphere\"\nmaterial = \"m\"\n\n[[lights]]\nkind = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\ncolor = [1.0, 1.0, 1.0]\n"
@@ -161,5 +159,4 @@ fn toml_bump_filter_key() {
         err.contains("bump_filter") && err.contains("'blurry'"),
         "{err}"
     );
-    let _ = std::fs::remove_dir_all(&d);
 }

@@ -2,19 +2,10 @@
 //! problems (missing MTL, missing/undecodable map_Kd, no UVs) become warnings.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
+use crate::tmp_common::TmpDir;
 use texsim::scene::{load, load_obj, load_toml, Scene};
 use texsim::Result;
-
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
-    let d = std::env::temp_dir().join(format!("texsim_bad_input_{}_{tag}_{n}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn write(dir: &Path, name: &str, text: &[u8]) -> PathBuf {
     let p = dir.join(name);
@@ -45,7 +36,7 @@ fn expect_err(
 
 #[test]
 fn missing_file_and_directory() {
-    let dir = temp_dir("missing");
+    let dir = TmpDir::new("missing");
     let p = dir.join("nope.obj");
     expect_err(move || load(&p), &["nope.obj"]);
     let p = dir.join("nope.toml");
@@ -62,7 +53,7 @@ fn missing_file_and_directory() {
 
 #[test]
 fn malformed_and_empty_obj() {
-    let dir = temp_dir("obj");
+    let dir = TmpDir::new("obj");
     let p = write(&dir, "bad.obj", b"v 0 0 zero\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     expect_err(move || load_obj(&p), &["bad.obj", "line 1"]);
     let p = write(&dir, "badface.obj", format!("{TRI}f 1 2 x\n").as_bytes());
@@ -89,7 +80,7 @@ fn malformed_and_empty_obj() {
 
 #[test]
 fn non_finite_vertex_names_file_and_index() {
-    let dir = temp_dir("nan");
+    let dir = TmpDir::new("nan");
     let p = write(
         &dir,
         "nan.obj",
@@ -102,7 +93,7 @@ fn non_finite_vertex_names_file_and_index() {
 
 #[test]
 fn mtl_problems() {
-    let dir = temp_dir("mtl");
+    let dir = TmpDir::new("mtl");
     // Malformed MTL: error naming the MTL file and line.
     write(&dir, "bad.mtl", b"newmtl a\nKd 1 zero 0\n");
     let p = write(
@@ -136,7 +127,7 @@ fn mtl_problems() {
 
 #[test]
 fn texture_problems_are_warnings_in_obj() {
-    let dir = temp_dir("tex");
+    let dir = TmpDir::new("tex");
     write(&dir, "garbage.png", b"this is not a png at all");
     write(
         &dir,
@@ -172,7 +163,7 @@ fn texture_problems_are_warnings_in_obj() {
 
 #[test]
 fn map_kd_options_spaces_and_backslashes() {
-    let dir = temp_dir("mapkd");
+    let dir = TmpDir::new("mapkd");
     std::fs::create_dir_all(dir.join("sub dir")).unwrap();
     image::RgbaImage::from_pixel(2, 2, image::Rgba([1, 2, 3, 255]))
         .save(dir.join("sub dir").join("my tex.png"))
@@ -200,7 +191,7 @@ fn map_kd_options_spaces_and_backslashes() {
 
 #[test]
 fn textured_material_without_uvs_warns() {
-    let dir = temp_dir("nouv");
+    let dir = TmpDir::new("nouv");
     image::RgbaImage::from_pixel(2, 2, image::Rgba([1, 2, 3, 255]))
         .save(dir.join("t.png"))
         .unwrap();
@@ -221,7 +212,7 @@ fn textured_material_without_uvs_warns() {
 
 #[test]
 fn obj_without_normals_or_uvs_gets_finite_normals() {
-    let dir = temp_dir("plain");
+    let dir = TmpDir::new("plain");
     // A tetrahedron plus a degenerate triangle, no vn, no vt.
     let p = write(&dir, "tet.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 5 5 5\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 5 5 5\n");
     let s = load_obj(&p).unwrap();
@@ -248,7 +239,7 @@ const GOOD_MESH: &str = "[[meshes]]\nshape = \"cube\"\n";
 
 #[test]
 fn toml_errors_name_file_and_field() {
-    let dir = temp_dir("toml");
+    let dir = TmpDir::new("toml");
     let p = write(&dir, "syntax.toml", b"[output\nwidth = 3\n");
     expect_err(move || load_toml(&p), &["syntax.toml", "line 1"]);
     let p = write(
@@ -376,7 +367,7 @@ fn toml_errors_name_file_and_field() {
 
 #[test]
 fn toml_texture_files_are_strict() {
-    let dir = temp_dir("ttex");
+    let dir = TmpDir::new("ttex");
     write(&dir, "garbage.png", b"\x89PNG\r\n\x1a\nnot really");
     let p = write(
         &dir,
@@ -409,7 +400,7 @@ fn toml_texture_files_are_strict() {
 
 #[test]
 fn toml_minimal_and_hw_path() {
-    let dir = temp_dir("min");
+    let dir = TmpDir::new("min");
     let p = write(
         &dir,
         "min.toml",
@@ -463,7 +454,7 @@ fn random_garbage_never_panics() {
         ",",
         "1e999",
     ];
-    let dir = temp_dir("fuzz");
+    let dir = TmpDir::new("fuzz");
     write(&dir, "m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd nothing.png\n");
     for i in 0..300 {
         let (toks, ext): (&[&str], &str) = if i % 2 == 0 {
@@ -483,7 +474,6 @@ fn random_garbage_never_panics() {
             assert!(e.to_string().contains(&format!("f{i}.{ext}")), "{e}");
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Runs `f` on another thread and waits at most 10 s: a loader that hangs (a FIFO) or reads
@@ -508,7 +498,7 @@ fn err_text<T>(r: Result<T>) -> String {
 /// before it is opened (a FIFO never blocks, /dev/zero is not read without bound).
 #[test]
 fn special_files_are_refused() {
-    let dir = temp_dir("special");
+    let dir = TmpDir::new("special");
     let fifo = |name: &str| {
         let p = dir.join(name);
         let st = std::process::Command::new("mkfifo")
@@ -569,14 +559,13 @@ fn special_files_are_refused() {
     let link = dir.join("link.toml");
     std::os::unix::fs::symlink(&real, &link).unwrap();
     load(&link).expect("a link to a regular file loads");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A text file over the cap is refused by its size, before it is read (a sparse file: no
 /// disk and no memory used).
 #[test]
 fn oversized_text_files_are_refused() {
-    let dir = temp_dir("huge");
+    let dir = TmpDir::new("huge");
     let p = dir.join("huge.toml");
     let f = std::fs::File::create(&p).unwrap();
     f.set_len(texsim::budget::MAX_TEXT_FILE_BYTES + 1).unwrap();
@@ -593,7 +582,6 @@ fn oversized_text_files_are_refused() {
         e.contains("huge_hw.toml") && e.contains("over the limit"),
         "{e}"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Budgets checked while loading, before the allocation: a procedural texture of 16384 (4 GiB
@@ -601,7 +589,7 @@ fn oversized_text_files_are_refused() {
 /// sphere at the per-mesh maximum, or several that are fine alone).
 #[test]
 fn loader_budgets_fail_fast_with_the_field() {
-    let dir = temp_dir("budget");
+    let dir = TmpDir::new("budget");
     for size in [16384, 8193] {
         let p = write(
             &dir,
@@ -638,7 +626,6 @@ fn loader_budgets_fail_fast_with_the_field() {
         &["meshes[3].segments", "3276800 triangles", "limit"],
     );
     assert!(t.elapsed().as_secs() < 10);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A seeded mutation fuzzer over valid OBJ, MTL, TOML scene, hardware TOML and PNG files
@@ -686,7 +673,7 @@ fn seeded_mutations_of_valid_files_never_panic() {
         z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
         z ^ (z >> 31)
     };
-    let dir = temp_dir("mutate");
+    let dir = TmpDir::new("mutate");
     std::fs::copy(root.join("checker64.png"), dir.join("checker64.png")).unwrap();
     std::fs::copy(root.join("cube.mtl"), dir.join("cube.mtl")).unwrap();
     std::fs::copy(root.join("cube.obj"), dir.join("cube.obj")).unwrap();
@@ -806,5 +793,4 @@ fn seeded_mutations_of_valid_files_never_panic() {
         "{cases} mutated files in {:.2} s",
         start.elapsed().as_secs_f64()
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

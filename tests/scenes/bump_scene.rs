@@ -1,16 +1,15 @@
 //! Bump fields of TOML scenes and their errors (named field, never a panic).
 
-use std::path::{Path, PathBuf};
+use crate::tmp_common::TmpFile;
+use std::path::Path;
 use texsim::scene::{self, FrameKind, MainDirection};
 
-fn write(name: &str, body: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-bumpscene-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
+/// `body` as `s.toml` beside a copy of `scenes/bump_height.png` as `h.png`.
+#[track_caller]
+fn write(name: &str, body: &str) -> TmpFile {
+    let p = TmpFile::new(name, "s.toml", body);
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bump_height.png");
-    std::fs::copy(src, d.join("h.png")).expect("copy");
-    let p = d.join("s.toml");
-    std::fs::write(&p, body).expect("write");
+    std::fs::copy(src, p.dir().join("h.png")).expect("copy");
     p
 }
 

@@ -2,19 +2,15 @@
 //! (the field named, never a panic); a TOML scene with an environment map renders with
 //! `env-fetch`.
 
+use crate::tmp_common::TmpFile;
 use hw_model::env_config::EnvFilter;
-use std::path::PathBuf;
 use texsim::pipeline::StageKind;
 use texsim::render::{render, Maps, RenderOptions};
 use texsim::scene;
 
-fn write(name: &str, body: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-envscene-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
-    let p = d.join("s.toml");
-    std::fs::write(&p, body).expect("write");
-    p
+#[track_caller]
+fn write(name: &str, body: &str) -> TmpFile {
+    TmpFile::new(name, "s.toml", body)
 }
 
 fn with_material(fields: &str) -> String {

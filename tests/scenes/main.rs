@@ -6,6 +6,8 @@
 
 #[path = "../rng_common/mod.rs"]
 mod rng_common;
+#[path = "../tmp_common/mod.rs"]
+mod tmp_common;
 
 mod bad_input_files;
 mod bad_input_validate;

@@ -2,18 +2,11 @@
 //! (target is a file, a name collides with a directory) write nothing, and what killed runs
 //! leave is finished or removed.
 
+use crate::tmp_common::TmpDir;
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use texsim::report::OutputSet;
-
-/// A fresh scratch directory unique to this process and test.
-fn scratch(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("texsim-report-{}-{test}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).expect("scratch dir");
-    d
-}
 
 fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = fs::read_dir(dir)
@@ -34,7 +27,7 @@ fn sample() -> OutputSet {
 
 #[test]
 fn writes_all_files_without_temps() {
-    let root = scratch("all");
+    let root = TmpDir::new("all");
     let dir = root.join("nested").join("out");
     let o = sample();
     let paths = o.write_to(&dir).expect("write");
@@ -62,12 +55,11 @@ fn writes_all_files_without_temps() {
     let empty = root.join("empty");
     assert!(OutputSet::new().write_to(&empty).expect("empty").is_empty());
     assert!(empty.is_dir());
-    fs::remove_dir_all(&root).expect("cleanup");
 }
 
 #[test]
 fn refuses_bad_names_and_writes_nothing() {
-    let root = scratch("names");
+    let root = TmpDir::new("names");
     for bad in ["", ".", "..", "a/b.png", "../up.png", "x\\y", "a..b"] {
         let dir = root.join("out");
         let mut o = sample();
@@ -78,12 +70,11 @@ fn refuses_bad_names_and_writes_nothing() {
     }
     assert!(listing(&root).is_empty());
     assert!(!root.parent().expect("parent").join("up.png").exists());
-    fs::remove_dir_all(&root).expect("cleanup");
 }
 
 #[test]
 fn target_is_a_file() {
-    let root = scratch("file");
+    let root = TmpDir::new("file");
     let target = root.join("out");
     fs::write(&target, b"keep me").expect("file");
     let e = sample().write_to(&target).expect_err("file as dir");
@@ -95,22 +86,20 @@ fn target_is_a_file() {
     let e = sample().write_to(&below).expect_err("below a file");
     assert!(e.message().contains(&below.display().to_string()), "{e}");
     assert_eq!(listing(&root), ["out"]);
-    fs::remove_dir_all(&root).expect("cleanup");
 }
 
 #[test]
 fn name_colliding_with_directory_writes_nothing() {
-    let root = scratch("collide");
+    let root = TmpDir::new("collide");
     fs::create_dir(root.join("ref.png")).expect("dir");
     let e = sample().write_to(&root).expect_err("collision");
     assert!(e.message().contains("ref.png"), "{e}");
     assert_eq!(listing(&root), ["ref.png"]);
-    fs::remove_dir_all(&root).expect("cleanup");
 }
 
 #[test]
 fn failed_write_removes_what_it_wrote() {
-    let root = scratch("cleanup");
+    let root = TmpDir::new("cleanup");
     let dir = root.join("out");
     sample().write_to(&dir).expect("first set");
     // The second file's name is too long for the file system: its write fails after the first
@@ -124,7 +113,6 @@ fn failed_write_removes_what_it_wrote() {
     assert_eq!(listing(&root), ["out"]);
     assert_eq!(listing(&dir), ["hw.png", "metrics.json", "ref.png"]);
     assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [1, 2, 3]);
-    fs::remove_dir_all(&root).expect("cleanup");
 }
 
 /// The id of a process that has ended.
@@ -140,7 +128,7 @@ fn dead_pid() -> u32 {
 /// directory whose swap was cut short is swapped in (all new), the old one removed.
 #[test]
 fn leftovers_of_killed_runs_are_finished_or_removed() {
-    let root = scratch("killed");
+    let root = TmpDir::new("killed");
     let dir = root.join("out");
     let family = ["hw.png", "ref.png", "metrics.json"];
     let mut first = sample();
@@ -173,14 +161,13 @@ fn leftovers_of_killed_runs_are_finished_or_removed() {
     assert_eq!(listing(&root), ["out"]);
     assert_eq!(listing(&dir), ["hw.png", "metrics.json", "notes.txt"]);
     assert_eq!(fs::read(dir.join("hw.png")).expect("read"), [6]);
-    fs::remove_dir_all(&root).expect("cleanup");
 }
 
 /// Outputs of an earlier run that this run did not produce are removed, but only names of the
 /// set's family, only files, and only once every new file is in place.
 #[test]
 fn removes_stale_family_files_and_nothing_else() {
-    let root = scratch("stale");
+    let root = TmpDir::new("stale");
     let family = ["hw.png", "ref.png", "error.png", "hw16.png", "metrics.json"];
     let mut first = sample();
     first.add("error.png", vec![5]);
@@ -232,5 +219,4 @@ fn removes_stale_family_files_and_nothing_else() {
     bad.family(&["../notes.txt"]);
     assert!(bad.write_to(&root.join("never")).is_err());
     assert!(!root.join("never").exists());
-    fs::remove_dir_all(&root).expect("cleanup");
 }

@@ -1,27 +1,14 @@
 //! Scene loading: example TOML, OBJ+MTL, built-in catalogue (Mesa anchor geometry and cameras),
 //! texture decoding, normals, camera fit, and large-OBJ load time.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use crate::rng_common::Rng;
+use crate::tmp_common::TmpDir;
 use glam::{DMat4, DVec3, DVec4};
+use std::path::{Path, PathBuf};
 use texsim::scene::{
     self, builtin, decode_texture, fit_camera, load, load_obj, smooth_normals, validate, Mesh,
     BUILTIN,
 };
-
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
-    let d = std::env::temp_dir().join(format!(
-        "texsim_scene_load_{}_{tag}_{n}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
@@ -64,7 +51,7 @@ fn example_toml_loads_everything() {
 /// field), with the file and line; a name near nothing keeps the list.
 #[test]
 fn unknown_scene_field_suggests_the_nearest_name() {
-    let d = temp_dir("unknown_field");
+    let d = TmpDir::new("unknown_field");
     let p = d.join("typo.toml");
     std::fs::write(&p, "[output]\nwidht = 64\n").unwrap();
     let e = load(&p).unwrap_err().to_string();
@@ -316,7 +303,7 @@ fn fit_camera_contains_random_meshes() {
 
 #[test]
 fn decode_png_formats() {
-    let dir = temp_dir("png");
+    let dir = TmpDir::new("png");
     let p8 = dir.join("rgba8.png");
     image::RgbaImage::from_fn(3, 2, |x, y| {
         image::Rgba([x as u8 * 100, y as u8 * 200, 7, 128])
@@ -362,13 +349,12 @@ fn decode_png_formats() {
         .texels
         .iter()
         .all(|p| p[3] == 65535 && p[0] % 257 == 0 && (i32::from(p[0] / 257) - 128).abs() <= 2));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn large_obj_loads_fast() {
     // 225 x 225 grid = 101,250 triangles, with vt and vn, written as quads.
-    let dir = temp_dir("big");
+    let dir = TmpDir::new("big");
     let path = dir.join("big.obj");
     let n = 226usize;
     let mut s = String::with_capacity(n * n * 60);
@@ -405,5 +391,4 @@ fn large_obj_loads_fast() {
         dt.as_secs_f64() * 1e3
     );
     assert!(dt.as_secs_f64() < 2.0, "{dt:?}");
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -414,13 +414,12 @@ fn outputs_and_paper_set() {
     );
     assert!(summary.starts_with("metal_light: 2x2 spheres at 8 px"));
     assert!(summary.contains("max 8-bit LSB error per sphere"));
-    let dir = std::env::temp_dir().join(format!("texsim_spheres_{}", std::process::id()));
+    let dir = crate::tmp_common::TmpDir::new("spheres");
     let paths = set.write_to(&dir).expect("writable temp dir");
     let png = std::fs::read(&paths[0]).expect("written");
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let decoded = image::load_from_memory(&png).expect("decodable").to_rgba8();
     assert_eq!(decoded.dimensions(), (16, 16));
-    let _ = std::fs::remove_dir_all(&dir);
 
     let grids = paper_grids();
     let names: Vec<&str> = grids.iter().map(|(n, _)| n.as_str()).collect();

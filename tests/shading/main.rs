@@ -7,6 +7,8 @@
 
 #[path = "../rng_common/mod.rs"]
 mod rng_common;
+#[path = "../tmp_common/mod.rs"]
+mod tmp_common;
 
 mod brdf_albedo;
 mod brdf_props;

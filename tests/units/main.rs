@@ -8,6 +8,8 @@
 
 #[path = "../rng_common/mod.rs"]
 mod rng_common;
+#[path = "../tmp_common/mod.rs"]
+mod tmp_common;
 
 mod ndf_common;
 

@@ -268,8 +268,7 @@ fn texcoord_offset_is_an_integer_period() {
 #[test]
 fn far_texture_coordinates_reduce_exactly() {
     use texsim::render::{render, Maps, RenderOptions};
-    let dir = std::env::temp_dir().join(format!("texsim-reduce-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::tmp_common::TmpDir::new("reduce");
     for wrap in ["repeat", "mirror"] {
         let p = dir.join(format!("plane_{wrap}.toml"));
         std::fs::write(
@@ -327,5 +326,4 @@ fn far_texture_coordinates_reduce_exactly() {
         );
         assert!(a.hw_image.px != c.hw_image.px, "{wrap}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
