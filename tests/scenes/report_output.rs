@@ -220,3 +220,25 @@ fn removes_stale_family_files_and_nothing_else() {
     assert!(bad.write_to(&root.join("never")).is_err());
     assert!(!root.join("never").exists());
 }
+
+/// The tests' scratch directories ([`TmpDir`]) live under `target/tmp`, go when their test
+/// passes and stay, for inspection, when it panics.
+#[test]
+fn scratch_dirs_go_when_a_test_passes_and_stay_when_it_fails() {
+    let passed = {
+        let d = TmpDir::new("passes");
+        fs::write(d.join("f"), b"x").expect("write");
+        assert!(d.starts_with(env!("CARGO_TARGET_TMPDIR")));
+        d.to_path_buf()
+    };
+    assert!(!passed.exists(), "{}", passed.display());
+    let failed = std::panic::catch_unwind(|| {
+        let d = TmpDir::new("fails");
+        fs::write(d.join("f"), b"x").expect("write");
+        std::panic::panic_any(d.to_path_buf());
+    })
+    .expect_err("panics");
+    let failed = failed.downcast::<std::path::PathBuf>().expect("its path");
+    assert!(failed.join("f").exists(), "{}", failed.display());
+    fs::remove_dir_all(&*failed).expect("cleanup");
+}

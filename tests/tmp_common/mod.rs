@@ -31,11 +31,6 @@ impl TmpDir {
         std::fs::create_dir_all(&d).expect("scratch dir");
         Self(d)
     }
-
-    /// The directory.
-    pub fn path(&self) -> &Path {
-        &self.0
-    }
 }
 
 impl Deref for TmpDir {
