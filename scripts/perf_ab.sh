@@ -2,9 +2,11 @@
 # Where two texsim builds spend a frame, by perf samples: renders SCENE with OLD and NEW in
 # alternation (PAIRS pairs, old then new) under `perf record`, and prints for each run the
 # samples of every symbol matching each of SYMS, and all samples, in units of the samples of
-# UNIT (a symbol both builds share unchanged), beside the run's median frame. On a shared,
-# noisy machine these ratios hold where wall times do not (docs/PERFORMANCE_LOG.md, stops
-# 49 to 55).
+# UNIT (a symbol both builds share unchanged), beside the run's median and fastest frame. On a
+# shared, noisy machine these ratios hold where wall times do not (docs/PERFORMANCE_LOG.md,
+# stops 49 to 55), but a change that slows every symbol alike (the core's clock) leaves them
+# unchanged: check the fastest frames too (stop 57's LOD batch: `lod` -20% in UNIT's samples,
+# fastest frame +8%).
 # Usage: scripts/perf_ab.sh OLD_TEXSIM NEW_TEXSIM SCENE [PAIRS] [THREADS]
 #   e.g. scripts/perf_ab.sh /tmp/texsim-main target/release/texsim w2-mesh 3 1
 # Environment: UNIT (regex, default 'texcoord::fixed_span'); SYMS (space-separated regexes,
@@ -19,13 +21,14 @@ SYMS=${SYMS:-trilinear lod::fixed_span interpolator Group::shade|run_spans}
 W=${PERF_DIR:-target/perf-ab}
 command -v perf >/dev/null || { echo "perf_ab: perf not found (apt-get install linux-perf)"; exit 2; }
 mkdir -p "$W"
-# One run's line: median frame, all samples and each of SYMS over UNIT's.
+# One run's line: median and fastest frames, all samples and each of SYMS over UNIT's.
 shares() {
     local median
-    median=$(grep -o 'median [0-9.]* ms' "$1.log" | head -1)
+    median=$(grep -o 'median [0-9.]* ms (min [0-9.]*' "$1.log" | head -1 |
+        sed 's/ ms (min \(.*\)/ ms, min \1 ms/')
     perf report -i "$1.data" --no-children --sort symbol -F sample,symbol 2>/dev/null |
         grep -v '^#' |
-        awk -v unit="$UNIT" -v syms="$SYMS" -v median="${median:-median ? ms}" '
+        awk -v unit="$UNIT" -v syms="$SYMS" -v median="${median:-median ? ms, min ? ms}" '
         BEGIN { n = split(syms, re, " ") }
         NF > 1 {
             s = $1; $1 = ""; total += s
