@@ -4,9 +4,9 @@
 # samples of every symbol matching each of SYMS, and all samples, in units of the samples of
 # UNIT (a symbol both builds share unchanged), beside the run's median and fastest frame. On a
 # shared, noisy machine these ratios hold where wall times do not (docs/PERFORMANCE_LOG.md,
-# stops 49 to 55), but a change that slows every symbol alike (the core's clock) leaves them
-# unchanged: check the fastest frames too (stop 57's LOD batch: `lod` -20% in UNIT's samples,
-# fastest frame +8%).
+# stops 49 to 55), but a change that slows other symbols as much as UNIT leaves them
+# unchanged: check the fastest frames too, in more than one hour (stop 57's LOD batch: `lod`
+# -20% in UNIT's samples; fastest W1 frame +8% in one hour, -2% forty minutes later).
 # Usage: scripts/perf_ab.sh OLD_TEXSIM NEW_TEXSIM SCENE [PAIRS] [THREADS]
 #   e.g. scripts/perf_ab.sh /tmp/texsim-main target/release/texsim w2-mesh 3 1
 # Environment: UNIT (regex, default 'texcoord::fixed_span'); SYMS (space-separated regexes,
