@@ -23,12 +23,12 @@ command -v perf >/dev/null || { echo "perf_ab: perf not found (apt-get install l
 mkdir -p "$W"
 # One run's line: median and fastest frames, all samples and each of SYMS over UNIT's.
 shares() {
-    local median
-    median=$(grep -o 'median [0-9.]* ms (min [0-9.]*' "$1.log" | head -1 |
+    local frames
+    frames=$(grep -o 'median [0-9.]* ms (min [0-9.]*' "$1.log" | head -1 |
         sed 's/ ms (min \(.*\)/ ms, min \1 ms/')
     perf report -i "$1.data" --no-children --sort symbol -F sample,symbol 2>/dev/null |
         grep -v '^#' |
-        awk -v unit="$UNIT" -v syms="$SYMS" -v median="${median:-median ? ms, min ? ms}" '
+        awk -v unit="$UNIT" -v syms="$SYMS" -v frames="${frames:-median ? ms, min ? ms}" '
         BEGIN { n = split(syms, re, " ") }
         NF > 1 {
             s = $1; $1 = ""; total += s
@@ -37,7 +37,7 @@ shares() {
         }
         END {
             if (u == 0) { print "no samples of " unit; exit 1 }
-            line = sprintf("%s  all %.2f", median, total / u)
+            line = sprintf("%s  all %.2f", frames, total / u)
             for (i = 1; i <= n; i++) line = line sprintf("  %s %.2f", re[i], got[i] / u)
             print line
         }'
