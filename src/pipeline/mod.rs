@@ -238,34 +238,43 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
 /// Per-fragment signals passed between stages. Each signal has an `f64` carrier (always
 /// written) and, when a Fixed stage produced it, its raw fixed value (`*_x`), which a Fixed
 /// consumer reads directly; a Fixed consumer of a Float producer quantizes the carrier.
+///
+/// Laid out in this order (`repr(C)`): the raw signals of the common stages first, then the
+/// colour and output carriers that every run sets and the trace (its count ahead of its
+/// footprints), so that a span of those stages touches the first few cache lines of each
+/// fragment (W1's fastest frame about 4% shorter than with the compiler's order, stop 58 in
+/// `docs/PERFORMANCE_LOG.md`).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C)]
 pub struct Frag {
-    /// Perspective-correct barycentrics at the sample, and at the helper samples (x+1, y) and
-    /// (x, y+1) when derivatives are needed.
-    pub bary: [[f64; 3]; 3],
     /// Raw barycentrics (`bary_bits` fraction bits).
     pub bary_x: [[i64; 3]; 3],
-    /// Interpolated colour (unorm, 0..1).
-    pub color: [f64; 4],
-    /// Raw colour (`color_bits` unorm).
-    pub color_x: [u32; 4],
-    /// Texture coordinates at the sample and the two helper samples (normalized).
-    pub uv: [[f64; 2]; 3],
     /// Raw texture coordinates (`texcoord_frac_bits`).
     pub uv_x: [[i64; 2]; 3],
-    /// Level of detail (log2 texels per pixel).
-    pub lod: f64,
     /// Raw LOD (`lod_frac_bits`).
     pub lod_x: i64,
-    /// Filtered texel (unorm).
-    pub texel: [f64; 4],
     /// Raw texel (`texel_bits` unorm).
     pub texel_x: [u32; 4],
-    /// The fragment's output colour (unorm).
-    pub out: [f64; 4],
     /// Raw output and its unorm width; `out_bits == 0` means the output is the float carrier.
     pub out_x: [u32; 4],
     pub out_bits: u32,
+    /// Raw colour (`color_bits` unorm).
+    pub color_x: [u32; 4],
+    /// Interpolated colour (unorm, 0..1).
+    pub color: [f64; 4],
+    /// The fragment's output colour (unorm).
+    pub out: [f64; 4],
+    /// The texel footprints the stages fetched (recorded only when `trace.on`).
+    pub trace: trace::Trace,
+    /// Perspective-correct barycentrics at the sample, and at the helper samples (x+1, y) and
+    /// (x, y+1) when derivatives are needed.
+    pub bary: [[f64; 3]; 3],
+    /// Texture coordinates at the sample and the two helper samples (normalized).
+    pub uv: [[f64; 2]; 3],
+    /// Level of detail (log2 texels per pixel).
+    pub lod: f64,
+    /// Filtered texel (unorm).
+    pub texel: [f64; 4],
     /// Bump stages (vectors in vector format `s1.F` when raw, lengths in len format).
     pub bump: BumpFrag,
     /// Roughness fetch: filtered D channels (unorm) and their raw texels.
@@ -279,8 +288,6 @@ pub struct Frag {
     pub lean: lean::LeanFrag,
     /// Lobe fetch: the fetched lobe texels of a fitted-lobe material.
     pub lobe: lobe_fit::LobeFrag,
-    /// The texel footprints the stages fetched (recorded only when `trace.on`).
-    pub trace: trace::Trace,
 }
 
 /// Most point lights shaded per pixel by a bump material (their vectors are interpolated).

@@ -46,8 +46,10 @@ pub struct TexelFootprint {
 pub const MAX_FOOTPRINTS: usize =
     2 * hw_model::footprint::MAX_PROBES + 2 * hw_model::multi_lobe::MAX_LOBES as usize;
 
-/// The footprints of one fragment, in the order its stages fetched them.
+/// The footprints of one fragment, in the order its stages fetched them (its count ahead of
+/// them, so that clearing it touches the fragment's first lines only: [`super::Frag`]).
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub struct Trace {
     /// Record footprints (set by the shading pass when it collects timing events).
     pub on: bool,
