@@ -242,7 +242,7 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
 /// Laid out in this order (`repr(C)`): the raw signals of the common stages first, then the
 /// colour and output carriers that every run sets and the trace (its count ahead of its
 /// footprints), so that a span of those stages touches the first few cache lines of each
-/// fragment (W1's fastest frame about 4% shorter than with the compiler's order, stop 58 in
+/// fragment (W1's fastest frame 2% to 4% shorter than with the compiler's order, stop 58 in
 /// `docs/PERFORMANCE_LOG.md`).
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C)]
