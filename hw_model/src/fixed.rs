@@ -285,6 +285,16 @@ impl<M: ConstRounding> ShiftRound<M> {
         debug_assert!(x.unsigned_abs() < 1 << 62, "{x}");
         (x + self.bias + ((x >> self.shift) & self.odd)) >> self.shift
     }
+
+    /// [`ShiftRound::apply`] with wrapping adds, so that it takes any `x` (a vector lane whose
+    /// input is out of range computes a value nobody reads): the same result for `|x| < 2^62`.
+    #[inline(always)]
+    #[must_use]
+    pub fn apply_wrapping(&self, x: i64) -> i64 {
+        x.wrapping_add(self.bias)
+            .wrapping_add((x >> self.shift) & self.odd)
+            >> self.shift
+    }
 }
 
 /// [`round_shift_right`] of the two 32-bit lanes of a `u64` at once (the trilinear filter's

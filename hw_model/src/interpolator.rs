@@ -1701,6 +1701,152 @@ pub fn interpolate_span<'a, const N: usize>(
     })
 }
 
+/// [`interpolate_pairs`] of three samples at each lane `j` of `lanes` in a structure of
+/// arrays: the barycentrics `bary[sample][component][j]` in, the pair's values
+/// `uv[sample][axis][j]` out. The same bits and counts as one [`interpolate_pairs`] call per
+/// lane (`interpolate_lanes_matches_interpolate_pairs`): the per-triangle terms and the
+/// rounding's constants resolved once, every lane's six values computed in `i64` (as vector
+/// lanes where the CPU has AVX-512), and a lane whose barycentrics leave the window where
+/// that accumulator is exact, or whose values leave the format's range, computed again by the
+/// exact path. `lanes.end` must not exceed `L`.
+pub fn interpolate_lanes<const L: usize>(
+    bary: &[[[i64; L]; 3]; 3],
+    lanes: std::ops::Range<usize>,
+    bary_bits: u32,
+    attr: [[i64; 2]; 3],
+    out: &Format,
+    sat: &mut SatCounter,
+    uv: &mut [[[i64; L]; 2]; 3],
+) {
+    crate::with_rounding!(out.rounding, M => {
+        interpolate_lanes_in::<M, L>(bary, lanes, bary_bits, attr, out, sat, uv)
+    })
+}
+
+/// [`interpolate_lanes`] compiled for the rounding mode `M` (`out.rounding`).
+#[inline(always)]
+fn interpolate_lanes_in<M: ConstRounding, const L: usize>(
+    bary: &[[[i64; L]; 3]; 3],
+    lanes: std::ops::Range<usize>,
+    bary_bits: u32,
+    attr: [[i64; 2]; 3],
+    out: &Format,
+    sat: &mut SatCounter,
+    uv: &mut [[[i64; L]; 2]; 3],
+) {
+    // Short spans, and every lane the vector loop cannot take, lane by lane.
+    let mut redo = [true; L];
+    if lanes.len() >= PAIR_LANES_MIN {
+        if let Some(k) = PairLanes::<M>::new(attr, bary_bits, out) {
+            redo = [false; L];
+            #[cfg(target_arch = "x86_64")]
+            if crate::has_avx512() {
+                // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
+                unsafe { pair_lanes_avx512(&k, bary, lanes.clone(), uv, &mut redo) };
+            } else {
+                pair_lanes(&k, bary, lanes.clone(), uv, &mut redo);
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            pair_lanes(&k, bary, lanes.clone(), uv, &mut redo);
+            if !redo[lanes.clone()].contains(&true) {
+                return;
+            }
+        }
+    }
+    for j in lanes.filter(|&j| redo[j]) {
+        let b: [[i64; 3]; 3] = std::array::from_fn(|s| [0, 1, 2].map(|c| bary[s][c][j]));
+        let mut r = [[0i64; 2]; 3];
+        let one = std::iter::once((&b[..], &mut r[..]));
+        interpolate_span_in::<M, 2>(one, bary_bits, attr, out, sat);
+        for (us, [u, v]) in uv.iter_mut().zip(r) {
+            (us[0][j], us[1][j]) = (u, v);
+        }
+    }
+}
+
+/// What [`pair_lanes`] needs of a triangle's pair of attributes: [`interpolate_span`]'s terms
+/// (`a0 2^B`, `a1 - a0`, `a2 - a0`), the rounding, the window `[-lim, lim)` of barycentrics
+/// for which the accumulator stays exact in `i64`, and the output format's range.
+struct PairLanes<M> {
+    terms: [(i64, i64, i64); 2],
+    round: crate::fixed::ShiftRound<M>,
+    lim: u64,
+    range: (i64, i64),
+}
+
+impl<M: ConstRounding> PairLanes<M> {
+    /// `None` where a term leaves `i64` or `bary_bits` is not a shift of 1..=63: then every
+    /// lane takes the exact path.
+    #[inline(always)]
+    fn new(attr: [[i64; 2]; 3], bary_bits: u32, out: &Format) -> Option<Self> {
+        let term = |ax: usize| {
+            let a0 = attr[0][ax];
+            Some((
+                a0.checked_mul(1i64.checked_shl(bary_bits)?)?,
+                attr[1][ax].checked_sub(a0)?,
+                attr[2][ax].checked_sub(a0)?,
+            ))
+        };
+        let terms = [term(0)?, term(1)?];
+        Some(Self {
+            terms,
+            round: crate::fixed::ShiftRound::new(bary_bits)?,
+            lim: narrow_limit(&terms),
+            range: (out.min_raw(), out.max_raw()),
+        })
+    }
+}
+
+/// Lanes from which [`interpolate_lanes`] runs a span as vector lanes.
+const PAIR_LANES_MIN: usize = 8;
+
+/// The six values of each lane of `lanes` in `i64`, and in `redo` whether any of them has a
+/// barycentric outside the window or a value outside the range (those lanes' values are not
+/// read). No branch on a lane's data, so the loop runs as vector lanes.
+#[inline(always)]
+fn pair_lanes<M: ConstRounding, const L: usize>(
+    k: &PairLanes<M>,
+    bary: &[[[i64; L]; 3]; 3],
+    lanes: std::ops::Range<usize>,
+    uv: &mut [[[i64; L]; 2]; 3],
+    redo: &mut [bool; L],
+) {
+    let (window, (lo, hi)) = (k.lim.wrapping_mul(2), k.range);
+    for s in 0..3 {
+        let (b1, b2) = (&bary[s][1][lanes.clone()], &bary[s][2][lanes.clone()]);
+        for (ax, &(t0, d1, d2)) in k.terms.iter().enumerate() {
+            let o = &mut uv[s][ax][lanes.clone()];
+            let redo = &mut redo[lanes.clone()];
+            for (((o, r), &p1), &p2) in o.iter_mut().zip(redo).zip(b1).zip(b2) {
+                let inside =
+                    ((p1 as u64).wrapping_add(k.lim) | (p2 as u64).wrapping_add(k.lim)) < window;
+                let acc = t0
+                    .wrapping_add(p1.wrapping_mul(d1))
+                    .wrapping_add(p2.wrapping_mul(d2));
+                let v = k.round.apply_wrapping(acc);
+                *o = v;
+                *r |= !(inside & (v >= lo) & (v <= hi));
+            }
+        }
+    }
+}
+
+/// [`pair_lanes`] compiled with AVX-512 enabled.
+///
+/// # Safety
+/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+unsafe fn pair_lanes_avx512<M: ConstRounding, const L: usize>(
+    k: &PairLanes<M>,
+    bary: &[[[i64; L]; 3]; 3],
+    lanes: std::ops::Range<usize>,
+    uv: &mut [[[i64; L]; 2]; 3],
+    redo: &mut [bool; L],
+) {
+    pair_lanes(k, bary, lanes, uv, redo);
+}
+
 /// [`interpolate_span`] compiled for the rounding mode `M` (`out.rounding`).
 #[inline(always)]
 fn interpolate_span_in<'a, M: ConstRounding, const N: usize>(

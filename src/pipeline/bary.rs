@@ -3,6 +3,7 @@
 //! with `lod_per_quad` the neighbours carry the finite differences of the pixel's 2x2 quad;
 //! with `attr_subpixel_bits` the edges come from the float positions on that finer grid.
 
+use super::lanes::Lanes;
 use super::stages::TriAttrs;
 use super::stages::{each_fragment, Counters, Machine};
 use super::{Frag, Plan, Px, StageKind};
@@ -77,6 +78,9 @@ pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
 /// fragment without them (the span's setup costs more than it saves), `lod_per_quad`,
 /// `attr_subpixel_bits` and spans beyond the edges' `i64` bounds run [`fixed`] per fragment.
 pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
+    if let Some(lanes) = px.lanes {
+        return into_lanes(px, frags, &mut lanes.borrow_mut(), c);
+    }
     if let Some(row) = px.row_bary {
         // Computed with the row's other spans ([`Row`]).
         for (frag, b) in frags.iter_mut().zip(row) {
@@ -109,6 +113,49 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
         perspective_bary_span(&span, inv_w, cfg, recip, sat, out);
     }
     carriers(px, frags);
+}
+
+/// [`fixed_span`] in a program that keeps the chain's signals in lanes
+/// ([`super::lanes`]): the same barycentrics, written to the span's lanes (from
+/// `px.base`) rather than to the fragments. (Such a program has derivatives and writes no
+/// carriers.)
+fn into_lanes(px: &Px, frags: &mut [Frag], lanes: &mut Lanes, c: &mut Counters) {
+    let base = px.base;
+    if let Some(row) = px.row_bary {
+        for (j, b) in row.iter().enumerate() {
+            lanes.set_bary(base + j, b);
+        }
+        return;
+    }
+    let hw = px.m.hw;
+    let n = frags.len();
+    let steps = span_edges(px.m, px.plan)
+        .then(|| {
+            px.tri
+                .edges_fixed_span(px.x, px.y, n, hw.raster.subpixel_bits)
+        })
+        .flatten();
+    let Some((edge, dx, dy)) = steps else {
+        each_fragment(fixed, px, frags, c);
+        for (j, frag) in frags.iter().enumerate() {
+            lanes.set_bary(base + j, &frag.bary_x);
+        }
+        return;
+    };
+    let sat = &mut c.sat[StageKind::Bary.index()];
+    let span = EdgeSpan {
+        edge,
+        dx,
+        dy,
+        lanes: n,
+    };
+    // A function, not a capture in the closure: the datapath's per-lane call then inlines.
+    #[inline(always)]
+    fn set(lanes: &mut Lanes, j: usize, b: &[[i64; 3]; 3]) {
+        lanes.set_bary(j, b);
+    }
+    let out = |j: usize, b: [[i64; 3]; 3]| set(lanes, base + j, &b);
+    perspective_bary_derivs_span(&span, px.a.inv_w_x, &hw.interp, &px.m.recip, sat, out);
 }
 
 /// The float carriers of the span's raw barycentrics, when the run reads them.

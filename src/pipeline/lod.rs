@@ -1,12 +1,14 @@
 //! `lod`: the level of detail of the material texture from the texture-coordinate derivatives
 //! (the OpenGL isotropic rule; `hw_model::lod`).
 
+use super::lanes::Lanes;
 use super::stages::{each_fragment, texel_derivs, texel_derivs_f64, Counters, Machine};
 use super::texcoord::quantize_uv;
 use super::{Frag, Plan, Px, StageKind};
 use crate::fixedpoint::from_raw;
 use crate::reference::lod_mode_f64;
 use hw_model::config::CoordArith;
+use hw_model::fixed::SatCounter;
 use hw_model::lod::{lod_cost, lod_with, LodSetup};
 use hw_model::UnitCost;
 
@@ -46,15 +48,35 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let (w, h) = (l0.width, l0.height);
     let cfg = &m.hw.lod;
     let k = LodSetup::new(m.uv_fmt.frac_bits, cfg);
-    for frag in frags.iter_mut() {
-        let d = texel_derivs(&frag.uv_x, w, h);
-        frag.lod_x = lod_with(&k, d, sat);
+    if let Some(lanes) = px.lanes {
+        from_lanes(&lanes.borrow(), px.base, (&k, w, h), frags, sat);
+    } else {
+        for frag in frags.iter_mut() {
+            let d = texel_derivs(&frag.uv_x, w, h);
+            frag.lod_x = lod_with(&k, d, sat);
+        }
     }
     if px.carriers {
         let lfb = cfg.lod_frac_bits;
         for frag in frags.iter_mut() {
             frag.lod = from_raw(frag.lod_x, lfb);
         }
+    }
+}
+
+/// [`fixed_span`]'s LOD of each fragment from the texture coordinates in the run's lanes
+/// ([`super::lanes`], the span's first fragment at lane `base`), for a `w` x `h` level 0.
+#[inline(never)]
+fn from_lanes(
+    lanes: &Lanes,
+    base: usize,
+    (k, w, h): (&LodSetup, u32, u32),
+    frags: &mut [Frag],
+    sat: &mut SatCounter,
+) {
+    for (j, frag) in frags.iter_mut().enumerate() {
+        let d = texel_derivs(&lanes.uv_of(base + j), w, h);
+        frag.lod_x = lod_with(k, d, sat);
     }
 }
 

@@ -21,6 +21,7 @@ pub mod coord_f32;
 pub mod env;
 pub mod env_fetch;
 pub mod frame;
+pub mod lanes;
 pub mod lean;
 pub mod lean_fetch;
 pub mod lean_shade;
@@ -243,7 +244,9 @@ pub fn plan_with_bump(material: &Material, has_uvs: bool, bump_map: Option<usize
 /// colour and output carriers that every run sets and the trace (its count ahead of its
 /// footprints), so that a span of those stages touches the first few cache lines of each
 /// fragment (W1's fastest frame 2% to 4% shorter than with the compiler's order, stop 58 in
-/// `docs/PERFORMANCE_LOG.md`).
+/// `docs/PERFORMANCE_LOG.md`). In a program that keeps the common chain's signals in lanes
+/// ([`lanes`]), its span twins pass the barycentrics and texture coordinates there and leave
+/// `bary_x` and `uv_x` unwritten.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C)]
 pub struct Frag {

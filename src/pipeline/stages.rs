@@ -7,6 +7,7 @@
 //! are one file each, registered in [`super::table`].
 
 use super::bump::BumpAttrs;
+use super::lanes::{LaneCell, LANES, LANES_SPAN_MIN};
 use super::table::RunFn;
 use super::{BumpPlan, Frag, Impl, Plan, Program, Px, StageImpls, StageKind, MAX_POINT_LIGHTS};
 use crate::fixedpoint::{floor_exact, to_raw, to_unorm};
@@ -495,7 +496,7 @@ pub fn run(
     c: &mut Counters,
 ) {
     start(frag, plan);
-    let px = prog.px(plan, m, tri, (a, af), (x, y), None);
+    let px = prog.px(plan, m, tri, (a, af), (x, y), None, (None, 0));
     for op in &prog.ops {
         (op.run)(&px, frag, c);
     }
@@ -538,37 +539,46 @@ pub struct SpanAt<'a> {
 /// twin runs its per-fragment twin on each fragment in turn. Every fragment ends as [`run`]
 /// leaves it, and the counters get the same sums (`frames_in_spans_equal_frames_per_fragment`
 /// in the pipeline tests). `row_bary`: the row's barycentrics, indexed by pixel, read by the
-/// spans with [`SpanAt::row_bary`].
+/// spans with [`SpanAt::row_bary`]. `lanes`: the worker's lanes, which a program that keeps
+/// the chain's signals there ([`Program::lanes`]) passes its stages, fragment `j` of the run
+/// in lane `j`.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn run_spans<'a>(
     prog: &'a Program,
     plan: &'a Plan,
     m: &'a Machine<'a>,
     spans: &[SpanAt<'a>],
     row_bary: &'a [[[i64; 3]; 3]],
+    lanes: &'a LaneCell,
     frags: &mut [Frag],
     c: &mut Counters,
 ) {
+    debug_assert!(frags.len() <= LANES);
     for frag in frags.iter_mut() {
         start(frag, plan);
     }
-    let px = |s: &SpanAt<'a>| -> Px<'a> {
+    // Lanes where the spans are long enough for `texcoord`'s vector loop to pay: a run of
+    // short spans (a mesh's) costs more in lanes than in the fragments (W2, stop 59).
+    let keep = prog.lanes && spans.iter().all(|s| s.n >= LANES_SPAN_MIN);
+    let lanes = keep.then_some(lanes);
+    let px = |s: &SpanAt<'a>, base: usize| -> Px<'a> {
         let x = s.x as usize;
         let bary = s.row_bary.then(|| &row_bary[x..x + s.n]);
-        prog.px(plan, m, s.tri, s.attrs, (s.x, s.y), bary)
+        prog.px(plan, m, s.tri, s.attrs, (s.x, s.y), bary, (lanes, base))
     };
     for op in &prog.ops {
         match op.span {
-            Some(span) if op.across => span(&px(&spans[0]), frags, c),
+            Some(span) if op.across => span(&px(&spans[0], 0), frags, c),
             _ => {
-                let mut rest = &mut *frags;
+                let (mut rest, mut base) = (&mut *frags, 0);
                 for s in spans {
                     let (head, tail) = rest.split_at_mut(s.n);
                     match op.span {
-                        Some(span) => span(&px(s), head, c),
-                        None => each_fragment(op.run, &px(s), head, c),
+                        Some(span) => span(&px(s, base), head, c),
+                        None => each_fragment(op.run, &px(s, base), head, c),
                     }
-                    rest = tail;
+                    (rest, base) = (tail, base + s.n);
                 }
             }
         }

@@ -10,6 +10,7 @@
 //! triangles at once (`across`, see [`AcrossFn`]). Adding a stage is a file with those four
 //! functions and a row here (see `docs/ARCHITECTURE.md`).
 
+use super::lanes::{keeps_lanes, LaneCell};
 use super::stages::{Counters, Machine, TriAttrs, TriFloat};
 use super::{
     as_shade, bary, bump_fetch, color, env_fetch, frame, lean_fetch, lean_shade, lobe_fetch,
@@ -48,6 +49,10 @@ pub struct Px<'a> {
     /// The span's barycentrics when its row computed them in one pass
     /// ([`super::bary::Row`], [`Program::row_bary`]).
     pub row_bary: Option<&'a [[[i64; 3]; 3]]>,
+    /// The run's lanes when the program keeps the chain's signals there ([`Program::lanes`]).
+    pub lanes: Option<&'a LaneCell>,
+    /// The lane of the span's first fragment (0 for a stage that runs across triangles).
+    pub base: usize,
 }
 
 impl Px<'_> {
@@ -385,6 +390,9 @@ pub struct Program {
     /// Some stage of the program runs across triangles ([`Op::across`]): the pixel loop
     /// gathers consecutive spans of this program into one run ([`super::stages::run_spans`]).
     pub gathers: bool,
+    /// The span twins of `bary`, `texcoord`, `lod` and `trilinear` pass the barycentrics and
+    /// texture coordinates in the run's lanes, not in the fragments ([`super::lanes`]).
+    pub lanes: bool,
 }
 
 impl Program {
@@ -405,8 +413,10 @@ impl Program {
     }
 
     /// What the stages of this program see at pixel (`x`, `y`) of `tri` (for a span, its first
-    /// fragment's pixel).
+    /// fragment's pixel), with the run's lanes (given only to a program that keeps them,
+    /// [`Program::lanes`]) and the span's first lane.
     #[must_use]
+    #[allow(clippy::too_many_arguments)]
     pub fn px<'a>(
         &'a self,
         plan: &'a Plan,
@@ -415,6 +425,7 @@ impl Program {
         (a, af): (&'a TriAttrs, &'a TriFloat),
         (x, y): (i64, i64),
         row_bary: Option<&'a [[[i64; 3]; 3]]>,
+        (lanes, base): (Option<&'a LaneCell>, usize),
     ) -> Px<'a> {
         Px {
             plan,
@@ -428,6 +439,8 @@ impl Program {
             color_raw: self.color_raw,
             carriers: self.carriers,
             row_bary,
+            lanes,
+            base,
         }
     }
 
@@ -472,6 +485,7 @@ impl Program {
                 && impls.of(StageKind::Bary) == Impl::Fixed
                 && super::bary::row_pass(m, plan),
             gathers: ops.iter().any(|op| op.across),
+            lanes: keeps_lanes(plan, impls, m),
             ops,
         }
     }

@@ -7,7 +7,9 @@ use crate::fixedpoint::{from_raw, to_raw};
 use crate::reference::interpolate_f64;
 use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
-use hw_model::interpolator::{interpolate_cost, interpolate_pairs, interpolate_span};
+use hw_model::interpolator::{
+    interpolate_cost, interpolate_lanes, interpolate_pairs, interpolate_span,
+};
 use hw_model::UnitCost;
 
 /// Fixed twin: two interpolations per sample.
@@ -45,6 +47,13 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     let m = px.m;
     if m.hw.interp.coord_arith == CoordArith::Float32 || !px.fixed(StageKind::Bary) {
         return each_fragment(fixed, px, frags, c);
+    }
+    if let Some(lanes) = px.lanes {
+        // The span's lanes ([`super::lanes`]): all three samples (the program has derivatives).
+        let l = &mut *lanes.borrow_mut();
+        let sat = &mut c.sat[StageKind::Texcoord.index()];
+        let (bb, span) = (m.hw.interp.bary_bits, px.base..px.base + frags.len());
+        return interpolate_lanes(&l.bary, span, bb, px.a.uv_x, &m.uv_fmt, sat, &mut l.uv);
     }
     let n = px.samples();
     let lanes = frags.iter_mut().map(|f| {

@@ -2,6 +2,7 @@
 //! `hw_model::trilinear`), or footprint assembly over `aniso_probes` probes along the major
 //! axis (`hw_model::footprint`) when the plan has derivatives.
 
+use super::lanes::{uv0_into, Lanes};
 use super::stages::{each_fragment, unorm, Counters, Machine};
 use super::texcoord::quantize_uv;
 use super::trace::{hardware_uv, trilinear_traced, unit_traced, Lookup, Trace};
@@ -98,11 +99,22 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
             if unit.repeats() && m.tex_pow2[t] {
                 match m.tex_batch[t].as_ref() {
                     Some(shape) if frags.len() >= BATCH_MIN && unit.batch_form() => {
-                        batches(&unit, levels, shape, t, tb, px.carriers, frags);
+                        let k = (&unit, &levels[..], shape, (t, tb), px.carriers);
+                        match px.lanes {
+                            Some(cell) => {
+                                let lanes = &cell.borrow();
+                                batches(k, &InLanes { lanes, base: px.base }, frags);
+                            }
+                            None => batches(k, &InFrags, frags),
+                        }
                     }
-                    _ => span_lanes::<F, W, true>(&unit, levels, t, tb, px.carriers, frags),
+                    _ => {
+                        uv0_into(px, frags);
+                        span_lanes::<F, W, true>(&unit, levels, t, tb, px.carriers, frags);
+                    }
                 }
             } else {
+                uv0_into(px, frags);
                 span_lanes::<F, W, false>(&unit, levels, t, tb, px.carriers, frags);
             }
         })
@@ -140,13 +152,9 @@ const BATCH_MIN: usize = 8;
 /// (whose [`TrilinearUnit::batch_form`] the caller has checked), which also gives the
 /// footprints of a batch with a traced fragment ([`Trace::record_lane`]).
 #[inline(always)]
-fn batches<F: ConstRounding, W: ConstRounding>(
-    unit: &TrilinearUnit<F, W>,
-    levels: &[Level],
-    shape: &BatchLevels,
-    t: usize,
-    tb: u32,
-    carriers: bool,
+fn batches<F: ConstRounding, W: ConstRounding, U: Uv0>(
+    (unit, levels, shape, (t, tb), carriers): Batches<'_, F, W>,
+    uv: &U,
     frags: &mut [Frag],
 ) {
     let at = first_lookup(t);
@@ -157,14 +165,18 @@ fn batches<F: ConstRounding, W: ConstRounding>(
         .iter()
         .any(|f| f.trace.on)
         .then(BatchFootprints::default);
-    for chunk in frags.chunks_mut(BATCH_LANES) {
+    for (k, chunk) in frags.chunks_mut(BATCH_LANES).enumerate() {
+        let first = k * BATCH_LANES;
         for (j, frag) in chunk.iter().enumerate() {
-            [batch.u[j], batch.v[j]] = frag.uv_x[0];
+            [batch.u[j], batch.v[j]] = uv.uv0(first + j, frag);
             batch.lod[j] = frag.lod_x;
         }
         let traced = fps.as_mut();
         if !unit.sample_batch_pow2_repeat(levels, shape, &batch, chunk.len(), &mut out, traced) {
             // Levels of another shape than the machine's (not reached): sample by sample.
+            for (j, frag) in chunk.iter_mut().enumerate() {
+                frag.uv_x[0] = uv.uv0(first + j, frag);
+            }
             span_lanes::<F, W, true>(unit, levels, t, tb, carriers, chunk);
             continue;
         }
@@ -174,6 +186,46 @@ fn batches<F: ConstRounding, W: ConstRounding>(
                 frag.trace.record_lane(at, fps, j);
             }
         }
+    }
+}
+
+/// What [`batches`] samples with: the unit, the texture's levels and their batch shape, the
+/// texture and its texel bits, and whether the plan keeps carriers.
+type Batches<'a, F, W> = (
+    &'a TrilinearUnit<'a, F, W>,
+    &'a [Level<'a>],
+    &'a BatchLevels,
+    (usize, u32),
+    bool,
+);
+
+/// Where [`batches`] reads a fragment's texture coordinates (sample 0): fragment `j` of the
+/// run, `frag`.
+trait Uv0 {
+    fn uv0(&self, j: usize, frag: &Frag) -> [i64; 2];
+}
+
+/// In the fragments ([`Frag::uv_x`]).
+struct InFrags;
+
+impl Uv0 for InFrags {
+    #[inline(always)]
+    fn uv0(&self, _: usize, frag: &Frag) -> [i64; 2] {
+        frag.uv_x[0]
+    }
+}
+
+/// In the run's lanes ([`super::lanes`]), the span's first fragment at lane `base`.
+struct InLanes<'a> {
+    lanes: &'a Lanes,
+    base: usize,
+}
+
+impl Uv0 for InLanes<'_> {
+    #[inline(always)]
+    fn uv0(&self, j: usize, _: &Frag) -> [i64; 2] {
+        let l = self.base + j;
+        [self.lanes.uv[0][0][l], self.lanes.uv[0][1][l]]
     }
 }
 

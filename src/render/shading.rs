@@ -6,6 +6,7 @@ use super::Geometry;
 use crate::pipeline::bump::{BumpAttrs, BumpVertex};
 use crate::pipeline::clip_f32::{outcode, ShadedVertex};
 use crate::pipeline::coord_f32::{self, F32Tri};
+use crate::pipeline::lanes::LaneCell;
 use crate::pipeline::stages::{
     output16, run, run_spans, Counters, Machine, QuietSetup, SpanAt, TriAttrs, TriFloat, SPAN_MAX,
 };
@@ -416,7 +417,7 @@ fn shade_row_spans(
 ) {
     let w = inp.vis.width as usize;
     let cap = if inp.per_fragment { 1 } else { SPAN_MAX };
-    let RowScratch { frags, bary } = scratch;
+    let RowScratch { frags, bary, lanes } = scratch;
     let frags = &mut frags[..cap];
     for frag in frags.iter_mut() {
         frag.trace.on = trace;
@@ -483,7 +484,7 @@ fn shade_row_spans(
             on_span(a.plan, t, &frags[..1]);
         } else {
             if !group.takes(pi, n) {
-                group.shade(inp, progs, bary, frags, row, c, &mut on_span);
+                group.shade(inp, progs, (&*bary, &*lanes), frags, row, c, &mut on_span);
             }
             let span = SpanAt {
                 tri,
@@ -495,12 +496,12 @@ fn shade_row_spans(
             };
             group.push(pi, t, span);
             if !progs[pi].gathers {
-                group.shade(inp, progs, bary, frags, row, c, &mut on_span);
+                group.shade(inp, progs, (&*bary, &*lanes), frags, row, c, &mut on_span);
             }
         }
         x += n;
     }
-    group.shade(inp, progs, bary, frags, row, c, &mut on_span);
+    group.shade(inp, progs, (&*bary, &*lanes), frags, row, c, &mut on_span);
     if let Some((p, k)) = run_of {
         progs[p].charge(k, c);
     }
@@ -557,7 +558,7 @@ impl<'a> Group<'a> {
         &mut self,
         inp: &ShadeInput,
         progs: &[Program],
-        bary: &bary::Row,
+        (bary, lanes): (&bary::Row, &LaneCell),
         frags: &mut [Frag],
         row: &mut [[u16; 4]],
         c: &mut Counters,
@@ -568,7 +569,7 @@ impl<'a> Group<'a> {
         }
         let frags = &mut frags[..self.filled];
         let (prog, plan) = (&progs[self.prog], &inp.geo.plans[self.prog]);
-        run_spans(prog, plan, inp.m, &self.spans, bary.bary(), frags, c);
+        run_spans(prog, plan, inp.m, &self.spans, bary.bary(), lanes, frags, c);
         let mut rest = &*frags;
         for (s, &t) in self.spans.iter().zip(&self.tris) {
             let (span, tail) = rest.split_at(s.n);
@@ -601,6 +602,7 @@ fn span_len(tris: &[u32], x: usize, cap: usize) -> usize {
 pub(super) struct RowScratch {
     frags: Vec<Frag>,
     bary: bary::Row,
+    lanes: LaneCell,
 }
 
 /// A worker's [`RowScratch`].
@@ -608,6 +610,7 @@ pub(super) fn frag_scratch() -> RowScratch {
     RowScratch {
         frags: vec![Frag::default(); SPAN_MAX],
         bary: bary::Row::default(),
+        lanes: LaneCell::default(),
     }
 }
 

@@ -7,10 +7,13 @@
 use crate::rng_common::Rng;
 use hw_model::config::{CoordArith, HwConfig, LodLog2};
 use hw_model::fixed::Rounding;
+use hw_model::fixed::SatCounter;
 use hw_model::wrap::WrapMode;
 use texsim::maps::{build_mip_chain, quantize_chain};
 use texsim::pipeline::bump::BumpAttrs;
+use texsim::pipeline::lanes::{vector_lanes, LaneCell, LANES};
 use texsim::pipeline::stages::{Counters, Machine, TriAttrs, TriFloat};
+use texsim::pipeline::table::Program;
 use texsim::pipeline::{
     bary, color, lod, modulate, normal, plan, texcoord, trilinear, Frag, Impl, Px, StageImpls,
     StageKind, MAX_POINT_LIGHTS,
@@ -187,6 +190,8 @@ fn span_twins_match_the_per_fragment_twins() {
                 color_raw: false,
                 carriers: rng.below(2) == 0,
                 row_bary: None,
+                lanes: None,
+                base: 0,
             };
             let mut span = vec![Frag::default(); n];
             let mut c_span = Counters::default();
@@ -217,6 +222,131 @@ fn span_twins_match_the_per_fragment_twins() {
             }
         }
     }
+}
+
+/// 300k seeded spans of 1..=32 fragments in a program that keeps the chain's signals in
+/// lanes (`pipeline::lanes`): `bary` then `texcoord` over the span, from lane `base` of the
+/// run, leave in the lanes the barycentrics and texture coordinates their per-fragment twins
+/// write to the fragments, with the same counters, and leave the other lanes alone; over the
+/// widths and paths of `span_twins_match_the_per_fragment_twins` (`lod_per_quad` and the
+/// attribute grid take the per-fragment path, huge triangles the edges' fallback) and
+/// barycentrics from the row's pass (`row_bary`). The textured plan with derivatives keeps
+/// lanes on a CPU with AVX-512; with a `color` stage, without derivatives or with a Float
+/// stage it does not. (The stages here are given the lanes whatever the CPU.)
+#[test]
+fn span_twins_in_lanes_match_the_per_fragment_twins() {
+    let mut rng = Rng(0x5a4e_10a1);
+    let textured = Material {
+        texture: Some(0),
+        lit: false,
+        ..Material::default()
+    };
+    let (mut from_row, mut long) = (0u32, 0u32);
+    for group in 0..150u32 {
+        let hw = config(&mut rng);
+        let m = Machine::new(&hw, &[], &[]);
+        let sub = hw.raster.subpixel_bits;
+        let mut pl = plan(&textured, true);
+        pl.derivatives = true;
+        let vector = vector_lanes();
+        assert_eq!(
+            Program::new(&pl, &StageImpls::FIXED, &m).lanes,
+            vector,
+            "group {group}"
+        );
+        let float_lod = StageImpls::FIXED.with(StageKind::Lod, Impl::Float);
+        assert!(!Program::new(&pl, &float_lod, &m).lanes);
+        let mut flat = plan(&textured, true);
+        flat.derivatives = false;
+        assert!(!Program::new(&flat, &StageImpls::FIXED, &m).lanes);
+        let lit = Material {
+            texture: Some(0),
+            lit: true,
+            ..Material::default()
+        };
+        let mut lit = plan(&lit, true);
+        lit.derivatives = true;
+        assert!(lit.has(StageKind::Color));
+        assert!(!Program::new(&lit, &StageImpls::FIXED, &m).lanes);
+        let cell = LaneCell::default();
+        for case in 0..2000u32 {
+            let tri = triangle(&mut rng, sub);
+            let (a, af) = attrs(&mut rng, &hw);
+            let (x, y, _) = span_near(&mut rng, &tri, sub);
+            let n = rng.int_in(1, LANES as i64) as usize;
+            let base = rng.int_in(0, (LANES - n) as i64) as usize;
+            long += u32::from(n >= 8);
+            let px = Px {
+                plan: &pl,
+                impls: &StageImpls::FIXED,
+                m: &m,
+                tri: &tri,
+                a: &a,
+                af: &af,
+                x,
+                y,
+                color_raw: false,
+                carriers: false,
+                row_bary: None,
+                lanes: Some(&cell),
+                base,
+            };
+            let mut c_one = Counters::default();
+            let want: Vec<Frag> = (0..n)
+                .map(|j| {
+                    let at = Px {
+                        x: px.x + j as i64,
+                        lanes: None,
+                        ..px
+                    };
+                    let mut f = Frag::default();
+                    bary::fixed(&at, &mut f, &mut c_one);
+                    texcoord::fixed(&at, &mut f, &mut c_one);
+                    f
+                })
+                .collect();
+            // Sometimes the row's pass computed the barycentrics (counted there).
+            let row: Vec<[[i64; 3]; 3]> = want.iter().map(|f| f.bary_x).collect();
+            let by_row = rng.below(4) == 0;
+            from_row += u32::from(by_row);
+            let px = Px {
+                row_bary: by_row.then_some(&row[..]),
+                ..px
+            };
+            let before = cell.borrow().clone();
+            let mut span = vec![Frag::default(); n];
+            let mut c_span = Counters::default();
+            bary::fixed_span(&px, &mut span, &mut c_span);
+            texcoord::fixed_span(&px, &mut span, &mut c_span);
+            let l = cell.borrow();
+            for j in 0..LANES {
+                let (b, uv) = if (base..base + n).contains(&j) {
+                    (want[j - base].bary_x, want[j - base].uv_x)
+                } else {
+                    (
+                        [0, 1, 2].map(|s| [0, 1, 2].map(|c| before.bary[s][c][j])),
+                        before.uv_of(j),
+                    )
+                };
+                let got_b = [0, 1, 2].map(|s| [0, 1, 2].map(|c| l.bary[s][c][j]));
+                let what = format!("group {group} case {case} lane {j} (base {base}, n {n})");
+                assert_eq!(got_b, b, "{what}: barycentrics");
+                assert_eq!(l.uv_of(j), uv, "{what}: coordinates");
+            }
+            let bary_sat = if by_row {
+                SatCounter::default()
+            } else {
+                c_one.sat[StageKind::Bary.index()]
+            };
+            assert_eq!(c_span.sat[StageKind::Bary.index()], bary_sat, "case {case}");
+            let k = StageKind::Texcoord.index();
+            assert_eq!(
+                c_span.sat[k], c_one.sat[k],
+                "group {group} case {case}: counts"
+            );
+        }
+    }
+    assert!(from_row > 50_000 && long > 200_000, "{from_row} {long}");
 }
 
 /// A texture of random size (powers of two and others, 1 to 80 texels a side) and texels,
@@ -314,6 +444,8 @@ fn lookup_span_twins_match_the_per_fragment_twins() {
                 color_raw: false,
                 carriers: rng.below(2) == 0,
                 row_bary: None,
+                lanes: None,
+                base: 0,
             };
             let n = rng.int_in(1, 16) as usize;
             // Coordinates mostly within a few textures of the origin, some anywhere in the
@@ -453,6 +585,8 @@ fn color_and_modulate_span_twins_match_the_per_fragment_twins() {
                 color_raw: impls.of(StageKind::Color) == Impl::Fixed,
                 carriers: rng.below(2) == 0,
                 row_bary: None,
+                lanes: None,
+                base: 0,
             };
             let input: Vec<Frag> = (0..n)
                 .map(|_| Frag {
@@ -589,6 +723,8 @@ fn normal_span_twin_matches_the_per_fragment_twin() {
                 color_raw: false,
                 carriers: rng.below(2) == 0,
                 row_bary: None,
+                lanes: None,
+                base: 0,
             };
             let input = vec![Frag::default(); n];
             let mut span = input.clone();

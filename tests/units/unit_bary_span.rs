@@ -8,8 +8,9 @@ use crate::rng_common::Rng;
 use hw_model::config::HwConfig;
 use hw_model::fixed::{Format, Overflow, Rounding, SatCounter};
 use hw_model::interpolator::{
-    interpolate, interpolate_pairs, interpolate_span, perspective_bary, perspective_bary_derivs,
-    perspective_bary_derivs_span, perspective_bary_span, EdgeSpan, SPAN_LANES,
+    interpolate, interpolate_lanes, interpolate_pairs, interpolate_span, perspective_bary,
+    perspective_bary_derivs, perspective_bary_derivs_span, perspective_bary_span, EdgeSpan,
+    SPAN_LANES,
 };
 use hw_model::reciprocal::Reciprocal;
 
@@ -243,6 +244,66 @@ fn interpolate_span_of_pairs_matches_per_fragment_calls() {
         }
         assert_eq!(sat, sat_ref, "case {case}: overflow counts");
     }
+}
+
+/// 1M runs of lanes (a range of 32 lanes, as the pipeline's runs): `interpolate_lanes` equals
+/// one `interpolate_pairs` per lane (values and overflow counts) and leaves the other lanes
+/// as they were, over formats, rounding and overflow modes, attributes from small to beyond
+/// the `i64` accumulator, barycentrics inside and far outside the triangle.
+#[test]
+fn interpolate_lanes_matches_interpolate_pairs() {
+    const L: usize = 32;
+    let mut rng = Rng(0x5a4e_0005);
+    let (mut lanes_seen, mut redone) = (0u64, 0u64);
+    for case in 0..1_000_000u32 {
+        let bb = rng.int_in(4, 30) as u32;
+        let frac = rng.int_in(4, 28) as u32;
+        let int = rng.int_in(1, 16) as u32;
+        let mut out = Format::signed(int, frac, MODES[rng.below(3) as usize]);
+        if rng.below(2) == 0 {
+            out = out.with_overflow(Overflow::Wrap);
+        }
+        let abits = [int + frac - 2, int + frac + 1, 40, 62][rng.below(4) as usize];
+        let attr = [[0i64; 2]; 3].map(|_| [0, 1].map(|_| signed(&mut rng, abits)));
+        let start = rng.int_in(0, L as i64 - 1) as usize;
+        let end = rng.int_in(start as i64 + 1, L as i64) as usize;
+        let bbits = [bb, bb + 1, bb + 3, 40][rng.below(4) as usize];
+        let mut bary = [[[0i64; L]; 3]; 3];
+        for lanes in bary.iter_mut().flatten() {
+            for b in lanes.iter_mut() {
+                *b = signed(&mut rng, bbits);
+            }
+        }
+        let before = [[[0i64; L]; 2]; 3].map(|s| s.map(|a| a.map(|_| rng.next() as i64)));
+        let mut got = before;
+        let mut sat = SatCounter::default();
+        interpolate_lanes(&bary, start..end, bb, attr, &out, &mut sat, &mut got);
+        let mut sat_ref = SatCounter::default();
+        for j in 0..L {
+            for s in 0..3 {
+                let want = if (start..end).contains(&j) {
+                    let b = [[bary[s][0][j], bary[s][1][j], bary[s][2][j]]];
+                    let mut r = [[0i64; 2]];
+                    interpolate_pairs(&b, bb, attr, &out, &mut sat_ref, &mut r);
+                    r[0]
+                } else {
+                    [before[s][0][j], before[s][1][j]]
+                };
+                assert_eq!(
+                    [got[s][0][j], got[s][1][j]],
+                    want,
+                    "case {case} lane {j} sample {s}"
+                );
+            }
+        }
+        assert_eq!(sat, sat_ref, "case {case}: overflow counts");
+        lanes_seen += (end - start) as u64;
+        redone += u64::from(sat.saturated > 0);
+    }
+    assert!(
+        lanes_seen > 8_000_000 && redone > 300_000,
+        "{lanes_seen} {redone}"
+    );
 }
 
 /// 1M spans of 1 to 16 one-sample fragments: `interpolate_span` of three attributes (a
