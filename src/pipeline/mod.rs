@@ -9,7 +9,9 @@
 //! its inputs to its declared input formats, computes in integers, and writes back the exact
 //! value of its fixed result; since every fixed value is exactly representable in `f64`, a chain
 //! of Fixed stages is bit-accurate, and a Fixed stage after a Float one sees the float value
-//! rounded into its input format (how a mixed run isolates one stage's error).
+//! rounded into its input format (how a mixed run isolates one stage's error). In a program of
+//! Fixed stages of the common texturing chain, the span twins pass the barycentrics and texture
+//! coordinates in lanes of the run instead of the fragments ([`lanes`]).
 
 pub mod as_shade;
 pub mod bary;
