@@ -56,6 +56,13 @@ impl Lanes {
         }
     }
 
+    /// Lane `j`'s texture coordinates of sample 0 (the pixel's own), as `Frag::uv_x[0]`.
+    #[inline(always)]
+    #[must_use]
+    pub fn uv0(&self, j: usize) -> [i64; 2] {
+        [self.uv[0][0][j], self.uv[0][1][j]]
+    }
+
     /// Lane `j`'s texture coordinates, as [`Frag::uv_x`] holds them.
     #[inline(always)]
     #[must_use]
@@ -116,8 +123,7 @@ pub fn uv0_into(px: &Px, frags: &mut [Frag]) {
     if let Some(cell) = px.lanes {
         let lanes = cell.borrow();
         for (j, frag) in frags.iter_mut().enumerate() {
-            let l = px.base + j;
-            frag.uv_x[0] = [lanes.uv[0][0][l], lanes.uv[0][1][l]];
+            frag.uv_x[0] = lanes.uv0(px.base + j);
         }
     }
 }

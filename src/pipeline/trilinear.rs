@@ -224,8 +224,7 @@ struct InLanes<'a> {
 impl Uv0 for InLanes<'_> {
     #[inline(always)]
     fn uv0(&self, j: usize, _: &Frag) -> [i64; 2] {
-        let l = self.base + j;
-        [self.lanes.uv[0][0][l], self.lanes.uv[0][1][l]]
+        self.lanes.uv0(self.base + j)
     }
 }
 
