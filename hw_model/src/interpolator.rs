@@ -299,7 +299,7 @@ pub fn perspective_bary_derivs_span(
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    out: impl FnMut(usize, [[i64; 3]; 3]),
+    out: impl DerivsOut,
 ) {
     crate::with_rounding!(cfg.interp_rounding, M => {
         crate::with_rounding!(recip.config().recip_rounding, R => {
@@ -453,6 +453,120 @@ fn lane_result(one: i64, p: [i64; 2], x: [i64; 2], y: [i64; 2]) -> [[i64; 3]; 3]
     [p, x, y].map(|[b1, b2]| [one - b1 - b2, b1, b2])
 }
 
+/// Where [`perspective_bary_derivs_span`] puts its results: lane by lane ([`DerivsOut::lane`];
+/// every closure `FnMut(usize, [[i64; 3]; 3])` is one), or the lanes of a vector batch at once
+/// when all of them took the fast form ([`DerivsOut::batch`], which a sink may decline).
+pub trait DerivsOut {
+    /// Lane `j`'s barycentrics at the pixel and one step in x and in y.
+    fn lane(&mut self, j: usize, v: [[i64; 3]; 3]);
+
+    /// Lanes `j0..j0 + n` of a batch, each `c` of them [`lane_result`] of `one`, `p[..][c]`
+    /// and the steps `dp[..][c]` (x then y) added to `p`; whether the sink took them (else
+    /// they come lane by lane).
+    #[inline(always)]
+    fn batch(&mut self, _: usize, _: usize, _: i64, _: &BatchLanes<HELD_LANES>) -> bool {
+        false
+    }
+}
+
+impl<F: FnMut(usize, [[i64; 3]; 3])> DerivsOut for F {
+    #[inline(always)]
+    fn lane(&mut self, j: usize, v: [[i64; 3]; 3]) {
+        self(j, v);
+    }
+}
+
+/// The fast-form results of a vector batch's lanes ([`DerivsOut::batch`]): the barycentrics
+/// `p_1`, `p_2` at the pixel and the four steps to its neighbours (x then y), by lane.
+pub struct BatchLanes<const L: usize> {
+    pub p: [[i64; L]; 2],
+    pub dp: [[i64; L]; 4],
+}
+
+/// A [`DerivsOut`] into lanes of a structure of arrays, `bary[sample][component][base + j]`
+/// for lane `j`, that takes whole batches as vector stores.
+pub struct DerivLanes<'a, const L: usize> {
+    pub bary: &'a mut [[[i64; L]; 3]; 3],
+    pub base: usize,
+}
+
+impl<const L: usize> DerivsOut for DerivLanes<'_, L> {
+    #[inline(always)]
+    fn lane(&mut self, j: usize, v: [[i64; 3]; 3]) {
+        debug_assert!(self.base + j < L, "lane {j} from {} beyond {L}", self.base);
+        // One mask rather than nine bounds checks where `L` is a power of two.
+        let j = if L.is_power_of_two() {
+            (self.base + j) & (L - 1)
+        } else {
+            self.base + j
+        };
+        for (lanes, bs) in self.bary.iter_mut().zip(v) {
+            for (lane, b) in lanes.iter_mut().zip(bs) {
+                lane[j] = b;
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn batch(&mut self, j0: usize, n: usize, one: i64, b: &BatchLanes<HELD_LANES>) -> bool {
+        let at = self.base + j0;
+        if at + n > L || n > HELD_LANES {
+            return false;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if crate::has_avx512() {
+            // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
+            unsafe { batch_into_lanes_avx512(self.bary, at, n, one, b) };
+            return true;
+        }
+        batch_into_lanes(self.bary, at, n, one, b);
+        true
+    }
+}
+
+/// [`DerivLanes::batch`]'s stores: lanes `at..at + n` of `bary` from the batch's first `n`
+/// lanes (`at + n <= L`, `n <= HELD_LANES`), with no branch on the data.
+#[inline(always)]
+fn batch_into_lanes<const L: usize>(
+    bary: &mut [[[i64; L]; 3]; 3],
+    at: usize,
+    n: usize,
+    one: i64,
+    b: &BatchLanes<HELD_LANES>,
+) {
+    let p = [&b.p[0][..n], &b.p[1][..n]];
+    for (s, sample) in bary.iter_mut().enumerate() {
+        // The sample's steps: none at the pixel, `dp[0..2]` one step in x, `dp[2..4]` in y.
+        let step = |i: usize, c: usize| if s == 0 { 0 } else { b.dp[2 * (s - 1) + i][c] };
+        let [c0, c1, c2] = sample;
+        let (c0, c1, c2) = (
+            &mut c0[at..at + n],
+            &mut c1[at..at + n],
+            &mut c2[at..at + n],
+        );
+        for c in 0..n {
+            let (b1, b2) = (p[0][c] + step(0, c), p[1][c] + step(1, c));
+            (c0[c], c1[c], c2[c]) = (one - b1 - b2, b1, b2);
+        }
+    }
+}
+
+/// [`batch_into_lanes`] compiled with AVX-512 enabled.
+///
+/// # Safety
+/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+unsafe fn batch_into_lanes_avx512<const L: usize>(
+    bary: &mut [[[i64; L]; 3]; 3],
+    at: usize,
+    n: usize,
+    one: i64,
+    b: &BatchLanes<HELD_LANES>,
+) {
+    batch_into_lanes(bary, at, n, one, b);
+}
+
 /// A span length the span datapaths are tuned for (the row loop's spans have at most 32
 /// fragments); they take any length.
 pub const SPAN_LANES: usize = 32;
@@ -466,7 +580,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    mut out: impl FnMut(usize, [[i64; 3]; 3]),
+    mut out: impl DerivsOut,
 ) {
     let &EdgeSpan {
         edge,
@@ -476,7 +590,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
     } = span;
     let Some(steps) = span_steps(span, inv_w) else {
         for j in 0..lanes {
-            out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
+            out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
         }
         return;
     };
@@ -542,7 +656,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
             })
         });
         let Some(([q1, q2, d], pj, r2)) = fast else {
-            out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
+            out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
             continue;
         };
         let (nx, ny) = *numerators.get_or_insert_with(|| {
@@ -562,7 +676,7 @@ fn perspective_bary_derivs_span_in<M: ConstRounding, R: ConstRounding>(
         let x2 = pj[2] + derivative_of_top::<M>(nx[1], r2, bb, sat);
         let y1 = pj[1] + derivative::<M>(ny[0], r2, bb, sat);
         let y2 = pj[2] + derivative::<M>(ny[1], r2, bb, sat);
-        out(j, lane_result(one, [pj[1], pj[2]], [x1, x2], [y1, y2]));
+        out.lane(j, lane_result(one, [pj[1], pj[2]], [x1, x2], [y1, y2]));
     }
 }
 
@@ -731,7 +845,7 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    mut out: impl FnMut(usize, [[i64; 3]; 3]),
+    mut out: impl DerivsOut,
 ) {
     let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
     let m_bits = recip.config().recip_mantissa_bits;
@@ -763,9 +877,9 @@ fn derivs_span_steady<M: ConstRounding, R: ConstRounding>(
             let x2 = p2 + derivative_of_top::<M>(nx[1], r2, bb, sat);
             let y1 = p1 + derivative::<M>(ny[0], r2, bb, sat);
             let y2 = p2 + derivative::<M>(ny[1], r2, bb, sat);
-            out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
+            out.lane(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
         } else {
-            out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
+            out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat));
         }
         q1 = q1.wrapping_add(a[1]);
         q2 = q2.wrapping_add(a[2]);
@@ -840,7 +954,7 @@ const RECIP_BATCH: usize = 8;
 
 /// Lanes of one vector batch of held lanes ([`held_batch_lanes`]): two AVX-512 registers of
 /// 64-bit lanes, so that each step has two independent chains.
-const HELD_LANES: usize = 2 * crate::reciprocal::RECIP_LANES;
+pub const HELD_LANES: usize = 2 * crate::reciprocal::RECIP_LANES;
 
 /// The most lanes of a span whose held lanes [`perspective_bary_derivs_spans`] gathers with
 /// other spans' ([`Gather`]); a longer span fills its own vector batches.
@@ -878,7 +992,7 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     cfg: &InterpConfig,
     recip: &Reciprocal,
     sat: &mut SatCounter,
-    mut out: impl FnMut(usize, [[i64; 3]; 3]),
+    mut out: impl DerivsOut,
 ) {
     let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
     let m_bits = recip.config().recip_mantissa_bits;
@@ -918,7 +1032,8 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
         while span.lanes - j0 >= HELD_MIN_LANES {
             let n = (span.lanes - j0).min(HELD_LANES);
             (input.n, input.d, input.q) = (n, d, [q1, q2]);
-            // Each lane's y numerators' tops; the lanes past the span repeat its last.
+            // Each lane's y numerators' tops; the lanes past the span repeat its last (so
+            // `nyj` ends at the batch's last lane).
             let mut nyj = ny;
             // Lane by lane with indices: the iterator form clippy prefers made this function's
             // short spans (no batch) 1.5 ms a W2 frame slower at one thread.
@@ -935,18 +1050,30 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                 break;
             }
             let b = &wide;
+            let all = u64::MAX >> (64 - n);
+            if b.ok & all == all && out.batch(j0, n, one, &b.fast) {
+                // Every lane took the fast form and the sink stored them: the next batch's
+                // first lane, `n` steps on (the same wrapping sums as lane by lane).
+                let n64 = n as i64;
+                q1 = q1.wrapping_add(n64.wrapping_mul(st.a[1]));
+                q2 = q2.wrapping_add(n64.wrapping_mul(st.a[2]));
+                ny = [0, 1].map(|k| nyj[k].wrapping_add(st.y_step[k]));
+                d = d.wrapping_add(n64.wrapping_mul(s));
+                j0 += n;
+                continue;
+            }
             for c in 0..n {
                 let j = j0 + c;
                 if b.ok >> c & 1 == 1 {
-                    let (p1, p2) = (b.p[0][c], b.p[1][c]);
-                    let (x1, x2) = (p1 + b.dp[0][c], p2 + b.dp[1][c]);
-                    let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
-                    out(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
+                    let (p1, p2) = (b.fast.p[0][c], b.fast.p[1][c]);
+                    let (x1, x2) = (p1 + b.fast.dp[0][c], p2 + b.fast.dp[1][c]);
+                    let (y1, y2) = (p1 + b.fast.dp[2][c], p2 + b.fast.dp[3][c]);
+                    out.lane(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
                 } else {
                     let rr = b.recips.get(c);
                     match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
-                        Some(v) => out(j, v),
-                        None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
+                        Some(v) => out.lane(j, v),
+                        None => out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
                     }
                 }
                 ([q1, q2], ny) = st.next_lane([q1, q2], ny);
@@ -972,8 +1099,8 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
         for (c, &rr) in recips[..n].iter().enumerate() {
             let j = j0 + c;
             match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
-                Some(v) => out(j, v),
-                None => out(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
+                Some(v) => out.lane(j, v),
+                None => out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
             }
             ([q1, q2], ny) = st.next_lane([q1, q2], ny);
         }
@@ -1265,9 +1392,9 @@ impl<const L: usize> Gather<L> {
         for c in 0..n {
             let (i, j) = (self.at[c].0 as usize, self.at[c].1 as usize);
             if b.ok >> c & 1 == 1 {
-                let (p1, p2) = (b.p[0][c], b.p[1][c]);
-                let (x1, x2) = (p1 + b.dp[0][c], p2 + b.dp[1][c]);
-                let (y1, y2) = (p1 + b.dp[2][c], p2 + b.dp[3][c]);
+                let (p1, p2) = (b.fast.p[0][c], b.fast.p[1][c]);
+                let (x1, x2) = (p1 + b.fast.dp[0][c], p2 + b.fast.dp[1][c]);
+                let (y1, y2) = (p1 + b.fast.dp[2][c], p2 + b.fast.dp[3][c]);
                 out(i, j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
             } else {
                 let ds = &spans[i];
@@ -1287,8 +1414,7 @@ impl<const L: usize> Gather<L> {
 /// form (a lane that did not takes the scalar lane from its `1/D` and `1/D^2`).
 struct HeldLanes<const L: usize> {
     recips: crate::reciprocal::RecipLanes<L>,
-    p: [[i64; L]; 2],
-    dp: [[i64; L]; 4],
+    fast: BatchLanes<L>,
     ok: u64,
 }
 
@@ -1296,8 +1422,10 @@ impl<const L: usize> Default for HeldLanes<L> {
     fn default() -> Self {
         Self {
             recips: crate::reciprocal::RecipLanes::default(),
-            p: [[0; L]; 2],
-            dp: [[0; L]; 4],
+            fast: BatchLanes {
+                p: [[0; L]; 2],
+                dp: [[0; L]; 4],
+            },
             ok: 0,
         }
     }
@@ -1357,7 +1485,7 @@ fn held_batch_lanes<M, R, const N: u32, const L: usize, I>(
             let (hi, lo) = mul_wide_lane(b.q(i, c), r.mant);
             let (v, fits) = round_shift_right_wide_lane::<M>(hi, lo, sh.clamp(1, 63) as u32);
             fast &= fits && bary_offset(v) <= limit;
-            out.p[i][c] = v;
+            out.fast.p[i][c] = v;
         }
         // The derivatives: each top rounded by `1/D^2`'s exponent less its drop.
         let r2_shift = i64::from(r2.shift);
@@ -1370,7 +1498,7 @@ fn held_batch_lanes<M, R, const N: u32, const L: usize, I>(
                 shift.clamp(2, 63) as u32,
             );
             fast &= bary_offset(v) <= limit;
-            out.dp[k][c] = v;
+            out.fast.dp[k][c] = v;
         }
         ok |= u64::from(fast) << c;
     }
@@ -2226,6 +2354,40 @@ mod tests {
         sat
     }
 
+    /// [`span_derivs`] into lanes ([`DerivLanes`], whose sink takes whole vector batches)
+    /// from lane `base` of 32, read back into `got`; panics unless every other lane keeps the
+    /// value it had.
+    fn span_derivs_in_lanes(
+        span: &EdgeSpan,
+        inv_w: [i64; 3],
+        (cfg, recip): (&InterpConfig, &Reciprocal),
+        base: usize,
+        got: &mut [[[i64; 3]; 3]],
+    ) -> SatCounter {
+        const UNTOUCHED: i64 = 0x5a5a_5a5a;
+        let mut bary = [[[UNTOUCHED; 32]; 3]; 3];
+        let mut sat = SatCounter::default();
+        let out = DerivLanes {
+            bary: &mut bary,
+            base,
+        };
+        perspective_bary_derivs_span(span, inv_w, cfg, recip, &mut sat, out);
+        for (j, lane) in bary[0][0].iter().enumerate() {
+            let ours = (base..base + span.lanes).contains(&j);
+            if ours {
+                got[j - base] = std::array::from_fn(|s| std::array::from_fn(|c| bary[s][c][j]));
+            } else {
+                let kept = (0..9).all(|k| bary[k / 3][k % 3][j] == UNTOUCHED);
+                assert!(
+                    kept && *lane == UNTOUCHED,
+                    "lane {j} outside {base}..+{}",
+                    span.lanes
+                );
+            }
+        }
+        sat
+    }
+
     fn signed(s: &mut u64, bits: u32) -> i64 {
         let v = (next(s) >> (64 - bits.clamp(1, 63))) as i64;
         if next(s) & 1 == 1 {
@@ -2812,7 +2974,9 @@ mod tests {
     /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
     /// small and positive), so that many lanes of the held loop need the clamp of `p_i`. Spans
     /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX-512: many
-    /// of their lanes take the batch's fast form, and many the scalar lane (the clamp).
+    /// of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
+    /// other span goes into lanes from a random base ([`DerivLanes`], which stores a batch
+    /// whose lanes all took the fast form whole): the same bits, the other lanes untouched.
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
@@ -2857,7 +3021,13 @@ mod tests {
                     }
                     let EdgeSpan { edge, dx, dy, .. } = span;
                     let at = |j: usize| lane_at(&span, j);
-                    let sa = span_derivs(&span, inv_w, cfg, &recip, &mut got);
+                    // Every other span into lanes from a random base.
+                    let sa = if i % 2 == 0 {
+                        span_derivs(&span, inv_w, cfg, &recip, &mut got)
+                    } else {
+                        let base = (next(&mut s) % (33 - n as u64)) as usize;
+                        span_derivs_in_lanes(&span, inv_w, (cfg, &recip), base, &mut got)
+                    };
                     let mut sb = SatCounter::default();
                     // Whether the ends' products and sums fit `i64` (the span steps them).
                     let fits = |j: usize| {

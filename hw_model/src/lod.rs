@@ -148,6 +148,103 @@ pub fn lod_with(k: &LodSetup, d: [i64; 4], sat: &mut SatCounter) -> i64 {
     v
 }
 
+/// [`lod_with`] of each lane `j` of `lanes` into `out[j]`, its derivatives those of the
+/// texture coordinates of three samples `uv[sample][axis][j]` (the pixel, its neighbour one
+/// step in x and one in y) on a `w` x `h` level 0: `d = ((u1 - u0) w, (v1 - v0) h, (u2 - u0) w,
+/// (v2 - v0) h)`. The same values and saturation counts as one [`lod_with`] call per lane
+/// (`lod_lanes_matches_lod_with`): in the Exact mode every lane is computed without a branch on
+/// its data (as vector lanes where the CPU has AVX-512: the table's quadratic by gathers), and
+/// a lane whose derivatives leave `[-2^31, 2^31)`, whose quadratic lies within
+/// [`LOG2_MARGIN`] of an integer, or whose result takes the clamp is computed again by
+/// [`lod_with`]; the piecewise-linear mode takes [`lod_with`] on every lane. `lanes.end` must
+/// not exceed `L`.
+pub fn lod_lanes<const L: usize>(
+    k: &LodSetup,
+    uv: &[[[i64; L]; 2]; 3],
+    lanes: std::ops::Range<usize>,
+    (w, h): (u32, u32),
+    sat: &mut SatCounter,
+    out: &mut [i64; L],
+) {
+    assert!(lanes.end <= L, "lanes {lanes:?} beyond {L}");
+    let size = (i64::from(w), i64::from(h));
+    let mut redo = [true; L];
+    if !k.piecewise {
+        redo = [false; L];
+        #[cfg(target_arch = "x86_64")]
+        if crate::has_avx512() {
+            // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
+            unsafe { exact_lanes_avx512(k, uv, lanes.clone(), size, out, &mut redo) };
+        } else {
+            exact_lanes(k, uv, lanes.clone(), size, out, &mut redo);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        exact_lanes(k, uv, lanes.clone(), size, out, &mut redo);
+    }
+    for j in lanes.filter(|&j| redo[j]) {
+        out[j] = lod_with(k, lane_derivs(uv, j, size), sat);
+    }
+}
+
+/// The derivatives of lane `j` of [`lod_lanes`] (wrapping, as a release build's `i64`).
+#[inline(always)]
+fn lane_derivs<const L: usize>(uv: &[[[i64; L]; 2]; 3], j: usize, (w, h): (i64, i64)) -> [i64; 4] {
+    let diff =
+        |s: usize, ax: usize, size: i64| uv[s][ax][j].wrapping_sub(uv[0][ax][j]).wrapping_mul(size);
+    [diff(1, 0, w), diff(1, 1, h), diff(2, 0, w), diff(2, 1, h)]
+}
+
+/// [`lod_with`]'s Exact mode on each lane of `lanes` without a branch on a lane's data (so
+/// the loop runs as vector lanes): the value in `out`, and in `redo` whether the lane is one
+/// [`lod_lanes`] computes again (its value here is not read).
+#[inline(always)]
+fn exact_lanes<const L: usize>(
+    k: &LodSetup,
+    uv: &[[[i64; L]; 2]; 3],
+    lanes: std::ops::Range<usize>,
+    size: (i64, i64),
+    out: &mut [i64; L],
+    redo: &mut [bool; L],
+) {
+    let (frac2, steps, drop) = (2 * i64::from(k.frac), k.steps, SERIAL_STEPS - k.steps);
+    for j in lanes {
+        let d = lane_derivs(uv, j, size);
+        let offsets = d.map(|x| (x as u64).wrapping_add(1 << 31));
+        let small = (offsets[0] | offsets[1] | offsets[2] | offsets[3]) < 1 << 32;
+        let sq = d.map(|x| x.wrapping_mul(x) as u64);
+        let l = sq[0].wrapping_add(sq[1]).max(sq[2].wrapping_add(sq[3]));
+        // The MSB index (-1 for `l` = 0, whose lane returns `floor_val`).
+        let e = 63 - i64::from(l.leading_zeros());
+        let m = if e >= i64::from(MANT_BITS) {
+            l.wrapping_shr((e - i64::from(MANT_BITS)) as u32)
+        } else {
+            l.wrapping_shl((i64::from(MANT_BITS) - e) as u32)
+        };
+        let (bits, direct) = quadratic_bits(m);
+        let v = (((e - frac2) << steps) + i64::from(bits >> drop)) >> k.halve;
+        let zero = l == 0;
+        out[j] = if zero { k.floor_val } else { v };
+        redo[j] = !small | (!zero & (!direct | (v < k.floor_val)));
+    }
+}
+
+/// [`exact_lanes`] compiled with AVX-512 enabled.
+///
+/// # Safety
+/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+unsafe fn exact_lanes_avx512<const L: usize>(
+    k: &LodSetup,
+    uv: &[[[i64; L]; 2]; 3],
+    lanes: std::ops::Range<usize>,
+    size: (i64, i64),
+    out: &mut [i64; L],
+    redo: &mut [bool; L],
+) {
+    exact_lanes(k, uv, lanes, size, out, redo);
+}
+
 /// The larger squared length `L` of [`lod`] in `u128` (some `|d| >= 2^31`, so `L > 0`): its
 /// MSB index and its mantissa with [`MANT_BITS`] fraction bits (truncated).
 #[inline(never)]
@@ -265,6 +362,14 @@ pub fn table_log2_bits(m: u64) -> u32 {
 /// (there [`table_log2_bits`] runs the loop).
 #[inline(always)]
 fn log2_quadratic(m: u64) -> Option<u32> {
+    let (bits, direct) = quadratic_bits(m);
+    direct.then_some(bits)
+}
+
+/// [`log2_quadratic`] without the branch: the quadratic's floor, and whether it lies at least
+/// [`LOG2_MARGIN`] from an integer (any `m`: only its low 32 bits are read).
+#[inline(always)]
+fn quadratic_bits(m: u64) -> (u32, bool) {
     let off = (m as u32) ^ (1 << MANT_BITS);
     // `off < 2^31`: the mask only drops the bounds check.
     let [z0, a, b, _] = LOG2_QUAD[(off >> SEG_SHIFT) as usize & (LOG2_QUAD.len() - 1)];
@@ -274,7 +379,8 @@ fn log2_quadratic(m: u64) -> Option<u32> {
         i64::from(z0) + round_shift_right_mid::<TruncateMode>(t * (i64::from(a) + tb), SEG_SHIFT);
     // z (16 fraction bits) within `[0, 2^31)`: the floor and the distance to an integer.
     let f = (z as u32) & 0xffff;
-    (f.wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN).then_some((z >> 16) as u32)
+    let direct = f.wrapping_sub(LOG2_MARGIN) <= 0x1_0000 - 2 * LOG2_MARGIN;
+    ((z >> 16) as u32, direct)
 }
 
 /// Whether [`table_log2_bits`] takes the quadratic's value for `m` (else it runs the loop).

@@ -12,8 +12,8 @@ use crate::raster::ScreenTri;
 use crate::reference::{perspective_bary_derivs_f64, perspective_bary_f64};
 use hw_model::interpolator::{
     perspective_bary, perspective_bary_cost, perspective_bary_derivs, perspective_bary_derivs_cost,
-    perspective_bary_derivs_span, perspective_bary_derivs_spans, perspective_bary_span, DerivSpan,
-    EdgeSpan, GATHER_MAX_LANES,
+    perspective_bary_derivs_span, perspective_bary_derivs_spans, perspective_bary_span, DerivLanes,
+    DerivSpan, DerivsOut, EdgeSpan, GATHER_MAX_LANES,
 };
 use hw_model::UnitCost;
 
@@ -120,10 +120,14 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
 /// `px.base`) rather than to the fragments. (Such a program has derivatives and writes no
 /// carriers.)
 fn into_lanes(px: &Px, frags: &mut [Frag], lanes: &mut Lanes, c: &mut Counters) {
-    let base = px.base;
+    // The datapath's vector batches store their lanes whole.
+    let mut out = DerivLanes {
+        bary: &mut lanes.bary,
+        base: px.base,
+    };
     if let Some(row) = px.row_bary {
         for (j, b) in row.iter().enumerate() {
-            lanes.set_bary(base + j, b);
+            out.lane(j, *b);
         }
         return;
     }
@@ -138,7 +142,7 @@ fn into_lanes(px: &Px, frags: &mut [Frag], lanes: &mut Lanes, c: &mut Counters) 
     let Some((edge, dx, dy)) = steps else {
         each_fragment(fixed, px, frags, c);
         for (j, frag) in frags.iter().enumerate() {
-            lanes.set_bary(base + j, &frag.bary_x);
+            out.lane(j, frag.bary_x);
         }
         return;
     };
@@ -149,12 +153,6 @@ fn into_lanes(px: &Px, frags: &mut [Frag], lanes: &mut Lanes, c: &mut Counters) 
         dy,
         lanes: n,
     };
-    // A function, not a capture in the closure: the datapath's per-lane call then inlines.
-    #[inline(always)]
-    fn set(lanes: &mut Lanes, j: usize, b: &[[i64; 3]; 3]) {
-        lanes.set_bary(j, b);
-    }
-    let out = |j: usize, b: [[i64; 3]; 3]| set(lanes, base + j, &b);
     perspective_bary_derivs_span(&span, px.a.inv_w_x, &hw.interp, &px.m.recip, sat, out);
 }
 

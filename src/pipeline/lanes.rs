@@ -43,19 +43,6 @@ impl Default for Lanes {
 }
 
 impl Lanes {
-    /// Lane `j`'s barycentrics, as [`Frag::bary_x`] holds them (`j` below [`LANES`]).
-    #[inline(always)]
-    pub fn set_bary(&mut self, j: usize, b: &[[i64; 3]; 3]) {
-        debug_assert!(j < LANES);
-        // One mask rather than nine bounds checks (LANES is a power of two).
-        let j = j & (LANES - 1);
-        for (lanes, bs) in self.bary.iter_mut().zip(b) {
-            for (lane, &v) in lanes.iter_mut().zip(bs) {
-                lane[j] = v;
-            }
-        }
-    }
-
     /// Lane `j`'s texture coordinates of sample 0 (the pixel's own), as `Frag::uv_x[0]`.
     #[inline(always)]
     #[must_use]

@@ -1,7 +1,7 @@
 //! `lod`: the level of detail of the material texture from the texture-coordinate derivatives
 //! (the OpenGL isotropic rule; `hw_model::lod`).
 
-use super::lanes::Lanes;
+use super::lanes::{Lanes, LANES};
 use super::stages::{each_fragment, texel_derivs, texel_derivs_f64, Counters, Machine};
 use super::texcoord::quantize_uv;
 use super::{Frag, Plan, Px, StageKind};
@@ -9,7 +9,7 @@ use crate::fixedpoint::from_raw;
 use crate::reference::lod_mode_f64;
 use hw_model::config::CoordArith;
 use hw_model::fixed::SatCounter;
-use hw_model::lod::{lod_cost, lod_with, LodSetup};
+use hw_model::lod::{lod_cost, lod_lanes, lod_with, LodSetup};
 use hw_model::UnitCost;
 
 /// Fixed twin: squared lengths, bit-serial log2.
@@ -65,7 +65,8 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
 }
 
 /// [`fixed_span`]'s LOD of each fragment from the texture coordinates in the run's lanes
-/// ([`super::lanes`], the span's first fragment at lane `base`), for a `w` x `h` level 0.
+/// ([`super::lanes`], the span's first fragment at lane `base`), for a `w` x `h` level 0: one
+/// call of the LOD unit's lanes datapath ([`lod_lanes`]).
 #[inline(never)]
 fn from_lanes(
     lanes: &Lanes,
@@ -74,9 +75,17 @@ fn from_lanes(
     frags: &mut [Frag],
     sat: &mut SatCounter,
 ) {
-    for (j, frag) in frags.iter_mut().enumerate() {
-        let d = texel_derivs(&lanes.uv_of(base + j), w, h);
-        frag.lod_x = lod_with(k, d, sat);
+    let mut lod = [0i64; LANES];
+    lod_lanes(
+        k,
+        &lanes.uv,
+        base..base + frags.len(),
+        (w, h),
+        sat,
+        &mut lod,
+    );
+    for (frag, &l) in frags.iter_mut().zip(&lod[base..]) {
+        frag.lod_x = l;
     }
 }
 

@@ -210,3 +210,75 @@ fn piecewise_linear_log2_random_with_fraction_bits() {
         );
     }
 }
+
+/// 800k runs of lanes (a range of 32 lanes, as the pipeline's runs): `lod_lanes` equals one
+/// `lod_with` per lane on the same derivatives (values and saturation counts) and leaves the
+/// other lanes as they were, over both log2 modes, every `lod_frac_bits`, coordinate
+/// fractions up to 40 bits (from 33 on, small footprints take the clamp), level-0 sizes that
+/// are and are not powers of two, and derivatives from zero to beyond `2^31`.
+#[test]
+fn lod_lanes_matches_lod_with() {
+    use hw_model::config::LodLog2;
+    use hw_model::lod::{lod_lanes, lod_with, LodSetup};
+    const L: usize = 32;
+    let mut rng = Rng(0x10d_1a4e);
+    let (mut lanes_seen, mut clamped) = (0u64, 0u64);
+    for case in 0..800_000u32 {
+        let mut c = cfg(rng.int_in(0, 16) as u32);
+        if rng.below(4) == 0 {
+            c.lod_log2 = LodLog2::PiecewiseLinear;
+        }
+        let frac = rng.int_in(0, 40) as u32;
+        let k = LodSetup::new(frac, &c);
+        let sizes = [1, 3, 256, 1000, 1024, 4096];
+        let size = [0; 2].map(|_| sizes[rng.below(sizes.len() as u64) as usize]);
+        let start = rng.int_in(0, L as i64 - 1) as usize;
+        let end = rng.int_in(start as i64 + 1, L as i64) as usize;
+        let mut uv = [[[0i64; L]; 2]; 3];
+        let step_bits = [0, 1, 4, 12, 20, 28, 34][rng.below(7) as usize];
+        let step = |rng: &mut Rng| {
+            let bits = if rng.below(8) == 0 {
+                rng.below(35) as u32
+            } else {
+                step_bits
+            };
+            let m = (1i64 << bits) - 1;
+            rng.int_in(-m, m)
+        };
+        let [s0, s1, s2] = &mut uv;
+        for ((a0, a1), a2) in s0.iter_mut().zip(s1.iter_mut()).zip(s2.iter_mut()) {
+            for ((u0, u1), u2) in a0.iter_mut().zip(a1.iter_mut()).zip(a2.iter_mut()) {
+                *u0 = rng.int_in(-(1 << 30), 1 << 30);
+                *u1 = *u0 + step(&mut rng);
+                *u2 = *u0 + step(&mut rng);
+            }
+        }
+        let before = [0i64; L].map(|_| rng.next() as i64);
+        let mut got = before;
+        let mut sat = SatCounter::default();
+        lod_lanes(&k, &uv, start..end, (size[0], size[1]), &mut sat, &mut got);
+        let mut sat_ref = SatCounter::default();
+        for j in 0..L {
+            let want = if (start..end).contains(&j) {
+                let (w, h) = (i64::from(size[0]), i64::from(size[1]));
+                let d = [
+                    (uv[1][0][j] - uv[0][0][j]) * w,
+                    (uv[1][1][j] - uv[0][1][j]) * h,
+                    (uv[2][0][j] - uv[0][0][j]) * w,
+                    (uv[2][1][j] - uv[0][1][j]) * h,
+                ];
+                lod_with(&k, d, &mut sat_ref)
+            } else {
+                before[j]
+            };
+            assert_eq!(got[j], want, "case {case} lane {j} ({c:?}, frac {frac})");
+        }
+        assert_eq!(sat, sat_ref, "case {case}: saturation counts");
+        lanes_seen += (end - start) as u64;
+        clamped += sat.saturated;
+    }
+    assert!(
+        lanes_seen > 6_000_000 && clamped > 10_000,
+        "{lanes_seen} lanes, {clamped} clamped"
+    );
+}
