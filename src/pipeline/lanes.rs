@@ -12,7 +12,6 @@
 use super::stages::{Machine, SPAN_MAX};
 use super::table::Px;
 use super::{Frag, Impl, Plan, StageImpls, StageKind};
-use hw_model::config::CoordArith;
 use std::cell::RefCell;
 
 /// Lanes of a run: one per fragment of [`super::stages::run_spans`].
@@ -67,30 +66,20 @@ impl Lanes {
 pub type LaneCell = RefCell<Lanes>;
 
 /// Whether a program compiled from `plan` with `impls` on `m` keeps the chain's signals in
-/// lanes: every stage runs Fixed and is one of `bary`, `texcoord`, `lod`, `trilinear`,
-/// `modulate` (no other stage reads the barycentrics or the coordinates, and no float carrier
-/// is written), with both `bary` and `texcoord`, derivatives, the integer coordinate path and
-/// one trilinear sample per lookup (footprint assembly reads the fragment's three samples),
-/// on a CPU with AVX-512 ([`vector_lanes`]): without it `interpolate_lanes` runs its
-/// lanes one by one, which took more instructions than the fragments' path (callgrind, W1,
-/// `texcoord` 126.3M against 91.8M).
+/// lanes: every stage runs Fixed and its row says it may ([`super::table::LanesFn`]: `bary`,
+/// `modulate`; `texcoord` and `lod` off the float32 coordinate path; `trilinear` with one
+/// probe, as footprint assembly reads the fragment's three samples), the plan has `bary`,
+/// `texcoord` and derivatives, and the CPU has AVX-512 ([`vector_lanes`]): without it
+/// `interpolate_lanes` runs its lanes one by one, which took more instructions than the
+/// fragments' path (callgrind, W1, `texcoord` 126.3M against 91.8M).
 #[must_use]
 pub fn keeps_lanes(plan: &Plan, impls: &StageImpls, m: &Machine) -> bool {
-    const CHAIN: [StageKind; 5] = [
-        StageKind::Bary,
-        StageKind::Texcoord,
-        StageKind::Lod,
-        StageKind::Trilinear,
-        StageKind::Modulate,
-    ];
     plan.stages
         .iter()
-        .all(|&k| impls.of(k) == Impl::Fixed && CHAIN.contains(&k))
+        .all(|&k| impls.of(k) == Impl::Fixed && (k.row().lanes)(m, plan))
         && plan.has(StageKind::Bary)
         && plan.has(StageKind::Texcoord)
         && plan.derivatives
-        && m.hw.interp.coord_arith != CoordArith::Float32
-        && m.hw.trilinear.aniso_probes <= 1
         && vector_lanes()
 }
 

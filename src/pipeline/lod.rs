@@ -97,6 +97,13 @@ pub fn across(m: &Machine, _: &Plan) -> bool {
     m.hw.interp.coord_arith != CoordArith::Float32
 }
 
+/// Whether the fixed twins may run with the chain's signals in lanes
+/// ([`super::table::LanesFn`]): off the float32 coordinate path, as `texcoord`'s.
+#[must_use]
+pub fn lanes(m: &Machine, plan: &Plan) -> bool {
+    super::texcoord::lanes(m, plan)
+}
+
 /// Float twin.
 pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     let Some(l0) = px.plan.texture.and_then(|t| px.m.tex_float[t].first()) else {

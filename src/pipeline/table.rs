@@ -7,7 +7,8 @@
 //! lookups per invocation (what the timing model budgets events for), and optionally a fixed
 //! twin over a span of fragments (`fixed_span`, see [`SpanFn`]; without one, a span runs the
 //! fixed twin on each fragment) and when that span twin may take the fragments of several
-//! triangles at once (`across`, see [`AcrossFn`]). Adding a stage is a file with those four
+//! triangles at once (`across`, see [`AcrossFn`]) and when it may run with the chain's
+//! signals in lanes (`lanes`, see [`LanesFn`]). Adding a stage is a file with those four
 //! functions and a row here (see `docs/ARCHITECTURE.md`).
 
 use super::lanes::{keeps_lanes, LaneCell};
@@ -88,6 +89,11 @@ pub type SpanFn = fn(&Px, &mut [Frag], &mut Counters);
 /// then take the fragments of consecutive spans of one program, of several triangles, at
 /// once ([`super::stages::run_spans`]), so that short spans (a mesh's) fill its batches.
 pub type AcrossFn = fn(&Machine, &Plan) -> bool;
+/// Whether a stage's fixed twins may run in a program that keeps the chain's signals in the
+/// run's lanes ([`super::lanes`]) in a plan on a machine: given [`Px::lanes`], its span twin
+/// reads and writes the barycentrics, texture coordinates and LOD there, and neither twin
+/// reads those fields of a fragment otherwise (the per-fragment twin never sees lanes).
+pub type LanesFn = fn(&Machine, &Plan) -> bool;
 /// A stage's cost per invocation in a plan on a machine (fixed units' ops, cycles, texels).
 pub type CostFn = fn(&Machine, &Plan) -> UnitCost;
 /// Texture lookups per invocation on a hardware configuration.
@@ -103,6 +109,8 @@ pub struct StageRow {
     pub fixed_span: Option<SpanFn>,
     /// When `fixed_span` may take several triangles' spans at once.
     pub across: AcrossFn,
+    /// When the stage may run in a program that keeps the chain's signals in lanes.
+    pub lanes: LanesFn,
     pub float: RunFn,
     /// The float twin reads the triangle's float vertex data (`Px::af`, a
     /// [`super::stages::TriFloat`]): a render builds it when such a twin runs
@@ -152,6 +160,16 @@ macro_rules! optional_across {
     };
 }
 
+/// A row's `lanes`: [`never`] unless given.
+macro_rules! optional_lanes {
+    () => {
+        never
+    };
+    ($lanes:expr) => {
+        $lanes
+    };
+}
+
 /// A row's `float_reads_vertices`: `false` unless given.
 macro_rules! optional_flag {
     () => {
@@ -165,7 +183,7 @@ macro_rules! optional_flag {
 macro_rules! stage_table {
     ($( $(#[doc = $doc:literal])* $kind:ident $name:literal {
         fixed: $fixed:expr, $(fixed_span: $span:expr,)? $(across: $across:expr,)?
-        float: $float:expr,
+        $(lanes: $lanes:expr,)? float: $float:expr,
         $(float_reads_vertices: $reads:expr,)? cost: $cost:expr, lookups: $lookups:expr $(,)?
     } )*) => {
         /// The kinds of stage, in pipeline order (generated from the stage table).
@@ -191,6 +209,7 @@ macro_rules! stage_table {
                 fixed: $fixed,
                 fixed_span: optional_span!($($span)?),
                 across: optional_across!($($across)?),
+                lanes: optional_lanes!($($lanes)?),
                 float: $float,
                 float_reads_vertices: optional_flag!($($reads)?),
                 cost: $cost,
@@ -203,7 +222,7 @@ macro_rules! stage_table {
 stage_table! {
     /// Perspective-correct barycentrics (reciprocal unit + interpolator setup).
     Bary "bary" {
-        fixed: bary::fixed, fixed_span: bary::fixed_span, float: bary::float,
+        fixed: bary::fixed, fixed_span: bary::fixed_span, lanes: always, float: bary::float,
         float_reads_vertices: true, cost: bary::cost, lookups: no_lookups,
     }
     /// Vertex colour interpolation (Gouraud lighting result).
@@ -213,22 +232,24 @@ stage_table! {
     }
     /// Texture-coordinate interpolation, with the helper samples for derivatives.
     Texcoord "texcoord" {
-        fixed: texcoord::fixed, fixed_span: texcoord::fixed_span, float: texcoord::float,
-        float_reads_vertices: true, cost: texcoord::cost, lookups: no_lookups,
+        fixed: texcoord::fixed, fixed_span: texcoord::fixed_span, lanes: texcoord::lanes,
+        float: texcoord::float, float_reads_vertices: true, cost: texcoord::cost,
+        lookups: no_lookups,
     }
     /// LOD from the texture-coordinate derivatives.
     Lod "lod" {
-        fixed: lod::fixed, fixed_span: lod::fixed_span, across: lod::across, float: lod::float,
-        cost: lod::cost, lookups: no_lookups,
+        fixed: lod::fixed, fixed_span: lod::fixed_span, across: lod::across, lanes: lod::lanes,
+        float: lod::float, cost: lod::cost, lookups: no_lookups,
     }
     /// Wrap + trilinear MIP filtering (footprint assembly with `aniso_probes` > 1).
     Trilinear "trilinear" {
         fixed: trilinear::fixed, fixed_span: trilinear::fixed_span, across: always,
-        float: trilinear::float, cost: trilinear::cost, lookups: trilinear::lookups,
+        lanes: trilinear::lanes, float: trilinear::float, cost: trilinear::cost,
+        lookups: trilinear::lookups,
     }
     /// Colour x texel.
     Modulate "modulate" {
-        fixed: modulate::fixed, fixed_span: modulate::fixed_span, across: always,
+        fixed: modulate::fixed, fixed_span: modulate::fixed_span, across: always, lanes: always,
         float: modulate::float, cost: modulate::cost, lookups: no_lookups,
     }
     /// Bump materials: interpolation of the normal, frame vectors/lengths and light vectors.

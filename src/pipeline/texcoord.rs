@@ -73,6 +73,14 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
     }
 }
 
+/// Whether the fixed twins may run with the chain's signals in lanes
+/// ([`super::table::LanesFn`]): not on the float32 coordinate path ([`super::coord_f32`]),
+/// which keeps its coordinates in the fragments.
+#[must_use]
+pub fn lanes(m: &Machine, _: &Plan) -> bool {
+    m.hw.interp.coord_arith != CoordArith::Float32
+}
+
 /// Float twin.
 pub fn float(px: &Px, frag: &mut Frag, _: &mut Counters) {
     for s in 0..px.samples() {

@@ -36,6 +36,14 @@ fn aniso(px: &Px) -> bool {
     px.m.hw.trilinear.aniso_probes > 1 && px.plan.derivatives
 }
 
+/// Whether the fixed twins may run with the chain's signals in lanes
+/// ([`super::table::LanesFn`]): with one probe (footprint assembly reads the fragment's three
+/// samples' coordinates).
+#[must_use]
+pub fn lanes(m: &Machine, _: &Plan) -> bool {
+    m.hw.trilinear.aniso_probes <= 1
+}
+
 /// Fixed twin.
 pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let Some(t) = px.plan.texture else { return };
