@@ -283,7 +283,7 @@ impl<M: ConstRounding> ShiftRound<M> {
     #[must_use]
     pub fn apply(&self, x: i64) -> i64 {
         debug_assert!(x.unsigned_abs() < 1 << 62, "{x}");
-        (x + self.bias + ((x >> self.shift) & self.odd)) >> self.shift
+        self.apply_wrapping(x)
     }
 
     /// [`ShiftRound::apply`] with wrapping adds, so that it takes any `x` (a vector lane whose

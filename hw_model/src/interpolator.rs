@@ -1907,15 +1907,10 @@ impl<M: ConstRounding> PairLanes<M> {
     /// lane takes the exact path.
     #[inline(always)]
     fn new(attr: [[i64; 2]; 3], bary_bits: u32, out: &Format) -> Option<Self> {
-        let term = |ax: usize| {
-            let a0 = attr[0][ax];
-            Some((
-                a0.checked_mul(1i64.checked_shl(bary_bits)?)?,
-                attr[1][ax].checked_sub(a0)?,
-                attr[2][ax].checked_sub(a0)?,
-            ))
-        };
-        let terms = [term(0)?, term(1)?];
+        let terms = [
+            span_terms(&attr, bary_bits, 0)?,
+            span_terms(&attr, bary_bits, 1)?,
+        ];
         Some(Self {
             terms,
             round: crate::fixed::ShiftRound::new(bary_bits)?,
@@ -1975,6 +1970,23 @@ unsafe fn pair_lanes_avx512<M: ConstRounding, const L: usize>(
     pair_lanes(k, bary, lanes, uv, redo);
 }
 
+/// The sample-independent terms of attribute `ax` of a triangle's `attr` for
+/// [`interpolate_span`] and [`interpolate_lanes`]: `a0 2^B`, `a1 - a0`, `a2 - a0` (`B` =
+/// `bary_bits`), or `None` where one leaves `i64` (then the exact wide path runs).
+#[inline(always)]
+fn span_terms<const N: usize>(
+    attr: &[[i64; N]; 3],
+    bary_bits: u32,
+    ax: usize,
+) -> Option<(i64, i64, i64)> {
+    let a0 = attr[0][ax];
+    Some((
+        a0.checked_mul(1i64.checked_shl(bary_bits)?)?,
+        attr[1][ax].checked_sub(a0)?,
+        attr[2][ax].checked_sub(a0)?,
+    ))
+}
+
 /// [`interpolate_span`] compiled for the rounding mode `M` (`out.rounding`).
 #[inline(always)]
 fn interpolate_span_in<'a, M: ConstRounding, const N: usize>(
@@ -1986,15 +1998,8 @@ fn interpolate_span_in<'a, M: ConstRounding, const N: usize>(
 ) {
     // The sample-independent terms `a0 2^B`, `a1 - a0`, `a2 - a0` once per attribute; an
     // accumulator that leaves `i64` takes `interpolate`'s exact wide path.
-    let terms = |ax: usize| {
-        let a0 = attr[0][ax];
-        Some((
-            a0.checked_mul(1i64.checked_shl(bary_bits)?)?,
-            attr[1][ax].checked_sub(a0)?,
-            attr[2][ax].checked_sub(a0)?,
-        ))
-    };
-    let all: [Option<(i64, i64, i64)>; N] = std::array::from_fn(terms);
+    let all: [Option<(i64, i64, i64)>; N] =
+        std::array::from_fn(|ax| span_terms(&attr, bary_bits, ax));
     if all.iter().any(Option::is_none) {
         for (bary, result) in lanes {
             for (b, r) in bary.iter().zip(result.iter_mut()) {

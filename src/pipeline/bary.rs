@@ -88,23 +88,11 @@ pub fn fixed_span(px: &Px, frags: &mut [Frag], c: &mut Counters) {
         }
         return carriers(px, frags);
     }
-    let hw = px.m.hw;
-    let sub = hw.raster.subpixel_bits;
-    let n = frags.len();
-    let steps = (span_edges(px.m, px.plan) && (n > 1 || px.plan.derivatives))
-        .then(|| px.tri.edges_fixed_span(px.x, px.y, n, sub))
-        .flatten();
-    let Some((e, dx, dy)) = steps else {
+    let Some(span) = edge_span(px, frags.len()) else {
         return each_fragment(fixed, px, frags, c);
     };
     let sat = &mut c.sat[StageKind::Bary.index()];
-    let (inv_w, cfg, recip) = (px.a.inv_w_x, &hw.interp, &px.m.recip);
-    let span = EdgeSpan {
-        edge: e,
-        dx,
-        dy,
-        lanes: n,
-    };
+    let (inv_w, cfg, recip) = (px.a.inv_w_x, &px.m.hw.interp, &px.m.recip);
     if px.plan.derivatives {
         let out = |j: usize, b| frags[j].bary_x = b;
         perspective_bary_derivs_span(&span, inv_w, cfg, recip, sat, out);
@@ -131,15 +119,7 @@ fn into_lanes(px: &Px, frags: &mut [Frag], lanes: &mut Lanes, c: &mut Counters) 
         }
         return;
     }
-    let hw = px.m.hw;
-    let n = frags.len();
-    let steps = span_edges(px.m, px.plan)
-        .then(|| {
-            px.tri
-                .edges_fixed_span(px.x, px.y, n, hw.raster.subpixel_bits)
-        })
-        .flatten();
-    let Some((edge, dx, dy)) = steps else {
+    let Some(span) = edge_span(px, frags.len()) else {
         each_fragment(fixed, px, frags, c);
         for (j, frag) in frags.iter().enumerate() {
             out.lane(j, frag.bary_x);
@@ -147,13 +127,24 @@ fn into_lanes(px: &Px, frags: &mut [Frag], lanes: &mut Lanes, c: &mut Counters) 
         return;
     };
     let sat = &mut c.sat[StageKind::Bary.index()];
-    let span = EdgeSpan {
+    perspective_bary_derivs_span(&span, px.a.inv_w_x, &px.m.hw.interp, &px.m.recip, sat, out);
+}
+
+/// The `n` pixels of the span at `px` as the span datapath takes them: their edges and
+/// steps on the raster's grid, when the plan takes the span datapath ([`span_edges`]), the
+/// span is worth it (more than one pixel, or derivatives) and the steps fit `i64`.
+fn edge_span(px: &Px, n: usize) -> Option<EdgeSpan> {
+    if !(span_edges(px.m, px.plan) && (n > 1 || px.plan.derivatives)) {
+        return None;
+    }
+    let sub = px.m.hw.raster.subpixel_bits;
+    let (edge, dx, dy) = px.tri.edges_fixed_span(px.x, px.y, n, sub)?;
+    Some(EdgeSpan {
         edge,
         dx,
         dy,
         lanes: n,
-    };
-    perspective_bary_derivs_span(&span, px.a.inv_w_x, &hw.interp, &px.m.recip, sat, out);
+    })
 }
 
 /// The float carriers of the span's raw barycentrics, when the run reads them.

@@ -91,8 +91,8 @@ pub type SpanFn = fn(&Px, &mut [Frag], &mut Counters);
 pub type AcrossFn = fn(&Machine, &Plan) -> bool;
 /// Whether a stage's fixed twins may run in a program that keeps the chain's signals in the
 /// run's lanes ([`super::lanes`]) in a plan on a machine: given [`Px::lanes`], its span twin
-/// reads and writes the barycentrics, texture coordinates and LOD there, and neither twin
-/// reads those fields of a fragment otherwise (the per-fragment twin never sees lanes).
+/// reads and writes the barycentrics and texture coordinates there, and neither twin reads
+/// those fields of a fragment otherwise (the per-fragment twin never sees lanes).
 pub type LanesFn = fn(&Machine, &Plan) -> bool;
 /// A stage's cost per invocation in a plan on a machine (fixed units' ops, cycles, texels).
 pub type CostFn = fn(&Machine, &Plan) -> UnitCost;
@@ -150,23 +150,13 @@ macro_rules! optional_span {
     };
 }
 
-/// A row's `across`: [`never`] unless given.
-macro_rules! optional_across {
+/// A row's `across` or `lanes`: [`never`] unless given.
+macro_rules! or_never {
     () => {
         never
     };
-    ($across:expr) => {
-        $across
-    };
-}
-
-/// A row's `lanes`: [`never`] unless given.
-macro_rules! optional_lanes {
-    () => {
-        never
-    };
-    ($lanes:expr) => {
-        $lanes
+    ($f:expr) => {
+        $f
     };
 }
 
@@ -208,8 +198,8 @@ macro_rules! stage_table {
                 name: $name,
                 fixed: $fixed,
                 fixed_span: optional_span!($($span)?),
-                across: optional_across!($($across)?),
-                lanes: optional_lanes!($($lanes)?),
+                across: or_never!($($across)?),
+                lanes: or_never!($($lanes)?),
                 float: $float,
                 float_reads_vertices: optional_flag!($($reads)?),
                 cost: $cost,
