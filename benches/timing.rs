@@ -8,6 +8,7 @@ use texsim::timing::{cycles, simulate};
 fn model(c: &mut Criterion) {
     for (name, preset) in [
         ("demo", "texram16"),
+        ("w1-plane", "texram16"),
         ("demo", "d3d11"),
         ("w2-mesh", "d3d11"),
     ] {

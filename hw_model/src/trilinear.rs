@@ -1236,7 +1236,8 @@ mod tests {
     /// weight width, coordinates with 4 to 30 fraction bits (and 31 or more, refused), LOD
     /// fractions of 0 to 20 bits (above 16 refused), LODs below the first level and beyond the
     /// last, coordinates near 0 and past `2^29` (sampled by themselves), batches of 1 to 16
-    /// lanes; short and non-power-of-two chains refused by [`BatchLevels::new`].
+    /// lanes (77k batches whose lanes all read one level, which skip the second); short and
+    /// non-power-of-two chains refused by [`BatchLevels::new`].
     #[test]
     fn batch_matches_sample_pow2_repeat() {
         let mut s = 0x5eed_0b17;
@@ -1246,7 +1247,8 @@ mod tests {
         assert!(batch_levels[..4].iter().all(Option::is_some));
         assert!(batch_levels[4..].iter().all(Option::is_none));
         let (mut lanes, mut refused, mut wide, mut two) = (0u32, 0u32, 0u32, 0u32);
-        let mut fp_lanes = 0u32;
+        // Batches whose lanes all read one level (the passes then skip the second).
+        let (mut fp_lanes, mut one_level) = (0u32, 0u32);
         for i in 0..300_000u32 {
             let cfg = cycled_config(i);
             let c = (i / 153 % 4) as usize;
@@ -1307,6 +1309,7 @@ mod tests {
                         let at = batch::Levels { levels, shape: bl };
                         let pfps = traced.then_some(&mut portable_fps);
                         batch::batch_passes(&unit, &at, &batch, n, &mut portable, pfps);
+                        let mut any_two = false;
                         for j in 0..n {
                             let (u, v, lod) = (batch.u[j], batch.v[j], batch.lod[j]);
                             let mut trace = TrilinearTrace::default();
@@ -1330,8 +1333,11 @@ mod tests {
                             }
                             let lf_mask = (1 << lfb) - 1;
                             let inner = lod > 0 && (lod >> lfb) < levels.len() as i64 - 1;
-                            two += u32::from(inner && lod & lf_mask != 0);
+                            let blends = inner && lod & lf_mask != 0;
+                            two += u32::from(blends);
+                            any_two |= blends;
                         }
+                        one_level += u32::from(!any_two);
                     }
                 })
             });
@@ -1341,6 +1347,7 @@ mod tests {
             "{lanes} {refused} {wide} {two}"
         );
         assert!(fp_lanes > 700_000, "{fp_lanes}");
+        assert!(one_level > 60_000, "{one_level}");
     }
 
     /// A sample's footprints: (level, columns, rows) of each level it used.
