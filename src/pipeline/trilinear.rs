@@ -175,10 +175,7 @@ fn batches<F: ConstRounding, W: ConstRounding, U: Uv0>(
         .then(BatchFootprints::default);
     for (k, chunk) in frags.chunks_mut(BATCH_LANES).enumerate() {
         let first = k * BATCH_LANES;
-        for (j, frag) in chunk.iter().enumerate() {
-            [batch.u[j], batch.v[j]] = uv.uv0(first + j, frag);
-            batch.lod[j] = frag.lod_x;
-        }
+        uv.fill(first, chunk, &mut batch);
         let traced = fps.as_mut();
         if !unit.sample_batch_pow2_repeat(levels, shape, &batch, chunk.len(), &mut out, traced) {
             // Levels of another shape than the machine's (not reached): sample by sample.
@@ -211,6 +208,15 @@ type Batches<'a, F, W> = (
 /// run, `frag`.
 trait Uv0 {
     fn uv0(&self, j: usize, frag: &Frag) -> [i64; 2];
+
+    /// The batch's coordinates and raw LODs from `chunk`, fragments `first..` of the run.
+    #[inline(always)]
+    fn fill(&self, first: usize, chunk: &[Frag], batch: &mut SampleBatch) {
+        for (j, frag) in chunk.iter().enumerate() {
+            [batch.u[j], batch.v[j]] = self.uv0(first + j, frag);
+            batch.lod[j] = frag.lod_x;
+        }
+    }
 }
 
 /// In the fragments ([`Frag::uv_x`]).
@@ -233,6 +239,19 @@ impl Uv0 for InLanes<'_> {
     #[inline(always)]
     fn uv0(&self, j: usize, _: &Frag) -> [i64; 2] {
         self.lanes.uv0(self.base + j)
+    }
+
+    /// The coordinates copied from the lanes as slices (W1's fastest frame -4% against lane
+    /// by lane, and -3% against copying whole batches of lanes, stop 61).
+    #[inline(always)]
+    fn fill(&self, first: usize, chunk: &[Frag], batch: &mut SampleBatch) {
+        let (at, n) = (self.base + first, chunk.len());
+        let [u, v] = &self.lanes.uv[0];
+        batch.u[..n].copy_from_slice(&u[at..at + n]);
+        batch.v[..n].copy_from_slice(&v[at..at + n]);
+        for (lod, frag) in batch.lod.iter_mut().zip(chunk) {
+            *lod = frag.lod_x;
+        }
     }
 }
 
