@@ -242,7 +242,7 @@ impl Uv0 for InLanes<'_> {
     }
 
     /// The coordinates copied from the lanes as slices (W1's fastest frame -4% against lane
-    /// by lane, and -3% against copying whole batches of lanes, stop 61).
+    /// by lane, and -2% against copying whole batches of lanes, stop 61).
     #[inline(always)]
     fn fill(&self, first: usize, chunk: &[Frag], batch: &mut SampleBatch) {
         let (at, n) = (self.base + first, chunk.len());
