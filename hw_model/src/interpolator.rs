@@ -1025,27 +1025,14 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
             s,
             q: [q1, q2],
             a: [st.a[1], st.a[2]],
-            ty: [[(0, 0); HELD_LANES]; 2],
+            ny: [(0, 0); 2],
+            y_step: st.y_step.map(words),
             k: span_consts,
         };
         let mut wide = HeldLanes::<HELD_LANES>::default();
         while span.lanes - j0 >= HELD_MIN_LANES {
             let n = (span.lanes - j0).min(HELD_LANES);
-            (input.n, input.d, input.q) = (n, d, [q1, q2]);
-            // Each lane's y numerators' tops; the lanes past the span repeat its last (so
-            // `nyj` ends at the batch's last lane).
-            let mut nyj = ny;
-            // Lane by lane with indices: the iterator form clippy prefers made this function's
-            // short spans (no batch) 1.5 ms a W2 frame slower at one thread.
-            #[allow(clippy::needless_range_loop)]
-            for c in 0..HELD_LANES {
-                for k in 0..2 {
-                    input.ty[k][c] = span_consts.y_top(k, nyj[k]);
-                    if c + 1 < n {
-                        nyj[k] = nyj[k].wrapping_add(st.y_step[k]);
-                    }
-                }
-            }
+            (input.n, input.d, input.q, input.ny) = (n, d, [q1, q2], ny.map(words));
             if !held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
                 break;
             }
@@ -1057,7 +1044,8 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
                 let n64 = n as i64;
                 q1 = q1.wrapping_add(n64.wrapping_mul(st.a[1]));
                 q2 = q2.wrapping_add(n64.wrapping_mul(st.a[2]));
-                ny = [0, 1].map(|k| nyj[k].wrapping_add(st.y_step[k]));
+                let n128 = i128::from(n64);
+                ny = [0, 1].map(|k| ny[k].wrapping_add(n128.wrapping_mul(st.y_step[k])));
                 d = d.wrapping_add(n64.wrapping_mul(s));
                 j0 += n;
                 continue;
@@ -1192,16 +1180,18 @@ trait HeldInputs<const L: usize> {
 }
 
 /// The inputs of one batch of a span's lanes in [`derivs_span_held`]: the lanes it takes
-/// (`n`, 1 to `L`; the lanes past them repeat its last), `D`, `q_1` and `q_2` at its first
-/// lane and their steps, each lane's y numerators' tops, and the span's constants `k` (the
-/// x numerators' tops, the drops and the range of `1/D^2`'s exponent: [`HeldInputs`]).
+/// (`n`, 1 to `L`; the lanes past them repeat its last), `D`, `q_1`, `q_2` and the y
+/// numerators (as high and low words) at its first lane and their steps, and the span's
+/// constants `k` (the x numerators' tops, the drops and the range of `1/D^2`'s exponent:
+/// [`HeldInputs`]).
 struct HeldBatch<'k, const L: usize> {
     n: usize,
     d: i64,
     s: i64,
     q: [i64; 2],
     a: [i64; 2],
-    ty: [[(i64, u64); L]; 2],
+    ny: [(i64, u64); 2],
+    y_step: [(i64, u64); 2],
     k: &'k LaneConsts,
 }
 
@@ -1227,7 +1217,8 @@ impl<const L: usize> HeldInputs<L> for HeldBatch<'_, L> {
         if k < 2 {
             self.k.nx[k]
         } else {
-            self.ty[k - 2][c]
+            let i = k - 2;
+            y_top_lane(self.ny[i], self.y_step[i], self.k.ns_y[i], self.lane(c))
         }
     }
     #[inline(always)]
@@ -1268,9 +1259,34 @@ impl LaneConsts {
     /// The top of y numerator `i` (`ny`, of a lane) as high and low words: `ny` less its drop.
     #[inline(always)]
     fn y_top(&self, i: usize, ny: i128) -> (i64, u64) {
-        let t = ny >> (self.ns_y[i] & 63);
-        ((t >> 64) as i64, t as u64)
+        words(ny >> (self.ns_y[i] & 63))
     }
+}
+
+/// `x` as its high (signed) and low words.
+#[inline(always)]
+fn words(x: i128) -> (i64, u64) {
+    ((x >> 64) as i64, x as u64)
+}
+
+/// [`LaneConsts::y_top`] of the y numerator `ny + c step` (wrapping; `ny`, `step` as high and
+/// low words, drop `ns`) for a lane `c` in 0..16, in 64-bit words with no branch (a vector
+/// lane): `c step` from `c` times the step's high word and its low word's two 32-bit halves,
+/// the sum's carry by compare, the drop a funnel shift. Bit-identical to the 128-bit form
+/// (`derivs_span_stepping_matches_per_lane_calls`, `y_top_lane_matches_the_wide_form`).
+#[inline(always)]
+fn y_top_lane((nh, nl): (i64, u64), (sh, sl): (i64, u64), ns: u32, c: i64) -> (i64, u64) {
+    let cu = c as u64;
+    // `c sl` as 128 bits: its low word, and its high word from `c < 2^4` and 32-bit halves.
+    let lo_off = cu.wrapping_mul(sl);
+    let hi_off = (cu * (sl >> 32) + ((cu * (sl & 0xffff_ffff)) >> 32)) >> 32;
+    let lo = nl.wrapping_add(lo_off);
+    let hi = nh
+        .wrapping_add(c.wrapping_mul(sh))
+        .wrapping_add(hi_off as i64)
+        .wrapping_add(i64::from(lo < lo_off));
+    let ns = ns & 63;
+    ((hi >> ns), (lo >> ns) | ((hi as u64) << 1 << (63 - ns)))
 }
 
 /// Held lanes ([`held_form`]) gathered across spans for one vector batch of `L` lanes
@@ -2982,6 +2998,29 @@ mod tests {
     /// of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
     /// other span goes into lanes from a random base ([`DerivLanes`], which stores a batch
     /// whose lanes all took the fast form whole): the same bits, the other lanes untouched.
+    /// `y_top_lane` against the 128-bit sum and shift it stands for: 4M seeded cases of
+    /// numerators and steps of 1 to 127 bits either sign, every lane 0..16 and drop 0..64.
+    #[test]
+    fn y_top_lane_matches_the_wide_form() {
+        let mut s = 0x0707_1e5e;
+        let wide = |s: &mut u64| {
+            let bits = 1 + (next(s) % 127) as u32;
+            let x = (u128::from(next(s)) << 64 | u128::from(next(s))) as i128;
+            x >> (128 - bits)
+        };
+        for _ in 0..1 << 18 {
+            let (ny, step, ns) = (wide(&mut s), wide(&mut s), (next(&mut s) % 64) as u32);
+            for c in 0..16i64 {
+                let want = words(ny.wrapping_add(i128::from(c).wrapping_mul(step)) >> ns);
+                assert_eq!(
+                    y_top_lane(words(ny), words(step), ns, c),
+                    want,
+                    "{ny} {step} {ns} {c}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;
