@@ -521,15 +521,25 @@ impl From<WrapArg> for crate::scene::WrapMode {
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
-    if let Some(n) = cli.threads {
-        if n == 0 {
-            return Err(Error::field("--threads", "must be at least 1"));
-        }
-        // A second initialization (tests calling run twice) keeps the first pool: harmless.
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global();
+    if cli.threads == Some(0) {
+        return Err(Error::field("--threads", "must be at least 1"));
     }
+    // A second initialization (tests calling run twice) keeps the first pool: harmless.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(cli.threads.unwrap_or(0))
+        .stack_size(WORKER_STACK)
+        .build_global();
+    rayon::scope(|_| dispatch(cli))
+}
+
+/// The stack of the worker threads, on one of which [`run`] runs the command: as large as a
+/// main thread's usual 8 MiB.
+const WORKER_STACK: usize = 8 << 20;
+
+/// [`run`] on a worker thread of the global pool: the command's parallel loops start there,
+/// not by waking a worker from the main thread and waiting for it (which cost each of a
+/// frame's parallel phases a thread switch).
+fn dispatch(cli: Cli) -> Result<()> {
     crate::budget::check_env()?;
     if let Some(m) = &cli.max_memory {
         let bytes = crate::budget::parse_size(m).map_err(|e| e.context("--max-memory"))?;
