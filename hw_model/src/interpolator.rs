@@ -2986,18 +2986,6 @@ mod tests {
         assert_eq!(sat.saturated, 2);
     }
 
-    /// 480k seeded spans of 1 to 24 lanes over 6 configurations x 3 interpolator roundings,
-    /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
-    /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
-    /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
-    /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
-    /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
-    /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
-    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`. Spans
-    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX-512: many
-    /// of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
-    /// other span goes into lanes from a random base ([`DerivLanes`], which stores a batch
-    /// whose lanes all took the fast form whole): the same bits, the other lanes untouched.
     /// `y_top_lane` against the 128-bit sum and shift it stands for: 4M seeded cases of
     /// numerators and steps of 1 to 127 bits either sign, every lane 0..16 and drop 0..64.
     #[test]
@@ -3021,6 +3009,18 @@ mod tests {
         }
     }
 
+    /// 480k seeded spans of 1 to 24 lanes over 6 configurations x 3 interpolator roundings,
+    /// edges and steps from 4 to 62 bits, so that `q_i = E_i invw_i` and `D` at the span's
+    /// ends straddle `i64` and 2^62: `perspective_bary_derivs_span` gives one
+    /// `perspective_bary_derivs` call per lane, bits and counts, and lanes of the fast form
+    /// are many in spans that take the steady loop (steps and both ends below 2^62), in other
+    /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
+    /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
+    /// small and positive), so that many lanes of the held loop need the clamp of `p_i`. Spans
+    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX-512: many
+    /// of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
+    /// other span goes into lanes from a random base ([`DerivLanes`], which stores a batch
+    /// whose lanes all took the fast form whole): the same bits, the other lanes untouched.
     #[test]
     fn derivs_span_stepping_matches_per_lane_calls() {
         let mut s = 0x5eed_0b47;

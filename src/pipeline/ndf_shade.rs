@@ -40,7 +40,7 @@ fn spec_scale(np: &NdfPlan) -> f64 {
 pub fn fixed(px: &Px, frag: &mut Frag, c: &mut Counters) {
     let Some((np, bp)) = plans(px) else { return };
     let m = px.m;
-    let Some(unit) = m.ndf.as_ref() else {
+    let Some(unit) = m.ndf() else {
         return float(px, frag, c);
     };
     let hw = m.hw;
