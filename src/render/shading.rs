@@ -133,9 +133,8 @@ fn uv_bounds(geo: &Geometry) -> Option<([f64; 2], [f64; 2])> {
 
 /// The most pixels per triangle at which [`tri_attrs`] scans the visibility buffer for the
 /// triangles it shades ([`shaded_triangles`]): with fewer triangles, the scan costs more than
-/// converting every triangle (W1, two triangles: the scan of its 1M pixels
-/// took 0.65 ms of a 25 ms frame). Either way the attributes shaded and the overflow counts
-/// are the same.
+/// converting every triangle (W1, two triangles: the scan of its 1M pixels took 0.65 ms of a
+/// 25 ms frame). Either way the attributes shaded and the overflow counts are the same.
 const SCAN_PIXELS_PER_TRI: usize = 256;
 
 /// Per-triangle attributes of every screen triangle in the machine's formats and, when
