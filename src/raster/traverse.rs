@@ -549,6 +549,13 @@ fn band(
                             &mut depth[row + xl as usize..row + xr as usize],
                             &mut tri[row + xl as usize..row + xr as usize],
                         );
+                        if d.len() >= 2 * DEPTH_LANES {
+                            let walk = (q, r, dq, dr);
+                            if let Some(f) = depth_test_long(walk, ft.den, zmax, id, d, t) {
+                                st.depth_fails += f;
+                                return;
+                            }
+                        }
                         let mut fails = 0;
                         for (dz, tz) in d.iter_mut().zip(t.iter_mut()) {
                             let zq = q.clamp(0, i64::from(zmax)) as u32;
@@ -593,6 +600,172 @@ fn band(
         }
     }
     st
+}
+
+/// The strictly-less depth test of a span of at least [`DEPTH_LANES`] x 2 pixels (`d` their
+/// stored depths, `t` their triangles) from the depth walker `(q, r, dq, dr)` of
+/// [`FixedTri::depth_start`] (quotient and remainder over `den`, stepped per pixel), the
+/// depths clamped to `0..=zmax`; a passing pixel takes `id`. Returns the pixels that fail, or
+/// `None` where [`DepthLanes`] do not serve the span (the band's loop then walks it pixel by
+/// pixel). [`DEPTH_LANES`] pixels at once, bit-identical to that walk
+/// (`depth_lanes_match_the_pixel_walk`). Out of line, so that the loop of short spans (a
+/// mesh's) compiles as before.
+#[inline(never)]
+fn depth_test_long(
+    walk: (i64, i64, i64, i64),
+    den: i64,
+    zmax: u32,
+    id: u32,
+    d: &mut [u32],
+    t: &mut [u32],
+) -> Option<u64> {
+    let lanes = DepthLanes::new(walk, den)?;
+    #[cfg(target_arch = "x86_64")]
+    if hw_model::has_avx512() {
+        // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
+        return Some(unsafe { depth_lanes_avx512(lanes, zmax, id, d, t) });
+    }
+    Some(depth_lanes(lanes, zmax, id, d, t))
+}
+
+/// One pixel's strictly-less test of the depth quotient `q` clamped to `0..=zmax` against
+/// the stored depth `dz`: a passing pixel stores it and takes `id`. Returns whether it passed.
+#[inline(always)]
+fn depth_pass(q: i64, zmax: u32, id: u32, dz: &mut u32, tz: &mut u32) -> bool {
+    let zq = q.clamp(0, i64::from(zmax)) as u32;
+    let pass = zq < *dz;
+    // The outcomes are not predictable: selects, not branches.
+    *dz = std::hint::select_unpredictable(pass, zq, *dz);
+    *tz = std::hint::select_unpredictable(pass, id, *tz);
+    pass
+}
+
+/// The depth walker's quotient and remainder over `den` advanced by `(dq, dr)` (`dr < den`).
+#[inline(always)]
+fn depth_step((q, r): (i64, i64), (dq, dr): (i64, i64), den: i64) -> (i64, i64) {
+    let r = r + dr;
+    let carry = r >= den;
+    (q + dq + i64::from(carry), r - if carry { den } else { 0 })
+}
+
+/// Lanes of [`depth_lanes`]: pixels walked at once.
+const DEPTH_LANES: usize = 8;
+
+/// The depth walker of a span as [`DEPTH_LANES`] lanes: lane `l` at pixel `l` (its quotient
+/// `q` and remainder `r` over `den`), and the step of `DEPTH_LANES` pixels, `DEPTH_LANES`
+/// times the per-pixel step `(dq, dr)` as a quotient and a remainder below `den`.
+#[derive(Clone, Copy)]
+struct DepthLanes {
+    q: [i64; DEPTH_LANES],
+    r: [i64; DEPTH_LANES],
+    step: (i64, i64),
+    den: i64,
+}
+
+impl DepthLanes {
+    /// `None` when the lanes' step would leave `i64` (then the span is walked pixel by
+    /// pixel). The quotients are only bounded between a span's covered pixels, so the lanes
+    /// serve a span of at least `DEPTH_LANES` + 1 pixels (its pixel `DEPTH_LANES` is covered).
+    #[inline(always)]
+    fn new((q, r, dq, dr): (i64, i64, i64, i64), den: i64) -> Option<Self> {
+        let lanes = DEPTH_LANES as i64;
+        let carries = (dr.checked_mul(lanes)?).div_euclid(den);
+        let step = (
+            dq.checked_mul(lanes)?.checked_add(carries)?,
+            dr * lanes - carries * den,
+        );
+        let mut walker = Self {
+            q: [q; DEPTH_LANES],
+            r: [r; DEPTH_LANES],
+            step,
+            den,
+        };
+        for l in 1..DEPTH_LANES {
+            (walker.q[l], walker.r[l]) =
+                depth_step((walker.q[l - 1], walker.r[l - 1]), (dq, dr), den);
+        }
+        Some(walker)
+    }
+}
+
+/// [`depth_test_long`] on [`DepthLanes`]: each chunk of [`DEPTH_LANES`] pixels tested and the
+/// lanes stepped at once, the last pixels by the lanes where they stand.
+#[inline(always)]
+fn depth_lanes(mut w: DepthLanes, zmax: u32, id: u32, d: &mut [u32], t: &mut [u32]) -> u64 {
+    let mut fails = 0;
+    let (mut dc, mut tc) = (
+        d.chunks_exact_mut(DEPTH_LANES),
+        t.chunks_exact_mut(DEPTH_LANES),
+    );
+    for (d, t) in (&mut dc).zip(&mut tc) {
+        for l in 0..DEPTH_LANES {
+            fails += u64::from(!depth_pass(w.q[l], zmax, id, &mut d[l], &mut t[l]));
+            (w.q[l], w.r[l]) = depth_step((w.q[l], w.r[l]), w.step, w.den);
+        }
+    }
+    let (d, t) = (dc.into_remainder(), tc.into_remainder());
+    for ((dz, tz), &q) in d.iter_mut().zip(t.iter_mut()).zip(&w.q) {
+        fails += u64::from(!depth_pass(q, zmax, id, dz, tz));
+    }
+    fails
+}
+
+/// [`depth_lanes`] in AVX-512 registers: the lanes' quotients and remainders in two vectors
+/// of eight `i64`, the test a compare mask that the stores of the depths and triangles take
+/// (the compiler's own vectors of [`depth_lanes`] moved that mask through general registers,
+/// W1: 3.2% of the frame's samples).
+///
+/// # Safety
+/// The CPU must have AVX-512 F, DQ, CD and VL (`hw_model::has_avx512`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+unsafe fn depth_lanes_avx512(
+    w: DepthLanes,
+    zmax: u32,
+    id: u32,
+    d: &mut [u32],
+    t: &mut [u32],
+) -> u64 {
+    use std::arch::x86_64::{
+        _mm256_cmplt_epu32_mask, _mm256_loadu_si256, _mm256_mask_storeu_epi32, _mm256_set1_epi32,
+        _mm512_add_epi64, _mm512_cmpge_epi64_mask, _mm512_cvtepi64_epi32, _mm512_loadu_si512,
+        _mm512_mask_sub_epi64, _mm512_max_epi64, _mm512_min_epi64, _mm512_set1_epi64,
+        _mm512_setzero_si512, _mm512_storeu_si512,
+    };
+    const _: () = assert!(DEPTH_LANES == 8);
+    let n = d.len().min(t.len());
+    let whole = n - n % DEPTH_LANES;
+    let mut q = _mm512_loadu_si512(w.q.as_ptr().cast());
+    let mut r = _mm512_loadu_si512(w.r.as_ptr().cast());
+    let (step_q, step_r) = (_mm512_set1_epi64(w.step.0), _mm512_set1_epi64(w.step.1));
+    let den = _mm512_set1_epi64(w.den);
+    let (zero, top) = (_mm512_setzero_si512(), _mm512_set1_epi64(i64::from(zmax)));
+    // A carry adds 1 to a quotient: subtracting the mask's -1.
+    let minus_one = _mm512_set1_epi64(-1);
+    let ids = _mm256_set1_epi32(id as i32);
+    let mut passed = 0u64;
+    for k in (0..whole).step_by(DEPTH_LANES) {
+        // SAFETY: `k + DEPTH_LANES <= n`, within both slices.
+        let (dp, tp) = (d.as_mut_ptr().add(k), t.as_mut_ptr().add(k));
+        let zq = _mm512_cvtepi64_epi32(_mm512_min_epi64(_mm512_max_epi64(q, zero), top));
+        let pass = _mm256_cmplt_epu32_mask(zq, _mm256_loadu_si256(dp.cast()));
+        _mm256_mask_storeu_epi32(dp.cast(), pass, zq);
+        _mm256_mask_storeu_epi32(tp.cast(), pass, ids);
+        passed += u64::from(pass.count_ones());
+        r = _mm512_add_epi64(r, step_r);
+        let carry = _mm512_cmpge_epi64_mask(r, den);
+        r = _mm512_mask_sub_epi64(r, carry, r, den);
+        let stepped = _mm512_add_epi64(q, step_q);
+        q = _mm512_mask_sub_epi64(stepped, carry, stepped, minus_one);
+    }
+    // The last pixels take the lanes' quotients where they stand.
+    let mut last = [0i64; DEPTH_LANES];
+    _mm512_storeu_si512(last.as_mut_ptr().cast(), q);
+    let mut fails = whole as u64 - passed;
+    for ((dz, tz), &q) in d[whole..n].iter_mut().zip(&mut t[whole..n]).zip(&last) {
+        fails += u64::from(!depth_pass(q, zmax, id, dz, tz));
+    }
+    fails
 }
 
 /// A prepared triangle handed to a span callback (fixed: with the edge values at `xl`).
@@ -720,6 +893,119 @@ mod tests {
     use super::*;
     use crate::raster::VertexSource;
     use crate::rng_common::Rng;
+
+    /// The depth test of spans of at least 16 pixels through [`depth_test_long`] (and its
+    /// lanes compiled without AVX-512), and of shorter ones through the walk's steps
+    /// ([`depth_pass`], [`depth_step`]), against each pixel's exact rounded depth
+    /// `floor((2 sum(e_i z_i) + den / 2) / den)` in `i128`, on 20k seeded triangles (depths
+    /// below 2^30, every depth width, sub-pixel widths 1 to 12): the same stored depths,
+    /// triangles and failures over random stored depths. (The band's own loop of short spans
+    /// is checked against a brute-force model in `tests/pipeline/raster_rules.rs`.)
+    #[test]
+    fn depth_lanes_match_the_pixel_walk() {
+        let mut rng = Rng(0xdef7_1a2e);
+        let (mut lane_spans, mut pixels) = (0u64, 0u64);
+        for i in 0..20_000u32 {
+            let s = 1 + i % 12;
+            let scale = 1i64 << s;
+            let reach = [8i64, 64, 400][(i % 3) as usize] * scale;
+            let c = [rng.int_in(0, 600) * scale, rng.int_in(0, 600) * scale];
+            let mut xy = [[0i64; 2]; 3];
+            for p in &mut xy {
+                *p = [
+                    c[0] + rng.int_in(-reach, reach),
+                    c[1] + rng.int_in(-reach, reach),
+                ];
+            }
+            let cross = (xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1])
+                - (xy[1][1] - xy[0][1]) * (xy[2][0] - xy[0][0]);
+            if cross == 0 {
+                continue;
+            }
+            if cross < 0 {
+                xy.swap(1, 2);
+            }
+            let db = 8 + i % 23;
+            let zmax = (1u32 << db) - 1;
+            let z = [0; 3].map(|_: u32| rng.int_in(0, i64::from(zmax)) as u32);
+            let width = 1024u32;
+            let lo = |c: usize| xy.iter().map(|p| p[c]).min().unwrap_or(0) >> s;
+            let hi = |c: usize| xy.iter().map(|p| p[c]).max().unwrap_or(0) >> s;
+            let clampw = |v: i64| v.clamp(0, i64::from(width)) as u32;
+            let t = ScreenTri {
+                xy,
+                xy_f: [[0.0; 2]; 3],
+                z,
+                z_f: [0.0; 3],
+                inv_w: [1.0; 3],
+                src: 0,
+                source: VertexSource::Unclipped { swapped: false },
+                area2: cross.abs(),
+                area2_f: 1.0,
+                bbox: [clampw(lo(0) - 1), 0, clampw(hi(0) + 2), 0],
+            };
+            let ft = FixedTri::new(&t, s, width);
+            let (py0, py1) = (lo(1), hi(1) + 1);
+            let mut walk = ft.walk(py0, py1);
+            for py in py0..py1 {
+                if py > py0 {
+                    ft.walk_next(&mut walk);
+                }
+                let (xl, xr, ev) = ft.walk_span(&walk);
+                if xl >= xr {
+                    continue;
+                }
+                let n = (xr - xl) as usize;
+                lane_spans += u64::from(n >= 2 * DEPTH_LANES);
+                pixels += n as u64;
+                let stored: Vec<u32> = (0..n)
+                    .map(|_| rng.int_in(0, i64::from(zmax)) as u32)
+                    .collect();
+                let (mut d, mut tris) = (stored.clone(), vec![7u32; n]);
+                let walk = ft.depth_start(&ev, xr - xl);
+                let fails = if n >= 2 * DEPTH_LANES {
+                    let f = depth_test_long(walk, ft.den, zmax, 3, &mut d, &mut tris);
+                    f.expect("lanes for a span's step")
+                } else {
+                    let (mut q, mut r) = (walk.0, walk.1);
+                    let mut fails = 0;
+                    for (dz, tz) in d.iter_mut().zip(tris.iter_mut()) {
+                        fails += u64::from(!depth_pass(q, zmax, 3, dz, tz));
+                        (q, r) = depth_step((q, r), (walk.2, walk.3), ft.den);
+                    }
+                    fails
+                };
+                let mut want_fails = 0;
+                for j in 0..n {
+                    let e = [0, 1, 2].map(|k| i128::from(ev[k] + ft.e[k].step * j as i64));
+                    let num: i128 = (0..3).map(|k| e[k] * i128::from(z[k])).sum();
+                    let den = i128::from(ft.den);
+                    let zq = (2 * num + den / 2)
+                        .div_euclid(den)
+                        .clamp(0, i128::from(zmax)) as u32;
+                    let pass = zq < stored[j];
+                    want_fails += u64::from(!pass);
+                    let want = if pass { (zq, 3) } else { (stored[j], 7) };
+                    assert_eq!(
+                        (d[j], tris[j]),
+                        want,
+                        "{xy:?} s {s} row {py} pixel {j} of {n}"
+                    );
+                }
+                assert_eq!(fails, want_fails, "{xy:?} s {s} row {py}");
+                // The lanes compiled without AVX-512 too.
+                if let (Some(walk), true) = (DepthLanes::new(walk, ft.den), n >= 2 * DEPTH_LANES) {
+                    let (mut d2, mut t2) = (stored.clone(), vec![7u32; n]);
+                    let f2 = depth_lanes(walk, zmax, 3, &mut d2, &mut t2);
+                    assert_eq!((f2, d2, t2), (fails, d, tris), "{xy:?} s {s} row {py}");
+                }
+            }
+        }
+        assert!(
+            lane_spans > 150_000 && pixels > 10_000_000,
+            "{lane_spans} {pixels}"
+        );
+    }
 
     /// The row walk gives the per-row span and edge values of [`FixedTri::span`] (the exact
     /// per-row division) on 250k seeded triangles, small to guard-band sized, every sub-pixel
