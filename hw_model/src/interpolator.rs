@@ -1029,46 +1029,47 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
             y_step: st.y_step.map(words),
             k: span_consts,
         };
-        let mut wide = HeldLanes::<HELD_LANES>::default();
-        while span.lanes - j0 >= HELD_MIN_LANES {
-            let n = (span.lanes - j0).min(HELD_LANES);
-            (input.n, input.d, input.q, input.ny) = (n, d, [q1, q2], ny.map(words));
-            if !held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, &mut wide) {
-                break;
-            }
-            let b = &wide;
-            let all = u64::MAX >> (64 - n);
-            if b.ok & all == all && out.batch(j0, n, one, &b.fast) {
-                // Every lane took the fast form and the sink stored them: the next batch's
-                // first lane, `n` steps on (the same wrapping sums as lane by lane).
-                let n64 = n as i64;
-                q1 = q1.wrapping_add(n64.wrapping_mul(st.a[1]));
-                q2 = q2.wrapping_add(n64.wrapping_mul(st.a[2]));
-                let n128 = i128::from(n64);
-                ny = [0, 1].map(|k| ny[k].wrapping_add(n128.wrapping_mul(st.y_step[k])));
-                d = d.wrapping_add(n64.wrapping_mul(s));
-                j0 += n;
-                continue;
-            }
-            for c in 0..n {
-                let j = j0 + c;
-                if b.ok >> c & 1 == 1 {
-                    let (p1, p2) = (b.fast.p[0][c], b.fast.p[1][c]);
-                    let (x1, x2) = (p1 + b.fast.dp[0][c], p2 + b.fast.dp[1][c]);
-                    let (y1, y2) = (p1 + b.fast.dp[2][c], p2 + b.fast.dp[3][c]);
-                    out.lane(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
-                } else {
-                    let rr = b.recips.get(c);
-                    match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
-                        Some(v) => out.lane(j, v),
-                        None => out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
-                    }
+        HELD_WIDE.with_borrow_mut(|wide| {
+            while span.lanes - j0 >= HELD_MIN_LANES {
+                let n = (span.lanes - j0).min(HELD_LANES);
+                (input.n, input.d, input.q, input.ny) = (n, d, [q1, q2], ny.map(words));
+                if !held_batch_wide::<M, R, N, HELD_LANES, _>(&lane_recip, &input, bb, wide) {
+                    break;
                 }
-                ([q1, q2], ny) = st.next_lane([q1, q2], ny);
+                let b = &*wide;
+                let all = u64::MAX >> (64 - n);
+                if b.ok & all == all && out.batch(j0, n, one, &b.fast) {
+                    // Every lane took the fast form and the sink stored them: the next batch's
+                    // first lane, `n` steps on (the same wrapping sums as lane by lane).
+                    let n64 = n as i64;
+                    q1 = q1.wrapping_add(n64.wrapping_mul(st.a[1]));
+                    q2 = q2.wrapping_add(n64.wrapping_mul(st.a[2]));
+                    let n128 = i128::from(n64);
+                    ny = [0, 1].map(|k| ny[k].wrapping_add(n128.wrapping_mul(st.y_step[k])));
+                    d = d.wrapping_add(n64.wrapping_mul(s));
+                    j0 += n;
+                    continue;
+                }
+                for c in 0..n {
+                    let j = j0 + c;
+                    if b.ok >> c & 1 == 1 {
+                        let (p1, p2) = (b.fast.p[0][c], b.fast.p[1][c]);
+                        let (x1, x2) = (p1 + b.fast.dp[0][c], p2 + b.fast.dp[1][c]);
+                        let (y1, y2) = (p1 + b.fast.dp[2][c], p2 + b.fast.dp[3][c]);
+                        out.lane(j, lane_result(one, [p1, p2], [x1, x2], [y1, y2]));
+                    } else {
+                        let rr = b.recips.get(c);
+                        match held_lane::<M>(&ctx, &mut rounds, rr, [q1, q2], ny, sat) {
+                            Some(v) => out.lane(j, v),
+                            None => out.lane(j, derivs_lane::<M>(span, j, inv_w, cfg, recip, sat)),
+                        }
+                    }
+                    ([q1, q2], ny) = st.next_lane([q1, q2], ny);
+                }
+                d = d.wrapping_add((n as i64).wrapping_mul(s));
+                j0 += n;
             }
-            d = d.wrapping_add((n as i64).wrapping_mul(s));
-            j0 += n;
-        }
+        });
     }
     // The other lanes, [`RECIP_BATCH`] reciprocals at a time.
     while j0 < span.lanes {
@@ -1097,6 +1098,14 @@ fn derivs_span_held<M: ConstRounding, R: ConstRounding, const N: u32>(
     }
 }
 
+thread_local! {
+    /// [`derivs_span_held`]'s vector results, reused span after span: each batch writes every
+    /// lane, and building them zeroed in each call took 1.25% of W1's frame (a 1.3 KB
+    /// `memset` per span of at most 32 pixels).
+    static HELD_WIDE: std::cell::RefCell<HeldLanes<HELD_LANES>> =
+        std::cell::RefCell::new(HeldLanes::default());
+}
+
 /// The span constants of [`held_lane`]: `bary_bits`, 1 in its format, the range of `1/D^2`'s
 /// exponent that keeps the derivatives' shifts in 64..126, the x numerators' tops and the y
 /// numerators' drops.
@@ -1110,8 +1119,8 @@ struct HeldLane {
 
 /// One lane of [`derivs_span_held`] from its `1/D`, `1/D^2`, `q_1`, `q_2` and y numerators;
 /// `None`: the lane's barycentrics need the clamp, and it takes the per-sample datapath
-/// ([`derivs_lane`]). `rounds` keeps the derivatives' roundings ([`held_rounding`]) for the last exponent of
-/// `1/D^2`: along a span `D` rarely crosses a power of two.
+/// ([`derivs_lane`]). `rounds` keeps the derivatives' roundings ([`held_rounding`]) for the
+/// last exponent of `1/D^2`: along a span `D` rarely crosses a power of two.
 #[inline(always)]
 fn held_lane<M: ConstRounding>(
     c: &HeldLane,
