@@ -894,6 +894,49 @@ mod tests {
     use crate::raster::VertexSource;
     use crate::rng_common::Rng;
 
+    /// A test triangle prepared for fixed traversal ([`prepared`]).
+    struct Prepared {
+        ft: FixedTri,
+        /// Its vertices oriented as setup orients them (`area2 > 0`).
+        xy: [[i64; 2]; 3],
+        /// The first and last pixel rows its positions reach.
+        rows: (i64, i64),
+    }
+
+    /// The triangle of sub-pixel positions `xy` (either winding) and depths `z` prepared for
+    /// fixed traversal with `s` sub-pixel bits on an image `width` pixels wide; `None` for a
+    /// degenerate one.
+    fn prepared(mut xy: [[i64; 2]; 3], z: [u32; 3], s: u32, width: u32) -> Option<Prepared> {
+        let cross = (xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1])
+            - (xy[1][1] - xy[0][1]) * (xy[2][0] - xy[0][0]);
+        if cross == 0 {
+            return None;
+        }
+        if cross < 0 {
+            xy.swap(1, 2);
+        }
+        let lo = |c: usize| xy.iter().map(|p| p[c]).min().unwrap_or(0) >> s;
+        let hi = |c: usize| xy.iter().map(|p| p[c]).max().unwrap_or(0) >> s;
+        let clampw = |v: i64| v.clamp(0, i64::from(width)) as u32;
+        let t = ScreenTri {
+            xy,
+            xy_f: [[0.0; 2]; 3],
+            z,
+            z_f: [0.0; 3],
+            inv_w: [1.0; 3],
+            src: 0,
+            source: VertexSource::Unclipped { swapped: false },
+            area2: cross.abs(),
+            area2_f: 1.0,
+            bbox: [clampw(lo(0) - 1), 0, clampw(hi(0) + 2), 0],
+        };
+        Some(Prepared {
+            ft: FixedTri::new(&t, s, width),
+            xy,
+            rows: (lo(1), hi(1)),
+        })
+    }
+
     /// The depth test of spans of at least 16 pixels through [`depth_test_long`] (and its
     /// lanes compiled without AVX-512), and of shorter ones through the walk's steps
     /// ([`depth_pass`], [`depth_step`]), against each pixel's exact rounded depth
@@ -917,35 +960,18 @@ mod tests {
                     c[1] + rng.int_in(-reach, reach),
                 ];
             }
-            let cross = (xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1])
-                - (xy[1][1] - xy[0][1]) * (xy[2][0] - xy[0][0]);
-            if cross == 0 {
-                continue;
-            }
-            if cross < 0 {
-                xy.swap(1, 2);
-            }
             let db = 8 + i % 23;
             let zmax = (1u32 << db) - 1;
             let z = [0; 3].map(|_: u32| rng.int_in(0, i64::from(zmax)) as u32);
-            let width = 1024u32;
-            let lo = |c: usize| xy.iter().map(|p| p[c]).min().unwrap_or(0) >> s;
-            let hi = |c: usize| xy.iter().map(|p| p[c]).max().unwrap_or(0) >> s;
-            let clampw = |v: i64| v.clamp(0, i64::from(width)) as u32;
-            let t = ScreenTri {
+            let Some(Prepared {
+                ft,
                 xy,
-                xy_f: [[0.0; 2]; 3],
-                z,
-                z_f: [0.0; 3],
-                inv_w: [1.0; 3],
-                src: 0,
-                source: VertexSource::Unclipped { swapped: false },
-                area2: cross.abs(),
-                area2_f: 1.0,
-                bbox: [clampw(lo(0) - 1), 0, clampw(hi(0) + 2), 0],
+                rows: (lo, hi),
+            }) = prepared(xy, z, s, 1024)
+            else {
+                continue;
             };
-            let ft = FixedTri::new(&t, s, width);
-            let (py0, py1) = (lo(1), hi(1) + 1);
+            let (py0, py1) = (lo, hi + 1);
             let mut walk = ft.walk(py0, py1);
             for py in py0..py1 {
                 if py > py0 {
@@ -1033,38 +1059,22 @@ mod tests {
             if i % 11 == 0 {
                 xy[0][0] = xy[2][0];
             }
-            let cross = (xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1])
-                - (xy[1][1] - xy[0][1]) * (xy[2][0] - xy[0][0]);
-            if cross == 0 {
+            let width = 1024 + (i % 3) * 500;
+            let Some(Prepared {
+                ft,
+                xy,
+                rows: (lo, hi),
+            }) = prepared(xy, [0; 3], s, width)
+            else {
                 continue;
-            }
-            if cross < 0 {
-                xy.swap(1, 2);
-            }
+            };
             horizontal += u64::from(
                 xy.iter()
                     .enumerate()
                     .any(|(k, p)| p[1] == xy[(k + 1) % 3][1]),
             );
-            let width = 1024 + (i % 3) * 500;
-            let lo = |c: usize| xy.iter().map(|p| p[c]).min().unwrap_or(0) >> s;
-            let hi = |c: usize| xy.iter().map(|p| p[c]).max().unwrap_or(0) >> s;
-            let clampw = |v: i64| v.clamp(0, i64::from(width)) as u32;
-            let t = ScreenTri {
-                xy,
-                xy_f: [[0.0; 2]; 3],
-                z: [0; 3],
-                z_f: [0.0; 3],
-                inv_w: [1.0; 3],
-                src: 0,
-                source: VertexSource::Unclipped { swapped: false },
-                area2: cross.abs(),
-                area2_f: 1.0,
-                bbox: [clampw(lo(0) - 1), 0, clampw(hi(0) + 2), 0],
-            };
-            let ft = FixedTri::new(&t, s, width);
-            let py0 = lo(1) - 2 + rng.int_in(0, 3);
-            let py1 = (hi(1) + 2).min(py0 + 40).max(py0 + 1);
+            let py0 = lo - 2 + rng.int_in(0, 3);
+            let py1 = (hi + 2).min(py0 + 40).max(py0 + 1);
             let mut walk = ft.walk(py0, py1);
             for py in py0..py1 {
                 if py > py0 {
