@@ -21,6 +21,11 @@ pub struct Cli {
     /// against it before anything large is allocated. Default: TEXSIM_MAX_MEMORY, else 2G.
     #[arg(long, global = true, value_name = "SIZE")]
     pub max_memory: Option<String>,
+    /// Vector instruction set of the batch kernels: portable, avx2 or avx512 (at most what
+    /// this CPU has). Output is bit-identical for any; only the time differs. Default:
+    /// TEXSIM_VECTOR_ISA, else the widest this CPU has.
+    #[arg(long, global = true, value_name = "ISA")]
+    pub vector_isa: Option<String>,
     #[command(subcommand)]
     pub command: Option<Command>,
 }
@@ -532,6 +537,33 @@ pub fn run(cli: Cli) -> Result<()> {
     rayon::scope(|_| dispatch(cli))
 }
 
+/// The environment variable that names the batch kernels' instruction set when
+/// `--vector-isa` does not.
+pub const ENV_VECTOR_ISA: &str = "TEXSIM_VECTOR_ISA";
+
+/// Runs the batch kernels with the instruction set `flag` (`--vector-isa`), else
+/// `TEXSIM_VECTOR_ISA`, names; with the widest this CPU has where neither is set.
+fn choose_vector_isa(flag: Option<&str>) -> Result<()> {
+    let env = std::env::var(ENV_VECTOR_ISA).ok();
+    let (field, name) = match (flag, env.as_deref()) {
+        (Some(f), _) => ("--vector-isa", f),
+        (None, Some(e)) => (ENV_VECTOR_ISA, e),
+        (None, None) => return Ok(()),
+    };
+    let isa = hw_model::VectorIsa::from_name(name.trim()).ok_or_else(|| {
+        Error::field(
+            field,
+            format!("unknown instruction set '{name}' (portable, avx2 or avx512)"),
+        )
+    })?;
+    hw_model::isa::limit_vector_isa(isa).map_err(|widest| {
+        Error::field(
+            field,
+            format!("this CPU has no {name}: its widest is {}", widest.name()),
+        )
+    })
+}
+
 /// The stack of the worker threads, on one of which [`run`] runs the command: as large as a
 /// main thread's usual 8 MiB.
 const WORKER_STACK: usize = 8 << 20;
@@ -545,6 +577,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         let bytes = crate::budget::parse_size(m).map_err(|e| e.context("--max-memory"))?;
         crate::budget::set_max_memory(bytes);
     }
+    choose_vector_isa(cli.vector_isa.as_deref())?;
     match cli.command {
         None => render_cmd(&RenderArgs {
             scene: SceneArgs {

@@ -3,12 +3,14 @@
 use serde::Serialize;
 
 /// The texsim version, the git commit it was built from (when built from a checkout: its HEAD
-/// at build time; uncommitted changes are not recorded) and the command line.
+/// at build time; uncommitted changes are not recorded), the command line and the vector
+/// instruction set the batch kernels ran with (it changes times, never results).
 #[derive(Clone, Debug, Serialize, PartialEq, Eq)]
 pub struct Provenance {
     pub texsim_version: &'static str,
     pub git_commit: Option<&'static str>,
     pub command_line: Vec<String>,
+    pub vector_isa: &'static str,
 }
 
 impl Provenance {
@@ -20,6 +22,7 @@ impl Provenance {
             texsim_version: env!("CARGO_PKG_VERSION"),
             git_commit: option_env!("TEXSIM_GIT_COMMIT"),
             command_line,
+            vector_isa: hw_model::vector_isa().name(),
         }
     }
 

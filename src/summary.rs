@@ -114,8 +114,8 @@ pub fn text(s: &RenderStats) -> String {
     let t = &s.timings;
     let _ = writeln!(
         o,
-        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1}); timing model {:.1} ms",
-        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms, t.timing_ms
+        "wall time: hardware path {:.1} ms (setup {:.1}, raster {:.1}, shade {:.1}); reference path {:.1} ms (shade {:.1}); timing model {:.1} ms; vector batches {}",
+        t.hw_total_ms, t.setup_ms, t.raster_ms, t.shade_hw_ms, t.ref_total_ms, t.shade_ref_ms, t.timing_ms, hw_model::vector_isa().name()
     );
     o
 }

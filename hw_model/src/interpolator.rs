@@ -319,7 +319,7 @@ pub struct DerivSpan {
 /// of its own triangle): `out(i, j, result)` gets lane `j` of span `i`, each lane once, in no
 /// promised order. Bit-identical to one call per lane, with the same saturation counts.
 ///
-/// At a narrow width on a CPU with AVX-512 the lanes of every span of at most
+/// At a narrow width on a CPU with vector batches ([`crate::VectorIsa::Avx2`] or wider) the lanes of every span of at most
 /// [`GATHER_MAX_LANES`] lanes in the held form ([`derivs_span_held`]) are gathered across the
 /// spans into vector batches of [`HELD_LANES`] lanes ([`Gather`]), so that the short spans of
 /// a mesh fill a batch as a long span does; each lane carries its span's constants. The
@@ -350,7 +350,8 @@ fn spans_in<M: ConstRounding, R: ConstRounding>(
     mut out: impl FnMut(usize, usize, [[i64; 3]; 3]),
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::has_avx512() && recip.config().recip_mantissa_bits <= 28 {
+    if crate::vector_isa() > crate::VectorIsa::Portable && recip.config().recip_mantissa_bits <= 28
+    {
         // The reciprocal's iteration count as a constant for the common widths.
         match recip.lane::<R>().narrow_iterations() {
             Some(1) => return spans_gathered::<M, R, 1>(spans, cfg, recip, sat, out),
@@ -365,7 +366,7 @@ fn spans_in<M: ConstRounding, R: ConstRounding>(
 }
 
 /// [`spans_in`] with the held lanes of the short `spans` gathered into vector batches
-/// (AVX-512, `1/D` by `eval_narrow::<N>`): each span of at most [`GATHER_MAX_LANES`] lanes in
+/// (AVX2 or AVX-512, `1/D` by `eval_narrow::<N>`): each span of at most [`GATHER_MAX_LANES`] lanes in
 /// the held form ([`held_form`]) pushes its lanes into the [`Gather`], which runs a batch
 /// whenever it is full and once more at the end; any other span takes
 /// [`perspective_bary_derivs_span_in`] at once.
@@ -513,13 +514,7 @@ impl<const L: usize> DerivsOut for DerivLanes<'_, L> {
         if at + n > L || n > HELD_LANES {
             return false;
         }
-        #[cfg(target_arch = "x86_64")]
-        if crate::has_avx512() {
-            // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
-            unsafe { batch_into_lanes_avx512(self.bary, at, n, one, b) };
-            return true;
-        }
-        batch_into_lanes(self.bary, at, n, one, b);
+        batch_into_lanes_vector(self.bary, at, n, one, b);
         true
     }
 }
@@ -551,20 +546,15 @@ fn batch_into_lanes<const L: usize>(
     }
 }
 
-/// [`batch_into_lanes`] compiled with AVX-512 enabled.
-///
-/// # Safety
-/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-unsafe fn batch_into_lanes_avx512<const L: usize>(
-    bary: &mut [[[i64; L]; 3]; 3],
-    at: usize,
-    n: usize,
-    one: i64,
-    b: &BatchLanes<HELD_LANES>,
-) {
-    batch_into_lanes(bary, at, n, one, b);
+crate::isa_kernel! {
+    /// [`batch_into_lanes`] built for the vector instruction set in force.
+    fn batch_into_lanes_vector[const L: usize](
+        bary: &mut [[[i64; L]; 3]; 3],
+        at: usize,
+        n: usize,
+        one: i64,
+        b: &BatchLanes<HELD_LANES>,
+    ) = batch_into_lanes::<L>;
 }
 
 /// A span length the span datapaths are tuned for (the row loop's spans have at most 32
@@ -976,7 +966,7 @@ const ANY_ITERATIONS: u32 = u32::MAX;
 /// numerators, and one test of `1/D^2`'s exponent puts all four derivatives on
 /// [`derivative_held`]'s 64-bit rounding, their four [`held_rounding`]s kept while that
 /// exponent holds (else each takes [`derivative_of_top`]). Checked against one call per lane
-/// in `derivs_span_stepping_matches_per_lane_calls`. At a narrow width on a CPU with AVX-512,
+/// in `derivs_span_stepping_matches_per_lane_calls`. At a narrow width with vector batches,
 /// the next [`HELD_MIN_LANES`] to [`HELD_LANES`] lanes run as one batch of vector lanes
 /// ([`held_batch_wide`]; a lane outside its fast form takes the scalar lane, [`held_lane`]);
 /// other lanes run in batches of [`RECIP_BATCH`], each batch's reciprocals ahead of the rest
@@ -1395,7 +1385,7 @@ impl<const L: usize> Gather<L> {
     }
 
     /// Runs the batch of the `n` filled lanes (the lanes past them repeat the last) on the
-    /// vector unit ([`held_batch_avx512`]) into `b` and gives each lane's result to `out(span,
+    /// vector unit ([`held_batch_vector`]) into `b` and gives each lane's result to `out(span,
     /// lane, result)`: the batch's own where the lane took its fast form, else the per-sample
     /// datapath's ([`derivs_lane`], of `spans`); then empties the gather.
     #[inline(always)]
@@ -1412,8 +1402,7 @@ impl<const L: usize> Gather<L> {
             self.repeat(n - 1, to);
         }
         let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
-        // SAFETY: the caller ([`spans_in`]) found every feature the function is built for.
-        unsafe { held_batch_avx512::<M, R, N, L, Self>(lane, self, bb, b) };
+        held_batch_vector::<M, R, N, L, Self>(lane, self, bb, b);
         for c in 0..n {
             let (i, j) = (self.at[c].0 as usize, self.at[c].1 as usize);
             if b.ok >> c & 1 == 1 {
@@ -1530,8 +1519,8 @@ fn held_batch_lanes<M, R, const N: u32, const L: usize, I>(
     out.ok = ok;
 }
 
-/// [`held_batch_lanes`] built for AVX-512 into `out` when this CPU has it (and `true`), else
-/// `false`.
+/// [`held_batch_lanes`] built for the vector instruction set in force into `out` (and `true`),
+/// or `false` where no vector batches run ([`crate::VectorIsa::Portable`]).
 #[inline(always)]
 fn held_batch_wide<M, R, const N: u32, const L: usize, I>(
     lane: &crate::reciprocal::RecipLane<'_, R>,
@@ -1544,33 +1533,22 @@ where
     R: ConstRounding,
     I: HeldInputs<L>,
 {
-    #[cfg(target_arch = "x86_64")]
-    if crate::has_avx512() {
-        // SAFETY: the CPU has every feature the function is built for.
-        unsafe { held_batch_avx512::<M, R, N, L, I>(lane, b, bb, out) };
-        return true;
+    if crate::vector_isa() == crate::VectorIsa::Portable {
+        return false;
     }
-    let _ = (lane, b, bb, out);
-    false
+    held_batch_vector::<M, R, N, L, I>(lane, b, bb, out);
+    true
 }
 
-/// [`held_batch_lanes`] compiled with AVX-512 enabled.
-///
-/// # Safety
-/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-unsafe fn held_batch_avx512<M, R, const N: u32, const L: usize, I>(
-    lane: &crate::reciprocal::RecipLane<'_, R>,
-    b: &I,
-    bb: u32,
-    out: &mut HeldLanes<L>,
-) where
-    M: ConstRounding,
-    R: ConstRounding,
-    I: HeldInputs<L>,
-{
-    held_batch_lanes::<M, R, N, L, I>(lane, b, bb, out);
+crate::isa_kernel! {
+    /// [`held_batch_lanes`] built for the vector instruction set in force.
+    fn held_batch_vector[M, R, const N: u32, const L: usize, I](
+        lane: &crate::reciprocal::RecipLane<'_, R>,
+        b: &I,
+        bb: u32,
+        out: &mut HeldLanes<L>,
+    ) where[M: ConstRounding, R: ConstRounding, I: HeldInputs<L>]
+        = held_batch_lanes::<M, R, N, L, I>;
 }
 
 /// [`perspective_bary`] at the samples of a row span: `out(j, result)` gets lane `j`'s result
@@ -1859,7 +1837,7 @@ pub fn interpolate_span<'a, const N: usize>(
 /// `uv[sample][axis][j]` out. The same bits and counts as one [`interpolate_pairs`] call per
 /// lane (`interpolate_lanes_matches_interpolate_pairs`): the per-triangle terms and the
 /// rounding's constants resolved once, every lane's six values computed in `i64` (as vector
-/// lanes where the CPU has AVX-512), and a lane whose barycentrics leave the window where
+/// lanes where the CPU has AVX2 or AVX-512), and a lane whose barycentrics leave the window where
 /// that accumulator is exact, or whose values leave the format's range, computed again by the
 /// exact path. `lanes.end` must not exceed `L`.
 pub fn interpolate_lanes<const L: usize>(
@@ -1892,15 +1870,7 @@ fn interpolate_lanes_in<M: ConstRounding, const L: usize>(
     if lanes.len() >= PAIR_LANES_MIN {
         if let Some(k) = PairLanes::<M>::new(attr, bary_bits, out) {
             redo = [false; L];
-            #[cfg(target_arch = "x86_64")]
-            if crate::has_avx512() {
-                // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
-                unsafe { pair_lanes_avx512(&k, bary, lanes.clone(), uv, &mut redo) };
-            } else {
-                pair_lanes(&k, bary, lanes.clone(), uv, &mut redo);
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            pair_lanes(&k, bary, lanes.clone(), uv, &mut redo);
+            pair_lanes_vector(&k, bary, lanes.clone(), uv, &mut redo);
             if !redo[lanes.clone()].contains(&true) {
                 return;
             }
@@ -1979,20 +1949,15 @@ fn pair_lanes<M: ConstRounding, const L: usize>(
     }
 }
 
-/// [`pair_lanes`] compiled with AVX-512 enabled.
-///
-/// # Safety
-/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-unsafe fn pair_lanes_avx512<M: ConstRounding, const L: usize>(
-    k: &PairLanes<M>,
-    bary: &[[[i64; L]; 3]; 3],
-    lanes: std::ops::Range<usize>,
-    uv: &mut [[[i64; L]; 2]; 3],
-    redo: &mut [bool; L],
-) {
-    pair_lanes(k, bary, lanes, uv, redo);
+crate::isa_kernel! {
+    /// [`pair_lanes`] built for the vector instruction set in force.
+    fn pair_lanes_vector[M: ConstRounding, const L: usize](
+        k: &PairLanes<M>,
+        bary: &[[[i64; L]; 3]; 3],
+        lanes: std::ops::Range<usize>,
+        uv: &mut [[[i64; L]; 2]; 3],
+        redo: &mut [bool; L],
+    ) = pair_lanes::<M, L>;
 }
 
 /// The sample-independent terms of attribute `ax` of a triangle's `attr` for
@@ -3026,7 +2991,7 @@ mod tests {
     /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
     /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
     /// small and positive), so that many lanes of the held loop need the clamp of `p_i`. Spans
-    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX-512: many
+    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX2 or AVX-512: many
     /// of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
     /// other span goes into lanes from a random base ([`DerivLanes`], which stores a batch
     /// whose lanes all took the fast form whole): the same bits, the other lanes untouched.
@@ -3136,7 +3101,7 @@ mod tests {
                                 held_lanes += 1;
                                 let clamped = want[0][1..].iter().any(|v| v.abs() == BARY_LIMIT);
                                 held_clamped += u64::from(clamped);
-                                // Lanes of the vector batches (on a CPU with AVX-512).
+                                // Lanes of the vector batches (on a CPU with AVX2 or AVX-512).
                                 if n >= HELD_MIN_LANES {
                                     held_batched[usize::from(clamped)] += 1;
                                 }
@@ -3180,7 +3145,7 @@ mod tests {
     /// spans near the horizon): one `perspective_bary_derivs_spans` call per row gives each
     /// lane once, with the bits of one [`perspective_bary_derivs`] call per lane and the
     /// row's saturation counts. Many lanes are in the held form (gathered across the spans
-    /// into vector batches where the CPU has AVX-512), many of those need the clamp (the
+    /// into vector batches where the CPU has AVX2 or AVX-512), many of those need the clamp (the
     /// per-sample datapath from a batch), and many spans take the other forms.
     #[test]
     fn gathered_spans_match_per_lane_calls() {

@@ -26,6 +26,7 @@ pub mod fixed;
 pub mod footprint;
 pub mod frame;
 pub mod interpolator;
+pub mod isa;
 pub mod lean;
 pub mod lod;
 pub mod modulate;
@@ -45,18 +46,7 @@ pub mod wrap;
 pub use config::{ConfigError, HwConfig};
 pub use cost::UnitCost;
 pub use fixed::{Format, Overflow, Rounding, SatCounter};
-
-/// Whether this CPU has the AVX-512 subsets the vector batches are built for (F, DQ, CD, VL;
-/// std caches the detection).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-#[must_use]
-pub fn has_avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-        && std::arch::is_x86_feature_detected!("avx512cd")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-}
+pub use isa::{vector_isa, VectorIsa};
 
 /// The seeded generator of the unit tests (splitmix64, as `tests/rng_common`).
 #[cfg(test)]

@@ -171,15 +171,7 @@ pub fn lod_lanes<const L: usize>(
     let mut redo = [true; L];
     if !k.piecewise {
         redo = [false; L];
-        #[cfg(target_arch = "x86_64")]
-        if crate::has_avx512() {
-            // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
-            unsafe { exact_lanes_avx512(k, uv, lanes.clone(), size, out, &mut redo) };
-        } else {
-            exact_lanes(k, uv, lanes.clone(), size, out, &mut redo);
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        exact_lanes(k, uv, lanes.clone(), size, out, &mut redo);
+        exact_lanes_vector(k, uv, lanes.clone(), size, out, &mut redo);
     }
     for j in lanes.filter(|&j| redo[j]) {
         out[j] = lod_with(k, lane_derivs(uv, j, size), sat);
@@ -228,21 +220,16 @@ fn exact_lanes<const L: usize>(
     }
 }
 
-/// [`exact_lanes`] compiled with AVX-512 enabled.
-///
-/// # Safety
-/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-unsafe fn exact_lanes_avx512<const L: usize>(
-    k: &LodSetup,
-    uv: &[[[i64; L]; 2]; 3],
-    lanes: std::ops::Range<usize>,
-    size: (i64, i64),
-    out: &mut [i64; L],
-    redo: &mut [bool; L],
-) {
-    exact_lanes(k, uv, lanes, size, out, redo);
+crate::isa_kernel! {
+    /// [`exact_lanes`] built for the vector instruction set in force.
+    fn exact_lanes_vector[const L: usize](
+        k: &LodSetup,
+        uv: &[[[i64; L]; 2]; 3],
+        lanes: std::ops::Range<usize>,
+        size: (i64, i64),
+        out: &mut [i64; L],
+        redo: &mut [bool; L],
+    ) = exact_lanes::<L>;
 }
 
 /// The larger squared length `L` of [`lod`] in `u128` (some `|d| >= 2^31`, so `L > 0`): its

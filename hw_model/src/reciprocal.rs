@@ -730,33 +730,40 @@ mod tests {
         assert!(fast > 500_000 && general > 500_000, "{fast} {general}");
     }
 
-    /// `eval_square_lanes` built for AVX-512 (as the vector batches of
-    /// `interpolator::derivs_span_held` are) when this CPU has it.
+    /// `eval_square_lanes` of `x` into `out` (one vector batch).
+    fn eval_square_batch<R: ConstRounding, const N: u32, S: ConstRounding>(
+        lane: &RecipLane<'_, R>,
+        x: &[u64; 2 * RECIP_LANES],
+        out: &mut RecipLanes<{ 2 * RECIP_LANES }>,
+    ) {
+        lane.eval_square_lanes::<N, S, { 2 * RECIP_LANES }>(x, out);
+    }
+
+    crate::isa_kernel! {
+        /// [`eval_square_batch`] built for the vector instruction set in force.
+        fn eval_square_vector[R: ConstRounding, const N: u32, S: ConstRounding](
+            lane: &RecipLane<'_, R>,
+            x: &[u64; 2 * RECIP_LANES],
+            out: &mut RecipLanes<{ 2 * RECIP_LANES }>,
+        ) = eval_square_batch::<R, N, S>;
+    }
+
+    /// `eval_square_lanes` built for the vector instruction set in force (as the vector
+    /// batches of `interpolator::derivs_span_held` are) where that is not the portable one.
     fn eval_square_lanes_wide<R: ConstRounding, const N: u32, S: ConstRounding>(
         lane: &RecipLane<'_, R>,
         x: &[u64; 2 * RECIP_LANES],
     ) -> Option<RecipLanes<{ 2 * RECIP_LANES }>> {
-        #[cfg(target_arch = "x86_64")]
-        if crate::has_avx512() {
-            #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-            fn avx512<R: ConstRounding, const N: u32, S: ConstRounding>(
-                lane: &RecipLane<'_, R>,
-                x: &[u64; 2 * RECIP_LANES],
-                out: &mut RecipLanes<{ 2 * RECIP_LANES }>,
-            ) {
-                lane.eval_square_lanes::<N, S, { 2 * RECIP_LANES }>(x, out);
-            }
-            let mut out = RecipLanes::default();
-            // SAFETY: the CPU has every feature the function is built for.
-            unsafe { avx512::<R, N, S>(lane, x, &mut out) };
-            return Some(out);
+        if crate::vector_isa() == crate::VectorIsa::Portable {
+            return None;
         }
-        let _ = (lane, x);
-        None
+        let mut out = RecipLanes::default();
+        eval_square_vector::<R, N, S>(lane, x, &mut out);
+        Some(out)
     }
 
     /// `eval_square_lanes::<N, S>` of the batch `x` (the portable build and, on a CPU with
-    /// AVX-512, `eval_square_lanes_wide`), each lane against `eval_narrow` and `square`.
+    /// AVX2 or AVX-512, `eval_square_lanes_wide`), each lane against `eval_narrow` and `square`.
     fn check_lanes<R: ConstRounding, S: ConstRounding, const N: u32>(
         lane: &RecipLane<'_, R>,
         x: &[u64; 2 * RECIP_LANES],
@@ -790,7 +797,7 @@ mod tests {
     /// 4.3M seeded lanes in 1..2^62 (every bit length; 1, 2^62 - 1 and runs of steps along a
     /// span included) over every pair of rounding modes of the reciprocal and of the square,
     /// LUT widths 1..=16, iteration counts 0..=4 and the mantissa widths 8..=26: each lane of
-    /// `eval_square_lanes` (portable, and built for AVX-512 where the CPU has it) gives
+    /// `eval_square_lanes` (portable, and built for AVX2 or AVX-512 where the CPU has it) gives
     /// `eval_narrow` and its `square`.
     #[test]
     fn eval_square_lanes_match_eval_narrow() {

@@ -69,7 +69,7 @@ pub type LaneCell = RefCell<Lanes>;
 /// lanes: every stage runs Fixed and its row says it may ([`super::table::LanesFn`]: `bary`,
 /// `modulate`; `texcoord` and `lod` off the float32 coordinate path; `trilinear` with one
 /// probe, as footprint assembly reads the fragment's three samples), the plan has `bary`,
-/// `texcoord` and derivatives, and the CPU has AVX-512 ([`vector_lanes`]): without it
+/// `texcoord` and derivatives, and the CPU has vector lanes ([`vector_lanes`]): without them
 /// `interpolate_lanes` runs its lanes one by one, which took more instructions than the
 /// fragments' path (callgrind, W1, `texcoord` 126.3M against 91.8M).
 #[must_use]
@@ -83,14 +83,11 @@ pub fn keeps_lanes(plan: &Plan, impls: &StageImpls, m: &Machine) -> bool {
         && vector_lanes()
 }
 
-/// Whether this CPU runs `interpolate_lanes` as vector lanes (AVX-512 F, DQ, CD and VL).
+/// Whether this CPU runs `interpolate_lanes` as vector lanes ([`hw_model::vector_isa`]: AVX2
+/// or AVX-512).
 #[must_use]
 pub fn vector_lanes() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    let vector = hw_model::has_avx512();
-    #[cfg(not(target_arch = "x86_64"))]
-    let vector = false;
-    vector
+    hw_model::vector_isa() > hw_model::VectorIsa::Portable
 }
 
 /// Sample 0 of the lanes' texture coordinates into the fragments of the span at `px` (a

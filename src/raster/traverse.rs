@@ -621,11 +621,23 @@ fn depth_test_long(
 ) -> Option<u64> {
     let lanes = DepthLanes::new(walk, den)?;
     #[cfg(target_arch = "x86_64")]
-    if hw_model::has_avx512() {
+    if hw_model::vector_isa() == hw_model::VectorIsa::Avx512 {
         // SAFETY: the CPU has AVX-512 F, DQ, CD and VL.
         return Some(unsafe { depth_lanes_avx512(lanes, zmax, id, d, t) });
     }
-    Some(depth_lanes(lanes, zmax, id, d, t))
+    Some(depth_lanes_vector(lanes, zmax, id, d, t))
+}
+
+hw_model::isa_kernel! {
+    /// [`depth_lanes`] built for the vector instruction set in force (AVX-512 takes
+    /// [`depth_lanes_avx512`] instead).
+    fn depth_lanes_vector[](
+        w: DepthLanes,
+        zmax: u32,
+        id: u32,
+        d: &mut [u32],
+        t: &mut [u32],
+    ) -> u64 = depth_lanes::<>;
 }
 
 /// One pixel's strictly-less test of the depth quotient `q` clamped to `0..=zmax` against
@@ -716,7 +728,7 @@ fn depth_lanes(mut w: DepthLanes, zmax: u32, id: u32, d: &mut [u32], t: &mut [u3
 /// W1: 3.2% of the frame's samples).
 ///
 /// # Safety
-/// The CPU must have AVX-512 F, DQ, CD and VL (`hw_model::has_avx512`).
+/// The CPU must have AVX-512 F, DQ, CD and VL ([`hw_model::VectorIsa::Avx512`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
 unsafe fn depth_lanes_avx512(

@@ -1072,3 +1072,72 @@ fn hw_cost_prints_units_and_follows_the_file() {
     assert!(!o.status.success());
     assert!(text(&o).contains("no-such-preset"), "{}", text(&o));
 }
+
+/// Every built-in benchmark scene (and the demo's many materials) renders the same image,
+/// statistics and cycles with the batch kernels built for each instruction set this CPU has
+/// (`--vector-isa`): the portable build, AVX2 and AVX-512. A wider set than the CPU's, or an
+/// unknown name, is refused naming the flag or the variable.
+#[test]
+fn every_vector_isa_renders_the_same() {
+    let d = tmp("vector_isa");
+    let widest = hw_model::VectorIsa::detected();
+    for scene in ["demo", "w1-plane", "w2-mesh"] {
+        let mut first: Option<(Vec<u8>, serde_json::Value)> = None;
+        for isa in hw_model::VectorIsa::ALL
+            .into_iter()
+            .filter(|&i| i <= widest)
+        {
+            let out = format!("{scene}-{}", isa.name());
+            let o = texsim(
+                &[
+                    "--vector-isa",
+                    isa.name(),
+                    "render",
+                    "--scene",
+                    scene,
+                    "--width",
+                    "256",
+                    "--height",
+                    "192",
+                    "--no-reference",
+                    "--out",
+                    &out,
+                ],
+                &d,
+            );
+            assert!(o.status.success(), "{scene} {isa:?}: {}", text(&o));
+            let png = std::fs::read(d.join(&out).join("hw.png")).unwrap();
+            let mut j: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(d.join(&out).join("summary.json")).unwrap())
+                    .unwrap();
+            assert_eq!(j["provenance"]["vector_isa"], isa.name());
+            j.as_object_mut().unwrap().remove("provenance");
+            assert!(
+                j["stats"]["timing"]["total_cycles"].is_u64(),
+                "{scene}: cycles counted"
+            );
+            match &first {
+                None => first = Some((png, j)),
+                Some((p, s)) => {
+                    assert!(*p == png, "{scene}: {isa:?} image differs from portable");
+                    assert_eq!(*s, j, "{scene}: {isa:?} summary differs from portable");
+                }
+            }
+        }
+    }
+    let o = texsim_env(&["render", "--out", "x"], &d, ("TEXSIM_VECTOR_ISA", "sse9"));
+    assert!(
+        !o.status.success() && text(&o).contains("TEXSIM_VECTOR_ISA"),
+        "{}",
+        text(&o)
+    );
+    if widest < hw_model::VectorIsa::Avx512 {
+        let o = texsim(&["--vector-isa", "avx512", "render", "--out", "x"], &d);
+        assert!(
+            !o.status.success() && text(&o).contains("--vector-isa"),
+            "{}",
+            text(&o)
+        );
+    }
+    assert!(!d.join("x").exists(), "nothing written");
+}

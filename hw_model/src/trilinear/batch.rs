@@ -151,10 +151,7 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
     #[must_use]
     pub fn batch_form(&self) -> bool {
         let k = self.setup;
-        #[cfg(target_arch = "x86_64")]
-        let vector = crate::has_avx512();
-        #[cfg(not(target_arch = "x86_64"))]
-        let vector = false;
+        let vector = crate::vector_isa() > crate::VectorIsa::Portable;
         vector && self.repeats() && k.narrow_frac && k.lf <= 16
     }
 
@@ -179,11 +176,7 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
         }
         debug_assert!(shape.fits(levels), "levels of another shape");
         let levels = &Levels { levels, shape };
-        #[cfg(target_arch = "x86_64")]
-        {
-            // SAFETY: the CPU has every feature the function is built for (`batch_form`).
-            unsafe { batch_avx512(self, levels, batch, n, out, footprints.as_deref_mut()) };
-        }
+        batch_vector(self, levels, batch, n, out, footprints.as_deref_mut());
         self.wide_lanes(levels, batch, n, out, footprints);
         true
     }
@@ -214,21 +207,16 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
     }
 }
 
-/// [`batch_passes`] compiled with AVX-512 enabled.
-///
-/// # Safety
-/// The CPU must have AVX-512 F, DQ, CD and VL ([`crate::has_avx512`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-unsafe fn batch_avx512<F: ConstRounding, W: ConstRounding>(
-    unit: &TrilinearUnit<F, W>,
-    levels: &Levels,
-    batch: &SampleBatch,
-    n: usize,
-    out: &mut [[u32; 4]; BATCH_LANES],
-    footprints: Option<&mut BatchFootprints>,
-) {
-    batch_passes(unit, levels, batch, n, out, footprints);
+crate::isa_kernel! {
+    /// [`batch_passes`] built for the vector instruction set in force.
+    fn batch_vector[F: ConstRounding, W: ConstRounding](
+        unit: &TrilinearUnit<F, W>,
+        levels: &Levels,
+        batch: &SampleBatch,
+        n: usize,
+        out: &mut [[u32; 4]; BATCH_LANES],
+        footprints: Option<&mut BatchFootprints>,
+    ) = batch_passes::<F, W>;
 }
 
 /// The passes of [`TrilinearUnit::sample_batch_pow2_repeat`]: the levels and LOD weight as
@@ -241,7 +229,6 @@ unsafe fn batch_avx512<F: ConstRounding, W: ConstRounding>(
 /// rows (taken apart from the texel indices). Where none of the first `n` lanes has a LOD
 /// weight, the passes take the finer level only ([`level_passes`] with one level: a magnified
 /// surface's batches: W1's fastest frame -5.5% at stop 61).
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 #[inline(always)]
 pub(super) fn batch_passes<F: ConstRounding, W: ConstRounding>(
     unit: &TrilinearUnit<F, W>,
