@@ -1930,12 +1930,15 @@ fn pair_lanes<M: ConstRounding, const L: usize>(
     redo: &mut [bool; L],
 ) {
     let (window, (lo, hi)) = (k.lim.wrapping_mul(2), k.range);
+    // Each lane's misses as a 64-bit lane (a `bool` lane beside `i64` ones took a pack and
+    // an unpack at every one of the six passes), written to `redo` once.
+    let mut miss = [0u64; L];
     for s in 0..3 {
         let (b1, b2) = (&bary[s][1][lanes.clone()], &bary[s][2][lanes.clone()]);
         for (ax, &(t0, d1, d2)) in k.terms.iter().enumerate() {
             let o = &mut uv[s][ax][lanes.clone()];
-            let redo = &mut redo[lanes.clone()];
-            for (((o, r), &p1), &p2) in o.iter_mut().zip(redo).zip(b1).zip(b2) {
+            let miss = &mut miss[lanes.clone()];
+            for (((o, r), &p1), &p2) in o.iter_mut().zip(miss).zip(b1).zip(b2) {
                 let inside =
                     ((p1 as u64).wrapping_add(k.lim) | (p2 as u64).wrapping_add(k.lim)) < window;
                 let acc = t0
@@ -1943,9 +1946,12 @@ fn pair_lanes<M: ConstRounding, const L: usize>(
                     .wrapping_add(p2.wrapping_mul(d2));
                 let v = k.round.apply_wrapping(acc);
                 *o = v;
-                *r |= !(inside & (v >= lo) & (v <= hi));
+                *r |= u64::from(!(inside & (v >= lo) & (v <= hi)));
             }
         }
+    }
+    for (r, &m) in redo[lanes.clone()].iter_mut().zip(&miss[lanes]) {
+        *r |= m != 0;
     }
 }
 
