@@ -319,12 +319,12 @@ pub struct DerivSpan {
 /// of its own triangle): `out(i, j, result)` gets lane `j` of span `i`, each lane once, in no
 /// promised order. Bit-identical to one call per lane, with the same saturation counts.
 ///
-/// At a narrow width on a CPU with vector batches ([`crate::VectorIsa::Avx2`] or wider) the lanes of every span of at most
-/// [`GATHER_MAX_LANES`] lanes in the held form ([`derivs_span_held`]) are gathered across the
-/// spans into vector batches of [`HELD_LANES`] lanes ([`Gather`]), so that the short spans of
-/// a mesh fill a batch as a long span does; each lane carries its span's constants. The
-/// other spans, and every span elsewhere, take [`perspective_bary_derivs_span`]'s forms span
-/// by span.
+/// At a narrow width on a CPU with vector batches ([`crate::VectorIsa::Avx2`] or wider) the
+/// lanes of every span of at most [`GATHER_MAX_LANES`] lanes in the held form
+/// ([`derivs_span_held`]) are gathered across the spans into vector batches of [`HELD_LANES`]
+/// lanes ([`Gather`]), so that the short spans of a mesh fill a batch as a long span does; each
+/// lane carries its span's constants. The other spans, and every span elsewhere, take
+/// [`perspective_bary_derivs_span`]'s forms span by span.
 pub fn perspective_bary_derivs_spans(
     spans: &[DerivSpan],
     cfg: &InterpConfig,
@@ -366,8 +366,8 @@ fn spans_in<M: ConstRounding, R: ConstRounding>(
 }
 
 /// [`spans_in`] with the held lanes of the short `spans` gathered into vector batches
-/// (AVX2 or AVX-512, `1/D` by `eval_narrow::<N>`): each span of at most [`GATHER_MAX_LANES`] lanes in
-/// the held form ([`held_form`]) pushes its lanes into the [`Gather`], which runs a batch
+/// (AVX2 or AVX-512, `1/D` by `eval_narrow::<N>`): each span of at most [`GATHER_MAX_LANES`]
+/// lanes in the held form ([`held_form`]) pushes its lanes into the [`Gather`], which runs a batch
 /// whenever it is full and once more at the end; any other span takes
 /// [`perspective_bary_derivs_span_in`] at once.
 #[cfg(target_arch = "x86_64")]
@@ -1837,9 +1837,9 @@ pub fn interpolate_span<'a, const N: usize>(
 /// `uv[sample][axis][j]` out. The same bits and counts as one [`interpolate_pairs`] call per
 /// lane (`interpolate_lanes_matches_interpolate_pairs`): the per-triangle terms and the
 /// rounding's constants resolved once, every lane's six values computed in `i64` (as vector
-/// lanes where the CPU has AVX2 or AVX-512), and a lane whose barycentrics leave the window where
-/// that accumulator is exact, or whose values leave the format's range, computed again by the
-/// exact path. `lanes.end` must not exceed `L`.
+/// lanes where the CPU has AVX2 or AVX-512), and a lane whose barycentrics leave the window
+/// where that accumulator is exact, or whose values leave the format's range, computed again by
+/// the exact path. `lanes.end` must not exceed `L`.
 pub fn interpolate_lanes<const L: usize>(
     bary: &[[[i64; L]; 3]; 3],
     lanes: std::ops::Range<usize>,
@@ -2997,8 +2997,8 @@ mod tests {
     /// spans whose `q_1`, `q_2`, `D` step along the span (both ends fit `i64`) and in spans
     /// whose lanes test their own; a quarter of the spans are moved near the horizon (`D`
     /// small and positive), so that many lanes of the held loop need the clamp of `p_i`. Spans
-    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX2 or AVX-512: many
-    /// of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
+    /// of 8 lanes or more run the held loop's vector batches where the CPU has AVX2 or AVX-512:
+    /// many of their lanes take the batch's fast form, and many the scalar lane (the clamp). Every
     /// other span goes into lanes from a random base ([`DerivLanes`], which stores a batch
     /// whose lanes all took the fast form whole): the same bits, the other lanes untouched.
     #[test]

@@ -121,10 +121,14 @@ macro_rules! isa_kernel {
                     $body::<$($p),*>($($arg),*)
                 }
                 match $crate::isa::vector_isa() {
-                    // SAFETY: `vector_isa` is never wider than this CPU.
-                    $crate::isa::VectorIsa::Avx512 => return unsafe { avx512::<$($p),*>($($arg),*) },
-                    // SAFETY: as above.
-                    $crate::isa::VectorIsa::Avx2 => return unsafe { avx2::<$($p),*>($($arg),*) },
+                    $crate::isa::VectorIsa::Avx512 => {
+                        // SAFETY: `vector_isa` is never wider than this CPU.
+                        return unsafe { avx512::<$($p),*>($($arg),*) };
+                    }
+                    $crate::isa::VectorIsa::Avx2 => {
+                        // SAFETY: as above.
+                        return unsafe { avx2::<$($p),*>($($arg),*) };
+                    }
                     $crate::isa::VectorIsa::Portable => {}
                 }
             }

@@ -153,8 +153,8 @@ pub fn lod_with(k: &LodSetup, d: [i64; 4], sat: &mut SatCounter) -> i64 {
 /// step in x and one in y) on a `w` x `h` level 0: `d = ((u1 - u0) w, (v1 - v0) h, (u2 - u0) w,
 /// (v2 - v0) h)`. The same values and saturation counts as one [`lod_with`] call per lane
 /// (`lod_lanes_matches_lod_with`): in the Exact mode every lane is computed without a branch on
-/// its data (as vector lanes where the CPU has AVX-512: the table's quadratic by gathers), and
-/// a lane whose derivatives leave `[-2^31, 2^31)`, whose quadratic lies within
+/// its data (as vector lanes where the CPU has AVX2 or AVX-512: the table's quadratic by
+/// gathers), and a lane whose derivatives leave `[-2^31, 2^31)`, whose quadratic lies within
 /// [`LOG2_MARGIN`] of an integer, or whose result takes the clamp is computed again by
 /// [`lod_with`]; the piecewise-linear mode takes [`lod_with`] on every lane. `lanes.end` must
 /// not exceed `L`.

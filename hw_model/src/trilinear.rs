@@ -1303,7 +1303,7 @@ mod tests {
                         assert_eq!(fps, BatchFootprints::default());
                         refused += 1;
                     } else {
-                        // The portable passes (what the AVX-512 ones are compiled from) on every
+                        // The portable passes (what the vector ones are compiled from) on every
                         // CPU; they leave the wide lanes to the caller.
                         let mut portable = stale;
                         let at = batch::Levels { levels, shape: bl };

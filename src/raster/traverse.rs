@@ -950,7 +950,7 @@ mod tests {
     }
 
     /// The depth test of spans of at least 16 pixels through [`depth_test_long`] (and its
-    /// lanes compiled without AVX-512), and of shorter ones through the walk's steps
+    /// lanes built without AVX-512), and of shorter ones through the walk's steps
     /// ([`depth_pass`], [`depth_step`]), against each pixel's exact rounded depth
     /// `floor((2 sum(e_i z_i) + den / 2) / den)` in `i128`, on 20k seeded triangles (depths
     /// below 2^30, every depth width, sub-pixel widths 1 to 12): the same stored depths,
@@ -1031,7 +1031,7 @@ mod tests {
                     );
                 }
                 assert_eq!(fails, want_fails, "{xy:?} s {s} row {py}");
-                // The lanes compiled without AVX-512 too.
+                // The lanes built without AVX-512 too (`depth_lanes`).
                 if let (Some(walk), true) = (DepthLanes::new(walk, ft.den), n >= 2 * DEPTH_LANES) {
                     let (mut d2, mut t2) = (stored.clone(), vec![7u32; n]);
                     let f2 = depth_lanes(walk, zmax, 3, &mut d2, &mut t2);
