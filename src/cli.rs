@@ -542,25 +542,42 @@ pub fn run(cli: Cli) -> Result<()> {
 pub const ENV_VECTOR_ISA: &str = "TEXSIM_VECTOR_ISA";
 
 /// Runs the batch kernels with the instruction set `flag` (`--vector-isa`), else
-/// `TEXSIM_VECTOR_ISA`, names; with the widest this CPU has where neither is set.
+/// `TEXSIM_VECTOR_ISA`, names (an empty variable is unset); with the widest this CPU has where
+/// neither is set. The variable is checked even where the flag overrides it, as
+/// `TEXSIM_MAX_MEMORY` is.
 fn choose_vector_isa(flag: Option<&str>) -> Result<()> {
-    let env = std::env::var(ENV_VECTOR_ISA).ok();
-    let (field, name) = match (flag, env.as_deref()) {
-        (Some(f), _) => ("--vector-isa", f),
-        (None, Some(e)) => (ENV_VECTOR_ISA, e),
-        (None, None) => return Ok(()),
+    let env_ctx = format!("environment variable {ENV_VECTOR_ISA}");
+    let env = std::env::var(ENV_VECTOR_ISA).unwrap_or_default();
+    let from_env = match env.trim() {
+        "" => None,
+        name => Some(parse_vector_isa(name).map_err(|e| e.context(&env_ctx))?),
     };
-    let isa = hw_model::VectorIsa::from_name(name.trim()).ok_or_else(|| {
-        Error::field(
-            field,
-            format!("unknown instruction set '{name}' (portable, avx2 or avx512)"),
-        )
-    })?;
+    let chosen = match flag {
+        Some(name) => Some((
+            parse_vector_isa(name).map_err(|e| e.context("--vector-isa"))?,
+            "--vector-isa".to_string(),
+        )),
+        None => from_env.map(|isa| (isa, env_ctx)),
+    };
+    let Some((isa, ctx)) = chosen else {
+        return Ok(());
+    };
     hw_model::isa::limit_vector_isa(isa).map_err(|widest| {
-        Error::field(
-            field,
-            format!("this CPU has no {name}: its widest is {}", widest.name()),
-        )
+        Error::msg(format!(
+            "this CPU has no {}: its widest is {}",
+            isa.name(),
+            widest.name()
+        ))
+        .context(ctx)
+    })
+}
+
+/// The instruction set `name` names (`portable`, `avx2` or `avx512`, in any case).
+fn parse_vector_isa(name: &str) -> Result<hw_model::VectorIsa> {
+    hw_model::VectorIsa::from_name(&name.trim().to_ascii_lowercase()).ok_or_else(|| {
+        Error::msg(format!(
+            "unknown instruction set '{name}' (portable, avx2 or avx512)"
+        ))
     })
 }
 

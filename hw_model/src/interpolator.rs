@@ -1385,7 +1385,7 @@ impl<const L: usize> Gather<L> {
     }
 
     /// Runs the batch of the `n` filled lanes (the lanes past them repeat the last) on the
-    /// vector unit ([`held_batch_vector`]) into `b` and gives each lane's result to `out(span,
+    /// vector unit ([`held_batch_wide`]) into `b` and gives each lane's result to `out(span,
     /// lane, result)`: the batch's own where the lane took its fast form, else the per-sample
     /// datapath's ([`derivs_lane`], of `spans`); then empties the gather.
     #[inline(always)]
@@ -1402,7 +1402,10 @@ impl<const L: usize> Gather<L> {
             self.repeat(n - 1, to);
         }
         let (bb, one) = (cfg.bary_bits, 1i64 << cfg.bary_bits);
-        held_batch_vector::<M, R, N, L, Self>(lane, self, bb, b);
+        if !held_batch_wide::<M, R, N, L, Self>(lane, self, bb, b) {
+            // No vector batches since [`spans_in`] chose the gather: every lane by itself.
+            b.ok = 0;
+        }
         for c in 0..n {
             let (i, j) = (self.at[c].0 as usize, self.at[c].1 as usize);
             if b.ok >> c & 1 == 1 {
@@ -1477,6 +1480,7 @@ fn product_top_lane((hi, lo): (i64, u64), mant: u64) -> i64 {
 /// then the scalar lane's (checked in `derivs_span_stepping_matches_per_lane_calls` and
 /// `gathered_spans_match_per_lane_calls`).
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 fn held_batch_lanes<M, R, const N: u32, const L: usize, I>(
     lane: &crate::reciprocal::RecipLane<'_, R>,
     b: &I,
@@ -1519,30 +1523,10 @@ fn held_batch_lanes<M, R, const N: u32, const L: usize, I>(
     out.ok = ok;
 }
 
-/// [`held_batch_lanes`] built for the vector instruction set in force into `out` (and `true`),
-/// or `false` where no vector batches run ([`crate::VectorIsa::Portable`]).
-#[inline(always)]
-fn held_batch_wide<M, R, const N: u32, const L: usize, I>(
-    lane: &crate::reciprocal::RecipLane<'_, R>,
-    b: &I,
-    bb: u32,
-    out: &mut HeldLanes<L>,
-) -> bool
-where
-    M: ConstRounding,
-    R: ConstRounding,
-    I: HeldInputs<L>,
-{
-    if crate::vector_isa() == crate::VectorIsa::Portable {
-        return false;
-    }
-    held_batch_vector::<M, R, N, L, I>(lane, b, bb, out);
-    true
-}
-
 crate::isa_kernel! {
-    /// [`held_batch_lanes`] built for the vector instruction set in force.
-    fn held_batch_vector[M, R, const N: u32, const L: usize, I](
+    /// [`held_batch_lanes`] built for the vector instruction set in force into `out` (and
+    /// `true`), or `false` where no vector batches run ([`crate::VectorIsa::Portable`]).
+    vector fn held_batch_wide[M, R, const N: u32, const L: usize, I](
         lane: &crate::reciprocal::RecipLane<'_, R>,
         b: &I,
         bb: u32,

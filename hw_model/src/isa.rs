@@ -99,7 +99,9 @@ pub fn limit_vector_isa(isa: VectorIsa) -> Result<(), VectorIsa> {
 /// branch-free loops at those widths), the portable build otherwise.
 ///
 /// The generic parameters and the where clause go in brackets; `= body::<params>` names the
-/// body and its generic arguments.
+/// body and its generic arguments. `vector fn` defines a kernel without a portable build (its
+/// callers take another path there): it returns whether it ran, `false` under
+/// [`VectorIsa::Portable`] with nothing done, so that no unused portable build is compiled.
 #[macro_export]
 macro_rules! isa_kernel {
     (
@@ -110,29 +112,59 @@ macro_rules! isa_kernel {
         $(#[$m])*
         #[inline(always)]
         $vis fn $name<$($g)*>($($arg: $ty),*) $(-> $ret)? $(where $($w)*)? {
-            #[cfg(target_arch = "x86_64")]
-            {
-                #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
-                fn avx512<$($g)*>($($arg: $ty),*) $(-> $ret)? $(where $($w)*)? {
-                    $body::<$($p),*>($($arg),*)
-                }
-                #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,fma")]
-                fn avx2<$($g)*>($($arg: $ty),*) $(-> $ret)? $(where $($w)*)? {
-                    $body::<$($p),*>($($arg),*)
-                }
-                match $crate::isa::vector_isa() {
-                    $crate::isa::VectorIsa::Avx512 => {
-                        // SAFETY: `vector_isa` is never wider than this CPU.
-                        return unsafe { avx512::<$($p),*>($($arg),*) };
-                    }
-                    $crate::isa::VectorIsa::Avx2 => {
-                        // SAFETY: as above.
-                        return unsafe { avx2::<$($p),*>($($arg),*) };
-                    }
-                    $crate::isa::VectorIsa::Portable => {}
-                }
-            }
+            $crate::isa_kernel!(
+                @builds [$($g)*] ($($arg: $ty),*) [$(-> $ret)?] [$(where $($w)*)?]
+                $body::<$($p),*> |r| r
+            );
             $body::<$($p),*>($($arg),*)
+        }
+    };
+    (
+        $(#[$m:meta])*
+        $vis:vis vector fn $name:ident[$($g:tt)*]($($arg:ident: $ty:ty),* $(,)?)
+        $(where[$($w:tt)*])? = $body:ident::<$($p:ident),*>;
+    ) => {
+        $(#[$m])*
+        #[inline(always)]
+        #[must_use]
+        $vis fn $name<$($g)*>($($arg: $ty),*) -> bool $(where $($w)*)? {
+            $crate::isa_kernel!(
+                @builds [$($g)*] ($($arg: $ty),*) [] [$(where $($w)*)?]
+                $body::<$($p),*> |_r| true
+            );
+            let _ = ($($arg,)*);
+            false
+        }
+    };
+    // The AVX-512 and AVX2 builds of `$body`, and the call of the one in force, which returns
+    // `$done` (of its result `$r`) from the function; nothing under `Portable`.
+    (
+        @builds [$($g:tt)*] ($($arg:ident: $ty:ty),*) [$($ret:tt)*] [$($wc:tt)*]
+        $body:ident::<$($p:ident),*> |$r:ident| $done:expr
+    ) => {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx512f,avx512dq,avx512cd,avx512vl")]
+            fn avx512<$($g)*>($($arg: $ty),*) $($ret)* $($wc)* {
+                $body::<$($p),*>($($arg),*)
+            }
+            #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,fma")]
+            fn avx2<$($g)*>($($arg: $ty),*) $($ret)* $($wc)* {
+                $body::<$($p),*>($($arg),*)
+            }
+            match $crate::isa::vector_isa() {
+                $crate::isa::VectorIsa::Avx512 => {
+                    // SAFETY: `vector_isa` is never wider than this CPU.
+                    let $r = unsafe { avx512::<$($p),*>($($arg),*) };
+                    return $done;
+                }
+                $crate::isa::VectorIsa::Avx2 => {
+                    // SAFETY: as above.
+                    let $r = unsafe { avx2::<$($p),*>($($arg),*) };
+                    return $done;
+                }
+                $crate::isa::VectorIsa::Portable => {}
+            }
         }
     };
 }

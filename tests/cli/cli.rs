@@ -1075,8 +1075,9 @@ fn hw_cost_prints_units_and_follows_the_file() {
 
 /// Every built-in benchmark scene (and the demo's many materials) renders the same image,
 /// statistics and cycles with the batch kernels built for each instruction set this CPU has
-/// (`--vector-isa`): the portable build, AVX2 and AVX-512. A wider set than the CPU's, or an
-/// unknown name, is refused naming the flag or the variable.
+/// (`--vector-isa`): the portable build, AVX2 and AVX-512. `TEXSIM_VECTOR_ISA` chooses where
+/// the flag does not; a wider set than the CPU's, or an unknown name, is refused naming the
+/// flag or the variable.
 #[test]
 fn every_vector_isa_renders_the_same() {
     let d = tmp("vector_isa");
@@ -1125,18 +1126,71 @@ fn every_vector_isa_renders_the_same() {
             }
         }
     }
-    let o = texsim_env(&["render", "--out", "x"], &d, ("TEXSIM_VECTOR_ISA", "sse9"));
-    assert!(
-        !o.status.success() && text(&o).contains("TEXSIM_VECTOR_ISA"),
-        "{}",
-        text(&o)
+    // The variable when no flag is given (any case), the flag over the variable.
+    let small = [
+        "render", "--scene", "w1-plane", "--width", "32", "--height", "24",
+    ];
+    let isa_of = |out: &str| -> serde_json::Value {
+        let j: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join(out).join("summary.json")).unwrap())
+                .unwrap();
+        j["provenance"]["vector_isa"].clone()
+    };
+    let o = texsim_env(
+        &[&small[..], &["--out", "env"]].concat(),
+        &d,
+        ("TEXSIM_VECTOR_ISA", " Portable "),
     );
-    if widest < hw_model::VectorIsa::Avx512 {
-        let o = texsim(&["--vector-isa", "avx512", "render", "--out", "x"], &d);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(isa_of("env"), "portable");
+    let o = texsim_env(
+        &[
+            &["--vector-isa", widest.name()],
+            &small[..],
+            &["--out", "flag"],
+        ]
+        .concat(),
+        &d,
+        ("TEXSIM_VECTOR_ISA", "portable"),
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(isa_of("flag"), widest.name());
+    // Refusals name the flag or the variable and write nothing.
+    let refused = |o: std::process::Output, names: &str| {
         assert!(
-            !o.status.success() && text(&o).contains("--vector-isa"),
+            !o.status.success() && text(&o).contains(names),
             "{}",
             text(&o)
+        );
+    };
+    refused(
+        texsim_env(&["render", "--out", "x"], &d, ("TEXSIM_VECTOR_ISA", "sse9")),
+        "environment variable TEXSIM_VECTOR_ISA: unknown instruction set 'sse9'",
+    );
+    refused(
+        texsim_env(
+            &["--vector-isa", "portable", "render", "--out", "x"],
+            &d,
+            ("TEXSIM_VECTOR_ISA", "sse9"),
+        ),
+        "TEXSIM_VECTOR_ISA",
+    );
+    refused(
+        texsim(&["--vector-isa", "neon", "render", "--out", "x"], &d),
+        "--vector-isa: unknown instruction set 'neon'",
+    );
+    if widest < hw_model::VectorIsa::Avx512 {
+        refused(
+            texsim(&["--vector-isa", "avx512", "render", "--out", "x"], &d),
+            "--vector-isa: this CPU has no avx512",
+        );
+        refused(
+            texsim_env(
+                &["render", "--out", "x"],
+                &d,
+                ("TEXSIM_VECTOR_ISA", "AVX512"),
+            ),
+            "environment variable TEXSIM_VECTOR_ISA: this CPU has no avx512",
         );
     }
     assert!(!d.join("x").exists(), "nothing written");
