@@ -775,6 +775,41 @@ struct Fetched {
     bytes: u64,
 }
 
+impl Fetched {
+    /// When the data of these footprints, reached at `ready`, leaves the memory unit `mem`
+    /// (plus a cache's `hit_latency`): they take it as one request of their summed occupancy,
+    /// the last one starting latest (the longest wait, charged to `worst`) and ready last.
+    #[inline(always)]
+    fn through_memory(
+        &self,
+        mem: &mut Unit,
+        ready: u64,
+        hit_latency: u64,
+        worst: &mut (u64, usize),
+    ) -> u64 {
+        if self.n == 0 {
+            return ready;
+        }
+        let ms = mem.take(ready, self.occ) + self.occ - self.last;
+        if ms - ready > worst.0 {
+            *worst = (ms - ready, C_MEM);
+        }
+        ms + self.last + hit_latency
+    }
+}
+
+/// A lookup whose data is ready at `data` on the filter unit `unit`, of (occupancy,
+/// occupancy-or-latency) `cost` ([`filter_cost`]): returns when its result is ready and
+/// updates the pixel's worst wait.
+#[inline(always)]
+fn filter_on(unit: &mut Unit, data: u64, (occ, lat): (u64, u64), worst: &mut (u64, usize)) -> u64 {
+    let fs = unit.take(data, occ);
+    if fs - data > worst.0 {
+        *worst = (fs - data, C_FILT);
+    }
+    fs + lat
+}
+
 /// A unit that serves requests in arrival order.
 #[derive(Clone, Copy, Debug, Default)]
 struct Unit {
@@ -1272,7 +1307,10 @@ impl<'a> Simulator<'a> {
     }
 }
 
-/// The latency stall cause (a pixel that never waited for a busy unit).
+/// The stall causes beyond the stage kinds: the memory unit, the filter units and latency (a
+/// pixel that never waited for a busy unit).
+const C_MEM: usize = StageKind::COUNT;
+const C_FILT: usize = StageKind::COUNT + 1;
 const C_LAT: usize = StageKind::COUNT + 2;
 
 /// Runs the arithmetic `steps` in order from `t`, each on its kind's unit: returns when the
@@ -1449,6 +1487,10 @@ fn quad_lane<'f>(
     };
     let ready_after = m.pre_cycles + m.setup.0;
     let quad_occ = tex.mem.quad_occ;
+    // The memory's occupancy for four page hits, and the filter's costs of a lookup of one
+    // and of two footprints (the only ones taken here).
+    let occ_four = quad_occ[4];
+    let (cost_one, cost_two) = (tex.filter_cost[1], tex.filter_cost[2]);
     let mut q = QuadLocals::load(tex);
     for fps in pixels {
         *fed += fps.len() as u64;
@@ -1474,14 +1516,20 @@ fn quad_lane<'f>(
         let (mut occ, mut last) = (0u64, 0u64);
         for fp in fps {
             let lv = tex.mem.map.level_recent(fp.tex, fp.level);
-            let pages = quad_pages(lv, fp);
             q.bytes += 4 * u64::from(lv.texel_bytes);
-            let page = pages[0];
-            let hits = if pages[1] == page && pages[2] == page {
-                // One page for the four texels (same columns' and rows' pages), so for the four
-                // banks: the hits do not depend on which texel is in which bank.
+            let (px, py) = lv.page_shift;
+            // `page_row` >= 1: the four texels share a page when their columns' pages and
+            // their rows' pages do.
+            let one_page = (fp.x[0] >> px == fp.x[1] >> px) & (fp.y[0] >> py == fp.y[1] >> py);
+            let o = if one_page {
+                let page = lv.page_base
+                    + u64::from(fp.y[0] >> py) * lv.page_row
+                    + u64::from(fp.x[0] >> px);
+                // So for the four banks: the hits do not depend on which texel is in which
+                // bank.
                 if page == q.uniform {
-                    4
+                    q.four += 1;
+                    occ_four
                 } else {
                     // Banks that all hold another page: no hit, nothing to count.
                     let hits = if q.uniform == EMPTY {
@@ -1491,27 +1539,31 @@ fn quad_lane<'f>(
                     };
                     q.open = [page; 4];
                     q.uniform = page;
-                    hits
+                    q.by_hits[hits & 7] += 1;
+                    quad_occ[hits & 7]
                 }
             } else {
                 // Two pages or more: the banks no longer hold one page.
                 q.uniform = EMPTY;
-                quad4_hits(&mut q.open, quad4_bank(fp), pages)
+                let hits = quad4_hits(&mut q.open, quad4_bank(fp), quad_pages(lv, fp));
+                q.by_hits[hits & 7] += 1;
+                quad_occ[hits & 7]
             };
-            let o = quad_occ[hits & 7];
-            q.by_hits[hits & 7] += 1;
             occ += o;
             last = o;
         }
+        // [`Texturing::lookup_timed`] on the locals: no cache, one filter unit, the bytes
+        // counted in `q.bytes`.
         let f = Fetched {
             n: fps.len(),
             occ,
             last,
-            // Counted in `q.bytes`, added to the stage's on store.
             bytes: 0,
         };
         let mut worst = (0u64, C_LAT);
-        let mut done = tex.lookup_timed::<false>(k, ready, &f, &mut worst);
+        let data = f.through_memory(&mut q.mem_unit, ready, 0, &mut worst);
+        let cost = if f.n == 1 { cost_one } else { cost_two };
+        let mut done = ready.max(filter_on(&mut q.filter, data, cost, &mut worst));
         if !one.post.is_empty() {
             done = arith(alu, one.post, done, &mut worst);
         }
@@ -1522,14 +1574,20 @@ fn quad_lane<'f>(
 }
 
 /// What [`quad_lane`] keeps in locals: the four banks' open pages, the page they all hold if
-/// one, the four-bank footprints by page hits and the texel bytes read since the last
-/// [`QuadLocals::store`].
+/// one, the four-bank footprints by page hits, the texel bytes read since the last
+/// [`QuadLocals::store`], the memory unit and the one filter unit.
 struct QuadLocals {
     open: [u64; 4],
     /// The page all four banks hold, if one ([`EMPTY`] otherwise: no page is).
     uniform: u64,
+    /// By page hits, the four-bank footprints but those counted in `four`.
     by_hits: [u64; 8],
+    /// Footprints that found `uniform` in all four banks since the last store (counted in
+    /// `by_hits[4]` on store).
+    four: u64,
     bytes: u64,
+    mem_unit: Unit,
+    filter: Unit,
 }
 
 impl QuadLocals {
@@ -1545,7 +1603,10 @@ impl QuadLocals {
                 EMPTY
             },
             by_hits: tex.mem.quads.by_hits,
+            four: 0,
             bytes: 0,
+            mem_unit: tex.mem_unit,
+            filter: tex.filters[0],
         }
     }
 
@@ -1553,8 +1614,11 @@ impl QuadLocals {
     #[inline(always)]
     fn store(&mut self, tex: &mut Texturing, k: usize) {
         tex.stage_bytes[k & (KINDS - 1)] += std::mem::take(&mut self.bytes);
+        self.by_hits[4] += std::mem::take(&mut self.four);
         tex.mem.open_page[..4].copy_from_slice(&self.open);
         tex.mem.quads.by_hits = self.by_hits;
+        tex.mem_unit = self.mem_unit;
+        tex.filters[0] = self.filter;
     }
 }
 
@@ -1770,15 +1834,8 @@ impl Texturing {
         f: &Fetched,
         worst: &mut (u64, usize),
     ) -> u64 {
-        const C_MEM: usize = StageKind::COUNT;
-        let mut data = ready;
-        if f.n != 0 {
-            let ms = self.mem_unit.take(ready, f.occ) + f.occ - f.last;
-            if ms - ready > worst.0 {
-                *worst = (ms - ready, C_MEM);
-            }
-            data = ms + f.last + if CACHED { self.mem.hit_latency } else { 0 };
-        }
+        let hit_latency = if CACHED { self.mem.hit_latency } else { 0 };
+        let data = f.through_memory(&mut self.mem_unit, ready, hit_latency, worst);
         let done = ready.max(self.filter(data, f.n, worst));
         self.stage_bytes[k & (KINDS - 1)] += f.bytes;
         done
@@ -1788,23 +1845,16 @@ impl Texturing {
     /// unit: returns when its result is ready and updates the pixel's worst wait.
     #[inline(always)]
     fn filter(&mut self, data: u64, n: usize, worst: &mut (u64, usize)) -> u64 {
-        const C_FILT: usize = StageKind::COUNT + 1;
         // The filter's occupancy and its occupancy-or-latency for `n` footprints.
-        let (occ, lat) = match self.filter_cost.get(n) {
+        let cost = match self.filter_cost.get(n) {
             Some(&c) => c,
             None => filter_cost(n as u64, self.bpc, self.bilinear_lat, self.blend_lat),
         };
-        let fs = match &mut self.filters[..] {
-            [one] => one.take(data, occ),
-            filters => {
-                let fu = earliest(filters, data);
-                filters[fu].take(data, occ)
-            }
+        let fu = match &self.filters[..] {
+            [_] => 0,
+            filters => earliest(filters, data),
         };
-        if fs - data > worst.0 {
-            *worst = (fs - data, C_FILT);
-        }
-        fs + lat
+        filter_on(&mut self.filters[fu], data, cost, worst)
     }
 }
 
