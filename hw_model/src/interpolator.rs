@@ -350,8 +350,7 @@ fn spans_in<M: ConstRounding, R: ConstRounding>(
     mut out: impl FnMut(usize, usize, [[i64; 3]; 3]),
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::vector_isa() > crate::VectorIsa::Portable && recip.config().recip_mantissa_bits <= 28
-    {
+    if crate::vector_batches() && recip.config().recip_mantissa_bits <= 28 {
         // The reciprocal's iteration count as a constant for the common widths.
         match recip.lane::<R>().narrow_iterations() {
             Some(1) => return spans_gathered::<M, R, 1>(spans, cfg, recip, sat, out),

@@ -82,6 +82,14 @@ fn detect() -> VectorIsa {
     vector_isa()
 }
 
+/// Whether the batch kernels run as vector lanes: [`vector_isa`] wider than
+/// [`VectorIsa::Portable`] (where it is not, their callers take the scalar paths).
+#[inline(always)]
+#[must_use]
+pub fn vector_batches() -> bool {
+    vector_isa() > VectorIsa::Portable
+}
+
 /// Runs the batch kernels with `isa` from now on (for timing one instruction set against
 /// another; results do not change). An error naming the widest this CPU has where `isa` is
 /// wider.

@@ -46,7 +46,7 @@ pub mod wrap;
 pub use config::{ConfigError, HwConfig};
 pub use cost::UnitCost;
 pub use fixed::{Format, Overflow, Rounding, SatCounter};
-pub use isa::{vector_isa, VectorIsa};
+pub use isa::{vector_batches, vector_isa, VectorIsa};
 
 /// The seeded generator of the unit tests (splitmix64, as `tests/rng_common`).
 #[cfg(test)]

@@ -83,11 +83,11 @@ pub fn keeps_lanes(plan: &Plan, impls: &StageImpls, m: &Machine) -> bool {
         && vector_lanes()
 }
 
-/// Whether this CPU runs `interpolate_lanes` as vector lanes ([`hw_model::vector_isa`]: AVX2
-/// or AVX-512).
+/// Whether this CPU runs `interpolate_lanes` as vector lanes ([`hw_model::vector_batches`]:
+/// AVX2 or AVX-512).
 #[must_use]
 pub fn vector_lanes() -> bool {
-    hw_model::vector_isa() > hw_model::VectorIsa::Portable
+    hw_model::vector_batches()
 }
 
 /// Sample 0 of the lanes' texture coordinates into the fragments of the span at `px` (a

@@ -231,8 +231,8 @@ fn span_twins_match_the_per_fragment_twins() {
 /// widths and paths of `span_twins_match_the_per_fragment_twins` (`lod_per_quad` and the
 /// attribute grid take the per-fragment path, huge triangles the edges' fallback) and
 /// barycentrics from the row's pass (`row_bary`). The textured plan with derivatives keeps
-/// lanes with vector batches (AVX2 or AVX-512); with a `color` stage, without derivatives or with a Float
-/// stage it does not. (The stages here are given the lanes whatever the CPU.)
+/// lanes with vector batches (AVX2 or AVX-512); with a `color` stage, without derivatives or
+/// with a Float stage it does not. (The stages here are given the lanes whatever the CPU.)
 #[test]
 fn span_twins_in_lanes_match_the_per_fragment_twins() {
     let mut rng = Rng(0x5a4e_10a1);

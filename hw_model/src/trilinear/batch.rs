@@ -152,8 +152,7 @@ impl<F: ConstRounding, W: ConstRounding> TrilinearUnit<'_, F, W> {
     #[must_use]
     pub fn batch_form(&self) -> bool {
         let k = self.setup;
-        let vector = crate::vector_isa() > crate::VectorIsa::Portable;
-        vector && self.repeats() && k.narrow_frac && k.lf <= 16
+        crate::vector_batches() && self.repeats() && k.narrow_frac && k.lf <= 16
     }
 
     /// [`TrilinearUnit::sample_pow2_repeat`] of `levels` (of the shape `shape`) at the first
